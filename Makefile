@@ -1,0 +1,53 @@
+# CBT_Commands_Lib — every task in one place. Each target installs what it needs (idempotent),
+# never touching the system Python: tools live in the local virtual environment .venv/.
+
+PYTHON   ?= python3
+VENV     := .venv
+VPY      := $(VENV)/bin/python
+STAMP    := $(VENV)/.deps-stamp
+SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
+export PYTHONPATH := $(CURDIR)/src:$(CURDIR)
+
+.PHONY: demo test bench check clean venv test-deps browser
+
+## demo: robot simulator + virtual PLC running the examples + web HMI (Ctrl-C stops everything)
+demo: venv
+	@$(VPY) examples/run_demo.py
+
+## test: every test (unit, golden, ST suites, simulator, library end-to-end, HMI in headless Chromium)
+test: test-deps browser
+	$(VPY) -m pytest -q
+
+## bench: performance figures of toolchain, simulator, library and HMI
+bench: venv
+	@$(VPY) bench/run_all.py
+
+## check: toolchain diagnostics over the library and the examples
+check: venv
+	$(VPY) -m vplc check lib/ examples/
+	$(VPY) -m vplc check --portable lib/CBT_Commands_Lib --exclude lib/CBT_Commands_Lib/platform
+
+clean:
+	rm -rf $(VENV) .pytest_cache artifacts build
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +
+
+venv: $(VPY)
+
+$(VPY):
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "Python 3.11 or newer is required")'
+	@$(PYTHON) -m venv $(VENV) 2>/dev/null || { \
+	  echo "Installing python3-venv (Debian package) ..."; \
+	  $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq python3-venv >/dev/null && \
+	  $(PYTHON) -m venv $(VENV); }
+
+test-deps: $(STAMP)
+
+$(STAMP): $(VPY) pyproject.toml
+	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15"
+	@touch $(STAMP)
+
+## browser: Debian's Chromium and ChromeDriver, used only by the HMI end-to-end tests
+browser:
+	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || { \
+	  echo "Installing chromium and chromium-driver (Debian packages, test only) ..."; \
+	  $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium chromium-driver >/dev/null; }

@@ -1,0 +1,60 @@
+"""Standing promises of the repository: two README commands, CI = `make test`, stdlib-only runtime."""
+from __future__ import annotations
+
+import ast
+import pathlib
+import re
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+RUNTIME_TREES = [ROOT / "src" / "vplc", ROOT / "sim"]
+OWN_PACKAGES = {"vplc", "sim"}
+
+
+def _imported_top_level_modules(path: pathlib.Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_readme_shows_demo_and_test_commands_first():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    first_block = re.search(r"```\n(.*?)```", text, re.S)
+    assert first_block, "README.md has no command block"
+    commands = [line.split("#")[0].strip() for line in first_block.group(1).splitlines()]
+    assert commands[:2] == ["make demo", "make test"]
+
+
+def test_ci_runs_exactly_the_readme_test_command():
+    script = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    commands = [line.strip() for line in script.splitlines()
+                if line.strip() and not line.lstrip().startswith("#")]
+    assert "make test" in commands
+    assert not [c for c in commands if c.startswith(("pytest", "python"))], "CI must not bypass make test"
+
+
+def test_makefile_has_the_documented_targets():
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    for target in ("demo", "test", "bench", "check", "clean"):
+        assert re.search(rf"^{target}:", makefile, re.M), f"Makefile lacks target '{target}'"
+
+
+def test_runtime_code_imports_only_the_standard_library():
+    offenders = []
+    for tree in RUNTIME_TREES:
+        for path in sorted(tree.rglob("*.py")):
+            for module in _imported_top_level_modules(path):
+                if module not in sys.stdlib_module_names and module not in OWN_PACKAGES:
+                    offenders.append(f"{path.relative_to(ROOT)} imports {module}")
+    assert offenders == []
+
+
+def test_stdlib_guard_detects_a_third_party_import(tmp_path):
+    sample = tmp_path / "sample.py"
+    sample.write_text("import os\nfrom selenium import webdriver\nfrom . import sibling\n", encoding="utf-8")
+    assert _imported_top_level_modules(sample) == {"os", "selenium"}
