@@ -25,7 +25,7 @@ bench: venv
 ## check: toolchain diagnostics over the library and the examples
 check: venv
 	$(VPY) -m vplc check lib/ examples/
-	$(VPY) -m vplc check --portable lib/CBT_Commands_Lib --exclude lib/CBT_Commands_Lib/platform
+	$(VPY) -m vplc check --portable --warnings-as-errors lib/CBT_Commands_Lib
 
 clean:
 	rm -rf $(VENV) .pytest_cache artifacts build
