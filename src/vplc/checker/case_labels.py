@@ -1,0 +1,66 @@
+"""ST1401 / ST1402 — CASE labels of the wrong type, or the same value twice.
+
+Passing::
+
+    CASE Step OF
+        eStep#Idle: ...
+        eStep#Busy, eStep#Done: ...
+    END_CASE;
+
+Failing::
+
+    CASE Count OF
+        1..5: ...
+        3: ...            (* ST1402: 3 is already handled by 1..5 *)
+        'A': ...          (* ST1401: STRING label for an INT selector *)
+    END_CASE;
+"""
+from __future__ import annotations
+
+from .. import ast as A
+from .. import types as T
+from .consteval import const_int
+from .symbols import EnumValueSymbol
+
+
+def _value(ck, e: A.Expr):
+    sym = getattr(e, "sym", None)
+    if isinstance(sym, EnumValueSymbol):
+        return sym.value
+    return const_int(e, ck.ctx, ck.scope)
+
+
+def check(ck, stmt: A.Case, sel_type: T.Type) -> None:
+    ctx = ck.ctx
+    sel = T.base_of(sel_type)
+    ok_sel = T.is_error(sel) or T.is_int(sel) or isinstance(sel, T.EnumType) or (
+        isinstance(sel, T.ElementaryType) and sel.kind == "bit")
+    if not ok_sel:
+        ctx.diags.error("ST1401", f"the CASE selector must be an integer or enumeration, not {sel_type.name}",
+                        stmt.selector.span)
+    seen: list[tuple[int, int, A.Node]] = []
+    for branch in stmt.branches:
+        for label in branch.labels:
+            parts = [label.lo, label.hi] if isinstance(label, A.CaseRange) else [label]
+            values = []
+            for p in parts:
+                lt = ck.expr(p, sel_type)
+                if not T.is_error(lt) and not T.is_error(sel) and ok_sel and not (
+                        T.same_type(T.base_of(lt), sel) or (T.is_int(lt) and T.is_int(sel)) or
+                        (T.is_int(lt) and sel.kind == "bit")):
+                    ctx.diags.error("ST1401", f"CASE label of type {lt.name} does not match the selector type "
+                                    f"{sel_type.name}", p.span)
+                v = _value(ck, p)
+                if v is None and not T.is_error(lt):
+                    ctx.diags.error("ST1401", "CASE labels must be constants", p.span)
+                values.append(v)
+            if any(v is None for v in values):
+                continue
+            lo, hi = values[0], values[-1]
+            for slo, shi, node in seen:
+                if lo <= shi and slo <= hi:
+                    line, col = node.span.file.line_col(node.span.start)
+                    ctx.diags.error("ST1402", f"CASE label `{ck.text(label)}` repeats a value already handled at "
+                                    f"line {line}", label.span)
+                    break
+            seen.append((lo, hi, label))

@@ -1,0 +1,225 @@
+"""Declaration pass: data types, POU interfaces and global variables into the symbol tables.
+
+Runs before any body is checked, so declarations may appear in any order and any file.
+"""
+from __future__ import annotations
+
+from .. import ast as A
+from .. import types as T
+from ..builtins import default_string
+from . import duplicates, undeclared
+from .consteval import const_int
+from .scope import GENERIC_TYPES, Ambiguous
+from .symbols import VarSymbol
+
+PARAM_DIRECTION = {"VAR_INPUT": "in", "VAR_OUTPUT": "out", "VAR_IN_OUT": "inout"}
+
+
+class Declarer:
+    def __init__(self, ctx) -> None:
+        self.ctx = ctx
+        self.tables = ctx.tables
+
+    # ---- pass 1: names --------------------------------------------------------------------------
+    def register(self, unit: A.CompilationUnit) -> None:
+        ns = unit.namespace
+        for item in unit.items:
+            if isinstance(item, A.TypeBlock):
+                for decl in item.decls:
+                    decl.namespace = ns
+                    shell = self.shell_type(decl, ns)
+                    prev = self.tables.types.add(ns, decl.name, shell)
+                    if prev is not None or decl.name.upper() in T.ELEMENTARY:
+                        duplicates.report(self.ctx, "data type", decl.name, decl.name_span, prev)
+                    else:
+                        self.ctx.type_decls.append((decl, shell, unit))
+            elif isinstance(item, A.Pou):
+                item.namespace = ns
+                kind = {"FUNCTION": "function", "FUNCTION_BLOCK": "fb", "PROGRAM": "program"}[item.kind]
+                pt = T.PouType(item.name, kind, pou=item, native=item.native, namespace=ns)
+                item.sym = pt
+                prev = self.tables.pous.add(ns, item.name, pt)
+                if prev is not None:
+                    duplicates.report(self.ctx, item.kind, item.name, item.name_span or item.span, prev)
+                elif self.tables.types.entries.get(((ns or "").upper(), item.name.upper())) is not None:
+                    duplicates.report(self.ctx, item.kind, item.name, item.name_span or item.span, None)
+                self.ctx.pou_units.append((item, unit))
+            elif isinstance(item, A.GlobalVarList):
+                item.namespace = ns
+                self.ctx.global_lists.append((item, unit))
+            elif isinstance(item, A.Configuration):
+                self.ctx.configurations.append((item, unit))
+
+    def shell_type(self, decl: A.TypeDecl, ns: str | None) -> T.Type:
+        spec = decl.spec
+        if isinstance(spec, A.StructTypeRef):
+            return T.StructType(decl.name, decl=decl, namespace=ns)
+        if isinstance(spec, A.EnumTypeRef):
+            return T.EnumType(decl.name, decl=decl, namespace=ns)
+        return T.AliasType(decl.name, decl=decl, namespace=ns)
+
+    # ---- pass 2: bodies of type declarations -------------------------------------------------
+    def complete_types(self) -> None:
+        for decl, shell, unit in self.ctx.type_decls:
+            if isinstance(shell, T.EnumType):
+                self.fill_enum(shell, decl.spec, unit)
+        for decl, shell, unit in self.ctx.type_decls:
+            if isinstance(shell, T.StructType):
+                self.fill_struct(shell, decl.spec, unit)
+            elif isinstance(shell, T.AliasType):
+                shell.target = self.resolve(decl.spec, unit, None)
+                if isinstance(decl.spec, A.SubrangeTypeRef) and isinstance(shell.target, T.SubrangeType):
+                    shell.target.alias = decl.name
+        for decl, shell, unit in self.ctx.type_decls:   # alias cycles
+            if isinstance(shell, T.AliasType):
+                seen, t = set(), shell
+                while isinstance(t, T.AliasType):
+                    if id(t) in seen:
+                        self.ctx.diags.error("ST1004", f"data type {decl.name} is defined in terms of itself",
+                                             decl.name_span)
+                        shell.target = T.ERROR
+                        break
+                    seen.add(id(t))
+                    t = t.target
+
+    def fill_enum(self, enum: T.EnumType, spec: A.EnumTypeRef, unit) -> None:
+        if spec.base is not None:
+            base = self.resolve(spec.base, unit, None)
+            if T.is_int(base):
+                enum.base = T.base_of(base)
+        next_value = 0
+        for v in spec.values:
+            if v.value is not None:
+                val = const_int(v.value, self.ctx, None)
+                if val is None:
+                    self.ctx.diags.error("ST1107", f"the value of {v.name} must be a constant integer", v.value.span)
+                else:
+                    next_value = val
+            if enum.lookup(v.name) is not None:
+                duplicates.report(self.ctx, "enumeration value", v.name, v.span, None)
+                continue
+            enum.values[v.name] = next_value
+            next_value += 1
+        self.tables.add_enum(enum)
+
+    def fill_struct(self, st: T.StructType, spec: A.StructTypeRef, unit) -> None:
+        for f in spec.fields:
+            ftype = self.resolve(f.type, unit, None)
+            if ftype is st:
+                self.ctx.diags.error("ST1004", f"structure {st.name} cannot contain itself (member {f.name})", f.name_span)
+                ftype = T.ERROR
+            if st.field(f.name) is not None:
+                duplicates.report(self.ctx, "member", f.name, f.span, None)
+                continue
+            st.fields[f.name.upper()] = T.StructField(f.name, ftype, f.init, f)
+
+    # ---- type references ----------------------------------------------------------------------
+    def resolve(self, ref: A.TypeRef, unit, scope) -> T.Type:
+        """Turn a syntactic type into a semantic type; unknown names are reported (ST1004)."""
+        ctx = self.ctx
+        if isinstance(ref, A.NamedTypeRef):
+            name = ref.name
+            up = name.name.upper()
+            if not name.namespace:
+                if up in T.ELEMENTARY:
+                    if up.startswith("L") and up not in ("LINT", "LREAL", "LWORD"):
+                        ctx.note_edition3(f"the type {name.name}", ref.span)
+                    return T.ELEMENTARY[up]
+                if up in GENERIC_TYPES and unit is not None and getattr(unit, "in_prelude", False):
+                    return GENERIC_TYPES[up]
+            try:
+                found = self.tables.types.lookup(name.name, name.namespace, unit.namespace if unit else None)
+                if found is None:
+                    found = self.tables.pous.lookup(name.name, name.namespace, unit.namespace if unit else None)
+                    if found is not None and found.kind == "function":
+                        ctx.diags.error("ST1004", f"{found.name} is a FUNCTION, not a type; only function "
+                                        "blocks can be instantiated", ref.span)
+                        return T.ERROR
+            except Ambiguous as amb:
+                undeclared.report_ambiguous(ctx, name.text(), amb.candidates, ref.span)
+                return T.ERROR
+            if found is None:
+                undeclared.report_type(ctx, name.text(), ref.span)
+                return T.ERROR
+            ctx.note_vendor(found, ref.span)
+            return found
+        if isinstance(ref, A.StringTypeRef):
+            if ref.length is None:
+                return default_string(ctx.dialect, ref.wide)
+            n = const_int(ref.length, ctx, scope)
+            if n is None or n < 1:
+                ctx.diags.error("ST1107", "the string length must be a positive constant integer", ref.length.span)
+                return default_string(ctx.dialect, ref.wide)
+            cap = n - 1 if ctx.dialect == "sysmac" else n
+            return T.StringType(n, ref.wide, capacity=cap)
+        if isinstance(ref, A.ArrayTypeRef):
+            dims = []
+            for d in ref.dims:
+                if d.lo is None:
+                    ctx.note_edition3("an open array bound `ARRAY[*]`", d.span)
+                    dims.append((None, None))
+                    continue
+                lo, hi = const_int(d.lo, ctx, scope), const_int(d.hi, ctx, scope)
+                if lo is None or hi is None:
+                    ctx.diags.error("ST1107", "array bounds must be constant integers", d.span)
+                    lo, hi = 0, 0
+                elif hi < lo:
+                    ctx.diags.error("ST1107", f"array upper bound {hi} is below the lower bound {lo}", d.span)
+                    hi = lo
+                dims.append((lo, hi))
+            return T.ArrayType(dims, self.resolve(ref.element, unit, scope))
+        if isinstance(ref, A.SubrangeTypeRef):
+            base = T.base_of(self.resolve(ref.base, unit, scope))
+            lo, hi = const_int(ref.lo, ctx, scope), const_int(ref.hi, ctx, scope)
+            if not T.is_int(base) or lo is None or hi is None or hi < lo:
+                ctx.diags.error("ST1107", "a subrange needs an integer base type and constant bounds lo..hi",
+                                ref.span)
+                return base if T.is_int(base) else T.ERROR
+            return T.SubrangeType(base, lo, hi)
+        if isinstance(ref, A.EnumTypeRef):
+            enum = T.EnumType("(" + ", ".join(v.name for v in ref.values) + ")")
+            self.fill_enum(enum, ref, unit)
+            return enum
+        if isinstance(ref, A.StructTypeRef):
+            st = T.StructType("STRUCT")
+            self.fill_struct(st, ref, unit)
+            return st
+        return T.ERROR
+
+    # ---- pass 3: POU interfaces and globals ---------------------------------------------------
+    def complete_pous(self) -> None:
+        for pou, unit in self.ctx.pou_units:
+            pt: T.PouType = pou.sym
+            if pou.kind == "FUNCTION":
+                pt.ret = self.resolve(pou.return_type, unit, None) if pou.return_type else T.VOID
+            else:
+                pt.ret = T.VOID
+            index = 0
+            consts = {d.name.upper(): VarSymbol(d.name, T.ERROR, s.kind, constant=True, decl=d)
+                      for s in pou.sections if s.constant for d in s.vars}
+            for section in pou.sections:
+                direction = PARAM_DIRECTION.get(section.kind)
+                for decl in section.vars:
+                    vt = self.resolve(decl.type, unit, consts)
+                    sym = VarSymbol(decl.name, vt, section.kind, pt, decl, section.constant, section.retain)
+                    decl.sym = sym
+                    if direction:
+                        pt.params.append(T.Param(decl.name, direction, vt, index, decl.init, decl))
+                        index += 1
+
+    def declare_globals(self, sections, unit, list_name: str | None) -> None:
+        for section in sections:
+            if section.kind != "VAR_GLOBAL":
+                self.ctx.diags.error("ST0206", f"{section.kind} is not allowed here; only VAR_GLOBAL sections may "
+                                     "appear outside a POU", section.span)
+                continue
+            for decl in section.vars:
+                vt = self.resolve(decl.type, unit, None)
+                sym = VarSymbol(decl.name, vt, "VAR_GLOBAL", None, decl, section.constant, section.retain,
+                                global_list=list_name)
+                decl.sym = sym
+                prev = self.tables.globals.get(decl.name.upper())
+                if prev is not None:
+                    duplicates.report(self.ctx, "global variable", decl.name, decl.name_span, prev)
+                    continue
+                self.tables.globals[decl.name.upper()] = sym

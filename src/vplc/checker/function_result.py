@@ -1,0 +1,48 @@
+"""ST1801 (warning) — a FUNCTION that does not assign its result on every path.
+
+Passing::
+
+    FUNCTION Clamp : INT
+    VAR_INPUT x : INT; END_VAR
+    IF x > 100 THEN Clamp := 100; ELSE Clamp := x; END_IF;
+    END_FUNCTION
+
+Failing::
+
+    FUNCTION Clamp : INT
+    VAR_INPUT x : INT; END_VAR
+    IF x > 100 THEN Clamp := 100; END_IF;       (* ST1801: not assigned when x <= 100 *)
+    END_FUNCTION
+"""
+from __future__ import annotations
+
+from .. import ast as A
+from .. import types as T
+
+
+def _assigns(stmts, result) -> bool | None:
+    """True: every path assigns; False: some path may end without assigning; None: a path RETURNs first."""
+    for s in stmts:
+        if isinstance(s, A.Assign) and isinstance(s.target, A.Name) and s.target.sym is result:
+            return True
+        if isinstance(s, A.Return):
+            return False
+        if isinstance(s, A.If) and s.else_body is not None:
+            if all(_assigns(b.body, result) for b in s.branches) and _assigns(s.else_body, result):
+                return True
+        if isinstance(s, A.Case) and s.else_body is not None:
+            if all(_assigns(b.body, result) for b in s.branches) and _assigns(s.else_body, result):
+                return True
+        if isinstance(s, A.CallStmt) and s.call.binding is not None:
+            for ba in s.call.binding.args:
+                if ba.param.direction == "out" and isinstance(ba.expr, A.Name) and ba.expr.sym is result:
+                    return True
+    return False
+
+
+def check(ck, pou: A.Pou) -> None:
+    if pou.kind != "FUNCTION" or pou.native or ck.result_sym is None or ck.result_sym.type is T.VOID:
+        return
+    if not _assigns(pou.body, ck.result_sym):
+        ck.ctx.diags.warning("ST1801", f"FUNCTION {pou.name} does not assign its result `{pou.name}` on every path; "
+                             "the result is then 0 / empty", pou.name_span or pou.span)

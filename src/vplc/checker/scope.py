@@ -1,0 +1,86 @@
+"""Symbol tables and name lookup (namespaces, case-insensitive names).
+
+Lookup rule for a bare name: the namespace of the file that uses it, then the global namespace, then any
+library namespace where it is unique (else ST1003 ambiguous). ``Ns\\Name`` looks only in ``Ns``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .. import types as T
+from .symbols import EnumValueSymbol, VarSymbol
+
+GENERIC_TYPES: dict[str, T.SpecialType] = {}
+
+
+def _generic(name: str, pred) -> None:
+    t = T.SpecialType(name, "generic")
+    t.accepts = pred  # type: ignore[attr-defined]
+    GENERIC_TYPES[name] = t
+
+
+_generic("ANY", lambda t: True)
+_generic("ANY_ELEMENTARY", T.is_elementary)
+_generic("ANY_NUM", T.is_num)
+_generic("ANY_INT", T.is_int)
+_generic("ANY_REAL", T.is_real)
+_generic("ANY_BIT", T.is_bits)
+_generic("ANY_STRING", T.is_string)
+_generic("ANY_DATE", T.is_date_like)
+
+
+def is_generic(t: T.Type) -> bool:
+    return isinstance(t, T.SpecialType) and t.kind == "generic"
+
+
+class Ambiguous(Exception):
+    def __init__(self, candidates: list[str]) -> None:
+        super().__init__(", ".join(candidates))
+        self.candidates = candidates
+
+
+@dataclass
+class NamedTable:
+    """Maps (namespace, NAME) → object; namespace '' is the global namespace."""
+    entries: dict[tuple[str, str], object] = field(default_factory=dict)
+    by_name: dict[str, list[tuple[str, object]]] = field(default_factory=dict)
+
+    def add(self, ns: str | None, name: str, obj) -> object | None:
+        """Register; returns the previous object with the same key (a duplicate) or None."""
+        key = ((ns or "").upper(), name.upper())
+        prev = self.entries.get(key)
+        if prev is not None:
+            return prev
+        self.entries[key] = obj
+        self.by_name.setdefault(name.upper(), []).append((ns or "", obj))
+        return None
+
+    def lookup(self, name: str, namespace: tuple[str, ...] = (), from_ns: str | None = None):
+        up = name.upper()
+        if namespace:
+            return self.entries.get(("\\".join(namespace).upper(), up))
+        if from_ns:
+            hit = self.entries.get((from_ns.upper(), up))
+            if hit is not None:
+                return hit
+        hit = self.entries.get(("", up))
+        if hit is not None:
+            return hit
+        cands = self.by_name.get(up, [])
+        if len(cands) == 1:
+            return cands[0][1]
+        if len(cands) > 1:
+            raise Ambiguous([f"{ns}\\{name}" if ns else name for ns, _ in cands])
+        return None
+
+
+@dataclass
+class Tables:
+    pous: NamedTable = field(default_factory=NamedTable)
+    types: NamedTable = field(default_factory=NamedTable)
+    globals: dict[str, VarSymbol] = field(default_factory=dict)
+    enum_values: dict[str, list[EnumValueSymbol]] = field(default_factory=dict)
+
+    def add_enum(self, enum: T.EnumType) -> None:
+        for name, value in enum.values.items():
+            self.enum_values.setdefault(name.upper(), []).append(EnumValueSymbol(enum, name, value))

@@ -1,0 +1,45 @@
+"""ST1001 / ST1003 / ST1004 — a name or type that is not declared, or is ambiguous between namespaces.
+
+Passing::
+
+    VAR Count : INT; END_VAR
+    Count := Count + 1;
+
+Failing::
+
+    Cuont := Count + 1;        (* ST1001: `Cuont` is not declared; did you mean `Count`? *)
+    x : stUnknown;             (* ST1004: unknown data type *)
+"""
+from __future__ import annotations
+
+import difflib
+
+
+def _suggest(name: str, candidates) -> list[str]:
+    names = {c for c in candidates if c}
+    close = difflib.get_close_matches(name.upper(), [n.upper() for n in names], n=1, cutoff=0.75)
+    if not close:
+        return []
+    by_upper = {n.upper(): n for n in names}
+    return [f"did you mean `{by_upper[close[0]]}`?"]
+
+
+def report(ctx, name: str, span, candidates=()) -> None:
+    ctx.diags.error("ST1001", f"`{name}` is not declared; declare it in a VAR section or check the spelling",
+                    span, _suggest(name, candidates))
+
+
+def report_type(ctx, name: str, span) -> None:
+    known = [k[1] for k in ctx.tables.types.entries] + [k[1] for k in ctx.tables.pous.entries]
+    notes = _suggest(name.rsplit("\\", 1)[-1], known)
+    if "\\" in name:
+        ns = name.strip("\\").split("\\")[0]
+        spaces = {k[0] for k in ctx.tables.types.entries} | {k[0] for k in ctx.tables.pous.entries}
+        if ns.upper() not in spaces:
+            notes.append(f"no library `{ns}` is loaded; add its folder (e.g. lib/{ns}) to the paths checked")
+    ctx.diags.error("ST1004", f"unknown data type `{name}`", span, notes)
+
+
+def report_ambiguous(ctx, name: str, candidates: list[str], span) -> None:
+    ctx.diags.error("ST1003", f"`{name}` is ambiguous: it is declared in {', '.join(candidates)}; qualify it "
+                    f"with its namespace (e.g. `{candidates[0]}`)", span)

@@ -1,0 +1,25 @@
+"""ST1901 (warning) — a local variable that is declared but never used.
+
+Passing::
+
+    VAR Count : INT; END_VAR
+    Count := Count + 1;
+
+Failing::
+
+    VAR Count, Spare : INT; END_VAR     (* ST1901: `Spare` is never used *)
+    Count := Count + 1;
+"""
+from __future__ import annotations
+
+
+def check(ck, pou) -> None:
+    if pou.native or ck.in_prelude:
+        return
+    for section in pou.sections:
+        if section.kind not in ("VAR", "VAR_TEMP", "VAR_STAT"):
+            continue
+        for decl in section.vars:
+            sym = decl.sym
+            if sym is not None and not sym.used:
+                ck.ctx.diags.warning("ST1901", f"`{decl.name}` is declared but never used; remove it", decl.name_span)

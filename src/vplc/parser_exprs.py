@@ -1,0 +1,330 @@
+"""Expression grammar (IEC 61131-3 precedence, left-associative binary operators).
+
+Precedence, lowest first: OR; XOR; AND &; = <>; < > <= >=; + -; * / MOD; unary - + NOT; **; postfix.
+"""
+from __future__ import annotations
+
+import calendar
+import re
+
+from . import ast as A
+from .lexer import decode_string
+from .parser_base import RESERVED
+
+BINARY_PREC = {"OR": 1, "XOR": 2, "AND": 3, "&": 3, "=": 4, "<>": 4, "<": 5, ">": 5, "<=": 5, ">=": 5,
+               "+": 6, "-": 6, "*": 7, "/": 7, "MOD": 7}
+
+INT_PREFIXES = {"SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "BYTE", "WORD", "DWORD", "LWORD"}
+REAL_PREFIXES = {"REAL", "LREAL"}
+_UNIT_NS = {"D": 86_400_000_000_000, "H": 3_600_000_000_000, "M": 60_000_000_000, "S": 1_000_000_000,
+            "MS": 1_000_000, "US": 1_000, "NS": 1}
+_DUR_PART = re.compile(r"([0-9][0-9_]*(?:\.[0-9_]+)?)(ms|us|ns|d|h|m|s)_?", re.I)
+_CLOCK_RE = re.compile(r"([0-9]+):([0-9]+)(?::([0-9]+)(?:\.([0-9]+))?)?$")
+
+
+def parse_duration(body: str) -> int | None:
+    """``1h2m3s4ms`` / ``-5s`` / ``1.5s`` → nanoseconds (None when malformed)."""
+    sign = 1
+    if body[:1] in "+-":
+        sign = -1 if body[0] == "-" else 1
+        body = body[1:]
+    pos = 0
+    total = 0.0
+    exact = 0
+    for m in _DUR_PART.finditer(body):
+        if m.start() != pos:
+            return None
+        num = m.group(1).replace("_", "")
+        unit = _UNIT_NS[m.group(2).upper()]
+        if "." in num:
+            total += float(num) * unit
+        else:
+            exact += int(num) * unit
+        pos = m.end()
+    if pos != len(body) or pos == 0:
+        return None
+    return sign * (exact + round(total))
+
+
+def parse_clock(text: str) -> int | None:
+    m = _CLOCK_RE.match(text)
+    if not m:
+        return None
+    h, mi, s = int(m.group(1)), int(m.group(2)), int(m.group(3) or 0)
+    frac = m.group(4) or ""
+    if h > 23 or mi > 59 or s > 59:
+        return None
+    ns = int((frac + "000000000")[:9]) if frac else 0
+    return ((h * 60 + mi) * 60 + s) * 1_000_000_000 + ns
+
+
+def parse_ymd(text: str) -> int | None:
+    try:
+        y, mo, d = (int(x) for x in text.split("-")[:3])
+        if not (1 <= mo <= 12 and 1 <= d <= calendar.monthrange(y, mo)[1]):
+            return None
+        return calendar.timegm((y, mo, d, 0, 0, 0))
+    except (ValueError, OverflowError):
+        return None
+
+
+class ExpressionsMixin:
+    # grammar: expression := unary { binop unary }   (precedence climbing, BINARY_PREC)
+    def expression(self, min_prec: int = 1) -> A.Expr:
+        self.enter()
+        start = self.tok.start
+        left = self.unary()
+        chain = 0
+        while True:
+            t = self.tok
+            if t.kind == "OP":
+                op = t.text
+            elif t.kind == "IDENT" and t.up in ("OR", "XOR", "AND", "MOD"):
+                op = t.up
+            else:
+                break
+            prec = BINARY_PREC.get(op)
+            if prec is None or prec < min_prec:
+                break
+            self.advance()
+            right = self.expression(prec + 1)
+            chain += 1
+            if chain + self.depth > 2 * 200:
+                self.fail("expression has too many operators in a row (over 400); split it using "
+                          "intermediate variables", "ST0203")
+            left = A.Binary("AND" if op == "&" else op, left, right, span=self.span_from(start))
+        self.leave()
+        return left
+
+    # grammar: unary := ('-' | '+' | NOT) unary | power
+    def unary(self) -> A.Expr:
+        t = self.tok
+        if (t.kind == "OP" and t.text in "-+" and t.text) or (t.kind == "IDENT" and t.up == "NOT"):
+            self.advance()
+            self.enter()
+            operand = self.unary()
+            self.leave()
+            op = "NOT" if t.kind == "IDENT" else t.text
+            return A.Unary(op, operand, span=self.span_from(t.start))
+        return self.power()
+
+    # grammar: power := postfix { '**' unary }
+    def power(self) -> A.Expr:
+        start = self.tok.start
+        left = self.postfix()
+        while self.at_op("**"):
+            self.advance()
+            self.enter()
+            right = self.unary() if (self.at_op("-") or self.at_op("+")) else self.postfix()
+            self.leave()
+            left = A.Binary("**", left, right, span=self.span_from(start))
+        return left
+
+    # grammar: postfix := primary { '.' ident | '.' digit | '[' expr {',' expr} ']' | '(' args ')' }
+    def postfix(self) -> A.Expr:
+        start = self.tok.start
+        node = self.primary()
+        while True:
+            if self.at_op("."):
+                self.advance()
+                t = self.tok
+                if t.kind == "INT":
+                    self.advance()
+                    node = A.BitAccess(node, int(t.text.replace("_", "")), span=self.span_from(start))
+                    continue
+                name = self.ident("a member name after `.`")
+                node = A.Member(node, name.text, span=self.span_from(start))
+            elif self.at_op("["):
+                self.advance()
+                idx = [self.expression()]
+                while self.accept_op(","):
+                    idx.append(self.expression())
+                self.expect_op("]", "to close the index")
+                node = A.Index(node, idx, span=self.span_from(start))
+            elif self.at_op("("):
+                if not isinstance(node, (A.Name, A.Member, A.Index)):
+                    break
+                args = self.call_args()
+                node = A.Call(node, args, span=self.span_from(start))
+            elif self.at_op("^"):
+                self.fail("pointer dereference `^` is not supported; IEC 61131-3 2nd edition and Sysmac "
+                          "libraries do not use pointers")
+            else:
+                break
+        return node
+
+    # grammar: args := '(' [ arg { ',' arg } ] ')' ; arg := [NOT] ident ('=>' [expr]) | ident ':=' expr | expr
+    def call_args(self) -> list[A.Arg]:
+        self.expect_op("(")
+        args: list[A.Arg] = []
+        if self.accept_op(")"):
+            return args
+        while True:
+            start = self.tok.start
+            t, nxt = self.tok, self.peek()
+            negated = False
+            if t.kind == "IDENT" and t.up == "NOT" and nxt.kind == "IDENT" and self.peek(2).text == "=>":
+                negated = True
+                self.advance()
+                t, nxt = self.tok, self.peek()
+            if t.kind == "IDENT" and nxt.kind == "OP" and nxt.text in (":=", "=>") and t.up not in RESERVED:
+                self.advance()
+                self.advance()
+                if nxt.text == "=>":
+                    value = None if (self.at_op(",") or self.at_op(")")) else self.expression()
+                    args.append(A.Arg(t.text, value, True, negated, span=self.span_from(start)))
+                else:
+                    args.append(A.Arg(t.text, self.expression(), span=self.span_from(start)))
+            else:
+                args.append(A.Arg(None, self.expression(), span=self.span_from(start)))
+            if self.accept_op(","):
+                continue
+            self.expect_op(")", "to close the argument list")
+            return args
+
+    # grammar: qualname := ['\'|'\\'] ident { ('\'|'\\') ident }
+    def qualname(self, what: str = "a name") -> tuple[A.QualName, str | None]:
+        """Parse a possibly namespace-qualified name. Returns (name, enum_value) where enum_value is set
+        when the last part was ``Type#Value``."""
+        start = self.tok.start
+        self.accept_op("\\\\") or self.accept_op("\\")
+        parts: list[str] = []
+        while True:
+            t = self.tok
+            if t.kind == "TYPED":
+                self.advance()
+                parts.append(t.text[:-1])
+                value = self.tok
+                if value.kind != "IDENT":
+                    self.fail_expected("an enumeration value after `#`")
+                self.advance()
+                return A.QualName(parts[-1], tuple(parts[:-1]), span=self.span_from(start)), value.text
+            parts.append(self.ident(what).text)
+            if (self.at_op("\\") or self.at_op("\\\\")) and self.peek().kind in ("IDENT", "TYPED"):
+                self.advance()
+                continue
+            return A.QualName(parts[-1], tuple(parts[:-1]), span=self.span_from(start)), None
+
+    # grammar: primary := literal | typed_literal | enum_literal | qualname | '(' expression ')'
+    def primary(self) -> A.Expr:
+        t = self.tok
+        kind = t.kind
+        start = t.start
+        if kind == "INT":
+            self.advance()
+            return A.Literal("int", int(t.text.replace("_", "")), None, t.text, span=self.tok_span(t))
+        if kind == "BASED":
+            self.advance()
+            return A.Literal("int", self.based_value(t), None, t.text, span=self.tok_span(t))
+        if kind == "REAL":
+            self.advance()
+            return A.Literal("real", float(t.text.replace("_", "")), None, t.text, span=self.tok_span(t))
+        if kind in ("STRING", "WSTRING"):
+            self.advance()
+            value, err = decode_string(t.text[1:-1], kind == "WSTRING")
+            if err:
+                self.diags.error("ST0104", err, self.tok_span(t))
+            return A.Literal(kind.lower(), value, None, t.text, span=self.tok_span(t))
+        if kind in ("TIME", "DATE", "TOD", "DT"):
+            self.advance()
+            return self.temporal_literal(t)
+        if kind == "TYPED":
+            prefix = t.text[:-1].upper()
+            if prefix in INT_PREFIXES or prefix in REAL_PREFIXES or prefix in ("BOOL", "STRING", "WSTRING"):
+                return self.typed_literal(t, prefix)
+            name, value = self.qualname()
+            return A.EnumLiteral(name, value, span=self.span_from(start))
+        if kind == "IDENT":
+            if t.up in ("MOD", "AND", "OR", "XOR") and self.peek().kind == "OP" and self.peek().text == "(":
+                self.advance()      # functional form of an operator: MOD(a, b), AND(a, b, c)
+                return A.Name(A.QualName(t.up, span=self.tok_span(t)), span=self.tok_span(t))
+            if t.up in ("TRUE", "FALSE"):
+                self.advance()
+                return A.Literal("bool", t.up == "TRUE", None, t.text, span=self.tok_span(t))
+        if kind == "IDENT" or (kind == "OP" and t.text in ("\\", "\\\\")):
+            name, value = self.qualname()
+            if value is not None:
+                return A.EnumLiteral(name, value, span=self.span_from(start))
+            return A.Name(name, span=self.span_from(start))
+        if kind == "OP" and t.text == "(":
+            self.advance()
+            inner = self.expression()
+            self.expect_op(")", "to close the parenthesis")
+            return inner
+        if kind == "ADDRESS":
+            self.fail("direct addresses (`%IX0.0`) are only allowed after AT in a declaration")
+        self.fail_expected("an expression")
+
+    def based_value(self, t) -> int:
+        base_text, digits = t.text.split("#", 1)
+        base = int(base_text)
+        digits = digits.replace("_", "")
+        if base not in (2, 8, 16):
+            self.diags.error("ST0106", f"base {base} is not allowed in `{t.text}`; use 2#, 8# or 16#",
+                             self.tok_span(t))
+            return 0
+        try:
+            return int(digits, base)
+        except ValueError:
+            self.diags.error("ST0106", f"`{t.text}` contains digits that are not valid in base {base}",
+                             self.tok_span(t))
+            return 0
+
+    def typed_literal(self, prefix_tok, prefix: str) -> A.Expr:
+        self.advance()
+        start = prefix_tok.start
+        sign = ""
+        if self.at_op("-") or self.at_op("+"):
+            sign = self.advance().text
+        t = self.tok
+        text = self.src.text[start:t.end]
+        if t.kind in ("INT", "BASED", "REAL") and prefix not in ("STRING", "WSTRING"):
+            self.advance()
+            if t.kind == "REAL":
+                if prefix not in REAL_PREFIXES:
+                    self.fail(f"`{text}`: a {prefix} literal cannot have a fraction", "ST0106", t)
+                value = float(t.text.replace("_", ""))
+            else:
+                value = self.based_value(t) if t.kind == "BASED" else int(t.text.replace("_", ""))
+            if sign == "-":
+                value = -value
+            if prefix in REAL_PREFIXES:
+                return A.Literal("real", float(value), prefix, text, span=self.span_from(start))
+            if prefix == "BOOL":
+                if value not in (0, 1):
+                    self.fail(f"`{text}`: BOOL literals are 0, 1, TRUE or FALSE", "ST0106", t)
+                return A.Literal("bool", bool(value), prefix, text, span=self.span_from(start))
+            return A.Literal("int", value, prefix, text, span=self.span_from(start))
+        if t.kind == "IDENT" and t.up in ("TRUE", "FALSE") and prefix == "BOOL" and not sign:
+            self.advance()
+            return A.Literal("bool", t.up == "TRUE", prefix, text, span=self.span_from(start))
+        if t.kind in ("STRING", "WSTRING") and prefix in ("STRING", "WSTRING") and not sign:
+            self.advance()
+            value, err = decode_string(t.text[1:-1], prefix == "WSTRING")
+            if err:
+                self.diags.error("ST0104", err, self.tok_span(t))
+            return A.Literal(prefix.lower(), value, prefix, text, span=self.span_from(start))
+        self.fail_expected(f"a {prefix} value after `{prefix_tok.text}`")
+
+    def temporal_literal(self, t) -> A.Literal:
+        prefix, body = t.text.split("#", 1)
+        up = prefix.upper()
+        span = self.tok_span(t)
+        if t.kind == "TIME":
+            value = parse_duration(body)
+            kind = "ltime" if up in ("LTIME", "LT") else "time"
+        elif t.kind == "DATE":
+            value = parse_ymd(body)
+            kind = "date"
+        elif t.kind == "TOD":
+            value = parse_clock(body)
+            kind = "tod"
+        else:
+            ymd, _, clock = body.rpartition("-")          # YYYY-MM-DD-hh:mm:ss: the clock follows the last '-'
+            day, tod = parse_ymd(ymd), parse_clock(clock)
+            value = None if day is None or tod is None else day * 1_000_000_000 + tod
+            kind = "dt"
+        if value is None:
+            self.diags.error("ST0106", f"`{t.text}` is not a valid {kind.upper()} literal", span)
+            value = 0
+        return A.Literal(kind, value, None, t.text, span=span)

@@ -1,0 +1,271 @@
+"""Load ST files into a checked project: ``load_project(paths) -> Project`` (docs/toolchain/frontend_api.md)."""
+from __future__ import annotations
+
+import gc
+import os
+from dataclasses import dataclass, field
+
+from . import ast as A
+from . import types as T
+from .checker import calls, portable as portable_rule, recursion
+from .checker.body import BodyChecker
+from .checker.declare import Declarer
+from .checker.scope import Ambiguous, Tables
+from .diagnostics import DiagnosticBag, Diagnostic, render_all, sort_key
+from .parser import parse
+from .source import SourceFile, Span
+
+PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
+VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st")
+
+
+@dataclass
+class Context:
+    dialect: str
+    diags: DiagnosticBag
+    tables: Tables = field(default_factory=Tables)
+    type_decls: list = field(default_factory=list)
+    pou_units: list = field(default_factory=list)
+    global_lists: list = field(default_factory=list)
+    configurations: list = field(default_factory=list)
+    vendor_objects: set = field(default_factory=set)
+    vendor_uses: list = field(default_factory=list)
+    edition3_uses: list = field(default_factory=list)
+
+    def note_vendor(self, obj, span) -> None:
+        if id(obj) in self.vendor_objects and span is not None:
+            self.vendor_uses.append((span, obj.name))
+
+    def note_edition3(self, what: str, span) -> None:
+        """Record a use of an IEC 61131-3 3rd-edition-only feature (reported by --portable)."""
+        if span is not None:
+            self.edition3_uses.append((span, what))
+
+
+class Project:
+    def __init__(self, dialect: str) -> None:
+        self.dialect = dialect
+        self.units: list[A.CompilationUnit] = []
+        self.pous: dict[str, T.PouType] = {}
+        self.types: dict[str, T.Type] = {}
+        self.globals: dict = {}
+        self.global_lists: list[A.GlobalVarList] = []
+        self.configurations: list[A.Configuration] = []
+        self.programs: list[T.PouType] = []
+        self.diagnostics: list[Diagnostic] = []
+        self._tables: Tables | None = None
+
+    @property
+    def has_errors(self) -> bool:
+        return any(d.is_error for d in self.diagnostics)
+
+    def render_diagnostics(self, context: bool = True) -> str:
+        return render_all(self.diagnostics, context)
+
+    def _lookup(self, table, text: str, from_ns: str | None):
+        parts = [p for p in text.replace("\\\\", "\\").split("\\") if p]
+        if not parts or self._tables is None:
+            return None
+        try:
+            return getattr(self._tables, table).lookup(parts[-1], tuple(parts[:-1]), from_ns)
+        except Ambiguous:
+            return None
+
+    def lookup_pou(self, text: str, from_ns: str | None = None) -> T.PouType | None:
+        return self._lookup("pous", text, from_ns)
+
+    def lookup_type(self, text: str, from_ns: str | None = None) -> T.Type | None:
+        return self._lookup("types", text, from_ns)
+
+
+# ---- files ---------------------------------------------------------------------------------------
+
+def namespace_of(path: str) -> str | None:
+    """The innermost folder whose name ends in ``Lib`` (a library folder), or None."""
+    parts = os.path.normpath(os.path.abspath(path)).split(os.sep)[:-1]
+    for part in reversed(parts):
+        if part.endswith("Lib"):
+            return part
+    return None
+
+
+def collect_files(paths, diags: DiagnosticBag) -> list[str]:
+    files: list[str] = []
+    for p in paths:
+        p = str(p)
+        if os.path.isdir(p):
+            found = []
+            for root, dirs, names in os.walk(p):
+                dirs.sort()
+                found += [os.path.join(root, n) for n in sorted(names) if n.lower().endswith(".st")]
+            if not found:
+                diags.warning("ST0004", f"folder `{p}` contains no .st files", Span(SourceFile(p, ""), 0, 0))
+            files += found
+        elif os.path.exists(p):
+            files.append(p)
+        else:
+            diags.error("ST0001", f"file or folder `{p}` does not exist", Span(SourceFile(p, ""), 0, 0))
+    seen, out = set(), []
+    for f in files:
+        key = os.path.abspath(f)
+        if key not in seen:
+            seen.add(key)
+            out.append(f)
+    return out
+
+
+def read_source(path: str, diags: DiagnosticBag) -> SourceFile | None:
+    empty = Span(SourceFile(path, ""), 0, 0)
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read()
+    except OSError as exc:
+        diags.error("ST0005", f"cannot read `{path}`: {exc.strerror or exc}", empty)
+        return None
+    if b"\x00" in data[:8192]:
+        diags.error("ST0003", f"`{path}` is a binary file, not Structured Text source", empty)
+        return None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        diags.error("ST0002", f"`{path}` is not valid UTF-8 (invalid byte 0x{data[exc.start]:02X} on line {line}); "
+                    "save the file as UTF-8", empty)
+        return None
+    src = SourceFile(path, text)
+    if not text.strip():
+        diags.error("ST0004", f"`{path}` is empty; it declares nothing", Span(src, 0, 0))
+        return None
+    return src
+
+
+# ---- loading -------------------------------------------------------------------------------------
+
+def load_project(paths, *, dialect: str = "sysmac", include_prelude: bool = True, portable: bool = False) -> Project:
+    """Read, parse and check ``paths`` (files or folders, recursively ``*.st``) plus the prelude."""
+    # The front end allocates many small long-lived objects and frees almost nothing: the cyclic garbage
+    # collector would only re-scan them (making large files quadratic-ish), so it is paused while loading.
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _load(paths, dialect, include_prelude, portable)
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _load(paths, dialect: str, include_prelude: bool, portable: bool) -> Project:
+    diags = DiagnosticBag()
+    ctx = Context(dialect, diags)
+    proj = Project(dialect)
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    user_files = collect_files(paths, diags)
+    prelude_files = sorted(os.path.join(PRELUDE_DIR, n) for n in os.listdir(PRELUDE_DIR) if n.endswith(".st")) \
+        if include_prelude and os.path.isdir(PRELUDE_DIR) else []
+    prelude_abs = {os.path.abspath(f) for f in prelude_files}
+    user_files = [f for f in user_files if os.path.abspath(f) not in prelude_abs]
+    for path in prelude_files + user_files:
+        src = read_source(path, diags)
+        if src is None:
+            continue
+        unit = parse(src, diags)
+        unit.namespace = None if os.path.abspath(path) in prelude_abs else namespace_of(path)
+        unit.in_prelude = os.path.abspath(path) in prelude_abs
+        unit.vendor = unit.in_prelude and os.path.basename(path) in VENDOR_PRELUDE
+        proj.units.append(unit)
+    check_units(ctx, proj)
+    if portable:
+        for unit in proj.units:
+            portable_rule.check_unit(ctx, unit)
+    proj.diagnostics = sorted(diags.items, key=sort_key)
+    return proj
+
+
+def check_units(ctx: Context, proj: Project) -> None:
+    dec = Declarer(ctx)
+    for unit in proj.units:
+        dec.register(unit)
+    for decl, shell, unit in ctx.type_decls:
+        if getattr(unit, "vendor", False):
+            ctx.vendor_objects.add(id(shell))
+    for pou, unit in ctx.pou_units:
+        if getattr(unit, "vendor", False):
+            ctx.vendor_objects.add(id(pou.sym))
+    dec.complete_types()
+    dec.complete_pous()
+    for gl, unit in ctx.global_lists:
+        dec.declare_globals(gl.sections, unit, gl.name)
+        proj.global_lists.append(gl)
+    for cfg, unit in ctx.configurations:
+        dec.declare_globals(cfg.sections, unit, cfg.name)
+        for res in cfg.resources:
+            dec.declare_globals(res.sections, unit, res.name or cfg.name)
+        proj.configurations.append(cfg)
+    # initial values of type declarations and globals
+    for decl, shell, unit in ctx.type_decls:
+        ck = BodyChecker(ctx, None, unit)
+        if decl.init is not None:
+            ck.initial_value(decl.init, shell, f"initial value of {decl.name}")
+        if isinstance(shell, T.StructType):
+            for f in shell.fields.values():
+                if f.init is not None:
+                    ck.initial_value(f.init, f.type, f"initial value of {f.name}")
+    for gl, unit in ctx.global_lists + ctx.configurations:
+        ck = BodyChecker(ctx, None, unit)
+        for section in gl.sections:
+            for d in section.vars:
+                if d.init is not None and d.sym is not None:
+                    ck.initial_value(d.init, d.sym.type, f"initial value of {d.name}")
+    edges: dict = {}
+    for pou, unit in ctx.pou_units:
+        ck = BodyChecker(ctx, pou, unit)
+        ck.check_pou()
+        pt = pou.sym
+        edges.setdefault(pt, []).extend(
+            [(callee, span) for callee, span in ck.calls_made if callee.kind != "fb" or callee is pt])
+        edges[pt].extend(recursion.instance_edges(pt, [d for s in pou.sections if s.kind in ("VAR", "VAR_STAT")
+                                                       for d in s.vars]))
+        if pou.kind == "PROGRAM" and not getattr(unit, "in_prelude", False):
+            proj.programs.append(pt)
+    recursion.check(ctx, edges)
+    for cfg, unit in ctx.configurations:
+        check_configuration(ctx, cfg, unit)
+    proj._tables = ctx.tables
+    for (ns, name), obj in ctx.tables.pous.entries.items():
+        proj.pous[f"{ns}\\{name}" if ns else name] = obj
+    for (ns, name), obj in ctx.tables.types.entries.items():
+        proj.types[f"{ns}\\{name}" if ns else name] = obj
+    proj.globals = dict(ctx.tables.globals)
+
+
+def check_configuration(ctx: Context, cfg: A.Configuration, unit) -> None:
+    ck = BodyChecker(ctx, None, unit)
+    for res in cfg.resources:
+        tasks = {}
+        for task in res.tasks:
+            if task.name.upper() in tasks:
+                ctx.diags.error("ST1002", f"task `{task.name}` is declared more than once", task.span)
+            tasks[task.name.upper()] = task
+            for prop in task.props:
+                want = {"INTERVAL": T.TIME, "PRIORITY": T.UINT, "SINGLE": T.BOOL}.get(prop.name)
+                if want is None:
+                    ctx.diags.error("ST1201", f"unknown task property `{prop.name}`; use INTERVAL, PRIORITY or SINGLE",
+                                    prop.span)
+                    continue
+                have = ck.expr(prop.value, want)
+                ck.coerce(prop.value, have, want, f"task property {prop.name}")
+        for inst in res.programs:
+            if inst.task is not None and inst.task.upper() not in tasks:
+                ctx.diags.error("ST1001", f"task `{inst.task}` is not declared in this resource", inst.span)
+            pt = None
+            try:
+                pt = ctx.tables.pous.lookup(inst.program.name, inst.program.namespace, unit.namespace)
+            except Ambiguous:
+                pass
+            if pt is None or pt.kind != "program":
+                ctx.diags.error("ST1001", f"`{inst.program.text()}` is not a PROGRAM", inst.span)
+                continue
+            call = A.Call(A.Name(inst.program, span=inst.program.span), inst.args, span=inst.span)
+            calls.bind_pou(ck, call, pt, "program", None)
+            inst.binding = call.binding

@@ -1,0 +1,43 @@
+"""Shared helpers of the front-end tests."""
+from __future__ import annotations
+
+import os
+import pathlib
+import subprocess
+import sys
+import textwrap
+
+from vplc.diagnostics import DiagnosticBag
+from vplc.parser import parse
+from vplc.project import load_project
+from vplc.source import SourceFile
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parents[2]
+
+
+def parse_text(text: str, path: str = "t.st"):
+    diags = DiagnosticBag()
+    unit = parse(SourceFile(path, textwrap.dedent(text)), diags)
+    return unit, diags.items
+
+
+def check_text(tmp_path, text: str, name: str = "t.st", **kw):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text), encoding="utf-8")
+    return load_project([str(path)], **kw)
+
+
+def codes(proj, severity: str | None = None) -> list[str]:
+    return [d.code for d in proj.diagnostics if severity is None or d.severity == severity]
+
+
+def run_cli(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=f"{ROOT / 'src'}{os.pathsep}{ROOT}")
+    return subprocess.run([sys.executable, "-m", "vplc", *args], capture_output=True, text=True, env=env,
+                          cwd=cwd or ROOT, timeout=120)
+
+
+def program(body: str, decls: str = "") -> str:
+    """Wrap statements in a PROGRAM with the given VAR declarations."""
+    return f"PROGRAM Main\nVAR\n{decls}\nEND_VAR\n{body}\nEND_PROGRAM\n"

@@ -1,0 +1,48 @@
+"""Bad input: each case gives a clear diagnostic and exit 1 — never a traceback or a hang."""
+from __future__ import annotations
+
+import pytest
+
+from fe_helpers import run_cli
+
+
+def _write(tmp_path, name, data):
+    p = tmp_path / name
+    if isinstance(data, bytes):
+        p.write_bytes(data)
+    else:
+        p.write_text(data, encoding="utf-8")
+    return str(p)
+
+
+CASES = {
+    "binary": (b"\x7fELF\x00\x01\x02" + bytes(range(256)), "ST0003"),
+    "latin1": (b"PROGRAM P (* caf\xe9 *) END_PROGRAM", "ST0002"),
+    "empty": ("", "ST0004"),
+    "deep_parens": ("PROGRAM P VAR x : INT; END_VAR x := " + "(" * 10000 + "1" + ")" * 10000 + "; END_PROGRAM",
+                    "ST0203"),
+    "deep_unary": ("PROGRAM P VAR x : INT; END_VAR x := " + "-" * 10000 + "1; END_PROGRAM", "ST0203"),
+    "long_line": ("PROGRAM P VAR x : INT; END_VAR x := " + "y" * 1_000_000 + "; END_PROGRAM", "ST1001"),
+    "unclosed_comment": ("PROGRAM P (* " + "x" * 1000, "ST0102"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_bad_file_gives_diagnostic_and_exit_1(tmp_path, name):
+    data, code = CASES[name]
+    result = run_cli("check", _write(tmp_path, f"{name}.st", data))
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert f"error[{code}]" in result.stdout
+    assert "Traceback" not in result.stdout + result.stderr
+    assert max(len(line) for line in result.stdout.splitlines()) < 1000
+
+
+def test_missing_file_gives_diagnostic_and_exit_1(tmp_path):
+    result = run_cli("check", str(tmp_path / "nope.st"))
+    assert result.returncode == 1 and "error[ST0001]" in result.stdout and "does not exist" in result.stdout
+
+
+def test_one_million_character_line_of_valid_code_checks(tmp_path):
+    path = _write(tmp_path, "wide.st", "PROGRAM P VAR x : INT; END_VAR x := 1;" + " " * 1_000_000 + "x := x; END_PROGRAM")
+    result = run_cli("check", path)
+    assert result.returncode == 0, result.stdout

@@ -1,0 +1,53 @@
+"""Standard-function signatures: result types, implicit widening of arguments, and refusals."""
+from __future__ import annotations
+
+import pytest
+
+from vplc import builtins as B
+from vplc import types as T
+from fe_helpers import check_text, codes, program
+
+DECLS = ("i : INT; d : DINT; u : UINT; r : REAL; lr : LREAL; w : WORD; b : BYTE; s : STRING[20]; "
+         "t : TIME; dt1 : DT; tod1 : TOD; day : DATE; x : BOOL; arr : ARRAY[1..4] OF INT;")
+
+RESULTS = [
+    ("ABS(i)", T.INT), ("SQRT(r)", T.REAL), ("SQRT(d)", T.LREAL), ("LN(lr)", T.LREAL), ("EXPT(r, 2)", T.REAL),
+    ("ATAN2(r, lr)", T.LREAL), ("MAX(i, d, 5)", T.DINT), ("MIN(u, 1)", T.UINT), ("LIMIT(0, i, 100)", T.INT),
+    ("SEL(x, i, d)", T.DINT), ("MUX(1, r, lr, 0.5)", T.LREAL), ("SHL(w, 2)", T.WORD), ("ROR(b, 1)", T.BYTE),
+    ("LEN(s)", T.UINT), ("FIND(s, 'a')", T.UINT), ("INT_TO_REAL(i)", T.REAL), ("TRUNC(r)", T.DINT),
+    ("REAL_TO_INT(r)", T.INT), ("DINT_TO_TIME(d)", T.TIME), ("TIME_TO_DINT(t)", T.DINT),
+    ("ADD_DT_TIME(dt1, t)", T.DT), ("SUB_DT_DT(dt1, dt1)", T.TIME), ("CONCAT_DATE_TOD(day, tod1)", T.DT),
+    ("UPPER_BOUND(arr, 1)", T.DINT), ("TO_INT(r)", T.INT), ("ADD(i, i, d)", T.DINT), ("MOD(d, 3)", T.DINT),
+    ("dt1 - dt1", T.TIME), ("tod1 + t", T.TOD), ("t * 2", T.TIME), ("t / r", T.TIME),
+]
+
+
+@pytest.mark.parametrize("expr,ty", RESULTS, ids=[e for e, _ in RESULTS])
+def test_builtin_result_types(tmp_path, expr, ty):
+    proj = check_text(tmp_path, program(f"v := {expr};", DECLS + f" v : {ty.name};"))
+    assert not proj.has_errors, proj.render_diagnostics()
+    value = proj.programs[0].pou.body[0].value
+    assert T.same_type(value.ty, ty)
+
+
+@pytest.mark.parametrize("expr", ["CONCAT(s, 'x', LEFT(s, 2), RIGHT(s, 1), MID(s, 2, 3))",
+                                  "INSERT(s, 'ab', 2)", "DELETE(s, 1, 1)", "REPLACE(s, 'x', 1, 1)",
+                                  "UINT_TO_STRING(u)"])
+def test_string_functions_return_strings(tmp_path, expr):
+    proj = check_text(tmp_path, program(f"s := {expr};", DECLS))
+    assert not proj.has_errors, proj.render_diagnostics()
+    assert T.is_string(proj.programs[0].pou.body[0].value.ty)
+
+
+@pytest.mark.parametrize("expr", ["SQRT(s)", "SHL(r, 1)", "LEN(i)", "MAX(s, i)", "INT_TO_REAL(s)", "MOD(r, 2)",
+                                  "SEL(i, 1, 2)", "CONCAT(s, i)"])
+def test_wrong_argument_types_are_refused(tmp_path, expr):
+    proj = check_text(tmp_path, program(f"x := {expr} = {expr};", DECLS))
+    assert "ST1103" in codes(proj), proj.render_diagnostics()
+
+
+def test_conversion_names_are_generated_for_every_elementary_pair():
+    assert B.lookup("usint_to_lreal").name == "USINT_TO_LREAL"
+    assert B.lookup("WSTRING_TO_STRING") is not None
+    assert B.lookup("FOO_TO_BAR") is None
+    assert "CONCAT" in B.names() and "ROL" in B.names()

@@ -1,0 +1,64 @@
+"""Lexer: token kinds and literal values for the grammar corners; errors at the right place."""
+from __future__ import annotations
+
+import pytest
+
+from vplc.diagnostics import DiagnosticBag
+from vplc.lexer import decode_string, tokenize
+from vplc.source import SourceFile
+
+
+def toks(text: str):
+    d = DiagnosticBag()
+    out = [(t.kind, t.text) for t in tokenize(SourceFile("t.st", text), d)][:-1]
+    return out, [x.code for x in d.items]
+
+
+@pytest.mark.parametrize("text,kind", [
+    ("16#FF", "BASED"), ("8#17", "BASED"), ("2#1010_1010", "BASED"), ("1_000", "INT"),
+    ("1.5e3", "REAL"), ("2E-3", "REAL"), ("T#1h2m3s4ms", "TIME"), ("TIME#-5s", "TIME"), ("LTIME#5ns", "TIME"),
+    ("t#1.5s", "TIME"), ("D#2024-02-29", "DATE"), ("DATE#2024-1-1", "DATE"), ("TOD#12:30:15.5", "TOD"),
+    ("TIME_OF_DAY#23:59:59", "TOD"), ("DT#2024-01-01-12:00:00", "DT"), ("DATE_AND_TIME#2024-01-01-00:00", "DT"),
+    ("'it$'s'", "STRING"), ('"wide"', "WSTRING"), ("%MW10", "ADDRESS"),
+])
+def test_single_token_literal_kinds(text, kind):
+    tokens, errors = toks(text)
+    assert tokens == [(kind, text)] and errors == []
+
+
+def test_typed_literal_and_enum_prefixes_split_into_prefix_and_value():
+    assert toks("BYTE#16#41")[0] == [("TYPED", "BYTE#"), ("BASED", "16#41")]
+    assert toks("Ns\\eColor#Red")[0] == [("IDENT", "Ns"), ("OP", "\\"), ("TYPED", "eColor#"), ("IDENT", "Red")]
+
+
+def test_nested_block_comments_line_comments_and_pragmas():
+    tokens, errors = toks("a (* x (* nested *) y *) b // rest\n c /* c-style */ {attribute 'x'} d")
+    assert tokens == [("IDENT", "a"), ("IDENT", "b"), ("IDENT", "c"), ("PRAGMA", "{attribute 'x'}"), ("IDENT", "d")]
+    assert errors == []
+
+
+def test_range_dots_do_not_make_a_real():
+    assert toks("1..5")[0] == [("INT", "1"), ("OP", ".."), ("INT", "5")]
+
+
+@pytest.mark.parametrize("text,code", [("x := 'abc", "ST0103"), ("(* open", "ST0102"), ("a ? b", "ST0101"),
+                                       ("{ pragma", "ST0105")])
+def test_lexical_errors_are_reported_with_their_code(text, code):
+    assert code in toks(text)[1]
+
+
+@pytest.mark.parametrize("body,value", [
+    ("$$", "$"), ("$'", "'"), ('$"', '"'), ("$L", "\n"), ("$N", "\n"), ("$P", "\f"), ("$R", "\r"), ("$T", "\t"),
+    ("$0D$0a", "\r\n"), ("$$TMSTA,2,00,*41$R$L", "$TMSTA,2,00,*41\r\n"), ("$l$r$t", "\n\r\t"),
+])
+def test_every_dollar_escape_decodes(body, value):
+    assert decode_string(body, wide=False) == (value, None)
+
+
+def test_invalid_escape_is_named():
+    value, err = decode_string("a$Qb", wide=False)
+    assert err is not None and "$Q" in err
+
+
+def test_wide_string_uses_four_hex_digits():
+    assert decode_string("$00E9", wide=True) == ("é", None)
