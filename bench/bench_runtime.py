@@ -1,0 +1,152 @@
+"""Runtime benchmarks (issue 4): per-scan cost, virtual scans/s, real-time lateness, compile time, memory.
+
+Run alone: ``python bench/bench_runtime.py`` (prints human-readable figures, exits 0).
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "src"))
+
+from vplc.api import load_plc            # noqa: E402
+from vplc.runtime.stats import ScanStats, percentile   # noqa: E402
+
+EMPTY = "PROGRAM Main\nVAR x : BOOL; END_VAR\n;\nEND_PROGRAM\n"
+
+
+def trig_program(n: int = 100) -> str:
+    return (f"PROGRAM Main\nVAR\n  edges : ARRAY[1..{n}] OF R_TRIG;\n  timers : ARRAY[1..{n}] OF TON;\n"
+            f"  i : INT; clk : BOOL; cnt : DINT;\nEND_VAR\nclk := NOT clk;\n"
+            f"FOR i := 1 TO {n} DO\n  edges[i](CLK := clk);\n  timers[i](IN := clk, PT := T#5ms);\n"
+            f"  IF edges[i].Q OR timers[i].Q THEN cnt := cnt + 1; END_IF;\nEND_FOR;\nEND_PROGRAM\n")
+
+
+def sequence_fb(name: str, states: int = 22) -> str:
+    """A typical ~300-line sequence: CASE state machine with timers, counters and string building."""
+    lines = [f"FUNCTION_BLOCK {name}", "VAR_INPUT", "    Start : BOOL;", "    Speed : INT;", "END_VAR",
+             "VAR_OUTPUT", "    Busy : BOOL;", "    Done : BOOL;", "    Msg : STRING[80];", "END_VAR", "VAR",
+             "    Step : INT;", "    Wait : TON;", "    Edge : R_TRIG;", "    Count : DINT;", "    Pos : REAL;",
+             "    Line : STRING[120];", "    Retries : INT;", "END_VAR",
+             "Edge(CLK := Start);", "IF Edge.Q AND Step = 0 THEN", "    Step := 10;", "END_IF;",
+             "Wait(IN := FALSE);", "CASE Step OF"]
+    for k in range(1, states + 1):
+        s = k * 10
+        lines += [f"{s}:", "    Busy := TRUE;", f"    Pos := Pos + INT_TO_REAL(Speed) * 0.{k % 9 + 1};",
+                  f"    Line := CONCAT('step {s} pos=', REAL_TO_STRING(Pos));",
+                  "    Line := CONCAT(Line, ' n=');", "    Line := CONCAT(Line, DINT_TO_STRING(Count));",
+                  "    Count := Count + 1;",
+                  f"    IF Count MOD {k + 2} = 0 THEN", "        Retries := Retries + 1;", "    END_IF;",
+                  f"    IF Pos > {k * 100}.0 OR Retries > {k} THEN",
+                  f"        Step := {s + 10 if k < states else 0};", "        Retries := 0;",
+                  "        Msg := LEFT(Line, 40);", "    END_IF;"]
+    lines += ["ELSE", "    Busy := FALSE;", "    Done := Step = 0 AND Count > 0;", "END_CASE;",
+              "END_FUNCTION_BLOCK"]
+    return "\n".join(lines) + "\n"
+
+
+def sequence_program() -> str:
+    return sequence_fb("Sequence") + ("PROGRAM Main\nVAR\n  seq : Sequence;\n  go : BOOL;\nEND_VAR\n"
+                                      "go := NOT go;\nseq(Start := go, Speed := 7);\nEND_PROGRAM\n")
+
+
+def big_source(lines_wanted: int = 5000) -> str:
+    parts, n, i = [], 0, 0
+    while n < lines_wanted:
+        fb = sequence_fb(f"Seq{i}")
+        parts.append(fb)
+        n += fb.count("\n")
+        i += 1
+    decl = "\n".join(f"  s{k} : Seq{k};" for k in range(i))
+    calls = "\n".join(f"s{k}(Start := TRUE, Speed := {k % 9 + 1});" for k in range(i))
+    parts.append(f"PROGRAM Main\nVAR\n{decl}\nEND_VAR\n{calls}\nEND_PROGRAM\n")
+    return "".join(parts)
+
+
+def load(tmp: str, name: str, text: str, **kw):
+    path = os.path.join(tmp, name)
+    with open(path, "w") as f:
+        f.write(text)
+    return load_plc([path], **kw)
+
+
+def per_scan(tmp, label, text, scans=5000):
+    plc = load(tmp, label.replace(" ", "_") + ".st", text, count_statements=True)
+    counted = ScanStats()
+    for k in range(scans // 5):
+        c0 = plc.statements_executed
+        plc.scan(k * 1_000_000)
+        counted.record(0, 0, plc.statements_executed - c0)
+    plc = load(tmp, label.replace(" ", "_") + ".st", text)
+    times = []
+    t = 0
+    for _ in range(scans):
+        s0 = time.perf_counter_ns()
+        plc.scan(t)
+        times.append(time.perf_counter_ns() - s0)
+        t += 1_000_000
+    med, p99 = percentile(times, .5) / 1000, percentile(times, .99) / 1000
+    print(f"  {label:<32} median {med:7.1f} us   p99 {p99:7.1f} us   statements/scan "
+          f"{percentile(counted.statements, .5)}")
+    return plc
+
+
+def main() -> int:
+    print("vplc runtime benchmark (Python %s)" % sys.version.split()[0])
+    with tempfile.TemporaryDirectory() as tmp:
+        print("per-scan cost (virtual time, 1 ms task):")
+        per_scan(tmp, "empty program", EMPTY)
+        per_scan(tmp, "100 R_TRIG + 100 TON", trig_program())
+        seq_text = sequence_program()
+        print(f"  (sequence program: {seq_text.count(chr(10))} lines)")
+        plc = per_scan(tmp, "300-line CASE sequence", seq_text)
+
+        n, t0 = 20000, time.perf_counter()
+        plc.run_until(lambda: False, n * plc.period_ns)
+        rate = n / (time.perf_counter() - t0)
+        print(f"virtual time: {rate:,.0f} scans/s for the sequence program (run_until)")
+
+        base = []
+        due = time.monotonic_ns()
+        for _ in range(1000):
+            due += 1_000_000
+            time.sleep(max(0, due - time.monotonic_ns()) / 1e9)
+            base.append(time.monotonic_ns() - due)
+        print(f"machine baseline, plain 1 ms sleep loop: lateness p99 {percentile(base, .99) / 1000:.1f} us, "
+              f"max {max(base) / 1000:.1f} us (jitter of the OS/VM, not of the PLC)")
+        for spin in (300_000, 800_000):
+            stop, stats = threading.Event(), ScanStats()
+            rt = load(tmp, "rt.st", seq_text)
+            timer = threading.Timer(3.0, stop.set)
+            timer.start()
+            cpu0 = time.process_time()
+            rt.run_realtime(stop, stats=stats, spin_ns=spin)
+            cpu = (time.process_time() - cpu0) / 3.0 * 100
+            timer.cancel()
+            print(f"real time, 1 ms task, 3 s, spin {spin // 1000} us: lateness median "
+                  f"{percentile(stats.lateness, .5) / 1000:.1f} us, p99 {percentile(stats.lateness, .99) / 1000:.1f} us, "
+                  f"max {max(stats.lateness) / 1000:.1f} us, overruns {stats.overruns} of {len(stats.lateness)} scans, "
+                  f"CPU {cpu:.0f} %")
+
+        big = big_source()
+        path = os.path.join(tmp, "big.st")
+        with open(path, "w") as f:
+            f.write(big)
+        code = ("import resource, sys, time; sys.path.insert(0, %r); from vplc.api import load_plc; "
+                "t0 = time.perf_counter(); p = load_plc([%r]); dt = time.perf_counter() - t0; "
+                "[p.scan(k * 1000000) for k in range(100)]; "
+                "print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)") % (os.path.join(ROOT, "src"), path)
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        dt, rss = (float(x) for x in out.stdout.split())
+        print(f"compile (load + check + codegen + instantiate) of {big.count(chr(10))} lines: {dt:.2f} s")
+        print(f"peak RSS of a fresh process with that program loaded and scanned 100 times: {rss:.1f} MB")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

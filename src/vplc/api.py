@@ -1,0 +1,199 @@
+"""Python API of the virtual PLC (Contract A): load ST sources, scan, read and write variables.
+
+    plc = load_plc(["lib/", "main.st"], task="Main@1ms")
+    plc.run_until(lambda: plc.read("Main.conn.Connected"), timeout_ns=5_000_000_000)
+"""
+from __future__ import annotations
+
+import re
+import threading
+import time
+
+from . import types as T
+from .codegen import CodeGen, bind_natives
+from .runtime.engine import Engine, Task
+from .runtime.faults import PlcFault
+from .runtime.values import PathError, Resolver, parse_duration
+
+__all__ = ["load_plc", "LoadError", "PlcFault", "Plc"]
+
+
+class LoadError(Exception):
+    """The sources could not be loaded: ``str()`` is the rendered diagnostics."""
+
+
+def load_plc(paths, task: str = "Main@1ms", programs=None, *, dialect: str = "sysmac",
+             watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
+             count_statements: bool = False, clock_base_ns: int | None = None) -> "Plc":
+    from .project import load_project
+    if isinstance(paths, str):
+        paths = [paths]
+    proj = load_project(list(paths), dialect=dialect)
+    if proj.has_errors:
+        raise LoadError(proj.render_diagnostics())
+    try:
+        module = CodeGen(proj, count_statements).generate()
+    except (NotImplementedError, RecursionError, SyntaxError, MemoryError) as exc:
+        raise LoadError(f"error: the runtime cannot compile this program: {getattr(exc, 'msg', None) or exc}") from None
+    except Exception as exc:    # noqa: BLE001 - a code generator defect must not show a traceback
+        raise LoadError(f"error: internal error of the code generator ({type(exc).__name__}: {exc}); "
+                        "please report it with the ST source") from None
+    return Plc(proj, module, task, programs, watchdog_ms=watchdog_ms, socket_limit=socket_limit,
+               socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns)
+
+
+class Plc:
+    def __init__(self, proj, module, task, programs, *, watchdog_ms, socket_limit, socket_latency_ns,
+                 clock_base_ns) -> None:
+        self.project = proj
+        self.module = module
+        self.engine = Engine(module, watchdog_ns=int(watchdog_ms * 1e6), socket_limit=socket_limit,
+                             socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns)
+        ns = module.namespace
+        bind_natives(ns, self.engine)
+        self.lock = threading.RLock()
+        try:
+            self.globals = module.globals_cls()
+            ns["G"] = self.globals
+            self.instances: dict[str, object] = ns["_PROGRAMS"]
+            self._setup_tasks(task, programs)
+        except Exception as exc:   # noqa: BLE001 - an initial value that faults
+            raise LoadError(f"error: initialising the variables failed: {self.engine.make_fault(exc)}") from None
+        self._resolver = Resolver(self)
+
+    # ---- tasks --------------------------------------------------------------------------------
+    def _program(self, name: str):
+        pt = self.project.lookup_pou(name)
+        if pt is None or pt.kind != "program":
+            raise LoadError(f"error: no PROGRAM named `{name}` in the loaded sources")
+        return pt
+
+    def _instance(self, inst_name: str, pt):
+        key = self.project.pous and next(k for k, v in self.project.pous.items() if v is pt)
+        inst = self.module.classes[key](inst_name)
+        self.instances[inst_name.upper()] = inst
+        return inst, self.module.bodies[key]
+
+    def _setup_tasks(self, task, programs) -> None:
+        configs = self.project.configurations
+        if configs:
+            for cfg in configs:
+                for res in cfg.resources:
+                    by_name = {}
+                    for td in res.tasks:
+                        props = {p.name.upper(): p.value for p in td.props}
+                        iv = props.get("INTERVAL")
+                        pr = props.get("PRIORITY")
+                        t = Task(td.name, int(iv.value) if iv is not None else 10_000_000,
+                                 int(pr.value) if pr is not None else 0)
+                        by_name[td.name.upper()] = t
+                        self.engine.tasks.append(t)
+                    for pi in res.programs:
+                        t = by_name.get((pi.task or "").upper())
+                        if t is None:
+                            if not self.engine.tasks:
+                                self.engine.tasks.append(Task("Default", 10_000_000, 0))
+                            t = self.engine.tasks[0]
+                        t.programs.append(self._instance(pi.name, self._program(pi.program.text())))
+        else:
+            m = re.fullmatch(r"\s*([A-Za-z_]\w*)\s*@\s*(.+)", task or "")
+            if not m:
+                raise LoadError(f"error: task `{task}` is not of the form Name@period (e.g. Main@1ms)")
+            period = parse_duration(m.group(2))
+            if period is None or period <= 0:
+                raise LoadError(f"error: task period `{m.group(2)}` is not a duration like 1ms, 500us or 0.01s")
+            t = Task(m.group(1), period, 0)
+            pts = [self._program(p) for p in programs] if programs else list(self.project.programs)
+            if not pts:
+                raise LoadError("error: the sources contain no PROGRAM to run")
+            for pt in pts:
+                t.programs.append(self._instance(pt.name, pt))
+            self.engine.tasks.append(t)
+        self.engine.tasks.sort(key=lambda t: t.priority)
+        for pt in self.project.programs:            # programs called from other programs need an instance
+            if pt.name.upper() not in self.instances:
+                self._instance(pt.name, pt)
+
+    # ---- Contract A -----------------------------------------------------------------------------
+    @property
+    def period_ns(self) -> int:
+        return self.engine.period_ns
+
+    @property
+    def now_ns(self) -> int:
+        return self.engine.now_ns
+
+    @property
+    def statements_executed(self) -> int:
+        return self.engine.stmt_counter[0]
+
+    def scan(self, now_ns: int) -> None:
+        with self.lock:
+            self.engine.scan(int(now_ns))
+
+    def read(self, path: str):
+        with self.lock:
+            return self._resolver.read(path)
+
+    def write(self, path: str, value) -> None:
+        with self.lock:
+            self._resolver.write(path, value)
+
+    def var_type(self, path: str) -> str:
+        return self._resolver.type_text(path)
+
+    def run_until(self, pred, timeout_ns: int, on_scan=None) -> bool:
+        eng = self.engine
+        t = eng.now_ns + self.period_ns if eng.started else eng.now_ns
+        end = t + max(int(timeout_ns), 1)
+        while t < end:
+            if on_scan is not None:
+                on_scan(t)
+            self.scan(t)
+            if pred():
+                return True
+            t += self.period_ns
+        return False
+
+    def run_realtime(self, stop_event, on_scan=None, stats=None, spin_ns: int = 300_000) -> None:
+        """Scan at the task period on the monotonic wall clock until ``stop_event`` is set.
+
+        The driver sleeps until ``spin_ns`` before the due time, then spins: a longer spin lowers the
+        lateness on a busy machine at the cost of CPU time (``spin_ns`` = period gives a busy-waiting task)."""
+        period = self.period_ns
+        base = time.monotonic_ns() - (self.engine.now_ns + period if self.engine.started else 0)
+        due = time.monotonic_ns()
+        while not stop_event.is_set():
+            now = time.monotonic_ns()
+            wait = due - now
+            if wait > spin_ns:
+                time.sleep((wait - spin_ns + 100_000) / 1e9)      # coarse sleep, then spin to the due time
+                continue
+            while time.monotonic_ns() < due:
+                pass
+            start = time.monotonic_ns()
+            if on_scan is not None:
+                on_scan(start - base)
+            c0 = self.statements_executed
+            self.scan(start - base)
+            end = time.monotonic_ns()
+            if stats is not None:
+                stats.record(start - due, end - start, self.statements_executed - c0)
+            due += period
+            if end > due:                       # overrun: skip the missed periods
+                missed = (end - due) // period + 1
+                if stats is not None:
+                    stats.overruns += missed
+                due += missed * period
+
+    def close(self) -> None:
+        self.engine.sockets.close_all()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+__all__ += ["PathError", "T"]

@@ -1,0 +1,183 @@
+"""``python -m vplc test PATHS... [--junit FILE]``: run TcUnit-style ST test suites on virtual time.
+
+A test suite is any FUNCTION_BLOCK (outside the prelude) whose body calls TEST('name'). All suites are
+instantiated in one generated runner program and called once per 1 ms scan until every test called
+TEST_FINISHED() (or ``--timeout`` of virtual time passed). Output: each failing assert with its ST location,
+then ``N passed, N failed``. Exit 0 when nothing failed, 1 otherwise, 2 for usage/load errors.
+"""
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+import time
+from xml.sax.saxutils import escape, quoteattr
+
+from . import ast as A
+from .runtime.values import parse_duration
+
+RUNNER = "VPLC_TestRunner"
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("test", help="run ST unit-test suites (TcUnit style)",
+                              description="Run every test-suite FB (a FUNCTION_BLOCK calling TEST('name')) found in "
+                                          "PATHS on virtual time and report the results.")
+    p.add_argument("paths", nargs="+", metavar="PATH", help="ST file or folder (recursive *.st)")
+    p.add_argument("--junit", metavar="FILE", help="also write the results as JUnit XML")
+    p.add_argument("--timeout", default="10s", help="virtual time allowed for all tests to finish (default 10s)")
+    p.add_argument("-v", "--verbose", action="store_true", help="list passing tests too")
+    p.set_defaults(handler=run_tests)
+
+
+def find_suites(proj) -> list[str]:
+    suites = []
+    for unit in proj.units:
+        if getattr(unit, "in_prelude", False):
+            continue
+        for item in unit.items:
+            if isinstance(item, A.Pou) and item.kind == "FUNCTION_BLOCK" and _calls_test(item):
+                suites.append(f"{item.namespace}\\{item.name}" if item.namespace else item.name)
+    return suites
+
+
+def _calls_test(pou) -> bool:
+    for stmt in pou.body:
+        for node in A.walk(stmt):
+            if isinstance(node, A.Call) and isinstance(node.callee, A.Name) and node.callee.name.name.upper() == "TEST":
+                return True
+    return False
+
+
+def runner_source(suites: list[str]) -> str:
+    decls = "\n".join(f"    {_inst(s)} : {s};" for s in suites)
+    calls = "\n".join(f"{_inst(s)}();" for s in suites)
+    return f"PROGRAM {RUNNER}\nVAR\n{decls}\nEND_VAR\n{calls}\nEND_PROGRAM\n"
+
+
+def _inst(suite: str) -> str:
+    return suite.rsplit("\\", 1)[-1]
+
+
+def run_tests(args) -> int:
+    from .api import LoadError, PlcFault, load_plc
+    from .project import load_project
+    timeout = parse_duration(args.timeout)
+    if timeout is None:
+        print(f"vplc test: error: --timeout {args.timeout!r} is not a duration like 10s or 500ms", file=sys.stderr)
+        return 2
+    proj = load_project(args.paths)
+    if proj.has_errors:
+        print(proj.render_diagnostics(), file=sys.stderr)
+        return 2
+    suites = find_suites(proj)
+    if not suites:
+        print("no test suites found (a test suite is a FUNCTION_BLOCK that calls TEST('name'))")
+        print("0 passed, 0 failed")
+        return 1
+    t0 = time.perf_counter()
+    results, errors = [], []
+    remaining = list(suites)
+    while remaining:
+        with tempfile.TemporaryDirectory() as tmp:
+            runner = os.path.join(tmp, "vplc_test_runner.st")
+            with open(runner, "w", encoding="utf-8") as f:
+                f.write(runner_source(remaining))
+            try:
+                plc = load_plc(list(args.paths) + [runner], task=f"{RUNNER}@1ms", programs=[RUNNER])
+            except LoadError as exc:
+                print(str(exc), file=sys.stderr)
+                return 2
+        faulted = None
+        try:
+            plc.run_until(lambda: _all_finished(plc), timeout)
+        except PlcFault as exc:
+            faulted = exc
+        finally:
+            plc.close()
+        col = getattr(plc.engine, "tests", None)
+        cases = col.order() if col else []
+        if faulted is None:
+            results.extend(cases)
+            break
+        bad = _inst_of(faulted.instance)
+        for c in cases:
+            if c.suite.split(".")[1:2] == [bad]:
+                if c is col.current.get(c.suite) and not c.finished:
+                    c.failures.append(_fault_failure(faulted))
+                    c.finished = True
+                results.append(c)
+        errors.append((bad, faulted))
+        remaining = [s for s in remaining if _inst(s) != bad]
+        if bad is None:
+            break
+    elapsed = time.perf_counter() - t0
+    return report(results, errors, args, elapsed)
+
+
+def _inst_of(path: str | None):
+    if not path or "." not in path:
+        return None
+    return path.split(".")[1].split("[")[0]
+
+
+def _fault_failure(fault):
+    from .runtime.testing import Failure
+    text = str(fault).split(": major fault in ", 1)[-1]
+    return Failure(fault.file or "<unknown>", fault.line or 0, f"major fault in {text}")
+
+
+def _all_finished(plc) -> bool:
+    col = getattr(plc.engine, "tests", None)
+    return bool(col and col.tests) and all(t.finished for t in col.tests.values())
+
+
+def report(results, errors, args, elapsed: float) -> int:
+    passed = failed = 0
+    for tc in results:
+        label = f"{tc.suite.split('.', 1)[-1]}.{tc.name}"
+        if not tc.finished:
+            tc.failures.append(_unfinished(tc))
+        if tc.failures:
+            failed += 1
+            for f in tc.failures:
+                print(f"{f.file}:{f.line}: FAIL {label}: {f.message}")
+        else:
+            passed += 1
+            if args.verbose:
+                print(f"ok   {label}")
+    for suite, fault in errors:
+        if not any(tc.suite.split(".")[1:2] == [suite] for tc in results):
+            failed += 1
+            print(f"FAIL {suite}: {fault}")
+    if args.junit:
+        write_junit(args.junit, results, elapsed)
+    print(f"{passed} passed, {failed} failed")
+    return 0 if failed == 0 else 1
+
+
+def _unfinished(tc):
+    from .runtime.testing import Failure
+    return Failure("<runner>", 0, "test did not call TEST_FINISHED() before the timeout")
+
+
+def write_junit(path: str, results, elapsed: float) -> None:
+    by_suite: dict[str, list] = {}
+    for tc in results:
+        by_suite.setdefault(tc.suite.split(".", 1)[-1], []).append(tc)
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
+             f'<testsuites tests="{len(results)}" failures="{sum(1 for t in results if t.failures)}" '
+             f'time="{elapsed:.3f}">']
+    for suite, cases in by_suite.items():
+        lines.append(f'  <testsuite name={quoteattr(suite)} tests="{len(cases)}" '
+                     f'failures="{sum(1 for t in cases if t.failures)}">')
+        for tc in cases:
+            lines.append(f'    <testcase classname={quoteattr(suite)} name={quoteattr(tc.name)}>')
+            for f in tc.failures:
+                lines.append(f'      <failure message={quoteattr(f.message)}>{escape(f"{f.file}:{f.line}: {f.message}")}'
+                             '</failure>')
+            lines.append("    </testcase>")
+        lines.append("  </testsuite>")
+    lines.append("</testsuites>")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("\n".join(lines) + "\n")

@@ -1,0 +1,422 @@
+"""Expression half of the code generator: typed ST expressions -> Python expression text.
+
+Integer results are wrapped to their IEC width inline, REAL results are rounded to 32 bits, division and
+indexing go through checking helpers of :mod:`vplc.runtime.iec` that raise a runtime fault with values.
+"""
+from __future__ import annotations
+
+import keyword
+
+from . import ast as A
+from . import types as T
+from .runtime import iec
+
+_PY_RESERVED = set(keyword.kwlist) | {"None", "True", "False", "s", "G"}
+
+
+def attr(name: str) -> str:
+    """Python attribute name of an ST variable (declared spelling; ST names never contain ``__``)."""
+    return name + "_" if name in _PY_RESERVED else name
+
+
+def is_scalar(t) -> bool:
+    t = T.base_of(t)
+    return not isinstance(t, (T.StructType, T.ArrayType, T.PouType))
+
+
+def _width(t):
+    t = T.base_of(t)
+    if isinstance(t, T.EnumType):
+        t = T.base_of(t.base)
+    if isinstance(t, T.ElementaryType):
+        return t
+    return None
+
+
+class ExprGen:
+    def __init__(self, proj) -> None:
+        self.proj = proj
+        self.consts: dict[str, object] = {}
+        self.struct_names: dict[int, tuple] = {}
+        self.pou_names: dict[int, str] = {}
+        self.current = None
+
+    # ---- names of generated things ----------------------------------------------------------
+    def struct_name(self, t) -> str:
+        entry = self.struct_names.get(id(t))
+        if entry is None:
+            entry = (t, f"S{len(self.struct_names)}_{''.join(c for c in t.name if c.isalnum() or c == '_')}")
+            self.struct_names[id(t)] = entry
+        return entry[1]
+
+    def cls_name(self, pt) -> str:
+        name = self.pou_names.get(id(pt))
+        if name is None:
+            clean = "".join(c for c in pt.name if c.isalnum() or c == "_")
+            name = f"P{len(self.pou_names)}_{clean}"
+            self.pou_names[id(pt)] = name
+        return name
+
+    def const(self, value, prefix: str = "_k") -> str:
+        name = f"{prefix}{len(self.consts)}"
+        self.consts[name] = value
+        return name
+
+    # ---- default values ---------------------------------------------------------------------
+    def default(self, t, init, path: str) -> str:
+        """Python expression creating a fresh value of type ``t`` (initialised by ``init`` if given)."""
+        if init is not None and not isinstance(init, (A.ArrayInit, A.StructInit)):
+            return self.store_conv(self.expr(init), init, t)
+        u = T.unalias(t)
+        if init is None and isinstance(getattr(u, "decl", None), A.TypeDecl) and u.decl.init is not None \
+                and not isinstance(u, T.StructType):
+            return self.default(t, u.decl.init, path)
+        if isinstance(u, T.SubrangeType):
+            return str(u.lo if u.lo > 0 or u.hi < 0 else 0)
+        if isinstance(u, T.EnumType):
+            return str(next(iter(u.values.values()), 0))
+        if isinstance(u, T.StringType):
+            return "''"
+        if isinstance(u, T.ElementaryType):
+            return {"bool": "False", "real": "0.0"}.get(u.kind, "0")
+        if isinstance(u, T.StructType):
+            code = f"{self.struct_name(u)}()"
+            if isinstance(init, A.StructInit):
+                parts = []
+                for fi in init.fields:
+                    f = u.field(fi.name)
+                    if f is not None:
+                        parts.append(f"{attr(f.name)}={self.default(f.type, fi.value, path)}")
+                code = f"_sinit({code}, {', '.join(parts)})"
+            return code
+        if isinstance(u, T.ArrayType):
+            n = u.count()
+            if isinstance(init, A.ArrayInit):
+                items = []
+                for it in init.items:
+                    rep = self.expr(it.repeat) if it.repeat is not None else None
+                    val = self.default(u.element, it.value, path) if it.value is not None else \
+                        self.default(u.element, None, path)
+                    items.append(f"*[{val} for _ in range({rep})]" if rep else val)
+                rest = self.default(u.element, None, path)
+                return f"_fill([{', '.join(items)}], {n}, lambda: {rest})"
+            el = T.unalias(u.element)
+            if isinstance(el, T.PouType):
+                lo = u.dims[0][0]
+                sub = f"({path}) + '[' + str(_j + {lo}) + ']'"
+                return f"[{self.default(el, None, sub)} for _j in range({n})]"
+            if is_scalar(el):
+                return f"[{self.default(el, None, path)}] * {n}"
+            return f"[{self.default(el, None, path)} for _ in range({n})]"
+        if isinstance(u, T.PouType):
+            if u.native:
+                return f"N_{u.name}({path})"
+            return f"{self.cls_name(u)}({path})"
+        return "None"
+
+    # ---- expressions --------------------------------------------------------------------------
+    spill_ok = False      # set by the statement generator where a value may be computed beforehand
+
+    def expr(self, e) -> str:
+        code = getattr(self, "ex_" + type(e).__name__)(e)
+        if e.conv is not None:
+            code = self.apply_conv(code, e.ty, e.conv)
+        if len(code) > 300 and _depth(code) > 60:
+            code = self.spill(code)
+        return code
+
+    def spill(self, code: str) -> str:
+        """Compute a deeply nested sub-expression into a temporary first (CPython nests at most 200 levels)."""
+        if not self.spill_ok:
+            raise NotImplementedError("an expression nested this deeply in a loop or IF condition; "
+                                      "compute part of it into a variable first")
+        tmp = self.tmp("_x")
+        self.emit(f"{tmp} = {code}")
+        return tmp
+
+    def cond(self, e) -> str:
+        return self.expr(e)
+
+    def apply_conv(self, code: str, src, dst) -> str:
+        s, d = T.base_of(src) if src is not None else None, T.base_of(dst)
+        if isinstance(d, T.StringType):
+            if isinstance(s, T.StringType) and s.capacity <= d.capacity:
+                return code
+            return f"({code})[:{d.capacity}]"
+        if not isinstance(d, T.ElementaryType):
+            return code
+        if d.kind == "real":
+            if isinstance(s, T.ElementaryType) and s.kind == "real" and (s.bits <= d.bits):
+                return code
+            return f"_f32({code})" if d.bits == 32 else f"float({code})"
+        if isinstance(s, T.ElementaryType) and s.kind == "bool" and d.kind != "bool":
+            return f"int({code})"
+        return code
+
+    def store_conv(self, code: str, e, t) -> str:
+        """Value ``code`` of expression ``e`` converted for storing into type ``t``."""
+        tt = T.base_of(t)
+        et = T.base_of(e.conv or e.ty) if e is not None and (e.conv or e.ty) is not None else None
+        if isinstance(tt, T.StringType):
+            if not (isinstance(et, T.StringType) and et.capacity <= tt.capacity) or \
+                    (isinstance(e, A.Literal) and isinstance(e.value, str) and len(e.value) > tt.capacity):
+                return f"({code})[:{tt.capacity}]"
+            return code
+        if isinstance(tt, T.ElementaryType) and tt.kind == "real":
+            if isinstance(et, T.ElementaryType) and et.kind == "real" and et.bits <= tt.bits:
+                return code
+            return f"_f32({code})" if tt.bits == 32 else f"float({code})"
+        if isinstance(tt, (T.StructType, T.ArrayType)):
+            return f"_copy({code})"
+        return code
+
+    def ex_Literal(self, e) -> str:
+        t = T.base_of(e.ty) if e.ty is not None else None
+        v = e.value
+        if e.kind == "bool":
+            if isinstance(t, T.ElementaryType) and t.kind != "bool":
+                return str(int(v))
+            return "True" if v else "False"
+        if e.kind in ("string", "wstring"):
+            return repr(v)
+        if e.kind == "date":
+            return str(v * 1_000_000_000)
+        if isinstance(t, T.ElementaryType) and t.kind == "real":
+            v = float(v)
+            return repr(iec.f32(v) if t.bits == 32 else v)
+        if isinstance(v, float):
+            return repr(v)
+        return str(int(v))
+
+    def ex_EnumLiteral(self, e) -> str:
+        return str(e.sym.value)
+
+    def ex_Name(self, e) -> str:
+        sym = e.sym
+        kind = type(sym).__name__
+        if kind == "EnumValueSymbol":
+            return str(sym.value)
+        if kind == "VarSymbol":
+            container, key = _cell(sym)
+            if container.endswith(".__dict__"):            # plain attribute access: the fast path
+                return f"{container[:-len('.__dict__')]}.{key[1:-1]}"
+            return f"{container}[{key}]"
+        if kind == "PouSymbol" and sym.type.kind == "program":
+            return f"_PROGRAMS[{sym.type.name.upper()!r}]"
+        raise NotImplementedError(f"name {e.name.text()}")
+
+    def ex_Member(self, e) -> str:
+        base = self.expr_raw(e.base)
+        sym = e.sym
+        name = sym.name if sym is not None else e.member
+        bt = T.base_of(e.base.ty) if e.base.ty is not None else None
+        if isinstance(bt, T.PouType) and not bt.native and sym is not None and sym.section == "VAR_IN_OUT" \
+                and is_scalar(sym.type):
+            return f"{base}.{attr(name)}__r[{base}.{attr(name)}__k]"
+        return f"{base}.{attr(name)}"
+
+    def expr_raw(self, e) -> str:
+        return getattr(self, "ex_" + type(e).__name__)(e)
+
+    def ex_BitAccess(self, e) -> str:
+        return f"((({self.expr_raw(e.base)}) >> {e.bit}) & 1 == 1)"
+
+    def ex_Index(self, e) -> str:
+        base = self.expr_raw(e.base)
+        at = T.unalias(e.base.ty)
+        what = self.const(_describe(e.base), "_w")
+        idx = [self.expr(i) for i in e.indices]
+        if not isinstance(at, T.ArrayType):
+            raise NotImplementedError("indexing a non-array")
+        if at.open:
+            return f"{base}[_ixo({idx[0]}, {base}, {what})]"
+        if len(at.dims) == 1:
+            lo, hi = at.dims[0]
+            if isinstance(e.indices[0], A.Literal) and isinstance(e.indices[0].value, int) \
+                    and lo <= e.indices[0].value <= hi:
+                return f"{base}[{e.indices[0].value - lo}]"
+            return f"{base}[_ix1({idx[0]}, {lo}, {hi}, {what})]"
+        dims = self.const(tuple(at.dims), "_d")
+        return f"{base}[_ixn(({', '.join(idx)},), {dims}, {what})]"
+
+    def ex_Unary(self, e) -> str:
+        x = self.expr(e.operand)
+        t = _width(e.ty)
+        if e.op == "+":
+            return x
+        if e.op == "-":
+            if t is not None and t.kind == "real":
+                return f"(-{x})"
+            if t is not None and t.kind in ("int", "uint", "bit", "time"):
+                return iec.wrap_expr(f"-{x}", t.bits, t.kind in ("int", "time"))
+            return f"(-{x})"
+        # NOT
+        if t is None or t.kind == "bool":
+            return f"(not {x})"
+        if t.kind in ("int", "time"):
+            return iec.wrap_expr(f"~{x}", t.bits, True)
+        return f"({x} ^ {(1 << t.bits) - 1})"
+
+    def ex_Binary(self, e) -> str:
+        op = e.op
+        a, b = self.expr(e.left), self.expr(e.right)
+        if op in ("=", "<>", "<", ">", "<=", ">="):
+            py = {"=": "==", "<>": "!="}.get(op, op)
+            return f"({a} {py} {b})"
+        t = _width(e.ty)
+        if op in ("AND", "OR", "XOR"):
+            if t is None or t.kind == "bool":
+                return {"AND": f"({a} and {b})", "OR": f"({a} or {b})", "XOR": f"({a} != {b})"}[op]
+            return f"({a} {dict(AND='&', OR='|', XOR='^')[op]} {b})"
+        if t is None:
+            return f"({a} {op} {b})"
+        if op == "**":
+            r = f"_expt({a}, {b})"
+            return f"_f32({r})" if t.bits == 32 and t.kind == "real" else r
+        if t.kind == "real":
+            if op == "/":
+                r = f"_rdiv({a}, {b})"
+            elif op == "MOD":
+                r = f"_fmod({a}, {b})"
+            else:
+                r = f"({a} {op} {b})"
+            return f"_f32({r})" if t.bits == 32 else r
+        signed = t.kind in ("int", "time", "date", "tod", "dt")
+        if op == "/":
+            if t.kind == "time" and _width(e.right.ty) is not None and _width(e.right.ty).kind == "real":
+                return f"int(_rdiv({a}, {b}))"
+            r = f"_idiv({a}, {b})"
+        elif op == "MOD":
+            r = f"_imod({a}, {b})"
+        elif op == "*" and t.kind == "time":
+            r = f"int(round({a} * {b}))"
+        else:
+            r = f"{a} {op} {b}"
+        return iec.wrap_expr(r, t.bits if t.bits > 1 else 64, signed)
+
+    def ex_Call(self, e) -> str:
+        return self.call_expr(e)
+
+    def ex_ArrayInit(self, e) -> str:
+        return self.default(e.ty, e, "''")
+
+    def ex_StructInit(self, e) -> str:
+        return self.default(e.ty, e, "''")
+
+    # ---- references (VAR_IN_OUT, outputs of functions) ---------------------------------------
+    def lvalue(self, e) -> str:
+        return self.expr_raw(e)
+
+    def ref(self, e) -> str:
+        """(container, key) tuple addressing the lvalue ``e``."""
+        if isinstance(e, A.Name):
+            container, key = _cell(e.sym)
+            return f"({container}, {key})"
+        if isinstance(e, A.Member):
+            return f"({self.expr_raw(e.base)}.__dict__, {attr(e.sym.name if e.sym else e.member)!r})"
+        if isinstance(e, A.Index):
+            code = self.expr_raw(e)
+            base, _, rest = code.partition("[")
+            # split "base[idx]" at the outermost last subscript
+            depth = 0
+            for i in range(len(code) - 1, -1, -1):
+                ch = code[i]
+                if ch == "]":
+                    depth += 1
+                elif ch == "[":
+                    depth -= 1
+                    if depth == 0:
+                        return f"({code[:i]}, {code[i + 1:-1]})"
+        return f"([{self.expr(e)}], 0)"
+
+    def aggregate_arg(self, ba) -> str:
+        if ba.from_element:
+            ref = self.ref(ba.expr)
+            return f"_View(*{ref})"
+        pt, at = T.unalias(ba.param.type), T.unalias(ba.expr.ty)
+        if isinstance(pt, T.ArrayType) and pt.open and isinstance(at, T.ArrayType) and not at.open \
+                and len(at.dims) == 1 and at.dims[0][0] != 0:
+            return f"_View({self.expr_raw(ba.expr)}, 0, {at.dims[0][0]})"
+        return self.expr_raw(ba.expr)
+
+    def input_value(self, ba, p) -> str:
+        """Value stored into input ``p``; an array element given to an array input copies the array
+        starting at that element (Sysmac rule), as many elements as the parameter holds."""
+        pt = T.unalias(p.type)
+        if ba.from_element and isinstance(pt, T.ArrayType):
+            n = pt.count() if not pt.open else None
+            view = f"_View(*{self.ref(ba.expr)})"
+            return f"_copy({view})" if n is None else f"_fill(_copy({view}), {n}, lambda: {self.default(pt.element, None, repr(p.name))})"
+        return self.store_conv(self.expr(ba.expr), ba.expr, p.type)
+
+    # ---- calls -------------------------------------------------------------------------------
+    def call_expr(self, e) -> str:
+        b = e.binding
+        if b.kind == "builtin":
+            from .runtime.stdlib import gen_builtin
+            return gen_builtin(self, b)
+        pt = b.pou
+        by_param = {ba.param.name.upper(): ba for ba in b.args}
+        args = []
+        for p in pt.params:
+            ba = by_param.get(p.name.upper())
+            generic = T.base_of(p.type).kind == "generic"
+            if ba is None:
+                if p.direction == "in" and p.default is not None:
+                    args.append(self.store_conv(self.expr(p.default), p.default, p.type))
+                else:
+                    args.append("None")
+                if pt.native and generic:
+                    args.append("None")
+                continue
+            if p.direction == "in":
+                args.append(self.expr(ba.expr) if generic else self.input_value(ba, p))
+            elif p.direction == "inout":
+                args.append(self.ref(ba.expr) if is_scalar(p.type) and not generic or
+                            (generic and is_scalar(ba.expr.ty)) else self.aggregate_arg(ba))
+            else:
+                args.append(self.ref(ba.expr))
+            if pt.native and generic:
+                args.append(self.const(ba.expr.ty, "_ty"))
+        fn = f"NF_{pt.name}" if pt.native else f"F{self.cls_name(pt)[1:]}"
+        return f"{fn}({', '.join(args)})"
+
+
+def _cell(sym) -> tuple[str, str]:
+    """(container, key) code of a variable: globals live in ``G``, POU variables in ``s``; a scalar VAR_IN_OUT
+    holds a reference cell (``s.X__r``, ``s.X__k``)."""
+    if sym.section == "VAR_EXTERNAL" and sym.target is not None:
+        sym = sym.target
+    a = attr(sym.name)
+    if sym.section in ("VAR_GLOBAL", "VAR_EXTERNAL"):
+        return "G.__dict__", repr(a)
+    if sym.section == "VAR_IN_OUT" and is_scalar(sym.type):
+        return f"s.{a}__r", f"s.{a}__k"
+    return "s.__dict__", repr(a)
+
+
+def _depth(code: str) -> int:
+    depth = best = 0
+    quote = None
+    for ch in code:
+        if quote:
+            if ch == quote:
+                quote = None
+        elif ch in "'\"":
+            quote = ch
+        elif ch in "([{":
+            depth += 1
+            best = max(best, depth)
+        elif ch in ")]}":
+            depth -= 1
+    return best
+
+
+def _describe(e) -> str:
+    if isinstance(e, A.Name):
+        return e.name.text()
+    if isinstance(e, A.Member):
+        return f"{_describe(e.base)}.{e.member}"
+    if isinstance(e, A.Index):
+        return f"{_describe(e.base)}[...]"
+    return "array"

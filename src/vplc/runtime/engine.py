@@ -1,0 +1,121 @@
+"""Scan loop: tasks (period, priority, program instances), the watchdog and fault reporting.
+
+``Engine.scan(now_ns)`` reads the time once, runs the programs of every task that is due (highest
+priority first, i.e. lowest PRIORITY number) and records statistics. Time is an argument: the virtual and
+the real-time drivers (``run_until`` / ``run_realtime`` in vplc.api) call the same ``scan``.
+"""
+from __future__ import annotations
+
+import math
+import time
+import traceback
+from dataclasses import dataclass, field
+
+from ..types import StructType
+from .faults import PlcFault, RuntimeFaultError, WatchdogError
+from .sockets import SocketManager
+
+
+@dataclass
+class Task:
+    name: str
+    period_ns: int
+    priority: int
+    programs: list = field(default_factory=list)      # (instance, body function)
+    next_due: int | None = None
+
+
+class Engine:
+    def __init__(self, module, *, watchdog_ns: int = 500_000_000, socket_limit: int = 30,
+                 socket_latency_ns: int = 0, clock_base_ns: int | None = None) -> None:
+        self.module = module
+        self.tasks: list[Task] = []
+        self.now_ns = 0
+        self.started = False
+        self.watchdog_ns = watchdog_ns
+        self.sockets = SocketManager(socket_limit, socket_latency_ns)
+        self.clock_base_ns = clock_base_ns
+        self.fault: PlcFault | None = None
+        self.scan_count = 0
+        self.deadline = module.namespace["_DL"]
+        self.stmt_counter = module.namespace["_NST"]
+
+    # ---- services used by native POUs -----------------------------------------------------------
+    def new_struct(self, name: str):
+        """A fresh value of the structure type ``name`` (used by native FBs for _sSOCKET outputs)."""
+        cache = self.__dict__.setdefault("_struct_classes", {})
+        cls = cache.get(name.upper())
+        if cls is None:
+            for c in self.module.namespace.values():
+                if isinstance(c, type) and isinstance(getattr(c, "i__type", None), StructType) and \
+                        c.i__type.name.upper() == name.upper():
+                    cls = cache[name.upper()] = c
+                    break
+            else:
+                raise RuntimeFaultError(f"system type {name} is not loaded")
+        return cls()
+
+    def clock_dt_ns(self) -> int:
+        """Controller calendar clock (DT): wall clock in real time, or a fixed base + scan time."""
+        if self.clock_base_ns is None:
+            return time.time_ns()
+        return self.clock_base_ns + self.now_ns
+
+    # ---- scanning -----------------------------------------------------------------------------
+    @property
+    def period_ns(self) -> int:
+        return min(t.period_ns for t in self.tasks) if self.tasks else 1_000_000
+
+    def scan(self, now_ns: int) -> None:
+        if self.fault is not None:
+            raise self.fault
+        if self.started and now_ns < self.now_ns:
+            raise ValueError(f"scan time must not go backwards ({now_ns} ns < {self.now_ns} ns)")
+        self.started = True
+        self.now_ns = now_ns
+        self.deadline[0] = time.perf_counter() + self.watchdog_ns / 1e9
+        try:
+            for task in self.tasks:
+                if task.next_due is None:
+                    task.next_due = now_ns
+                if now_ns < task.next_due:
+                    continue
+                for inst, body in task.programs:
+                    body(inst)
+                missed = (now_ns - task.next_due) // task.period_ns
+                task.next_due += (missed + 1) * task.period_ns
+        except Exception as exc:          # noqa: BLE001 - every Python error becomes a PLC major fault
+            self.fault = self.make_fault(exc)
+            self.sockets.close_all()
+            raise self.fault from None
+        finally:
+            self.deadline[0] = math.inf
+        self.scan_count += 1
+
+    def make_fault(self, exc: BaseException) -> PlcFault:
+        from ..codegen import GEN_FILE
+        loc, inst = None, None
+        for frame, lineno in traceback.walk_tb(exc.__traceback__):
+            if frame.f_code.co_filename == GEN_FILE:
+                loc = self.module.linemap.get(lineno, loc)
+                s = frame.f_locals.get("s")
+                inst = getattr(s, "i__path", inst) if s is not None else inst
+        if isinstance(exc, WatchdogError):
+            kind, what = "watchdog", f"watchdog: scan exceeded {self.watchdog_ns / 1e6:g} ms ({exc})"
+        elif isinstance(exc, RuntimeFaultError):
+            kind, what = "runtime", str(exc)
+        elif isinstance(exc, RecursionError):
+            kind, what = "runtime", "call nesting too deep"
+        else:
+            kind, what = "internal", f"internal runtime error ({type(exc).__name__}: {exc})"
+        where = f"{loc[0]}:{loc[1]}" if loc and loc[0] else "<unknown location>"
+        msg = f"{where}: major fault in {inst or '<unknown instance>'}: {what}"
+        return PlcFault(msg, file=loc[0] if loc else None, line=loc[1] if loc else None, instance=inst, kind=kind)
+
+
+def watchdog() -> None:
+    raise WatchdogError("a loop did not finish")
+
+
+def fault(message: str) -> None:
+    raise RuntimeFaultError(message)

@@ -1,0 +1,233 @@
+"""POUs declared ``{native}`` in the prelude, implemented in Python.
+
+Function blocks are classes built as ``cls(rt, path)`` whose variables are attributes named like the ST
+parameters and whose ``i__run()`` executes one call. Functions take ``rt`` first, then the parameters in
+declaration order; a generic (ANY_ELEMENTARY) parameter is followed by its actual type; a scalar VAR_IN_OUT
+arrives as a (container, key) reference, an array as a list or an array view.
+"""
+from __future__ import annotations
+
+from . import sockets as S
+from .sysmac_fns import FUNCTIONS
+from .testing import FUNCTIONS as TEST_FUNCTIONS
+
+
+class _SocketFB:
+    """Execute/Busy/Done/Error handshake shared by the socket instructions."""
+
+    def __init__(self, rt, path: str) -> None:
+        self.i__rt, self.i__path = rt, path
+        self.Execute = False
+        self.Done = self.Busy = self.Error = False
+        self.ErrorID = 0
+        self.Socket = rt.new_struct("_sSOCKET")
+        self.i__state = "idle"
+        self.i__t0 = 0
+
+    def i__run(self) -> None:
+        ex = self.Execute
+        st = self.i__state
+        if st == "shown":
+            if not ex:
+                self.Done = self.Error = False
+                self.ErrorID = 0
+                self.i__state = st = "idle"
+                self.i__last = False
+                return
+            return
+        if st == "idle":
+            if ex and not getattr(self, "i__last", False):
+                self.Done = self.Error = False
+                self.ErrorID = 0
+                self.Busy = True
+                self.i__state = "busy"
+                self.i__t0 = self.i__rt.now_ns
+                self.start()
+            self.i__last = ex
+            return
+        # busy: complete at the earliest one call later and after the latency
+        rt = self.i__rt
+        if rt.now_ns - self.i__t0 < rt.sockets.latency_ns:
+            return
+        result = self.poll()
+        if result is None:
+            return
+        self.Busy = False
+        if result:
+            self.Error, self.ErrorID = True, result
+        else:
+            self.Done = True
+        self.i__state = "shown"
+        self.i__last = ex
+
+    def start(self) -> None:
+        self.i__err = 0
+
+    def handle(self) -> int:
+        return self.Socket.Handle
+
+
+class SktTCPConnect(_SocketFB):
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.SrcTcpPort = 0
+        self.DstAdr = ""
+        self.DstTcpPort = 0
+
+    def start(self):
+        self.i__handle, self.i__err = self.i__rt.sockets.open(self.DstAdr, self.DstTcpPort, self.SrcTcpPort)
+
+    def poll(self):
+        if self.i__err:
+            return self.i__err
+        mgr = self.i__rt.sockets
+        r = mgr.connect_result(self.i__handle)
+        if r is None:
+            return None
+        if r == 0:
+            (sh, sp), (dh, dp) = mgr.addresses(self.i__handle)
+            self.Socket.Handle = self.i__handle
+            self.Socket.SrcAdr.IpAdr, self.Socket.SrcAdr.PortNo = sh, sp
+            self.Socket.DstAdr.IpAdr, self.Socket.DstAdr.PortNo = dh, dp
+        return r
+
+
+class SktTCPSend(_SocketFB):
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Size = 0
+        self.SendDat = []
+
+    def start(self):
+        self.i__err = 0
+        c = self.i__rt.sockets.get(self.Socket.Handle)
+        if c is None:
+            self.i__err = S.ERR_HANDLE
+        elif self.Size > len(self.SendDat):
+            self.i__err = S.ERR_PARAM
+        else:
+            c.pump()
+        if c is not None and not self.i__err and (c.eof or c.error):
+            self.i__err = S.ERR_CLOSED
+        if not self.i__err:
+            c.tx += bytes(self.SendDat[k] & 0xFF for k in range(self.Size))
+
+    def poll(self):
+        if self.i__err:
+            return self.i__err
+        c = self.i__rt.sockets.get(self.Socket.Handle)
+        if c is None:
+            return S.ERR_HANDLE
+        try:
+            return 0 if c.flush() else None
+        except OSError:
+            return S.ERR_CLOSED
+
+
+class SktTCPRcv(_SocketFB):
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.TimeOut = 0
+        self.Size = 0
+        self.RcvSize = 0
+        self.RcvDat = []
+
+    def start(self):
+        self.i__err = 0
+        self.RcvSize = 0
+        if self.Size > len(self.RcvDat):
+            self.i__err = S.ERR_PARAM
+
+    def poll(self):
+        if self.i__err:
+            return self.i__err
+        rt = self.i__rt
+        c = rt.sockets.get(self.Socket.Handle)
+        if c is None:
+            return S.ERR_HANDLE
+        c.pump()
+        if c.rx:
+            n = min(len(c.rx), self.Size)
+            for k in range(n):
+                self.RcvDat[k] = c.rx[k]
+            del c.rx[:n]
+            self.RcvSize = n
+            return 0
+        if c.eof:
+            return S.ERR_CLOSED
+        if self.TimeOut == 0 or rt.now_ns - self.i__t0 >= self.TimeOut * 100_000_000:
+            return S.ERR_TIMEOUT
+        return None
+
+
+class SktGetTCPStatus(_SocketFB):
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.TcpStatus = S.CLOSED
+        self.DatRcvFlag = False
+
+    def start(self):
+        self.i__err = 0
+
+    def poll(self):
+        mgr = self.i__rt.sockets
+        if mgr.get(self.Socket.Handle) is None:
+            self.TcpStatus, self.DatRcvFlag = S.CLOSED, False
+            return S.ERR_HANDLE
+        self.TcpStatus, self.DatRcvFlag = mgr.status(self.Socket.Handle)
+        return 0
+
+
+class SktClearBuf(_SocketFB):
+    def poll(self):
+        c = self.i__rt.sockets.get(self.Socket.Handle)
+        if c is None:
+            return S.ERR_HANDLE
+        c.pump()
+        c.rx.clear()
+        return 0
+
+
+class SktClose(_SocketFB):
+    def poll(self):
+        return 0 if self.i__rt.sockets.close(self.Socket.Handle) else S.ERR_HANDLE
+
+
+class SktTCPAccept(_SocketFB):
+    """Passive open: listens on SrcTcpPort (bound to 127.0.0.1) until a client connects or TimeOut
+    (0.1 s units, 0 = wait forever) expires."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.SrcTcpPort = 0
+        self.TimeOut = 0
+        self.i__listener = None
+
+    def start(self):
+        self.i__listener, self.i__err = self.i__rt.sockets.listen(self.SrcTcpPort)
+
+    def poll(self):
+        if self.i__err:
+            return self.i__err
+        rt = self.i__rt
+        try:
+            conn, _ = self.i__listener.accept()
+        except (BlockingIOError, InterruptedError):
+            if self.TimeOut and rt.now_ns - self.i__t0 >= self.TimeOut * 100_000_000:
+                self.i__listener.close()
+                return S.ERR_TIMEOUT
+            return None
+        self.i__listener.close()
+        handle = rt.sockets.adopt(conn)
+        if not handle:
+            return S.ERR_RESOURCES
+        (sh, sp), (dh, dp) = rt.sockets.addresses(handle)
+        self.Socket.Handle = handle
+        self.Socket.SrcAdr.IpAdr, self.Socket.SrcAdr.PortNo = sh, sp
+        self.Socket.DstAdr.IpAdr, self.Socket.DstAdr.PortNo = dh, dp
+        return 0
+
+
+NATIVE_FBS = {c.__name__: c for c in (SktTCPConnect, SktTCPSend, SktTCPRcv, SktGetTCPStatus, SktClearBuf,
+                                      SktClose, SktTCPAccept)}
+NATIVE_FUNCTIONS = {**FUNCTIONS, **TEST_FUNCTIONS}

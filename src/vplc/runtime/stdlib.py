@@ -1,0 +1,283 @@
+"""IEC standard functions (vplc.builtins) for generated code: code templates and Python helpers.
+
+``gen_builtin(gen, binding)`` returns the Python expression for a builtin call; the helpers below are put
+in the namespace of the generated module (``NAMESPACE``).
+"""
+from __future__ import annotations
+
+import math
+
+from .. import types as T
+from . import iec
+from .faults import RuntimeFaultError
+
+
+def _nan_on_domain(fn):
+    def f(x):
+        try:
+            return fn(x)
+        except (ValueError, OverflowError):
+            return math.nan
+    return f
+
+
+def _fmod(a, b):
+    if b == 0:
+        raise RuntimeFaultError(f"division by zero ({a} MOD 0)")
+    return math.fmod(a, b)
+
+
+def _mux(k, values):
+    if not 0 <= k < len(values):
+        raise RuntimeFaultError(f"MUX selector {k} out of range 0..{len(values) - 1}")
+    return values[k]
+
+
+def _left(s: str, n: int) -> str:
+    return s[:max(n, 0)]
+
+
+def _right(s: str, n: int) -> str:
+    return s[len(s) - n:] if 0 < n else ""
+
+
+def _mid(s: str, n: int, p: int) -> str:
+    if p < 1:
+        return ""
+    return s[p - 1:p - 1 + max(n, 0)]
+
+
+def _insert(a: str, b: str, p: int) -> str:
+    p = max(0, min(p, len(a)))
+    return a[:p] + b + a[p:]
+
+
+def _delete(s: str, n: int, p: int) -> str:
+    if p < 1 or n <= 0:
+        return s
+    return s[:p - 1] + s[p - 1 + n:]
+
+
+def _replace(a: str, b: str, n: int, p: int) -> str:
+    if p < 1:
+        p = 1
+    return a[:p - 1] + b + a[p - 1 + max(n, 0):]
+
+
+def _find(a: str, b: str) -> int:
+    return a.find(b) + 1 if b else 0
+
+
+def _sinit(obj, **values):
+    obj.__dict__.update(values)
+    return obj
+
+
+def _fill(items: list, n: int, make):
+    items = items[:n]
+    while len(items) < n:
+        items.append(make())
+    return items
+
+
+MATH = {name: _nan_on_domain(fn) for name, fn in {
+    "SQRT": math.sqrt, "LN": math.log, "LOG": math.log10, "EXP": math.exp, "SIN": math.sin, "COS": math.cos,
+    "TAN": math.tan, "ASIN": math.asin, "ACOS": math.acos, "ATAN": math.atan}.items()}
+
+NAMESPACE = {
+    "_fmod": _fmod, "_mux": _mux, "_left": _left, "_right": _right, "_mid": _mid, "_insert": _insert,
+    "_delete": _delete, "_replace": _replace, "_find": _find, "_sinit": _sinit, "_fill": _fill,
+    "_round": iec.round_half_even, "_trunc": iec.trunc, "_shl": iec.shl, "_shr": iec.shr, "_rol": iec.rol,
+    "_ror": iec.ror, "_lbound": iec.lower_bound, "_ubound": iec.upper_bound, "_atan2": _nan_on_domain(lambda yx: math.atan2(*yx)),
+    **{"_m" + k: v for k, v in MATH.items()},
+}
+
+
+# ---- conversions -----------------------------------------------------------------------------------
+
+def _kind(t):
+    t = T.base_of(t)
+    if isinstance(t, T.EnumType):
+        return "int", T.base_of(t.base)
+    if isinstance(t, T.StringType):
+        return "string", t
+    if isinstance(t, T.ElementaryType):
+        k = t.kind
+        return ("int" if k in ("int", "uint", "bit") else k), t
+    return "other", t
+
+
+def to_string(v, t, dialect: str = "sysmac") -> str:
+    """Text of a value as the *_TO_STRING conversions produce it (Sysmac formats, docs/toolchain/runtime.md)."""
+    k, bt = _kind(t)
+    if k == "bool":
+        return "TRUE" if v else "FALSE"
+    if k == "int":
+        if dialect == "sysmac" and isinstance(bt, T.ElementaryType) and bt.kind == "bit":
+            return f"{v:x}"              # Sysmac: bit strings convert to hexadecimal digits
+        return str(v)
+    if k == "real":
+        return iec.fmt_real(v, bt.bits == 32)
+    if k == "time":
+        return iec.fmt_time(v)
+    if k in ("date", "dt", "tod"):
+        import datetime as _dt
+        if k == "tod":
+            s, ns = divmod(v, 1_000_000_000)
+            h, rem = divmod(s, 3600)
+            text = f"TOD#{h:02d}:{rem // 60:02d}:{rem % 60:02d}"
+            return text + (f".{ns:09d}".rstrip("0") if ns else "")
+        secs, ns = divmod(v, 1_000_000_000)
+        d = _dt.datetime(1970, 1, 1) + _dt.timedelta(seconds=secs)
+        if k == "date":
+            return f"D#{d:%Y-%m-%d}"
+        return f"DT#{d:%Y-%m-%d-%H:%M:%S}" + (f".{ns:09d}".rstrip("0") if ns else "")
+    return str(v)
+
+
+def _parse_number(s: str, real: bool):
+    text = s.strip().replace("_", "")
+    try:
+        if real:
+            return float(text)
+        if "#" in text:
+            base, _, digits = text.partition("#")
+            return int(digits, int(base))
+        return int(float(text)) if "." in text or "e" in text.lower() else int(text)
+    except ValueError:
+        return 0.0 if real else 0
+
+
+def conversion(src, dst, dialect: str = "sysmac"):
+    """Python function converting a value of type ``src`` to ``dst`` (IEC *_TO_* semantics)."""
+    sk, st = _kind(src)
+    dk, dt = _kind(dst)
+    if dk == "string":
+        cap = dt.capacity
+        return lambda v: to_string(v, src, dialect)[:cap]
+    if dk == "bool":
+        if sk == "string":
+            return lambda v: v.strip().upper() in ("TRUE", "1")
+        return lambda v: v != 0
+    if dk == "real":
+        f = iec.f32 if dt.bits == 32 else float
+        if sk == "string":
+            return lambda v: f(_parse_number(v, True))
+        return lambda v: f(v)
+    if dk in ("int", "time", "date", "tod", "dt"):
+        bits = dt.bits
+        signed = dt.kind in ("int", "time")
+        w = iec.wrapper(bits, signed)
+        if sk == "real":
+            return lambda v: w(iec.round_half_even(v))
+        if sk == "string":
+            return lambda v: w(int(_parse_number(v, False)))
+        if sk == "bool":
+            return lambda v: int(v)
+        if dk == "date" and sk == "dt":
+            return lambda v: v - v % 86_400_000_000_000
+        if dk == "tod" and sk == "dt":
+            return lambda v: v % 86_400_000_000_000
+        return w
+    return lambda v: v
+
+
+# ---- builtin call generation -----------------------------------------------------------------------
+
+def gen_builtin(gen, b) -> str:
+    name = b.builtin.name.upper()
+    args = [gen.expr(ba.expr) for ba in b.args]
+    tys = [ba.expr.conv or ba.expr.ty for ba in b.args]
+    rt = T.base_of(b.ty) if b.ty is not None else None
+    bits = rt.bits if isinstance(rt, T.ElementaryType) else 64
+    signed = isinstance(rt, T.ElementaryType) and rt.kind in ("int", "time")
+    real = isinstance(rt, T.ElementaryType) and rt.kind == "real"
+
+    def fix(code):
+        if real:
+            return f"_f32({code})" if bits == 32 else code
+        if isinstance(rt, T.ElementaryType) and rt.kind in ("int", "uint", "bit", "time"):
+            return iec.wrap_expr(code, bits, signed)
+        return code
+
+    if "_TO_" in name or name.startswith("TO_"):
+        if name.startswith("TRUNC_"):
+            return fix(f"_trunc({args[0]})")
+        fn = gen.const(conversion(tys[0], b.ty, getattr(gen.proj, "dialect", "sysmac")), "_cv")
+        return f"{fn}({args[0]})"
+    if name.startswith("TRUNC"):
+        return fix(f"_trunc({args[0]})")
+    if name == "ABS":
+        return fix(f"abs({args[0]})")
+    if name in MATH:
+        return fix(f"_m{name}({args[0]})")
+    if name == "ATAN2":
+        return fix(f"_atan2(({args[0]}, {args[1]}))")
+    if name == "EXPT":
+        return fix(f"_expt({args[0]}, {args[1]})")
+    if name in ("ADD", "MUL"):
+        return fix((" + " if name == "ADD" else " * ").join(f"({a})" for a in args))
+    if name == "SUB":
+        return fix(f"({args[0]}) - ({args[1]})")
+    if name == "DIV":
+        return fix(f"_rdiv({args[0]}, {args[1]})" if real else f"_idiv({args[0]}, {args[1]})")
+    if name == "MOD":
+        return fix(f"_fmod({args[0]}, {args[1]})" if real else f"_imod({args[0]}, {args[1]})")
+    if name == "SEL":
+        return f"({args[2]} if {args[0]} else {args[1]})"
+    if name in ("MAX", "MIN"):
+        return f"{name.lower()}({', '.join(args)})"
+    if name == "LIMIT":
+        return f"min(max({args[1]}, {args[0]}), {args[2]})"
+    if name == "MUX":
+        return f"_mux({args[0]}, ({', '.join(args[1:])},))"
+    if name in ("SHL", "SHR", "ROL", "ROR"):
+        code = f"_{name.lower()}({args[0]}, {args[1]}, {bits})"
+        return iec.wrap_expr(code, bits, True) if signed else code
+    if name in ("AND", "OR", "XOR"):
+        if isinstance(rt, T.ElementaryType) and rt.kind == "bool":
+            op = {"AND": " and ", "OR": " or ", "XOR": " != "}[name]
+        else:
+            op = {"AND": " & ", "OR": " | ", "XOR": " ^ "}[name]
+        return "(" + op.join(f"({a})" for a in args) + ")"
+    if name == "NOT":
+        if isinstance(rt, T.ElementaryType) and rt.kind == "bool":
+            return f"(not {args[0]})"
+        return fix(f"~({args[0]})")
+    if name == "MOVE":
+        return args[0]
+    if name == "LEN":
+        return f"len({args[0]})"
+    cap = rt.capacity if isinstance(rt, T.StringType) else 1985
+    if name == "LEFT":
+        return f"_left({args[0]}, {args[1]})"
+    if name == "RIGHT":
+        return f"_right({args[0]}, {args[1]})"
+    if name == "MID":
+        return f"_mid({args[0]}, {args[1]}, {args[2]})"
+    if name == "CONCAT":
+        return f"''.join(({', '.join(args)},))[:{cap}]"
+    if name == "INSERT":
+        return f"_insert({args[0]}, {args[1]}, {args[2]})[:{cap}]"
+    if name == "DELETE":
+        return f"_delete({args[0]}, {args[1]}, {args[2]})"
+    if name == "REPLACE":
+        return f"_replace({args[0]}, {args[1]}, {args[2]}, {args[3]})[:{cap}]"
+    if name == "FIND":
+        return f"_find({args[0]}, {args[1]})"
+    if name in ("LOWER_BOUND", "UPPER_BOUND"):
+        at = T.unalias(b.args[0].expr.ty)
+        dim = b.args[1].expr.value if hasattr(b.args[1].expr, "value") else 1
+        if isinstance(at, T.ArrayType) and not at.open:
+            lo, hi = at.dims[dim - 1]
+            return str(lo if name == "LOWER_BOUND" else hi)
+        return f"_lbound({args[0]})" if name == "LOWER_BOUND" else f"_ubound({args[0]})"
+    if name in ("ADD_TIME", "ADD_TOD_TIME", "ADD_DT_TIME", "CONCAT_DATE_TOD"):
+        return f"({args[0]} + {args[1]})"
+    if name in ("SUB_TIME", "SUB_DATE_DATE", "SUB_TOD_TIME", "SUB_TOD_TOD", "SUB_DT_TIME", "SUB_DT_DT"):
+        return f"({args[0]} - {args[1]})"
+    if name == "MUL_TIME":
+        return f"int(round({args[0]} * {args[1]}))"
+    if name == "DIV_TIME":
+        return f"int(_rdiv({args[0]}, {args[1]}))"
+    raise NotImplementedError(f"standard function {name}")

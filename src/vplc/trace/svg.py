@@ -1,0 +1,48 @@
+"""SVG timing diagram in the style of PLCopen Execute/Busy/Done/Error charts: one row per signal, BOOL as a
+square wave, other values as a bus with the value written at each change."""
+from __future__ import annotations
+
+from xml.sax.saxutils import escape
+
+ROW, LABEL_W, WIDTH, HIGH = 34, 220, 900, 18
+
+
+def _fmt(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+def write_svg(rec, filename: str) -> None:
+    t0 = min((ch[0][0] for ch in rec.changes if ch), default=0)
+    span = max(rec.end_ns - t0, 1)
+    x = lambda t: LABEL_W + (t - t0) * (WIDTH - LABEL_W - 10) / span   # noqa: E731
+    h = ROW * len(rec.paths) + 40
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{h}" font-family="sans-serif" '
+           f'font-size="12">', f'<rect width="{WIDTH}" height="{h}" fill="white"/>']
+    for i, (p, (kind, _bits)) in enumerate(zip(rec.paths, rec.kinds)):
+        top = 10 + i * ROW
+        base, hi = top + ROW - 8, top + ROW - 8 - HIGH
+        out.append(f'<text x="6" y="{base - 4}">{escape(p)}</text>')
+        out.append(f'<line x1="{LABEL_W}" y1="{base + 4}" x2="{WIDTH - 10}" y2="{base + 4}" stroke="#ddd"/>')
+        ch = rec.changes[i] + [(rec.end_ns, None)]
+        if kind == "bool":
+            pts = []
+            for (t, v), (t2, _) in zip(ch, ch[1:]):
+                y = hi if v else base
+                pts += [f"{x(t):.1f},{y}", f"{x(t2):.1f},{y}"]
+            out.append(f'<polyline points="{" ".join(pts)}" fill="none" stroke="#1a5fb4" stroke-width="2"/>')
+        else:
+            for (t, v), (t2, _) in zip(ch, ch[1:]):
+                x1, x2 = x(t), x(t2)
+                out.append(f'<polygon points="{x1 + 3:.1f},{hi} {x2:.1f},{hi} {x2:.1f},{base} {x1 + 3:.1f},{base} '
+                           f'{x1:.1f},{(hi + base) / 2}" fill="#eef" stroke="#1a5fb4"/>')
+                if x2 - x1 > 25:
+                    out.append(f'<text x="{x1 + 6:.1f}" y="{base - 4}" font-size="10">{escape(_fmt(v))}</text>')
+    axis = 10 + ROW * len(rec.paths) + 14
+    for k in range(6):
+        t = t0 + span * k / 5
+        out.append(f'<text x="{x(t):.1f}" y="{axis}" font-size="10" text-anchor="middle">{t / 1e6:.3g} ms</text>')
+    out.append("</svg>")
+    with open(filename, "w", encoding="utf-8") as f:
+        f.write("\n".join(out) + "\n")

@@ -1,0 +1,71 @@
+"""Contract A surface: load errors, read/write checks, var_type, run_until, run_realtime, lock."""
+import threading
+
+import pytest
+
+from vplc.api import LoadError, load_plc
+from rt_helpers import plc_from
+
+TYPES = """
+TYPE eMode : (Off, Auto); stP : STRUCT X : REAL; Name : STRING[8]; END_STRUCT; END_TYPE
+"""
+
+
+def test_load_error_renders_diagnostics(tmp_path):
+    p = tmp_path / "bad.st"
+    p.write_text("PROGRAM Main\nVAR x : INT; END_VAR\nx := y;\nEND_PROGRAM\n")
+    with pytest.raises(LoadError, match=r"bad\.st:3:6: error\[ST"):
+        load_plc([str(p)])
+
+
+def test_bad_task_specification_is_a_load_error(tmp_path):
+    with pytest.raises(LoadError, match="Name@period"):
+        plc_from(tmp_path, "", "x : INT;", task="Main")
+
+
+def test_write_is_type_checked(tmp_path):
+    plc = plc_from(tmp_path, "", "i : INT; b : BOOL; s : STRING[4]; m : eMode; p : stP;", TYPES)
+    with pytest.raises(ValueError, match="outside the range"):
+        plc.write("Main.i", 40000)
+    with pytest.raises(ValueError, match="BOOL"):
+        plc.write("Main.b", 1)
+    with pytest.raises(ValueError, match="at most 3"):
+        plc.write("Main.s", "abcd")
+    with pytest.raises(ValueError, match="members one by one"):
+        plc.write("Main.p", {})
+    plc.write("Main.m", "Auto")
+    plc.write("Main.p.X", 1)
+    assert plc.read("Main.m") == "Auto" and plc.read("Main.p") == {"X": 1.0, "Name": ""}
+    with pytest.raises(ValueError, match="is not a variable of Main"):
+        plc.read("Main.nope")
+
+
+def test_var_type_names_iec_types(tmp_path):
+    plc = plc_from(tmp_path, "", "s : STRING[50]; p : stP; a : ARRAY[1..3] OF INT;", TYPES)
+    assert plc.var_type("Main.s") == "STRING[50]"
+    assert plc.var_type("Main.p") == "stP"
+    assert plc.var_type("Main.a[2]") == "INT"
+
+
+def test_run_until_calls_on_scan_before_each_scan_and_stops_on_the_predicate(tmp_path):
+    plc = plc_from(tmp_path, "n := n + 1;", "n : INT;")
+    seen = []
+    assert plc.run_until(lambda: plc.read("Main.n") == 3, 10_000_000, on_scan=seen.append)
+    assert seen == [0, 1_000_000, 2_000_000] and plc.now_ns == 2_000_000
+    assert not plc.run_until(lambda: False, 3_000_000)
+    assert plc.now_ns == 5_000_000
+
+
+def test_run_realtime_scans_until_the_stop_event(tmp_path):
+    plc = plc_from(tmp_path, "n := n + 1;", "n : DINT;")
+    stop = threading.Event()
+
+    def on_scan(now):
+        with plc.lock:
+            if plc.read("Main.n") >= 5:
+                stop.set()
+    th = threading.Thread(target=plc.run_realtime, args=(stop,), kwargs={"on_scan": on_scan})
+    th.start()
+    th.join(10)
+    assert not th.is_alive()
+    assert plc.read("Main.n") >= 5

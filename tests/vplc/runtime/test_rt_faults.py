@@ -1,0 +1,51 @@
+"""Runtime faults stop the controller with the ST location, instance path and values; never a traceback."""
+import pytest
+
+from vplc.api import PlcFault
+from rt_helpers import plc_from
+
+FB = """
+FUNCTION_BLOCK Divider
+VAR_INPUT d : INT; END_VAR
+VAR_OUTPUT q : INT; END_VAR
+    q := 100 / d;
+END_FUNCTION_BLOCK
+"""
+
+
+def test_division_by_zero_names_file_line_instance_and_values(tmp_path):
+    plc = plc_from(tmp_path, "div(d := z);", "div : Divider; z : INT;", FB)
+    with pytest.raises(PlcFault) as ei:
+        plc.scan(0)
+    msg = str(ei.value)
+    assert "main.st:11:" in msg and "Main.div" in msg and "(100 / 0)" in msg
+    assert "Traceback" not in msg and ".py" not in msg
+    assert ei.value.line == 11 and ei.value.instance == "Main.div"
+
+
+def test_index_out_of_range_reports_index_and_bounds(tmp_path):
+    plc = plc_from(tmp_path, "a[i] := 1;", "a : ARRAY[1..4] OF INT; i : INT := 5;")
+    with pytest.raises(PlcFault, match=r"index 5 out of range 1\.\.4 of a"):
+        plc.scan(0)
+
+
+def test_endless_while_trips_the_watchdog(tmp_path):
+    plc = plc_from(tmp_path, "WHILE TRUE DO n := n + 1; END_WHILE;", "n : DINT;", watchdog_ms=50)
+    with pytest.raises(PlcFault, match="watchdog") as ei:
+        plc.scan(0)
+    assert ei.value.kind == "watchdog"
+
+
+def test_a_faulted_controller_stays_stopped(tmp_path):
+    plc = plc_from(tmp_path, "n := n / z;", "n, z : INT;")
+    with pytest.raises(PlcFault):
+        plc.scan(0)
+    with pytest.raises(PlcFault):
+        plc.scan(1_000_000)
+
+
+def test_scan_time_going_backwards_is_rejected(tmp_path):
+    plc = plc_from(tmp_path, "n := n + 1;", "n : INT;")
+    plc.scan(5_000_000)
+    with pytest.raises(ValueError, match="backwards"):
+        plc.scan(1_000_000)

@@ -1,0 +1,56 @@
+"""Sysmac byte/string/time instructions: pinned behaviour (see docs/toolchain/runtime_sysmac.md)."""
+import struct
+
+from rt_helpers import run1
+
+
+def test_to_ary_byte_low_high_is_little_endian(tmp_path):
+    plc = run1(tmp_path, "n := ToAryByte(In := d, Order := _LOW_HIGH, AryOut := b[0]);",
+               "d : DINT := 16#11223344; b : ARRAY[0..3] OF BYTE; n : UINT;")
+    assert plc.read("Main.b") == [0x44, 0x33, 0x22, 0x11] and plc.read("Main.n") == 4
+
+
+def test_to_ary_byte_high_low_swaps_inside_each_word_low_word_first(tmp_path):
+    plc = run1(tmp_path, "ToAryByte(In := d, Order := _HIGH_LOW, AryOut := b[0]);",
+               "d : DINT := 16#11223344; b : ARRAY[0..3] OF BYTE;")
+    assert plc.read("Main.b") == [0x33, 0x44, 0x11, 0x22]
+
+
+def test_to_ary_byte_of_real_writes_the_ieee_image(tmp_path):
+    plc = run1(tmp_path, "ToAryByte(In := r, Order := _LOW_HIGH, AryOut := b[0]);",
+               "r : REAL := 1.5; b : ARRAY[0..3] OF BYTE;")
+    assert bytes(plc.read("Main.b")) == struct.pack("<f", 1.5)
+
+
+def test_ary_byte_to_is_the_inverse_of_to_ary_byte(tmp_path):
+    plc = run1(tmp_path, """ToAryByte(In := d, Order := _HIGH_LOW, AryOut := b[1]);
+        AryByteTo(In := b[1], Size := 4, Order := _HIGH_LOW, Out := back);
+        ToAryByte(In := w, Order := _LOW_HIGH, AryOut := b[5]);
+        AryByteTo(In := b[5], Size := 2, Order := _LOW_HIGH, Out := wback);""",
+               "d : DINT := -123456; back : DINT; w : UINT := 500; wback : UINT; b : ARRAY[0..9] OF BYTE;")
+    assert plc.read("Main.back") == -123456 and plc.read("Main.wback") == 500
+
+
+def test_string_to_ary_and_ary_to_string_round_trip(tmp_path):
+    plc = run1(tmp_path, "n := StringToAry(In := 'Hi TM', AryOut := b[2]); s := AryToString(In := b[2], Size := n);",
+               "b : ARRAY[0..19] OF BYTE; n : UINT; s : STRING[20];")
+    assert plc.read("Main.n") == 5 and plc.read("Main.s") == "Hi TM"
+    assert plc.read("Main.b")[2:7] == list(b"Hi TM")
+
+
+def test_real_to_format_string_width_decimals_sign_exponent(tmp_path):
+    plc = run1(tmp_path, """a := RealToFormatString(In := 3.14159, Exp := FALSE, Sign := FALSE, Width := 8, Decimals := 2);
+        b := RealToFormatString(In := 2.5, Exp := FALSE, Sign := TRUE, Width := 0, Decimals := 1);
+        c := RealToFormatString(In := 1234.5, Exp := TRUE, Sign := FALSE, Width := 0, Decimals := 3);""",
+               "a, b, c : STRING[30];")
+    assert (plc.read("Main.a"), plc.read("Main.b"), plc.read("Main.c")) == ("    3.14", "+2.5", "1.234e+03")
+
+
+def test_time_instructions(tmp_path):
+    plc = run1(tmp_path, """dt1 := SecToDt(In := 86400); s := DtToSec(In := DT#1970-01-02-00:00:10);
+        t := NanoSecToTime(In := 1500000); ns := TimeToNanoSec(In := T#2ms); now := GetTime();""",
+               "dt1 : DT; s : LINT; t : TIME; ns : LINT; now : DT;", clock_base_ns=1_700_000_000_000_000_000)
+    assert plc.read("Main.dt1") == 86400 * 10**9
+    assert plc.read("Main.s") == 86410
+    assert plc.read("Main.t") == 1_500_000 and plc.read("Main.ns") == 2_000_000
+    assert plc.read("Main.now") == 1_700_000_000_000_000_000
