@@ -1,0 +1,290 @@
+"""Motion planning for the robot model: targets, paths and durations (all derived from the parameters).
+
+Duration of one motion (trapezoidal speed profile):
+
+    ta  = accel_ms / 1000                         time to reach the cruise speed
+    T(d, v) = d / v + ta          if d >= v * ta   (the arm reaches cruise speed)
+            = 2 * sqrt(d * ta / v) otherwise       (triangular profile)
+
+* PTP / joint moves: every joint i moves d_i degrees with v_i = JOINT_SPEED[i] * speed% / 100;
+  all joints are synchronised, so T = max_i T(d_i, v_i).
+* Line / PLine / Circle: d = path length in mm with v = TCP_SPEED * speed% / 100 (formats "?P?")
+  or v = min(speed mm/s, TCP_SPEED) (formats "?A?"); the orientation change runs at
+  ROT_SPEED scaled the same way; T = max of both.
+* Blending (blend > 0) overlaps the deceleration with the next motion:
+  T -= b * min(ta, T/2), b = blend% / 100, or for radius formats b = min(1, radius / (d / 2)).
+* Precise positioning (last argument false) adds SETTLE_S of fine settling at the end.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from . import kinematics as kin
+
+JOINT_SPEED = (180.0, 180.0, 180.0, 225.0, 225.0, 225.0)   # deg/s, TM5-700 data sheet
+TCP_SPEED = 1100.0                                           # mm/s
+ROT_SPEED = 225.0                                            # deg/s for the TCP orientation
+SETTLE_S = 0.15                                              # precise positioning settling time
+
+
+class MotionError(Exception):
+    """A motion that cannot be executed (bad value, unreachable target, joint limit)."""
+
+
+def trapezoid_time(distance, speed, ta):
+    if distance <= 0:
+        return 0.0
+    if ta <= 0 or distance >= speed * ta:
+        return distance / speed + max(ta, 0.0)
+    return 2.0 * math.sqrt(distance * ta / speed)
+
+
+def trapezoid_fraction(t, total, ta):
+    """Fraction of the path covered at time t of a symmetric trapezoidal profile of length total."""
+    if total <= 0 or t >= total:
+        return 1.0
+    if t <= 0:
+        return 0.0
+    ta = min(ta, total / 2.0)
+    if ta <= 0:
+        return t / total
+    vmax = 1.0 / (total - ta)              # normalised cruise speed (area under profile = 1)
+    if t < ta:
+        return 0.5 * vmax * t * t / ta
+    if t <= total - ta:
+        return vmax * (t - ta / 2.0)
+    rest = total - t
+    return 1.0 - 0.5 * vmax * rest * rest / ta
+
+
+@dataclass
+class MotionRequest:
+    """One queued motion as written in the script (values already evaluated)."""
+    function: str             # PTP, Line, Circle, PLine, Move_PTP, Move_Line, Move_PLine
+    fmt: str
+    target: list              # 6 values (or 12 for Circle: via point then end point)
+    speed: float
+    accel_ms: float
+    blend: float
+    precise: bool
+    config: tuple | None = None
+    arc_angle: float = 0.0
+    line: str = ""
+
+
+@dataclass
+class Plan:
+    """A motion ready to run: start/end joints, a path function and its duration."""
+    request: MotionRequest
+    start_joints: list
+    end_joints: list
+    duration: float            # motion time without settling/blending adjustments
+    ta: float
+    total: float               # time until the next FIFO item starts
+    cartesian: object = None   # callable s -> TCP matrix in robot coordinates, None = joint interpolation
+    end_pose: list = field(default_factory=list)
+    tool: object = None
+    start_pose: list = field(default_factory=list)
+
+    def joints_at(self, t, reference=None):
+        s = trapezoid_fraction(t, self.duration, self.ta)
+        if s >= 1.0:
+            return list(self.end_joints)
+        if self.cartesian is None:
+            return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints)]
+        try:
+            return kin.inverse_kinematics(self.cartesian(s), self.tool, reference=reference or self.start_joints)
+        except kin.KinematicsError:
+            return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints)]
+
+
+def _rot(m):
+    return [row[:3] for row in m[:3]]
+
+
+def _slerp_matrix(m0, m1, s):
+    """Interpolate position linearly and orientation along the shortest rotation."""
+    r0, r1 = _rot(m0), _rot(m1)
+    rel = [[sum(r0[k][i] * r1[k][j] for k in range(3)) for j in range(3)] for i in range(3)]   # r0^T r1
+    angle = math.acos(max(-1.0, min(1.0, (rel[0][0] + rel[1][1] + rel[2][2] - 1) / 2)))
+    if angle < 1e-9:
+        rs = r0
+    else:
+        axis = [rel[2][1] - rel[1][2], rel[0][2] - rel[2][0], rel[1][0] - rel[0][1]]
+        n = math.sqrt(sum(a * a for a in axis))
+        if n < 1e-9:                       # 180 degrees: axis from the diagonal
+            axis = [math.sqrt(max(0.0, (rel[i][i] + 1) / 2)) for i in range(3)]
+            n = math.sqrt(sum(a * a for a in axis)) or 1.0
+        x, y, z = (a / n for a in axis)
+        a = angle * s
+        c, sn, v = math.cos(a), math.sin(a), 1 - math.cos(a)
+        rr = [[c + x * x * v, x * y * v - z * sn, x * z * v + y * sn],
+              [y * x * v + z * sn, c + y * y * v, y * z * v - x * sn],
+              [z * x * v - y * sn, z * y * v + x * sn, c + z * z * v]]
+        rs = [[sum(r0[i][k] * rr[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    p = [m0[i][3] + (m1[i][3] - m0[i][3]) * s for i in range(3)]
+    return [rs[0] + [p[0]], rs[1] + [p[1]], rs[2] + [p[2]], [0.0, 0.0, 0.0, 1.0]]
+
+
+def rotation_angle(m0, m1):
+    r0, r1 = _rot(m0), _rot(m1)
+    trace = sum(sum(r0[k][i] * r1[k][i] for k in range(3)) for i in range(3))
+    return math.degrees(math.acos(max(-1.0, min(1.0, (trace - 1) / 2))))
+
+
+def _check_common(req):
+    if req.fmt[1:2] == "P" or req.function.startswith(("PTP", "Move_PTP")):
+        if not 0 < req.speed <= 100:
+            raise MotionError(f"{req.function} speed {req.speed:g} % is outside 1..100 %")
+    elif req.speed <= 0:
+        raise MotionError(f"{req.function} speed {req.speed:g} mm/s must be positive")
+    if req.accel_ms < 0:
+        raise MotionError(f"{req.function} acceleration time {req.accel_ms:g} ms is negative")
+    if req.blend < 0 or (req.fmt[2:3] == "P" and req.blend > 100):
+        raise MotionError(f"{req.function} blending {req.blend:g} is outside its range")
+
+
+class Planner:
+    """Turns MotionRequests into Plans for a given robot state (base, tool, joints)."""
+
+    def __init__(self, base, tool):
+        self.base = base          # base frame matrix in robot coordinates
+        self.tool = tool          # TCP matrix in flange coordinates
+        self.base_inverse = kin.inverse(base)
+
+    def tcp_in_base(self, joints):
+        return kin.matmul(self.base_inverse, kin.forward(joints, self.tool))
+
+    def flange_target(self, pose_in_base):
+        """TCP pose in the current base -> TCP matrix in robot coordinates."""
+        return kin.matmul(self.base, kin.pose_to_matrix(pose_in_base))
+
+    def plan(self, req: MotionRequest, joints: list) -> Plan:
+        plan = self._plan(req, joints)
+        plan.start_pose = kin.matrix_to_pose(kin.matmul(self.base_inverse, kin.forward(joints, self.tool)))
+        return plan
+
+    def _plan(self, req: MotionRequest, joints: list) -> Plan:
+        _check_common(req)
+        relative = req.function.startswith("Move_")
+        frame = req.fmt[0]
+        start_tcp = kin.forward(joints, self.tool)
+        if req.function == "Circle":
+            return self._plan_circle(req, joints, start_tcp)
+        if frame == "J":
+            end_joints = [a + b for a, b in zip(joints, req.target)] if relative else list(req.target)
+            if not kin.within_limits(end_joints):
+                raise MotionError(f"{req.function} target joints exceed the joint limits")
+            end_tcp = kin.forward(end_joints, self.tool)
+        else:
+            if relative and frame == "T":
+                end_tcp = kin.matmul(start_tcp, kin.pose_to_matrix(req.target))
+            elif relative:
+                cur = kin.matmul(kin.inverse(self.base), start_tcp)
+                delta = kin.pose_to_matrix([0, 0, 0] + list(req.target[3:]))
+                moved = kin.matmul(delta, [r[:3] + [0.0] for r in cur[:3]] + [[0.0, 0.0, 0.0, 1.0]])
+                for i in range(3):
+                    moved[i][3] = cur[i][3] + req.target[i]
+                end_tcp = kin.matmul(self.base, moved)
+            else:
+                end_tcp = self.flange_target(req.target)
+            try:
+                end_joints = kin.inverse_kinematics(end_tcp, self.tool, reference=joints, config=req.config)
+            except kin.KinematicsError as exc:
+                raise MotionError(f"{req.function}: {exc}") from None
+        ta = req.accel_ms / 1000.0
+        joint_move = req.function in ("PTP", "Move_PTP")
+        if joint_move:
+            duration = max(trapezoid_time(abs(b - a), JOINT_SPEED[i] * req.speed / 100.0, ta)
+                           for i, (a, b) in enumerate(zip(joints, end_joints)))
+            distance = math.dist([start_tcp[i][3] for i in range(3)], [end_tcp[i][3] for i in range(3)])
+            path = None
+        else:
+            distance = math.dist([start_tcp[i][3] for i in range(3)], [end_tcp[i][3] for i in range(3)])
+            duration = self._linear_time(req, distance, rotation_angle(start_tcp, end_tcp), ta)
+            path = None if frame == "J" else (lambda s, a=start_tcp, b=end_tcp: _slerp_matrix(a, b, s))
+        return self._finish(req, joints, end_joints, duration, ta, distance, path)
+
+    def _linear_time(self, req, distance, angle, ta):
+        if req.fmt[1] == "P":
+            v, w = TCP_SPEED * req.speed / 100.0, ROT_SPEED * req.speed / 100.0
+        else:
+            v = min(req.speed, TCP_SPEED)
+            w = ROT_SPEED * v / TCP_SPEED
+        return max(trapezoid_time(distance, v, ta), trapezoid_time(angle, w, ta))
+
+    def _finish(self, req, joints, end_joints, duration, ta, distance, path):
+        total = duration
+        if req.blend > 0 and duration > 0:
+            b = req.blend / 100.0 if req.fmt[2:3] != "R" else min(1.0, req.blend / max(distance / 2.0, 1e-9))
+            total -= b * min(ta, duration / 2.0)
+        if req.precise:
+            total += SETTLE_S
+        tool_pose = kin.matrix_to_pose(self.tcp_in_base(end_joints))
+        return Plan(req, list(joints), list(end_joints), duration, ta, total, path, tool_pose, self.tool)
+
+    def _plan_circle(self, req, joints, start_tcp):
+        via = self.flange_target(req.target[:6])
+        end = self.flange_target(req.target[6:12])
+        p0 = [start_tcp[i][3] for i in range(3)]
+        p1 = [via[i][3] for i in range(3)]
+        p2 = [end[i][3] for i in range(3)]
+        centre, radius, normal = _circle(p0, p1, p2)
+        if centre is None:
+            raise MotionError("Circle: start, via and end points are on one line")
+        u = [(p0[i] - centre[i]) / radius for i in range(3)]
+        w = _cross(normal, u)
+        ang_via = _angle_on(p1, centre, u, w)
+        ang_end = _angle_on(p2, centre, u, w)
+        if ang_via > ang_end:             # going the other way round keeps the via point on the arc
+            normal = [-n for n in normal]
+            w = _cross(normal, u)
+            ang_end = _angle_on(p2, centre, u, w)
+        sweep = math.radians(req.arc_angle) if req.arc_angle else ang_end
+        keep = bool(req.arc_angle)
+
+        def tcp(s, c=centre, r=radius, u=u, w=w, a=start_tcp, b=end):
+            th = sweep * s
+            m = a if keep else _slerp_matrix(a, b, s)
+            m = [row[:] for row in m]
+            for i in range(3):
+                m[i][3] = c[i] + r * (math.cos(th) * u[i] + math.sin(th) * w[i])
+            return m
+
+        end_tcp = tcp(1.0)
+        try:
+            end_joints = kin.inverse_kinematics(end_tcp, self.tool, reference=joints)
+        except kin.KinematicsError as exc:
+            raise MotionError(f"Circle: {exc}") from None
+        ta = req.accel_ms / 1000.0
+        distance = abs(sweep) * radius
+        duration = self._linear_time(req, distance, 0.0 if keep else rotation_angle(start_tcp, end), ta)
+        return self._finish(req, joints, end_joints, duration, ta, distance, tcp)
+
+
+def _cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def _angle_on(p, c, u, w):
+    v = [p[i] - c[i] for i in range(3)]
+    a = math.atan2(sum(v[i] * w[i] for i in range(3)), sum(v[i] * u[i] for i in range(3)))
+    return a if a >= 0 else a + 2 * math.pi
+
+
+def _circle(p0, p1, p2):
+    """Centre, radius and unit normal of the circle through three points (None when collinear)."""
+    a = [p1[i] - p0[i] for i in range(3)]
+    b = [p2[i] - p0[i] for i in range(3)]
+    n = _cross(a, b)
+    nn = sum(x * x for x in n)
+    if nn < 1e-6:
+        return None, 0.0, None
+    aa, bb = sum(x * x for x in a), sum(x * x for x in b)
+    t1 = _cross(n, a)
+    t2 = _cross(b, n)
+    centre = [p0[i] + (bb * t1[i] + aa * t2[i]) / (2 * nn) for i in range(3)]
+    radius = math.dist(centre, p0)
+    norm = math.sqrt(nn)
+    return centre, radius, [x / norm for x in n]

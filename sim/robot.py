@@ -1,0 +1,215 @@
+"""TM5-700 robot model: a motion FIFO that takes time, plus base, tool, load, IO and queue tags.
+
+State changes only in ``tick(dt)`` (and in the immediate commands ``pause``, ``resume``,
+``stop_and_clear``). FIFO items run strictly in order; a queue tag is reached when every item
+queued before it has finished. Durations come from ``sim.motion`` (documented formulas there).
+"""
+from __future__ import annotations
+
+from collections import deque
+
+from . import kinematics as kin
+from .motion import MotionError, MotionRequest, Planner
+
+HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)
+_MATRICES: dict[tuple, list] = {}          # pose -> matrix of bases and tools in use (never modified)
+IDENTITY_POSE = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+class RobotModel:
+    """One arm. ``tick(dt)`` returns the list of events (dicts) that happened during dt."""
+
+    def __init__(self, tag_history=4, bases=None, tools=None):
+        self.joints = list(HOME_JOINTS)
+        self.bases = {"RobotBase": IDENTITY_POSE, **(bases or {})}
+        self.tools = {"NOTOOL": IDENTITY_POSE, **(tools or {})}
+        self.base_name, self.base_pose = "RobotBase", list(IDENTITY_POSE)
+        self.tool_name, self.tool_pose = "NOTOOL", list(IDENTITY_POSE)
+        self.tool_mass = 0.0
+        self.load = 0.0
+        self.io = {}
+        self.fifo = deque()
+        self.active = None
+        self.active_t = 0.0
+        self.paused = False
+        self.tag_history = tag_history
+        self.tags = {}             # tag -> "true" | "false" in order of last change
+        self.fault = None
+
+    # ---- queue --------------------------------------------------------------------------------
+    def enqueue_motion(self, request: MotionRequest):
+        self.fifo.append(("motion", request))
+
+    def enqueue_tag(self, tag: int):
+        self.tags.pop(tag, None)
+        self.tags[tag] = "false"
+        self.fifo.append(("tag", tag))
+
+    def enqueue_setting(self, kind: str, value):
+        self.fifo.append((kind, value))
+
+    @property
+    def queue_length(self):
+        return len(self.fifo) + (1 if self.active else 0)
+
+    @property
+    def idle(self):
+        return not self.fifo and self.active is None
+
+    def tag_status(self, tag: int) -> str:
+        return self.tags.get(tag, "none")
+
+    # ---- immediate commands -------------------------------------------------------------------
+    def pause(self):
+        self.paused = True
+
+    def resume(self):
+        self.paused = False
+
+    def stop_and_clear(self):
+        """Stop where the arm is now and drop the FIFO; returns the queue tags that were dropped."""
+        if self.active is not None:
+            self.joints = self.active.joints_at(self.active_t, self.joints)
+            self.active = None
+        dropped = [value for kind, value in self.fifo if kind == "tag"]
+        for tag in dropped:
+            if self.tags.get(tag) == "false":
+                del self.tags[tag]
+        self.fifo.clear()
+        return dropped
+
+    # ---- time ---------------------------------------------------------------------------------
+    def tick(self, dt: float) -> list[dict]:
+        events = []
+        while not self.paused:
+            if self.active is not None:
+                remaining = self.active.total - self.active_t
+                if dt < remaining:
+                    self.active_t += dt
+                    break
+                dt -= remaining
+                finished, self.active = self.active, None
+                self.joints = list(finished.end_joints)
+                events.append({"kind": "motion_end", "function": finished.request.function,
+                               "line": finished.request.line, "joints": _frozen(self.joints),
+                               "pose": _frozen(finished.end_pose)})
+                continue
+            if not self.fifo:
+                break
+            kind, value = self.fifo.popleft()
+            handler = getattr(self, "_run_" + kind)
+            event = handler(value)
+            if event:
+                events.append(event)
+            if self.fault:
+                break
+        return events
+
+    def _run_motion(self, request):
+        planner = Planner(self._matrix(self.base_pose), self._matrix(self.tool_pose))    # cached matrices
+        try:
+            plan = planner.plan(request, self.joints)
+        except MotionError as exc:
+            self.fault = str(exc)
+            self.stop_and_clear()
+            return {"kind": "motion_failed", "function": request.function, "line": request.line,
+                    "reason": str(exc)}
+        self.active, self.active_t = plan, 0.0
+        return {"kind": "motion_start", "function": request.function, "line": request.line,
+                "from": _frozen(plan.start_pose), "to": _frozen(plan.end_pose),
+                "joints_to": _frozen(plan.end_joints), "duration_s": round(plan.total, 4)}
+
+    def _run_tag(self, tag):
+        self.tags.pop(tag, None)
+        self.tags[tag] = "true"
+        reached = [t for t, s in self.tags.items() if s == "true"]
+        for old in reached[:-self.tag_history] if self.tag_history > 0 else reached:
+            del self.tags[old]
+        return {"kind": "tag_reached", "tag": tag}
+
+    def _run_base(self, value):
+        name, pose = self._resolve(value, self.bases, "base")
+        if name is None:
+            return self._fault_event("ChangeBase", pose)
+        self.base_name, self.base_pose = name, pose
+        return {"kind": "setting", "what": "base", "name": name, "pose": _frozen(pose)}
+
+    def _run_tcp(self, value):
+        mass = None
+        if isinstance(value, tuple):
+            value, mass = value
+        name, pose = self._resolve(value, self.tools, "tool")
+        if name is None:
+            return self._fault_event("ChangeTCP", pose)
+        self.tool_name, self.tool_pose = name, pose
+        if mass is not None:
+            self.tool_mass = mass
+        return {"kind": "setting", "what": "tcp", "name": name, "pose": _frozen(pose)}
+
+    def _run_load(self, value):
+        self.load = value
+        return {"kind": "setting", "what": "load", "value": value}
+
+    def _run_io(self, value):
+        key, level = value
+        self.io[key] = level
+        return {"kind": "io", "point": key, "value": level}
+
+    def _fault_event(self, function, reason):
+        self.fault = reason
+        self.stop_and_clear()
+        return {"kind": "motion_failed", "function": function, "line": "", "reason": reason}
+
+    @staticmethod
+    def _resolve(value, table, what):
+        if isinstance(value, str):
+            if value not in table:
+                return None, f"{what} '{value}' is not defined on the robot"
+            return value, list(table[value])
+        return "(custom)", [float(v) for v in value[:6]]
+
+    @staticmethod
+    def _matrix(pose):
+        key = tuple(pose)
+        matrix = _MATRICES.get(key)
+        if matrix is None:
+            if len(_MATRICES) > 256:
+                _MATRICES.clear()
+            matrix = _MATRICES[key] = kin.pose_to_matrix(pose)
+        return matrix
+
+    # ---- reading ------------------------------------------------------------------------------
+    def current_joints(self):
+        if self.active is None:
+            return list(self.joints)
+        return self.active.joints_at(self.active_t, self.joints)
+
+    def tcp_pose(self, joints=None):
+        """TCP pose (X, Y, Z, Rx, Ry, Rz) in the current base."""
+        joints = self.current_joints() if joints is None else joints
+        m = kin.matmul(kin.inverse(self._matrix(self.base_pose)),
+                       kin.forward(joints, self._matrix(self.tool_pose)))
+        return kin.matrix_to_pose(m)
+
+    def tcp_pose_robot(self):
+        return kin.matrix_to_pose(kin.forward(self.current_joints(), self._matrix(self.tool_pose)))
+
+    def state(self) -> dict:
+        joints = self.current_joints()
+        return {"joints": _round(joints), "tcp": _round(self.tcp_pose(joints)),
+                "tcp_robot": _round(kin.matrix_to_pose(kin.forward(joints, self._matrix(self.tool_pose)))),
+                "configuration": list(kin.configuration(joints)),
+                "base": {"name": self.base_name, "pose": _round(self.base_pose)},
+                "tool": {"name": self.tool_name, "pose": _round(self.tool_pose), "mass": self.tool_mass},
+                "load": self.load, "io": dict(self.io), "queue_length": self.queue_length,
+                "moving": self.active is not None, "paused": self.paused,
+                "tags": {str(k): v for k, v in self.tags.items()}, "fault": self.fault}
+
+
+def _round(values):
+    return [round(v, 4) + 0.0 for v in values]
+
+
+def _frozen(values):
+    """Rounded values as a tuple: events keep tuples so the garbage collector can skip them."""
+    return tuple(round(v, 4) + 0.0 for v in values)

@@ -1,0 +1,466 @@
+"""SimServer: TCP adapter around the sans-I/O sessions (selectors, non-blocking, bounded buffers).
+
+``poll(now_s)`` is one non-blocking step on a virtual clock: advance the robot models, accept,
+read, process, write. ``start_background()`` runs the same step in a thread on the wall clock.
+
+Limits (per robot unless noted):
+* frame DATA <= codec.MAX_DATA (64 KiB); longer declared lengths are answered with CPERR 01
+* MAX_CLIENTS simultaneous connections; more are accepted and closed at once
+* MAX_PENDING buffered scripts; beyond that the server stops reading from that robot's clients
+  (TCP back-pressure) until the queue shrinks
+* MAX_OUTBOX bytes waiting to be sent to one client; a client that does not read is dropped
+"""
+from __future__ import annotations
+
+import json
+import selectors
+import socket
+import threading
+import time
+
+from . import codec
+from .control import ControlChannel
+from .faults import KNOWN as KNOWN_FAULTS, FaultState
+from .robot import RobotModel
+from .session import STOPPED, ListenSession
+
+MAX_CLIENTS = 256
+MAX_PENDING = 1000
+MAX_OUTBOX = 1 << 20
+RECV_SIZE = 65536
+EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all)
+IO_SLICE_S = 0.0005
+
+
+class _Conn:
+    __slots__ = ("sock", "id", "rbuf", "wbuf", "eof", "frames_in", "peer")
+
+    def __init__(self, sock, conn_id, peer):
+        self.sock, self.id, self.peer = sock, conn_id, peer
+        self.rbuf = bytearray()
+        self.wbuf = bytearray()
+        self.eof = False
+        self.frames_in = 0
+
+
+class Robot:
+    """Control interface of one simulated robot (``SimServer.robots[i]``)."""
+
+    def __init__(self, server, index, port, send_message, auto_enter, tag_history, timeouts, frames=(None, None)):
+        self._server = server
+        self.index = index
+        self.port = port
+        self.events: list[dict] = []
+        self._waiters: list[tuple] = []          # (predicate, threading.Event, [match]) of wait_event
+        self.faults = FaultState()
+        self.session = ListenSession(RobotModel(tag_history=tag_history, bases=frames[0], tools=frames[1]),
+                                     send_message, self._log,
+                                     auto_enter=auto_enter, data_timeout=timeouts[0], connection_timeout=timeouts[1])
+        self.listener = None
+        self.conns: dict[int, _Conn] = {}
+        self.reading_paused = False
+
+    # ---- event log ----------------------------------------------------------------------------
+    def _log(self, kind, **fields):
+        session = self.__dict__.get("session")
+        event = {"t": round(session.now, 6) if session is not None else 0.0, "robot": self.index, "kind": kind,
+                 **fields}
+        self.events.append(event)
+        for predicate, flag, found in list(self._waiters):
+            if not flag.is_set() and predicate(event):
+                found.append(event)
+                flag.set()
+        if len(self.events) > self._server.event_limit:
+            del self.events[: len(self.events) // 2]
+        if self._server.log_file is not None:
+            self._server.log_file.write(json.dumps(event, ensure_ascii=False) + "\n")
+
+    def wait_event(self, kind: str, timeout: float = 5.0, since: int = 0, **fields) -> dict | None:
+        """First event of ``kind`` whose fields equal ``fields``, among events[since:] or logged later
+        (from another thread, e.g. start_background()); None after ``timeout`` wall-clock seconds."""
+        def predicate(event):
+            return event["kind"] == kind and all(event.get(k) == v for k, v in fields.items())
+        flag, found = threading.Event(), []
+        entry = (predicate, flag, found)
+        self._waiters.append(entry)
+        try:
+            for event in list(self.events[since:]):
+                if predicate(event):
+                    return event
+            return found[0] if flag.wait(timeout) else None
+        finally:
+            self._waiters.remove(entry)
+
+    # ---- control ------------------------------------------------------------------------------
+    def enter_listen_node(self):
+        with self._server.lock:
+            self.session.fire("enter_node", source="control")
+
+    def leave_listen_node(self):
+        with self._server.lock:
+            self.session.fire("leave_node", path="Pass", source="control")
+
+    def stop_project(self):
+        with self._server.lock:
+            self.session.fire("stop_project", source="control")
+            self._server._close_robot_sockets(self)
+
+    def start_project(self, enter_node=None):
+        with self._server.lock:
+            self.session.fire("start_project", source="control")
+            self._server._listen(self)
+            if self._server.auto_enter if enter_node is None else enter_node:
+                self.session.fire("enter_node", source="control")
+
+    def inject(self, fault: str, **params):
+        """Arm a fault (see docs/simulator.md, 'Fault injection'); raises ValueError when unknown."""
+        if fault not in KNOWN_FAULTS:
+            raise ValueError(f"unknown fault '{fault}'; known faults: {', '.join(KNOWN_FAULTS)}")
+        with self._server.lock:
+            if fault == "reply_error":
+                try:
+                    self.session.faults["reply_error"] += int(params.get("count", 1))
+                except (TypeError, ValueError):
+                    raise ValueError(f"bad parameter for fault 'reply_error': count must be an integer, "
+                                     f"got {params.get('count')!r}") from None
+            elif fault == "leave_node":
+                self.session.fire("leave_node", path=params.get("path", "Pass"), source="fault")
+            elif fault == "stop_project":
+                self.stop_project()
+            elif fault == "refuse_connections":
+                self.faults.arm(fault, **params)
+                self._server._apply_refuse(self)
+            elif fault == "disconnect":
+                for conn in list(self.conns.values()):
+                    self._server._drop(self, conn, "fault: disconnect")
+            else:
+                self.faults.arm(fault, **params)
+            self._log("fault", fault=fault, params=params)
+
+    def clear_faults(self):
+        with self._server.lock:
+            held = self.faults
+            self.faults = FaultState()
+            self.faults.adopt(held)          # frames already held back still leave at their time
+            self.session.faults["reply_error"] = 0
+            self._server._apply_refuse(self)
+            self._log("fault", fault="cleared", params={})
+
+    def state(self) -> dict:
+        with self._server.lock:
+            data = self.session.snapshot()
+            data.update(port=self.port, clients=len(self.conns), faults=self.faults.describe())
+            return data
+
+
+class SimServer:
+    def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
+                 send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
+                 control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None):
+        if not 1 <= robots <= 512:
+            raise ValueError(f"robots must be 1..512, got {robots}")
+        if speedup <= 0:
+            raise ValueError(f"speedup must be positive, got {speedup}")
+        self.host, self.speedup, self.auto_enter = host, speedup, auto_enter
+        self.lock = threading.RLock()
+        self.event_limit = event_limit or max(1000, EVENT_BUDGET // robots)    # per robot
+        try:
+            self.log_file = open(log_path, "a", encoding="utf-8", buffering=1) if log_path else None
+        except OSError as exc:
+            raise OSError(exc.errno, f"cannot open the event log {log_path}: {exc.strerror}") from None
+        self.selector = selectors.DefaultSelector()
+        self.robots = [Robot(self, i, port + i if port else 0, send_message, auto_enter, tag_history,
+                             (data_timeout, connection_timeout), (bases, tools)) for i in range(robots)]
+        self._next_conn = 1
+        self._thread = None
+        self._stop = threading.Event()
+        self._now = 0.0
+        self._dispatch = {"listen": self._accept, "conn": self._read}
+        self.started = False
+        self.control = None
+        self._control_port = control_port
+
+    @property
+    def ports(self) -> list[int]:
+        return [r.port for r in self.robots]
+
+    # ---- lifecycle ----------------------------------------------------------------------------
+    def start(self):
+        with self.lock:
+            try:
+                for robot in self.robots:
+                    self._listen(robot)
+                if self._control_port is not None:
+                    self.control = ControlChannel(self, self.host, self._control_port)
+            except OSError:
+                self.close()
+                raise
+            self.started = True
+        return self
+
+    def _listen(self, robot):
+        if robot.listener is not None or robot.faults.refuse:
+            return
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            sock.bind((self.host, robot.port))
+        except OSError as exc:
+            sock.close()
+            raise OSError(exc.errno, f"cannot listen on {self.host}:{robot.port} for robot {robot.index}: "
+                                     f"{exc.strerror}") from None
+        sock.listen(128)
+        sock.setblocking(False)
+        robot.port = sock.getsockname()[1]
+        robot.listener = sock
+        self.selector.register(sock, selectors.EVENT_READ, ("listen", robot, None))
+        robot._log("listening", host=self.host, port=robot.port)
+
+    def _apply_refuse(self, robot):
+        if robot.faults.refuse and robot.listener is not None:
+            self.selector.unregister(robot.listener)
+            robot.listener.close()
+            robot.listener = None
+        elif not robot.faults.refuse and robot.listener is None and robot.session.state != STOPPED:
+            self._listen(robot)
+
+    def _close_robot_sockets(self, robot, reason="project stopped"):
+        for conn in list(robot.conns.values()):
+            self._drop(robot, conn, reason)
+        if robot.listener is not None:
+            self.selector.unregister(robot.listener)
+            robot.listener.close()
+            robot.listener = None
+
+    def close(self):
+        self.stop()
+        with self.lock:
+            for robot in self.robots:
+                self._close_robot_sockets(robot, "simulator closed")
+            if self.control is not None:
+                self.control.close()
+                self.control = None
+            self.selector.close()
+            if self.log_file is not None:
+                self.log_file.close()
+                self.log_file = None
+
+    def serve_forever(self, stop_event: threading.Event):
+        """Serve in the calling thread on the wall clock (scaled by ``speedup``) until stop_event is set."""
+        if not self.started:
+            self.start()
+        origin = time.monotonic()
+        offset = self._now
+        while not stop_event.is_set():
+            self.poll(offset + (time.monotonic() - origin) * self.speedup, timeout=0.002)
+
+    def start_background(self):
+        """Serve in a thread on the wall clock (scaled by ``speedup``) until ``stop()``."""
+        if not self.started:
+            self.start()
+        self._stop.clear()
+        self._thread = threading.Thread(target=self.serve_forever, args=(self._stop,), name="tmflow-sim",
+                                        daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self):
+        if self._thread is not None:
+            self._stop.set()
+            self._thread.join(timeout=5)
+            self._thread = None
+
+    # ---- one step -----------------------------------------------------------------------------
+    def poll(self, now_s: float, timeout: float = 0.0):
+        """Advance to ``now_s`` and serve every socket that is ready; never blocks unless timeout>0.
+
+        Planning a motion (inverse kinematics) can take a millisecond; when advancing the robots
+        takes longer than IO_SLICE_S the sockets are served in between, so replies never wait for
+        the motion planning of all other robots.
+        """
+        with self.lock:
+            self._now = max(self._now, now_s)
+            slice_start = time.perf_counter()
+            advanced = []
+            for robot in self.robots:
+                robot.session.advance(self._now)
+                advanced.append(robot)
+                if time.perf_counter() - slice_start > IO_SLICE_S:
+                    for done in advanced:          # pushes (tag reached) leave without waiting
+                        self._flush(done)
+                    advanced.clear()
+                    self._serve(0.0)
+                    slice_start = time.perf_counter()
+            self._serve(timeout)
+            for robot in self.robots:
+                self._flush(robot)
+                if robot.session.state == STOPPED and (robot.listener is not None or robot.conns):
+                    self._close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
+                if robot.reading_paused and len(robot.session.pending) < MAX_PENDING // 2:
+                    self._set_reading(robot, True)
+
+    def _set_reading(self, robot, reading: bool):
+        """Back-pressure: stop reading this robot's clients while its script buffer is full."""
+        robot.reading_paused = not reading
+        robot._log("reading_resumed" if reading else "reading_paused", buffered=len(robot.session.pending))
+        for conn in robot.conns.values():
+            if conn.eof:
+                continue
+            try:
+                if reading:
+                    self.selector.register(conn.sock, selectors.EVENT_READ, ("conn", robot, conn))
+                else:
+                    self.selector.unregister(conn.sock)
+            except (KeyError, ValueError):
+                pass
+
+    def _serve(self, timeout):
+        touched = set()
+        for key, _mask in self.selector.select(timeout):
+            kind, robot, conn = key.data
+            touched.add(robot)
+            try:
+                self._dispatch[kind](robot, conn)
+            except Exception as exc:          # safety net: one bad client never stops the others
+                if robot is None or conn is None:
+                    raise
+                robot._log("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
+                self._drop(robot, conn, "internal error while handling this client")
+        for robot in touched:
+            if robot is not None:
+                robot.session.advance(self._now)      # start what the new scripts queued
+                self._flush(robot)
+
+    def _accept(self, robot, _conn):
+        for _ in range(64):
+            try:
+                sock, addr = robot.listener.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                robot._log("accept_error", reason=exc.strerror)
+                return
+            sock.setblocking(False)
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            if len(robot.conns) >= MAX_CLIENTS:
+                robot._log("rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")
+                sock.close()
+                continue
+            conn = _Conn(sock, self._next_conn, addr[0])
+            self._next_conn += 1
+            robot.conns[conn.id] = conn
+            robot.session.connect(conn.id, addr[0])
+            self.selector.register(sock, selectors.EVENT_READ, ("conn", robot, conn))
+
+    def _read(self, robot, conn):
+        if conn.id not in robot.conns or conn.eof:
+            return
+        if len(robot.session.pending) >= MAX_PENDING:
+            self._set_reading(robot, False)
+            return
+        try:
+            data = conn.sock.recv(RECV_SIZE)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:
+            self._drop(robot, conn, f"receive failed: {exc.strerror}")
+            return
+        if not data:
+            conn.eof = True
+            self.selector.unregister(conn.sock)
+            robot._log("peer_closed", conn=conn.id)
+            return
+        if robot.faults.black_hole:
+            robot._log("black_hole", conn=conn.id, bytes=len(data))
+            return
+        conn.rbuf += data
+        for item in codec.decode_all(conn.rbuf):
+            if isinstance(item, codec.Frame):
+                conn.frames_in += 1
+                robot._log("frame_in", conn=conn.id, raw=_text(item.raw), header=item.header,
+                           data=_text(item.data))
+            robot.session.handle(conn.id, item)
+            if robot.faults.close_after is not None and conn.frames_in >= robot.faults.close_after:
+                robot.faults.close_after = None
+                self._flush(robot)
+                self._drop(robot, conn, "fault: close_after")
+                return
+
+    def _flush(self, robot):
+        now = self._now
+        for conn_id, client in list(robot.session.clients.items()):
+            conn = robot.conns.get(conn_id)
+            if conn is None:
+                continue
+            if client.outbox:
+                frames, client.outbox[:] = list(client.outbox), []
+                for frame in frames:
+                    header, _, rest = frame[1:].partition(b",")
+                    robot._log("frame_out", conn=conn_id, raw=_text(frame), header=_text(header),
+                               data=_text(rest.partition(b",")[2][:-6]))
+            else:
+                frames = []
+            if robot.faults.active:
+                robot.faults.queue(conn_id, frames, now)
+                chunks, close = robot.faults.take(conn_id, now)
+            elif not frames and not conn.wbuf and not conn.eof:
+                continue
+            else:
+                chunks, close = frames, False
+            try:
+                for chunk in chunks:              # one send per reply frame when the socket keeps up
+                    if conn.wbuf:
+                        conn.wbuf += chunk
+                    else:
+                        sent = _send(conn.sock, chunk)
+                        conn.wbuf += chunk[sent:]
+                if conn.wbuf:
+                    del conn.wbuf[:_send(conn.sock, conn.wbuf)]
+            except OSError as exc:
+                self._drop(robot, conn, f"send failed: {exc.strerror}")
+                continue
+            if len(conn.wbuf) > MAX_OUTBOX:
+                self._drop(robot, conn, f"client does not read (more than {MAX_OUTBOX} bytes waiting)")
+                continue
+            if close:
+                self._drop(robot, conn, "fault: close_mid_frame")
+            elif conn.eof and not conn.wbuf and not robot.faults.holding(conn_id) and \
+                    not _has_work_for(robot.session, conn_id):
+                self._drop(robot, conn, "peer closed its side")
+        for conn in [c for c in robot.conns.values() if c.id not in robot.session.clients]:
+            self._drop(robot, conn, "session ended")
+
+    def _drop(self, robot, conn, reason):
+        if robot.conns.pop(conn.id, None) is None:
+            return
+        if not conn.eof:
+            try:
+                self.selector.unregister(conn.sock)
+            except (KeyError, ValueError):
+                pass
+        try:
+            conn.sock.close()
+        except OSError:
+            pass
+        robot.faults.forget(conn.id)
+        robot.session.disconnect(conn.id)
+        robot._log("closed", conn=conn.id, reason=reason)
+
+
+def _send(sock, data) -> int:
+    try:
+        return sock.send(data)
+    except (BlockingIOError, InterruptedError):
+        return 0
+
+
+def _has_work_for(session, conn_id):
+    if session.running is not None and session.running.packet.conn == conn_id:
+        return True
+    return any(p.conn == conn_id for p in session.pending)
+
+
+def _text(raw: bytes) -> str:
+    return raw.decode("utf-8", "backslashreplace")
+
+

@@ -1,0 +1,370 @@
+"""Listen Node session of one robot: a sans-I/O state machine (bytes and time in, frames out).
+
+The server calls ``connect``/``handle``/``disconnect``/``advance(now)``; replies and pushes are
+collected per connection in ``clients[conn].outbox`` (one bytes object per frame, so each goes out in one
+send). The node state follows an explicit transition table; the scripts of all clients are run
+strictly in arrival order, one at a time.
+"""
+from __future__ import annotations
+
+import re
+from collections import deque
+from dataclasses import dataclass, field
+
+from . import codec
+from .checker import check_script
+from .interp import Context, ScriptRuntimeError, run_script
+from .robot import RobotModel
+from .script import split_lines
+
+STOPPED, IDLE, IN_NODE, EXITING = "project_stopped", "not_in_node", "in_node", "exiting"
+
+# (state, event) -> next state. Actions with the same name as the event run on the transition.
+TRANSITIONS = {
+    (STOPPED, "start_project"): IDLE,
+    (IDLE, "stop_project"): STOPPED,
+    (IN_NODE, "stop_project"): STOPPED,
+    (EXITING, "stop_project"): STOPPED,
+    (IDLE, "enter_node"): IN_NODE,
+    (IN_NODE, "script_exit"): EXITING,        # ScriptExit(): drain the FIFO, then leave (Pass)
+    (EXITING, "drain_done"): IDLE,
+    (IN_NODE, "leave_node"): IDLE,            # control channel / priority ScriptExit(0|1)
+    (EXITING, "leave_node"): IDLE,
+    (IDLE, "robot_fault"): STOPPED,
+    (IN_NODE, "robot_fault"): STOPPED,        # a failed motion is a robot error: the project stops
+    (EXITING, "robot_fault"): STOPPED,
+}
+
+_PRIORITY = re.compile(r"^\s*(ScriptExit|StopAndClearBuffer)\s*\(\s*(\d)\s*\)\s*$")
+_PRIORITY_ARGS = {"ScriptExit": (0, 1), "StopAndClearBuffer": (0, 1, 2)}
+
+
+@dataclass
+class Packet:
+    conn: int
+    id: str
+    script: str
+
+
+@dataclass
+class Running:
+    packet: Packet
+    gen: object
+    warnings: list
+    wait: tuple | None = None          # ("tag", tag, deadline or None)
+
+
+@dataclass
+class Client:
+    peer: str
+    outbox: list = field(default_factory=list)
+
+
+class TransitionError(Exception):
+    """An event that is not allowed in the current node state."""
+
+
+class ListenSession:
+    def __init__(self, robot: RobotModel | None = None, send_message="Listen1", log=None,
+                 auto_enter=True, data_timeout=None, connection_timeout=None):
+        self.robot = robot or RobotModel()
+        self.send_message = send_message
+        self.log = log or (lambda kind, **fields: None)
+        self.state = STOPPED
+        self.exit_path = None
+        self.now = 0.0
+        self.clients: dict[int, Client] = {}
+        self.pending: deque[Packet] = deque()
+        self.running: Running | None = None
+        self.variables, self.types = {}, {}
+        self.faults = {"reply_error": 0}
+        # node parameters (seconds; None or <= 0 = none): no packet / no client while in the node -> Fail exit
+        self.data_timeout = data_timeout if data_timeout and data_timeout > 0 else None
+        self.connection_timeout = connection_timeout if connection_timeout and connection_timeout > 0 else None
+        self.last_packet = 0.0
+        self.entered_at = 0.0
+        self.last_error = None                          # text of the last robot error (failed motion)
+        self.fire("start_project")
+        if auto_enter:
+            self.fire("enter_node")
+
+    # ---- node state machine -------------------------------------------------------------------
+    def fire(self, event: str, **info):
+        nxt = TRANSITIONS.get((self.state, event))
+        if nxt is None:
+            raise TransitionError(f"'{event}' is not possible while the robot is {self.state.replace('_', ' ')}")
+        previous, self.state = self.state, nxt
+        self.log("state", event=event, previous=previous, state=nxt, **info)
+        action = getattr(self, "_on_" + event, None)
+        if action:
+            action(**info)
+
+    def _on_enter_node(self, **_):
+        self.variables, self.types = {}, {}
+        self.entered_at = self.last_packet = self.now
+        self.exit_path = None
+        self.push(codec.encode("TMSCT", "0," + self.send_message))
+
+    def _on_stop_project(self, **_):
+        self.robot.stop_and_clear()
+        self.robot.resume()
+        self._abort_scripts(reply=False)
+        self.variables, self.types = {}, {}
+
+    def _on_robot_fault(self, reason="", **_):
+        self.last_error = reason
+        self._on_stop_project()
+
+    def _on_leave_node(self, path="Pass", **_):
+        self.exit_path = path
+        self._stop_robot()
+        self.variables, self.types = {}, {}
+        self._abort_scripts(reply=True)
+
+    def _on_drain_done(self, **_):
+        self.exit_path = "Pass"
+        self.variables, self.types = {}, {}
+        self._pump()
+
+    def _abort_scripts(self, reply):
+        if self.running is not None:
+            if reply:
+                self._reply(self.running.packet, "OK")
+            self.running = None
+        if reply:
+            self._pump()
+        else:
+            self.pending.clear()
+
+    # ---- connections --------------------------------------------------------------------------
+    def connect(self, conn: int, peer="127.0.0.1"):
+        self.clients[conn] = Client(peer)
+        self.log("connect", conn=conn, peer=peer)
+
+    def disconnect(self, conn: int):
+        if self.clients.pop(conn, None) is not None:
+            self.log("disconnect", conn=conn)
+
+    def send(self, conn, frame: bytes):
+        client = self.clients.get(conn)
+        if client is not None:
+            client.outbox.append(frame)
+
+    def push(self, frame: bytes, ip_filter=None):
+        for conn, client in self.clients.items():
+            if ip_filter is None or client.peer == ip_filter:
+                client.outbox.append(frame)
+
+    # ---- input --------------------------------------------------------------------------------
+    def handle(self, conn: int, item):
+        """Process one decoded item (codec.Frame / BadFrame / Garbage) from connection ``conn``."""
+        self.last_packet = self.now
+        if isinstance(item, codec.Garbage):
+            self.log("garbage", conn=conn, bytes=len(item.raw))
+        elif isinstance(item, codec.BadFrame):
+            self.log("bad_frame", conn=conn, code=item.code, reason=item.reason)
+            self.send(conn, codec.encode("CPERR", item.code))
+        elif item.header == "TMSTA":
+            self._tmsta(conn, item.data)
+        elif item.header == "TMSCT":
+            self._tmsct(conn, item.data)
+        else:
+            self.send(conn, codec.encode("CPERR", codec.CPERR_HEADER))
+
+    def _tmsta(self, conn, data: bytes):
+        text = data.decode("utf-8", "replace")
+        sub, _, param = text.partition(",")
+        if sub == "00":
+            reply = f"00,true,{self.send_message}" if self.state in (IN_NODE, EXITING) else "00,false,"
+        elif sub == "01" and param:
+            try:
+                tag = int(param)
+            except ValueError:
+                tag = None
+            reply = f"01,{param},{self.robot.tag_status(tag) if tag is not None else 'none'}"
+        else:
+            self.send(conn, codec.encode("CPERR", codec.CPERR_DATA))
+            return
+        self.send(conn, codec.encode("TMSTA", reply))
+
+    def _tmsct(self, conn, data: bytes):
+        ident, comma, body = data.partition(b",")
+        try:
+            ident_text, script = ident.decode("ascii"), body.decode("utf-8")
+        except UnicodeDecodeError:
+            ident_text, script = "", ""
+        if not comma or not ident_text or not ident_text.isalnum():
+            self.send(conn, codec.encode("CPERR", codec.CPERR_DATA))
+            return
+        packet = Packet(conn, ident_text, script)
+        if self.state not in (IN_NODE, EXITING):
+            self._not_in_node(packet)
+            return
+        priority = priority_command(script)
+        if priority is not None:
+            self._priority(packet, *priority)
+            return
+        self.pending.append(packet)
+        self._pump()
+
+    def _not_in_node(self, packet):
+        self.log("rejected", conn=packet.conn, id=packet.id, reason="not in the Listen node")
+        self.send(packet.conn, codec.encode("CPERR", codec.CPERR_NOT_IN_NODE))
+
+    # ---- priority commands --------------------------------------------------------------------
+    def _priority(self, packet, name, arg):
+        self.log("priority", conn=packet.conn, id=packet.id, command=f"{name}({arg})")
+        self._stop_robot()
+        if name == "ScriptExit":
+            if self.running is not None:
+                self._reply(self.running.packet, "OK")
+                self.running = None
+            self._reply(packet, "OK")
+            self.fire("leave_node", path="Pass" if arg == 1 else "Fail")
+            return
+        if arg >= 1 and self.running is not None:
+            self._reply(self.running.packet, "OK")
+            self.running = None
+        if arg == 2:
+            for dropped in self.pending:
+                self.log("discarded", conn=dropped.conn, id=dropped.id)
+            self.pending.clear()
+        self._reply(packet, "OK")
+        self._pump()
+
+    def _stop_robot(self):
+        dropped = self.robot.stop_and_clear()
+        self.log("stop", dropped_tags=dropped)
+
+    # ---- script execution ---------------------------------------------------------------------
+    def _reply(self, packet, status):
+        self.send(packet.conn, codec.encode("TMSCT", f"{packet.id},{status}"))
+
+    def _pump(self):
+        """Resume the running script if it may continue, then run buffered scripts in order until
+        one blocks or none is left (a loop, so any number of buffered scripts costs no stack)."""
+        while True:
+            self._resume_waits()
+            if self.running is not None or not self.pending:
+                return
+            packet = self.pending.popleft()
+            if packet.conn not in self.clients:
+                continue
+            if self.state != IN_NODE:
+                self._not_in_node(packet)
+                continue
+            self._start(packet)
+
+    def _start(self, packet):
+        lines = split_lines(packet.script)
+        if self.faults["reply_error"] > 0:
+            self.faults["reply_error"] -= 1
+            self.log("fault", fault="reply_error", id=packet.id)
+            self._reply(packet, "ERROR;1")
+            return
+        check_script(lines, self.types)
+        errors = [line.number for line in lines if line.error]
+        for line in lines:
+            if line.error:
+                self.log("script_error", id=packet.id, line=line.number, text=line.text, reason=line.error)
+        if errors:
+            self._reply(packet, "ERROR;" + ";".join(map(str, errors)))
+            return
+        warnings = [line.number for line in lines if line.warnings]
+        ctx = Context(self.robot, self.variables, self.types, self._listen_send, self._stop_robot,
+                      lambda line, p=packet: self.log("script_line", conn=p.conn, id=p.id,
+                                                      line=line.number, text=line.text))
+        self.running = Running(packet, run_script(lines, ctx), warnings)
+        self._step(None)
+
+    def _step(self, value):
+        run = self.running
+        try:
+            request = run.gen.send(value)
+        except StopIteration as stop:
+            self.running = None
+            self._reply(run.packet, "OK" + "".join(f";{n}" for n in run.warnings))
+            if stop.value == "exit":
+                self.fire("script_exit")
+                self._check_drain()
+            return
+        except ScriptRuntimeError as exc:
+            self.running = None
+            line = str(exc).split(":")[0].replace("line ", "")
+            self.log("runtime_error", id=run.packet.id, reason=str(exc))
+            self._reply(run.packet, "ERROR;" + line)
+            return
+        _kind, tag, timeout = request
+        run.wait = ("tag", tag, None if timeout is None else self.now + timeout)
+
+    def _resume_waits(self):
+        """Resume the running script if what it waits for has happened."""
+        while self.running is not None and self.running.wait is not None:
+            _kind, tag, deadline = self.running.wait
+            status = self.robot.tag_status(tag)
+            if status == "true":
+                result = 1
+            elif status == "none" and deadline is None:
+                result = -1             # never queued, forgotten, or dropped by a stop
+            elif deadline is not None and self.now >= deadline:
+                result = 0
+            else:
+                return
+            self.running.wait = None
+            self._step(result)
+
+    def _listen_send(self, ip_filter, sub, payload):
+        self.push(codec.encode("TMSTA", f"{sub},".encode() + payload), ip_filter)
+
+    # ---- time ---------------------------------------------------------------------------------
+    def advance(self, now: float):
+        dt = max(0.0, now - self.now)
+        self.now = max(self.now, now)
+        if self.state == IN_NODE and (self.data_timeout or self.connection_timeout):
+            self._check_timeouts()
+        if self.state == STOPPED or (self.robot.idle and self.running is None and self.state != EXITING):
+            return
+        for event in self.robot.tick(dt):
+            kind = event.pop("kind")
+            self.log(kind, **event)
+            if kind == "tag_reached":
+                self.push(codec.encode("TMSTA", f"01,{event['tag']:02d},true"))
+        if self.robot.fault:
+            reason, self.robot.fault = self.robot.fault, None
+            self.fire("robot_fault", reason=reason)
+            return
+        self._pump()
+        self._check_drain()
+
+    def _check_timeouts(self):
+        if self.connection_timeout and not self.clients and self.now - self.entered_at >= self.connection_timeout:
+            self.fire("leave_node", path="Fail", reason="connection timeout")
+        elif self.data_timeout and self.now - self.last_packet >= self.data_timeout:
+            self.fire("leave_node", path="Fail", reason="data timeout")
+
+    def _check_drain(self):
+        if self.state == EXITING and self.robot.idle and self.running is None:
+            self.fire("drain_done")
+
+    # ---- control ------------------------------------------------------------------------------
+    def snapshot(self) -> dict:
+        data = self.robot.state()
+        data.update(in_listen_node=self.state in (IN_NODE, EXITING), node_state=self.state,
+                    project_running=self.state != STOPPED, exit_path=self.exit_path, last_error=self.last_error,
+                    buffered_scripts=len(self.pending) + (1 if self.running else 0),
+                    variables=dict(self.variables))
+        return data
+
+
+def priority_command(script: str):
+    """(name, arg) of the priority command in a packet, or None. ScriptExit wins; first one wins."""
+    found = []
+    for text in script.split("\r\n"):
+        match = _PRIORITY.match(text)
+        if match and int(match.group(2)) in _PRIORITY_ARGS[match.group(1)]:
+            found.append((match.group(1), int(match.group(2))))
+    for name in ("ScriptExit", "StopAndClearBuffer"):
+        for item in found:
+            if item[0] == name:
+                return item
+    return None

@@ -1,0 +1,153 @@
+"""Bad input and load: the simulator answers per protocol or drops that client, and keeps serving."""
+import random
+import socket
+import time
+
+from sim import codec
+from sim.script import split_lines
+from sim.checker import check_script
+from sim_harness import Harness, sct, sta
+
+
+def alive(h):
+    peer = h.connect()
+    return h.request(peer, sta("00")) == [("TMSTA", "00,true,Listen1")]
+
+
+def test_random_bytes_from_a_client_never_break_the_server(harness):
+    h = harness
+    rng = random.Random(1234)
+    noisy = h.connect()
+    for _ in range(200):
+        noisy.send(bytes(rng.randrange(256) for _ in range(rng.randrange(1, 300))))
+        h.step()
+    h.run(0.2)
+    assert alive(h)
+    assert all(f.header == "CPERR" for f in noisy.frames)
+
+
+def test_oversized_frame_is_rejected_with_cperr_01_and_bytes_are_skipped(harness):
+    h = harness
+    peer = h.connect()
+    huge = b"$TMSCT,%d,1," % (codec.MAX_DATA + 10) + b"x" * (codec.MAX_DATA + 10) + b",*00\r\n"
+    peer.send(huge + sta("00"))
+    assert h.until(lambda: ("TMSTA", "00,true,Listen1") in peer.texts(), timeout=5)
+    assert peer.texts()[0] == ("CPERR", "01")
+    assert len(peer.frames) == 2
+
+
+def test_largest_allowed_frame_is_processed(harness):
+    h = harness
+    peer = h.connect()
+    body = "1," + "\r\n".join(["ChangeLoad(1)"] * ((codec.MAX_DATA - 10) // 15))
+    assert h.request(peer, codec.encode("TMSCT", body), timeout=20) == [("TMSCT", "1,OK")]
+
+
+def test_flood_of_small_frames_is_answered_in_order(harness):
+    h = harness
+    peer = h.connect()
+    peer.send(b"".join(sta(f"01,{i % 15 + 1}") for i in range(2000)))
+    assert h.until(lambda: len(peer.frames) >= 2000, timeout=60, dt=0.001)
+    assert [t for _, t in peer.texts()][:3] == ["01,1,none", "01,2,none", "01,3,none"]
+    assert alive(h)
+
+
+def test_hundred_clients_connecting_and_vanishing(harness):
+    h = harness
+    for round_ in range(100):
+        s = socket.create_connection(("127.0.0.1", h.srv.ports[0]), timeout=5)
+        if round_ % 3 == 0:
+            s.sendall(sct(f"c{round_}", "ChangeLoad(1)")[:10])      # vanish mid-frame
+        elif round_ % 3 == 1:
+            s.sendall(sta("00"))
+        s.close()
+        h.step()
+    h.run(0.3)
+    assert alive(h)
+    assert h.robot.state()["clients"] == 1
+
+
+def test_client_that_never_reads_is_dropped_when_its_buffer_limit_is_reached(harness):
+    h = harness
+    lazy = socket.create_connection(("127.0.0.1", h.srv.ports[0]), timeout=5)
+    lazy.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    frame = sct("1", 'ListenSend(90,"' + "x" * 60000 + '")')
+    lazy.setblocking(False)
+
+    def dropped():
+        return any(e["kind"] == "closed" and "does not read" in e["reason"] for e in h.robot.events)
+
+    for _ in range(1000):
+        if dropped():
+            break
+        try:
+            lazy.sendall(frame)
+        except (BlockingIOError, ConnectionError):
+            pass
+        h.step()
+    assert dropped()
+    lazy.close()
+    assert alive(h)
+
+
+def test_seeded_fuzz_of_mutated_valid_frames_is_time_bounded():
+    rng = random.Random(20261122)
+    seeds = [sta("00"), sta("01,03"), sct("1", 'PTP("JPP",0,0,90,0,90,0,35,200,0,false)\r\nQueueTag(1)'),
+             sct("A", 'Line("CAR",400,-100,350,180,0,90,100,200,5,true)'), sct("Z", "int x = 1\r\nx++"),
+             sct("P", "StopAndClearBuffer(2)"), sct("Q", "ListenSend(90,GetString(Robot[0].Joint))"),
+             sct("R", "Circle(\"CAP\",{1,2,3,4,5,6},{7,8,9,10,11,12},100,200,0,0,false)")]
+    h = Harness()
+    deadline = time.monotonic() + 8.0
+    try:
+        peer = h.connect()
+        cases = 0
+        while time.monotonic() < deadline and cases < 3000:
+            frame = bytearray(rng.choice(seeds))
+            for _ in range(rng.randrange(1, 4)):
+                op = rng.randrange(3)
+                pos = rng.randrange(len(frame))
+                if op == 0:
+                    frame[pos] = rng.randrange(256)
+                elif op == 1:
+                    del frame[pos]
+                else:
+                    frame.insert(pos, rng.choice(b"$,*\r\n(){}\"0123456789"))
+            if peer.closed:
+                peer = h.connect()
+            peer.send(bytes(frame))
+            h.step(0.01)
+            cases += 1
+            if not h.robot.state()["project_running"]:
+                h.robot.start_project()
+            elif not h.robot.state()["in_listen_node"] and h.robot.session.state == "not_in_node":
+                h.robot.enter_listen_node()
+        h.run(0.5)
+        assert not any(e["kind"] == "internal_error" for e in h.robot.events)
+        assert cases > 100
+        assert alive(h)
+    finally:
+        h.close()
+
+
+def test_fuzzed_script_lines_never_raise_from_parser_or_checker():
+    rng = random.Random(99)
+    alphabet = 'PTPLineQueTag()[]{},."=+-*/!<>&|0123456789 abcxyzIORobot\t'
+    for _ in range(3000):
+        text = "".join(rng.choice(alphabet) for _ in range(rng.randrange(0, 60)))
+        lines = split_lines(text)
+        check_script(lines, {})
+        assert all(line.error is None or isinstance(line.error, str) for line in lines)
+
+
+def test_full_script_buffer_pauses_reading_and_resumes_when_it_drains(harness):
+    h = harness
+    peer = h.connect()
+    peer.send(sct("A", 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)\r\nQueueTag(1,1)'))
+    peer.send(b"".join(sct(f"B{i}", "ChangeLoad(1)") for i in range(1100)))
+    h.run(0.1)
+    peer.send(b"".join(sct(f"C{i}", "ChangeLoad(2)") for i in range(100)))
+    h.run(0.4)
+    assert h.robot.reading_paused and len(h.robot.session.pending) == 1100
+    assert h.until(lambda: len(peer.frames) >= 1202, timeout=30, dt=0.01)
+    assert not h.robot.reading_paused
+    assert peer.texts()[-1] == ("TMSCT", "C99,OK")

@@ -1,0 +1,358 @@
+"""SimServer over real loopback sockets, driven by poll() on a virtual clock (no sleeps)."""
+import json
+import socket
+import subprocess
+import sys
+import pathlib
+
+import pytest
+
+from sim import codec
+from sim.control import request as control_request
+from sim.server import SimServer
+
+from sim_harness import Harness, sct, sta
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+PTP_LONG = 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)'
+
+
+def test_ports_are_bound_on_loopback_and_listed(harness):
+    assert len(harness.srv.ports) == 1 and harness.srv.ports[0] > 0
+    assert harness.robot.state()["port"] == harness.srv.ports[0]
+
+
+def test_status_query_and_script_round_trip(harness):
+    peer = harness.connect()
+    assert harness.request(peer, sta("00")) == [("TMSTA", "00,true,Listen1")]
+    assert harness.request(peer, b'$TMSCT,25,1,ChangeBase("RobotBase"),*08\r\n') == [("TMSCT", "1,OK")]
+
+
+def test_nothing_is_sent_on_accept(harness):
+    peer = harness.connect()
+    harness.run(0.5)
+    assert peer.raw_reads == []
+
+
+def test_each_reply_is_written_in_its_own_send_with_upper_case_checksum(harness):
+    peer = harness.connect()
+    harness.request(peer, b"$TMSTA,3,00,,*6c\r\n")
+    assert peer.raw_reads == [b"$TMSTA,15,00,true,Listen1,*79\r\n"]
+
+
+def test_motion_with_tag_and_event_log_order(harness):
+    peer = harness.connect()
+    script = "\r\n".join([f'PTP("JPP",{10 * i},0,90,0,90,0,100,100,0,true)' for i in range(1, 7)] + ["QueueTag(1,1)"])
+    replies = harness.request(peer, sct("M1", script), count=2)
+    assert replies == [("TMSTA", "01,01,true"), ("TMSCT", "M1,OK")]
+    events = harness.robot.events
+    ends = [e for e in events if e["kind"] == "motion_end"]
+    assert [e["joints"][0] for e in ends] == [10, 20, 30, 40, 50, 60]
+    assert all(json.dumps(e) for e in events)
+    kinds = [e["kind"] for e in events]
+    assert kinds.index("frame_in") < kinds.index("script_line") < kinds.index("motion_start")
+    assert kinds[-1] == "frame_out"
+
+
+def test_two_clients_are_served_in_arrival_order(harness):
+    a, b = harness.connect(), harness.connect()
+    a.send(sct("A", PTP_LONG + "\r\nQueueTag(1,1)"))
+    harness.run(0.1)
+    b.send(sct("B", "ChangeLoad(2)"))
+    harness.run(1.0)
+    assert ("TMSCT", "B,OK") not in b.texts()
+    assert harness.until(lambda: ("TMSCT", "B,OK") in b.texts(), timeout=10)
+    assert ("TMSCT", "A,OK") in a.texts()
+
+
+def test_enter_message_goes_to_every_connected_client(harness):
+    a, b = harness.connect(), harness.connect()
+    harness.robot.leave_listen_node()
+    harness.robot.enter_listen_node()
+    assert harness.until(lambda: a.frames and b.frames)
+    assert a.texts() == b.texts() == [("TMSCT", "0,Listen1")]
+
+
+def test_stop_project_closes_everything_and_start_project_listens_again():
+    h = Harness()
+    try:
+        peer = h.connect()
+        port = h.srv.ports[0]
+        h.robot.stop_project()
+        assert h.until(lambda: peer.closed)
+        with pytest.raises(OSError):
+            socket.create_connection(("127.0.0.1", port), timeout=1).close()
+        h.robot.start_project()
+        again = h.connect()
+        assert h.request(again, sta("00")) == [("TMSTA", "00,true,Listen1")]
+        assert h.srv.ports[0] == port
+    finally:
+        h.close()
+
+
+def test_fault_reply_delay_holds_replies_on_the_virtual_clock(harness):
+    peer = harness.connect()
+    harness.robot.inject("reply_delay", seconds=0.5)
+    peer.send(sta("00"))
+    harness.run(0.4)
+    assert peer.frames == []
+    assert harness.until(lambda: peer.frames, timeout=1.0)
+    assert harness.t >= 0.5
+
+
+def test_fault_split_replies_sends_pieces(harness):
+    peer = harness.connect()
+    harness.robot.inject("split_replies", size=4)
+    harness.request(peer, sta("00"))
+    assert len(peer.raw_reads) >= 2 and b"".join(peer.raw_reads) == b"$TMSTA,15,00,true,Listen1,*79\r\n"
+
+
+def test_fault_glue_replies_sends_frames_in_one_chunk(harness):
+    peer = harness.connect()
+    harness.robot.inject("glue_replies", count=2, max_wait=10)
+    peer.send(sta("00"))
+    harness.run(0.1)
+    assert peer.frames == []
+    peer.send(sta("01,1"))
+    assert harness.until(lambda: len(peer.frames) == 2)
+    assert len(peer.raw_reads) == 1
+
+
+def test_fault_corrupt_checksum_affects_only_the_next_reply(harness):
+    peer = harness.connect()
+    harness.robot.inject("corrupt_checksum")
+    peer.send(sta("00"))
+    assert harness.until(lambda: peer.rbuf or peer.raw_reads)
+    assert peer.raw_reads[0] != b"$TMSTA,15,00,true,Listen1,*79\r\n" and not peer.frames
+    peer.rbuf.clear()
+    assert harness.request(peer, sta("00")) == [("TMSTA", "00,true,Listen1")]
+
+
+def test_fault_close_after_frames_answers_then_closes(harness):
+    peer = harness.connect()
+    harness.robot.inject("close_after", frames=2)
+    harness.request(peer, sta("00"))
+    peer.send(sta("00"))
+    assert harness.until(lambda: peer.closed)
+    assert len(peer.frames) == 2
+
+
+def test_fault_close_mid_frame(harness):
+    peer = harness.connect()
+    harness.robot.inject("close_mid_frame")
+    peer.send(sta("00"))
+    assert harness.until(lambda: peer.closed)
+    assert peer.frames == [] and 0 < len(b"".join(peer.raw_reads)) < 32
+
+
+def test_fault_reply_error(harness):
+    peer = harness.connect()
+    harness.robot.inject("reply_error")
+    assert harness.request(peer, sct("1", "ChangeLoad(1)")) == [("TMSCT", "1,ERROR;1")]
+    assert not any(e["kind"] == "script_line" for e in harness.robot.events)
+
+
+def test_fault_black_hole_then_clear(harness):
+    peer = harness.connect()
+    harness.robot.inject("black_hole")
+    peer.send(sta("00"))
+    harness.run(1.0)
+    assert peer.frames == []
+    harness.robot.clear_faults()
+    assert harness.request(peer, sta("00")) == [("TMSTA", "00,true,Listen1")]
+
+
+def test_fault_refuse_connections_keeps_existing_clients(harness):
+    peer = harness.connect()
+    harness.robot.inject("refuse_connections")
+    with pytest.raises(OSError):
+        socket.create_connection(("127.0.0.1", harness.srv.ports[0]), timeout=1).close()
+    assert harness.request(peer, sta("00")) == [("TMSTA", "00,true,Listen1")]
+    harness.robot.inject("refuse_connections", enabled=False)
+    assert harness.request(harness.connect(), sta("00")) == [("TMSTA", "00,true,Listen1")]
+
+
+def test_fault_leave_node_and_stop_project(harness):
+    peer = harness.connect()
+    harness.robot.inject("leave_node")
+    assert harness.request(peer, sct("1", "QueueTag(1)")) == [("CPERR", "F1")]
+    harness.robot.inject("stop_project")
+    assert harness.until(lambda: peer.closed)
+
+
+def test_unknown_fault_is_a_clear_error(harness):
+    with pytest.raises(ValueError, match="unknown fault 'explode'"):
+        harness.robot.inject("explode")
+    with pytest.raises(ValueError, match="bad parameter"):
+        harness.robot.inject("split_replies", size="big")
+
+
+def test_half_closed_client_still_gets_its_reply_then_is_closed(harness):
+    peer = harness.connect()
+    peer.send(sct("H", PTP_LONG + "\r\nQueueTag(1,1)"))
+    peer.sock.shutdown(socket.SHUT_WR)
+    assert harness.until(lambda: peer.closed, timeout=10)
+    assert ("TMSCT", "H,OK") in peer.texts()
+
+
+def test_many_robots_on_consecutive_ports_are_independent():
+    probe = socket.socket()
+    probe.bind(("127.0.0.1", 0))
+    base = probe.getsockname()[1]
+    probe.close()
+    try:
+        srv = SimServer(port=base, robots=3).start()
+    except OSError:
+        pytest.skip("no three free consecutive ports")
+    try:
+        assert srv.ports == [base, base + 1, base + 2]
+        srv.robots[1].leave_listen_node()
+        assert [r.state()["in_listen_node"] for r in srv.robots] == [True, False, True]
+    finally:
+        srv.close()
+
+
+def test_control_channel_commands():
+    srv = SimServer(port=0, control_port=0).start()
+    port = srv.control.port
+    try:
+        srv.start_background()
+        assert control_request(port, {"cmd": "ping"}) == {"ok": True, "result": "pong"}
+        assert control_request(port, {"cmd": "leave_listen_node"})["ok"]
+        state = control_request(port, {"cmd": "state", "robot": 0})["result"]
+        assert state["in_listen_node"] is False
+        assert control_request(port, {"cmd": "enter_listen_node"})["ok"]
+        assert control_request(port, {"cmd": "inject", "fault": "reply_delay", "params": {"seconds": 0.1}})["ok"]
+        events = control_request(port, {"cmd": "events", "since": 0})["result"]
+        assert any(e["kind"] == "fault" for e in events["events"]) and events["next"] == len(events["events"])
+        bad = control_request(port, {"cmd": "enter_listen_node"})
+        assert bad["ok"] is False and "in node" in bad["error"]
+        assert "unknown command" in control_request(port, {"cmd": "fly"})["error"]
+        assert "does not exist" in control_request(port, {"cmd": "state", "robot": 7})["error"]
+        assert control_request(port, {"cmd": "inject", "fault": "nope"})["ok"] is False
+    finally:
+        srv.close()
+
+
+def test_event_log_file_is_json_lines(tmp_path):
+    log = tmp_path / "events.jsonl"
+    h = Harness(log_path=str(log))
+    try:
+        peer = h.connect()
+        h.request(peer, sta("00"))
+    finally:
+        h.close()
+    lines = [json.loads(line) for line in log.read_text().splitlines()]
+    assert {"listening", "frame_in", "frame_out"} <= {e["kind"] for e in lines}
+    assert all("t" in e and "robot" in e for e in lines)
+
+
+def test_cli_starts_prints_one_line_per_robot_and_stops_on_terminate(tmp_path):
+    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", "0",
+                             "--robots", "2", "--control-port", "0", "--speedup", "5",
+                             "--log", str(tmp_path / "log.jsonl")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        lines = [proc.stdout.readline() for _ in range(3)]
+        assert lines[0].startswith("robot 1: TM5-700 listening on 127.0.0.1:")
+        assert lines[1].startswith("robot 2: ")
+        assert lines[2].startswith("control channel: ")
+        port = int(lines[2].split(":")[2].split()[0])
+        assert control_request(port, {"cmd": "robots"})["result"][1]["node_state"] == "in_node"
+    finally:
+        proc.terminate()
+        out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 0 and "Traceback" not in err
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--robots", "0"], "--robots must be between 1 and 512"),
+    (["--speedup", "0"], "--speedup must be positive"),
+    (["--port", "65535", "--robots", "2"], "leaves the port range"),
+])
+def test_cli_rejects_bad_arguments_with_a_clear_message(args, message):
+    result = subprocess.run([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), *args],
+                            capture_output=True, text=True, timeout=20)
+    assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
+
+
+def test_cli_reports_a_busy_port_without_traceback():
+    blocker = socket.socket()
+    blocker.bind(("127.0.0.1", 0))
+    blocker.listen(1)
+    port = blocker.getsockname()[1]
+    try:
+        result = subprocess.run([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(port),
+                                 "--no-control"], capture_output=True, text=True, timeout=20)
+    finally:
+        blocker.close()
+    assert result.returncode == 1 and f"cannot listen on 127.0.0.1:{port}" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_poll_is_deterministic_for_the_same_inputs():
+    def run_once():
+        h = Harness()
+        try:
+            peer = h.connect()
+            h.request(peer, sct("1", PTP_LONG + "\r\nQueueTag(1,1)"), count=2)
+            return [(e["t"], e["kind"]) for e in h.robot.events if e["kind"].startswith("motion")]
+        finally:
+            h.close()
+    assert run_once() == run_once()
+
+
+def test_listen_send_int_array_goes_out_as_little_endian_binary(harness):
+    peer = harness.connect()
+    replies = harness.request(peer, sct("1", "int[] v = {1,2}\r\nListenSend(93,v)"), count=2)
+    assert replies[0][0] == "TMSTA" and peer.frames[0].data == b"93," + (1).to_bytes(4, "little") + (2).to_bytes(4, "little")
+    assert codec.checksum(peer.frames[0].raw[1:-5]) == int(peer.frames[0].raw[-4:-2], 16)
+
+
+def test_event_log_proves_a_discarded_frame_was_never_executed(harness):
+    peer = harness.connect()
+    peer.send(sct("A", PTP_LONG + "\r\nQueueTag(1,1)"))
+    peer.send(sct("B", "ChangeLoad(4)"))
+    harness.run(0.1)
+    assert harness.request(peer, sct("C", "StopAndClearBuffer(2)"), count=2) == [("TMSCT", "A,OK"), ("TMSCT", "C,OK")]
+    harness.run(1.0)
+    events = harness.robot.events
+    assert any(e["kind"] == "frame_in" and e["data"].startswith("B,") for e in events)
+    assert not any(e["kind"] == "script_line" and e["id"] == "B" for e in events)
+    assert [e["id"] for e in events if e["kind"] == "discarded"] == ["B"]
+    assert harness.robot.state()["load"] == 0.0
+
+
+def test_robot_error_stops_the_project_and_closes_connections(harness):
+    peer = harness.connect()
+    harness.request(peer, sct("1", 'Line("CPP",2000,0,0,180,0,0,10,200,0,true)'))
+    assert harness.until(lambda: peer.closed, timeout=2)
+    state = harness.robot.state()
+    assert state["project_running"] is False and "out of reach" in state["last_error"]
+    closed = [e for e in harness.robot.events if e["kind"] == "closed"]
+    assert closed and "out of reach" in closed[-1]["reason"]
+    harness.robot.start_project()
+    assert harness.request(harness.connect(), sta("00")) == [("TMSTA", "00,true,Listen1")]
+
+
+def test_clearing_faults_still_delivers_held_replies(harness):
+    peer = harness.connect()
+    harness.robot.inject("reply_delay", seconds=0.3)
+    peer.send(sta("00"))
+    harness.run(0.1)
+    harness.robot.clear_faults()
+    assert harness.until(lambda: peer.frames, timeout=1.0)
+
+
+def test_wait_event_returns_an_event_logged_by_the_background_thread():
+    srv = SimServer(port=0).start_background()
+    try:
+        robot = srv.robots[0]
+        sock = socket.create_connection(("127.0.0.1", srv.ports[0]), timeout=5)
+        sock.sendall(sta("00"))
+        event = robot.wait_event("frame_out", timeout=5, header="TMSTA")
+        assert event is not None and event["data"] == "00,true,Listen1"
+        assert robot.wait_event("frame_out", timeout=0.05, header="CPERR") is None
+        sock.close()
+    finally:
+        srv.close()
