@@ -1,0 +1,86 @@
+"""Test rig: the library on the virtual PLC against the simulator, scan by scan on virtual time (Contract D)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from sim.server import SimServer
+from vplc.api import load_plc
+
+ROOT = Path(__file__).resolve().parents[2]
+LIB = ROOT / "lib" / "CBT_Commands_Lib"
+ST = Path(__file__).resolve().parent / "st"
+SEC = 1_000_000_000
+
+HOME_JOINTS = dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=0)
+
+
+class Rig:
+    """One simulator robot + the library program Main_Lib.st, pumped once per PLC scan."""
+
+    def __init__(self, program="Main_Lib.st", connect=True, load_args=None, **sim_args):
+        sim_args.setdefault("auto_enter", True)
+        self.srv = SimServer(host="127.0.0.1", port=0, **sim_args)
+        self.srv.start()
+        self.robot = self.srv.robots[0]
+        self.plc = load_plc([str(LIB), str(ST / program)], task="Main@1ms", **(load_args or {}))
+        self.plc.write("Main.Port", self.srv.ports[0])
+        if connect:
+            self.write("ConnExec", True)
+            assert self.until(lambda: self.read("conn.Connected"), 5), self.read("conn.ErrorDescrip")
+
+    # --- access -------------------------------------------------------------------------------
+    def read(self, path):
+        return self.plc.read("Main." + path)
+
+    def write(self, path, value):
+        self.plc.write("Main." + path, value)
+
+    def set_struct(self, path, values: dict):
+        for key, value in values.items():
+            if isinstance(value, dict):
+                self.set_struct(f"{path}.{key}", value)
+            else:
+                self.write(f"{path}.{key}", value)
+
+    # --- time ---------------------------------------------------------------------------------
+    def pump(self, now_ns):
+        self.srv.poll(now_ns / 1e9)
+
+    def until(self, pred, seconds, on_scan=None):
+        def hook(now_ns):
+            self.pump(now_ns)
+            if on_scan:
+                on_scan(now_ns)
+        return self.plc.run_until(pred, timeout_ns=int(seconds * SEC), on_scan=hook)
+
+    def scans(self, n):
+        for _ in range(n):
+            now = self.plc.now_ns + self.plc.period_ns
+            self.pump(now)
+            self.plc.scan(now)
+
+    # --- simulator log ------------------------------------------------------------------------
+    def events(self, kind):
+        return [e for e in self.robot.events if e["kind"] == kind]
+
+    def scripts_in(self):
+        """(id, script) of every TMSCT frame the robot received, in order."""
+        out = []
+        for e in self.events("frame_in"):
+            if e.get("header") == "TMSCT":
+                ident, _, script = e["data"].partition(",")
+                out.append((ident, script))
+        return out
+
+    def close(self):
+        self.plc.close()
+        self.srv.close()
+
+
+def move_abs(**kw):
+    """stCBT_MovAbsParam values: PTP JPP to the home joints at 50 %, non-blended, unless overridden."""
+    p = dict(MovementCommand=1, DataFormat=0, TargetPosition=dict(HOME_JOINTS), Speed=50, AccelTime=200,
+             BlendingEnable=False, BlendingValue=0, PrecisePositioning=False, RobotPoseEnable=False,
+             ExitNode=False)
+    p.update(kw)
+    return p
