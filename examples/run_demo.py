@@ -1,0 +1,160 @@
+"""`make demo`: robot simulator + virtual PLC running the examples in real time + web HMI, stopped by Ctrl-C.
+
+    python examples/run_demo.py [--host 127.0.0.1] [--robot-port 5890] [--hmi-port 8080]
+"""
+from __future__ import annotations
+
+import argparse
+import errno
+import pathlib
+import signal
+import socket
+import sys
+import threading
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+for entry in (ROOT / "src", ROOT):
+    if str(entry) not in sys.path:
+        sys.path.insert(0, str(entry))
+
+from sim.server import SimServer  # noqa: E402
+from vplc.hmi_server import HmiServer, Mapping, MappingError  # noqa: E402
+
+SOURCES = [ROOT / "lib" / "CBT_Commands_Lib", ROOT / "examples"]
+
+
+class DemoError(Exception):
+    """A problem the user can fix; str() is printed as it is."""
+
+
+def check_port_free(host: str, port: int, what: str, option: str) -> None:
+    probe = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        probe.bind((host, port))
+    except OSError as exc:
+        if exc.errno == errno.EADDRINUSE:
+            raise DemoError(f"error: port {port} on {host} ({what}) is already in use - is another demo or "
+                            f"simulator running? Stop it, or choose another port with {option} PORT.") from None
+        raise DemoError(f"error: cannot use {host}:{port} for the {what}: {exc.strerror}") from None
+    finally:
+        probe.close()
+
+
+def tcp_port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: '{text}'") from None
+    if not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"{port} is not a TCP port (1..65535)")
+    return port
+
+
+def parse_args(argv):
+    parser = argparse.ArgumentParser(prog="make demo", description=__doc__.splitlines()[0])
+    parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    parser.add_argument("--robot-port", type=tcp_port, default=5890, help="robot Listen Node port (default 5890)")
+    parser.add_argument("--hmi-port", type=tcp_port, default=8080, help="web HMI port (default 8080)")
+    return parser.parse_args(argv)
+
+
+class Demo:
+    def __init__(self, host: str, robot_port: int, hmi_port: int):
+        self.host, self.robot_port, self.hmi_port = host, robot_port, hmi_port
+        self.stop_event = threading.Event()
+        self.sim = self.plc = self.hmi = self.plc_thread = None
+        self.fault: str | None = None
+
+    def start(self) -> None:
+        check_port_free(self.host, self.robot_port, "robot simulator", "--robot-port")
+        check_port_free(self.host, self.hmi_port, "web HMI", "--hmi-port")
+        try:
+            mapping = Mapping.load()
+        except MappingError as exc:
+            raise DemoError(f"error: {exc}") from None
+        try:
+            from vplc.api import LoadError, load_plc
+        except ImportError as exc:
+            raise DemoError(f"error: the virtual PLC runtime is missing from this checkout ({exc})") from None
+        try:
+            self.plc = load_plc([str(p) for p in SOURCES])
+        except LoadError as exc:
+            raise DemoError(f"error: the example programs do not compile:\n{exc}") from None
+        try:
+            mapping.check_against_plc(self.plc)
+        except MappingError as exc:
+            raise DemoError(f"error: {exc}") from None
+        with self.plc.lock:
+            self.plc.write("Connect_AddressIP", self.host)
+            self.plc.write("Connect_Dest_PortIP", self.robot_port)
+        self.sim = SimServer(host=self.host, port=self.robot_port, robots=1)
+        try:
+            self.sim.start_background()
+        except OSError as exc:
+            raise DemoError(f"error: robot simulator: {exc.strerror}") from None
+        self.hmi = HmiServer(self.plc, mapping, host=self.host, port=self.hmi_port)
+        try:
+            self.hmi.start()
+        except OSError as exc:
+            raise DemoError(f"error: web HMI on {self.host}:{self.hmi_port}: {exc.strerror}") from None
+        self.plc_thread = threading.Thread(target=self._run_plc, name="vplc-realtime", daemon=True)
+        self.plc_thread.start()
+
+    def _run_plc(self) -> None:
+        from vplc.api import PlcFault
+        try:
+            self.plc.run_realtime(self.stop_event)
+        except PlcFault as exc:
+            self.fault = f"PLC major fault - the virtual PLC stopped:\n{exc}"
+            self.stop_event.set()
+
+    def banner(self) -> str:
+        period_ms = self.plc.period_ns / 1e6
+        return "\n".join([
+            "CBT_Commands_Lib demo is running:",
+            f"  robot simulator   TM Listen Node, 1 robot on {self.host}:{self.robot_port}",
+            f"  virtual PLC       PnP_Example + Commands_Example in a {period_ms:g} ms task (real time)",
+            f"  web HMI           {self.hmi.url}",
+            "",
+            f"Open {self.hmi.url} in a browser, press Connect, then try the Motion pages.",
+            "Press Ctrl-C to stop.",
+        ])
+
+    def stop(self) -> None:
+        self.stop_event.set()
+        if self.plc_thread is not None:
+            self.plc_thread.join(timeout=5)
+        if self.hmi is not None:
+            self.hmi.stop()
+        if self.plc is not None:
+            self.plc.close()
+        if self.sim is not None:
+            self.sim.close()
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    demo = Demo(args.host, args.robot_port, args.hmi_port)
+    signal.signal(signal.SIGTERM, lambda *_: demo.stop_event.set())
+    try:
+        demo.start()
+        print(demo.banner(), flush=True)
+        while not demo.stop_event.wait(0.5):
+            pass
+    except DemoError as exc:
+        print(exc, file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        pass
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)     # a second Ctrl-C must not interrupt the shutdown
+        demo.stop()
+    if demo.fault:
+        print(demo.fault, file=sys.stderr)
+        return 1
+    print("Demo stopped: simulator, virtual PLC and web HMI are shut down.")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

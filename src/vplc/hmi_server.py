@@ -1,0 +1,409 @@
+"""Web HMI server: serves hmi/ and a JSON API over the PLC-HMI variable table (hmi/mapping.json).
+
+The browser is not trusted. Every write names a variable of the mapping file, is checked against its type
+and range here again, and reaches the PLC only through Contract A (plc.write under plc.lock). Reads are
+limited to mapped variables too.
+
+API (all answers are JSON objects with "ok"):
+  GET  /api/mapping                         the variable table (types, ranges, enumerations)
+  GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "values": {name: value}}
+  POST /api/write   {"values": {path: v}}   validate all, then write all in one scan gap
+  POST /api/execute {"execute": "X_Execute", "values": {path: v}}
+                                            validate, write the values and Execute := FALSE, wait for one
+                                            PLC scan, then Execute := TRUE (a clean rising edge per press)
+"""
+from __future__ import annotations
+
+import datetime
+import ipaddress
+import json
+import math
+import mimetypes
+import pathlib
+import threading
+import time
+from http import HTTPStatus
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from urllib.parse import parse_qs, urlsplit
+
+HMI_DIR = pathlib.Path(__file__).resolve().parents[2] / "hmi"
+DEFAULT_MAPPING = HMI_DIR / "mapping.json"
+MAX_BODY = 16 * 1024
+MAX_NAMES = 400
+SCAN_WAIT_S = 1.0
+
+INT_RANGES = {
+    "SINT": (-2**7, 2**7 - 1), "INT": (-2**15, 2**15 - 1), "DINT": (-2**31, 2**31 - 1),
+    "LINT": (-2**63, 2**63 - 1), "USINT": (0, 2**8 - 1), "UINT": (0, 2**16 - 1), "UDINT": (0, 2**32 - 1),
+    "ULINT": (0, 2**64 - 1), "BYTE": (0, 2**8 - 1), "WORD": (0, 2**16 - 1), "DWORD": (0, 2**32 - 1),
+    "LWORD": (0, 2**64 - 1),
+}
+REAL_TYPES = {"REAL", "LREAL"}
+
+
+class MappingError(Exception):
+    """The mapping file is unreadable, inconsistent, or does not match the PLC program."""
+
+
+class RequestError(Exception):
+    """A request the HMI server refuses; str() is the message shown to the operator."""
+
+    def __init__(self, message: str, status: HTTPStatus = HTTPStatus.BAD_REQUEST):
+        super().__init__(message)
+        self.status = status
+
+
+class Leaf:
+    """One scalar PLC variable reachable from the HMI (a mapped variable or a field inside one)."""
+
+    __slots__ = ("path", "type", "access", "min", "max", "enum", "maxlen", "pattern", "execute", "unit")
+
+    def __init__(self, path: str, spec: dict, access: str, enum: dict | None = None):
+        self.path = path
+        self.type = spec["type"]
+        self.access = access
+        self.enum = enum
+        self.min = spec.get("min")
+        self.max = spec.get("max")
+        self.maxlen = spec.get("maxlen")
+        self.pattern = spec.get("pattern")
+        self.execute = bool(spec.get("execute"))
+        self.unit = spec.get("unit", "")
+
+    def describe_range(self) -> str:
+        if self.enum:
+            return "one of " + ", ".join(f"{k} ({v})" for k, v in self.enum.items())
+        return f"{self.min} .. {self.max}"
+
+
+def _string_length(type_text: str) -> int | None:
+    if type_text.startswith("STRING[") and type_text.endswith("]"):
+        return int(type_text[7:-1])
+    return 80 if type_text == "STRING" else None
+
+
+class Mapping:
+    """The PLC-HMI variable table flattened to leaf paths such as 'PnP_MoveParameters[2].TargetPosition.X'."""
+
+    def __init__(self, document: dict, source: str = "mapping"):
+        self.document = document
+        self.source = source
+        self.leaves: dict[str, Leaf] = {}
+        self.roots: dict[str, dict] = {}
+        try:
+            types = document["types"]
+            for name, spec in document["variables"].items():
+                self.roots[name] = spec
+                access = spec.get("access", "r")
+                if access not in ("r", "rw"):
+                    raise MappingError(f"{source}: variable '{name}': access must be 'r' or 'rw', not {access!r}")
+                self._expand(name, spec, access, types)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MappingError(f"{source}: malformed variable table ({type(exc).__name__}: {exc})") from None
+
+    @classmethod
+    def load(cls, path: pathlib.Path | str = DEFAULT_MAPPING) -> "Mapping":
+        path = pathlib.Path(path)
+        try:
+            document = json.loads(path.read_text(encoding="utf-8"))
+        except OSError as exc:
+            raise MappingError(f"{path}: cannot read the HMI variable table ({exc.strerror})") from None
+        except json.JSONDecodeError as exc:
+            raise MappingError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
+        return cls(document, str(path))
+
+    def _expand(self, path: str, spec: dict, access: str, types: dict) -> None:
+        if "array" in spec:
+            low, high = spec["array"]
+            for index in range(low, high + 1):
+                self._expand_element(f"{path}[{index}]", spec, access, types)
+        else:
+            self._expand_element(path, spec, access, types)
+
+    def _expand_element(self, path: str, spec: dict, access: str, types: dict) -> None:
+        type_name = spec["type"]
+        definition = types.get(type_name)
+        if definition is None:
+            if type_name not in INT_RANGES and type_name not in REAL_TYPES and type_name != "BOOL" \
+                    and _string_length(type_name) is None and type_name not in ("DATE_AND_TIME", "DT", "TIME"):
+                raise MappingError(f"{self.source}: '{path}' has unknown type '{type_name}'")
+            self.leaves[path] = Leaf(path, spec, access)
+        elif "enum" in definition:
+            self.leaves[path] = Leaf(path, spec, access, enum=dict(definition["enum"]))
+        else:
+            for field, field_spec in definition["fields"].items():
+                self._expand(f"{path}.{field}", field_spec, access, types)
+
+    def is_readable(self, name: str) -> bool:
+        """A mapped variable, a leaf inside one, or an inner struct/array element of one."""
+        if name in self.roots or name in self.leaves:
+            return True
+        return any(leaf.startswith(name + ".") or leaf.startswith(name + "[") for leaf in self.leaves)
+
+    def check_against_plc(self, plc) -> None:
+        """Raise MappingError listing every mapped leaf the PLC does not have with the same type."""
+        problems = []
+        for path, leaf in self.leaves.items():
+            try:
+                with plc.lock:
+                    actual = plc.var_type(path)
+            except (KeyError, ValueError) as exc:
+                problems.append(f"  {path}: not found in the PLC program ({exc})")
+                continue
+            bare = actual.rsplit("\\", 1)[-1]
+            expected = leaf.type
+            same = bare == expected or (expected in ("DATE_AND_TIME", "DT") and bare in ("DATE_AND_TIME", "DT"))
+            if not same and _string_length(expected) is not None and _string_length(bare) is not None:
+                same = _string_length(bare) >= _string_length(expected) or leaf.access == "r"
+            if not same:
+                problems.append(f"  {path}: the table says {expected}, the PLC program declares {actual}")
+        if problems:
+            raise MappingError(f"{self.source} does not match the PLC program:\n" + "\n".join(problems))
+
+
+def validate(leaf: Leaf, value):
+    """Return the value to hand to plc.write, or raise RequestError saying what is wrong."""
+    where = f"'{leaf.path}'"
+    if leaf.enum is not None:
+        if isinstance(value, str) and value in leaf.enum:
+            return leaf.enum[value]
+        if isinstance(value, int) and not isinstance(value, bool) and value in leaf.enum.values():
+            return value
+        raise RequestError(f"{where}: {value!r} is not valid, expected {leaf.describe_range()}")
+    if leaf.type == "BOOL":
+        if not isinstance(value, bool):
+            raise RequestError(f"{where} is BOOL: expected true or false, got {json.dumps(value)}")
+        return value
+    if leaf.type in INT_RANGES:
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if not isinstance(value, int) or isinstance(value, bool):
+            raise RequestError(f"{where} is {leaf.type}: expected a whole number, got {json.dumps(value)}")
+        low, high = INT_RANGES[leaf.type]
+        low = low if leaf.min is None else max(low, leaf.min)
+        high = high if leaf.max is None else min(high, leaf.max)
+        if not low <= value <= high:
+            raise RequestError(f"{where}: {value} is out of range {low} .. {high}")
+        return value
+    if leaf.type in REAL_TYPES:
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            raise RequestError(f"{where} is {leaf.type}: expected a number, got {json.dumps(value)}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise RequestError(f"{where}: the value must be a finite number")
+        if (leaf.min is not None and value < leaf.min) or (leaf.max is not None and value > leaf.max):
+            raise RequestError(f"{where}: {value:g} is out of range {leaf.min} .. {leaf.max}")
+        return value
+    size = _string_length(leaf.type)
+    if size is not None:
+        if not isinstance(value, str):
+            raise RequestError(f"{where} is {leaf.type}: expected text, got {json.dumps(value)}")
+        limit = min(size - 1, leaf.maxlen or size)   # Sysmac STRING[n] holds n-1 characters (NUL)
+        if len(value) > limit or not value.isascii():
+            raise RequestError(f"{where}: text must be at most {limit} ASCII characters")
+        if leaf.pattern == "ipv4":
+            try:
+                ipaddress.IPv4Address(value)
+            except ValueError:
+                raise RequestError(f"{where}: '{value}' is not an IPv4 address such as 192.168.1.10") from None
+        return value
+    raise RequestError(f"{where} ({leaf.type}) cannot be written from the HMI")
+
+
+def format_dt(value) -> str:
+    """DATE_AND_TIME as the runtime holds it (ns since 1970-01-01) -> 'DT#2026-11-22-21:42:38'; 0 -> '—'."""
+    if not isinstance(value, int) or isinstance(value, bool):
+        return str(value)
+    if value == 0:
+        return "—"
+    moment = datetime.datetime(1970, 1, 1) + datetime.timedelta(microseconds=value // 1000)
+    return moment.strftime("DT#%Y-%m-%d-%H:%M:%S")
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if hasattr(value, "value") and isinstance(getattr(value, "value"), int):
+        return value.value
+    return str(value)
+
+
+class HmiServer:
+    """HTTP server for one PLC. start() binds (port 0 = ephemeral), serves in a thread; stop() ends it."""
+
+    def __init__(self, plc, mapping: Mapping | None = None, host: str = "127.0.0.1", port: int = 8080,
+                 root: pathlib.Path = HMI_DIR):
+        self.plc = plc
+        self.mapping = mapping or Mapping.load()
+        self.host = host
+        self.requested_port = port
+        self.root = pathlib.Path(root).resolve()
+        self._httpd: ThreadingHTTPServer | None = None
+        self._thread: threading.Thread | None = None
+        self.requests = 0
+
+    @property
+    def port(self) -> int:
+        return self._httpd.server_address[1] if self._httpd else self.requested_port
+
+    @property
+    def url(self) -> str:
+        return f"http://{self.host}:{self.port}/"
+
+    def start(self) -> None:
+        handler = type("BoundHandler", (_Handler,), {"hmi": self})
+        self._httpd = ThreadingHTTPServer((self.host, self.requested_port), handler)
+        self._httpd.daemon_threads = True
+        self._thread = threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.1},
+                                        name="hmi-http", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        if self._httpd:
+            self._httpd.shutdown()
+            self._httpd.server_close()
+            self._thread.join(timeout=5)
+            self._httpd = None
+
+    # --- operations behind the API -------------------------------------------------------------
+    def read(self, names: list[str]) -> dict:
+        if not names:
+            raise RequestError("give the variables to read: /api/read?names=Name1,Name2")
+        if len(names) > MAX_NAMES:
+            raise RequestError(f"at most {MAX_NAMES} variables per read")
+        unknown = [n for n in names if not self.mapping.is_readable(n)]
+        if unknown:
+            raise RequestError("not in the HMI variable table: " + ", ".join(unknown[:10]), HTTPStatus.FORBIDDEN)
+        with self.plc.lock:
+            values = {name: self.plc.read(name) for name in names}
+            now = self.plc.now_ns
+        for name in names:
+            leaf = self.mapping.leaves.get(name)
+            if leaf is not None and leaf.type in ("DATE_AND_TIME", "DT"):
+                values[name] = format_dt(values[name])
+        return {"ok": True, "time_ns": now, "values": _jsonable(values)}
+
+    def _checked(self, values) -> list[tuple[str, object]]:
+        if not isinstance(values, dict) or not values:
+            raise RequestError('"values" must be a non-empty object {"Variable": value, ...}')
+        checked = []
+        for path, value in values.items():
+            leaf = self.mapping.leaves.get(path)
+            if leaf is None:
+                raise RequestError(f"'{path}' is not in the HMI variable table", HTTPStatus.FORBIDDEN)
+            if leaf.access != "rw":
+                raise RequestError(f"'{path}' is read-only for the HMI", HTTPStatus.FORBIDDEN)
+            checked.append((path, validate(leaf, value)))
+        return checked
+
+    def _write_all(self, checked) -> int:
+        with self.plc.lock:
+            for path, value in checked:
+                try:
+                    self.plc.write(path, value)
+                except (ValueError, KeyError, TypeError) as exc:
+                    raise RequestError(f"the PLC refused '{path}': {exc}") from None
+            return self.plc.now_ns
+
+    def write(self, body: dict) -> dict:
+        now = self._write_all(self._checked(body.get("values")))
+        return {"ok": True, "time_ns": now}
+
+    def execute(self, body: dict) -> dict:
+        name = body.get("execute")
+        leaf = self.mapping.leaves.get(name) if isinstance(name, str) else None
+        if leaf is None or not leaf.execute:
+            raise RequestError(f'"execute" must name an Execute variable of the table, not {name!r}')
+        values = body.get("values") or {}
+        checked = self._checked(values) if values else []
+        written_at = self._write_all(checked + [(name, False)])
+        deadline = time.monotonic() + SCAN_WAIT_S
+        while self.plc.now_ns == written_at:
+            if time.monotonic() > deadline:
+                raise RequestError("the PLC is not scanning: Execute was not set", HTTPStatus.SERVICE_UNAVAILABLE)
+            time.sleep(0.0005)
+        return {"ok": True, "time_ns": self._write_all([(name, True)])}
+
+
+class _Handler(BaseHTTPRequestHandler):
+    hmi: HmiServer
+    server_version = "CBT-HMI/1.0"
+
+    def log_message(self, format, *args):  # noqa: A002 - signature of the base class
+        """Quiet: the demo prints its own status lines."""
+
+    def _send(self, status: HTTPStatus, payload: bytes, content_type: str) -> None:
+        self.send_response(status)
+        self.send_header("Content-Type", content_type)
+        self.send_header("Content-Length", str(len(payload)))
+        self.send_header("Cache-Control", "no-store")
+        self.end_headers()
+        self.wfile.write(payload)
+
+    def _json(self, status: HTTPStatus, obj: dict) -> None:
+        self._send(status, json.dumps(obj).encode("utf-8"), "application/json")
+
+    def _fail(self, error: RequestError) -> None:
+        self._json(error.status, {"ok": False, "error": str(error)})
+
+    def do_GET(self):  # noqa: N802 - http.server naming
+        self.hmi.requests += 1
+        url = urlsplit(self.path)
+        try:
+            if url.path == "/api/mapping":
+                self._json(HTTPStatus.OK, {"ok": True, **self.hmi.mapping.document})
+            elif url.path == "/api/read":
+                query = parse_qs(url.query)
+                names = [n for part in query.get("names", []) for n in part.split(",") if n]
+                self._json(HTTPStatus.OK, self.hmi.read(names))
+            elif url.path.startswith("/api/"):
+                raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
+            else:
+                self._static(url.path)
+        except RequestError as exc:
+            self._fail(exc)
+
+    def do_POST(self):  # noqa: N802 - http.server naming
+        self.hmi.requests += 1
+        url = urlsplit(self.path)
+        try:
+            operation = {"/api/write": self.hmi.write, "/api/execute": self.hmi.execute}.get(url.path)
+            if operation is None:
+                raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
+            self._json(HTTPStatus.OK, operation(self._body()))
+        except RequestError as exc:
+            self._fail(exc)
+
+    def _body(self) -> dict:
+        try:
+            length = int(self.headers.get("Content-Length", ""))
+        except ValueError:
+            raise RequestError("the request needs a Content-Length header", HTTPStatus.LENGTH_REQUIRED) from None
+        if length > MAX_BODY or length < 0:
+            self.close_connection = True
+            raise RequestError(f"request body of {length} bytes exceeds the limit of {MAX_BODY} bytes",
+                               HTTPStatus.REQUEST_ENTITY_TOO_LARGE)
+        raw = self.rfile.read(length)
+        try:
+            body = json.loads(raw.decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise RequestError(f"the request body is not valid JSON ({exc})") from None
+        if not isinstance(body, dict):
+            raise RequestError("the request body must be a JSON object")
+        return body
+
+    def _static(self, path: str) -> None:
+        relative = "index.html" if path in ("", "/") else path.lstrip("/")
+        target = (self.hmi.root / relative).resolve()
+        if self.hmi.root not in target.parents or not target.is_file():
+            raise RequestError(f"no such page: {path}", HTTPStatus.NOT_FOUND)
+        content_type = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
+        if content_type.startswith("text/") or content_type.endswith(("javascript", "json")):
+            content_type += "; charset=utf-8"
+        self._send(HTTPStatus.OK, target.read_bytes(), content_type)

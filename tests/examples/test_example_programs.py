@@ -1,0 +1,149 @@
+"""The example programs on the virtual PLC against the robot simulator, scan by scan on virtual time
+(Contract D): they check clean, connect, run every command rung, and run the PnP cycle with its dwell,
+Pause/Resume and clean stop."""
+from __future__ import annotations
+
+import pathlib
+
+import pytest
+
+from sim.server import SimServer
+from vplc.api import load_plc
+from vplc.hmi_server import Mapping
+from vplc.project import load_project
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
+SECOND = 1_000_000_000
+
+
+class Rig:
+    """PLC + simulator in one thread; the simulator is polled before every scan at the PLC's time."""
+
+    def __init__(self):
+        self.sim = SimServer(port=0, robots=1)
+        self.sim.start()
+        self.robot = self.sim.robots[0]
+        self.plc = load_plc(SOURCES)
+        self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
+        self.plc.write("Connect_AddressIP", "127.0.0.1")
+
+    def close(self):
+        self.plc.close()
+        self.sim.close()
+
+    def until(self, predicate, what: str, seconds: float = 10) -> None:
+        ok = self.plc.run_until(predicate, timeout_ns=int(seconds * SECOND),
+                                on_scan=lambda now_ns: self.sim.poll(now_ns / 1e9))
+        assert ok, f"{what} did not happen within {seconds} s of PLC time"
+
+    def run_for(self, seconds: float) -> None:
+        end = self.plc.now_ns + int(seconds * SECOND)
+        self.until(lambda: self.plc.now_ns >= end, f"{seconds} s to pass", seconds + 1)
+
+    def read(self, name):
+        return self.plc.read(name)
+
+    def scripts(self, since: int = 0) -> list[str]:
+        """Script lines the robot executed, without the position polling of CBT_ReadActualPosition."""
+        return [e["text"] for e in self.robot.events[since:]
+                if e["kind"] == "script_line" and not e["text"].startswith("ListenSend(")]
+
+    def connect(self):
+        self.plc.write("Connect_Execute", True)
+        self.until(lambda: self.read("Connect_Connected"), "the connection")
+
+    def command(self, group: str, seconds: float = 15) -> list[str]:
+        """Rising edge on <group>_Execute, wait for Done (or fail on Error); return the scripts it sent."""
+        since = len(self.robot.events)
+        self.plc.write(f"{group}_Execute", False)
+        self.run_for(0.002)
+        self.plc.write(f"{group}_Execute", True)
+        self.until(lambda: self.read(f"{group}_Done") or self.read(f"{group}_Error"), f"{group} to finish",
+                   seconds)
+        assert not self.read(f"{group}_Error"), self.read(f"{group}_ErrorDescrip")
+        self.plc.write(f"{group}_Execute", False)
+        return self.scripts(since)
+
+
+@pytest.fixture
+def rig():
+    r = Rig()
+    yield r
+    r.close()
+
+
+def test_examples_check_clean_with_the_library():
+    project = load_project(SOURCES)
+    assert not project.has_errors, project.render_diagnostics()
+
+
+def test_hmi_variable_table_matches_the_example_globals(rig):
+    Mapping.load().check_against_plc(rig.plc)
+
+
+def test_connect_rung_connects_and_reports_the_time(rig):
+    rig.connect()
+    assert rig.read("Connect_Error") is False
+    assert rig.read("Connect_LastConnTime") != rig.read("Connect_LastLostTime")
+    rig.until(lambda: rig.read("ReadPos_Valid"), "a valid actual position")
+    position = rig.read("ReadPos_Position")
+    tcp = rig.robot.state()["tcp"]
+    assert [position["TCP"][k] for k in ("X", "Y", "Z")] == pytest.approx(tcp[:3], abs=0.5)
+
+
+def motion(script: list[str]) -> str:
+    """The motion line of a non-blended move; the library follows it with its own QueueTag(n)."""
+    assert len(script) == 2 and script[1].startswith("QueueTag("), script
+    return script[0]
+
+
+def test_every_command_rung_sends_the_exact_script(rig):
+    rig.connect()
+    rig.plc.write("MoveAbs_Param.TargetPosition.X", 380.0)
+    assert motion(rig.command("MoveAbs")) == 'PTP("CPP",380,0,400,180,0,90,30,200,0,true)'
+    assert rig.read("MoveAbs_CmdID_Ack") > 0
+    assert motion(rig.command("MoveRel")) == 'Move_Line("CPP",0,0,50,0,0,0,20,200,0,true)'
+    assert motion(rig.command("MoveCircle")) == \
+        'Circle("CPP",450,50,400,180,0,90,400,100,400,180,0,90,30,200,0,0,true)'
+    assert rig.command("ChangeBase") == ["ChangeBase(0,0,0,0,0,0)"]
+    assert rig.command("ChangeTCP") == ["ChangeTCP(0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0)"]
+    rig.plc.write("ProgramControl_Param.Command", "Pause")
+    assert rig.command("ProgramControl") == ["Pause()"]
+    rig.plc.write("ProgramControl_Param.Command", "Resume")
+    assert rig.command("ProgramControl") == ["Resume()"]
+
+
+def test_pnp_runs_two_cycles_with_dwell_pause_resume_and_stops_cleanly(rig):
+    rig.connect()
+    since = len(rig.robot.events)
+    rig.plc.write("PnP_Example_Execute", True)
+    rig.until(lambda: rig.read("PnP_Waiting"), "the dwell after pick", 30)
+    assert rig.read("PnP_Segment") == 1
+    dwell_start = rig.plc.now_ns
+    rig.until(lambda: not rig.read("PnP_Waiting"), "the end of the dwell", 5)
+    assert rig.plc.now_ns - dwell_start == pytest.approx(2 * SECOND, abs=0.01 * SECOND)
+
+    rig.until(lambda: rig.read("PnP_Segment") == 4 and rig.read("PnP_MoveBusy"), "the place move", 30)
+    rig.run_for(0.2)
+    rig.plc.write("ProgramControl_Param.Command", 0)
+    rig.command("ProgramControl")
+    assert rig.robot.state()["paused"]
+    rig.run_for(3)
+    assert rig.read("PnP_Segment") == 4, "the sequence must wait while the robot is paused"
+    rig.plc.write("ProgramControl_Param.Command", 1)
+    rig.command("ProgramControl")
+
+    rig.until(lambda: rig.read("PnP_CycleCount") >= 2, "two complete cycles", 120)
+    rig.plc.write("PnP_Example_Execute", False)
+    rig.until(lambda: not rig.read("PnP_MoveBusy") and rig.read("PnP_Segment") == 0, "a clean stop", 30)
+    moves_after_stop = len([e for e in rig.robot.events if e["kind"] == "motion_start"])
+    rig.run_for(3)
+    assert len([e for e in rig.robot.events if e["kind"] == "motion_start"]) == moves_after_stop
+
+    targets = [[p["TargetPosition"][k] for k in ("X", "Y", "Z")] for p in rig.read("PnP_MoveParameters")]
+    ends = [e["pose"][:3] for e in rig.robot.events[since:] if e["kind"] == "motion_end"]
+    for segment, target in enumerate(targets):
+        reached = [end for end in ends if end == pytest.approx(target, abs=0.5)]
+        assert len(reached) >= 2, f"segment {segment} reached {len(reached)} times"
+    assert rig.read("PnP_MoveError") is False

@@ -1,0 +1,95 @@
+"""`make demo` launcher: clear messages instead of tracebacks when it cannot start."""
+from __future__ import annotations
+
+import pathlib
+import socket
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+DEMO = ROOT / "examples" / "run_demo.py"
+
+
+def run_demo(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, str(DEMO), *args], capture_output=True, text=True, timeout=60,
+                          cwd=ROOT)
+
+
+@pytest.fixture
+def busy_port():
+    holder = socket.socket()
+    holder.bind(("127.0.0.1", 0))
+    holder.listen(1)
+    yield holder.getsockname()[1]
+    holder.close()
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def test_taken_robot_port_is_named_with_the_option_to_change_it(busy_port):
+    result = run_demo("--robot-port", str(busy_port), "--hmi-port", str(free_port()))
+    assert result.returncode == 2
+    assert f"port {busy_port} on 127.0.0.1 (robot simulator) is already in use" in result.stderr
+    assert "--robot-port PORT" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_taken_hmi_port_is_named_with_the_option_to_change_it(busy_port):
+    result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(busy_port))
+    assert result.returncode == 2
+    assert f"port {busy_port} on 127.0.0.1 (web HMI) is already in use" in result.stderr
+    assert "--hmi-port PORT" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_bad_option_value_is_reported_by_the_argument_parser():
+    result = run_demo("--hmi-port", "eighty")
+    assert result.returncode == 2 and "invalid int value: 'eighty'" in result.stderr
+
+
+def test_port_outside_the_tcp_range_is_refused():
+    result = run_demo("--robot-port", "70000")
+    assert result.returncode == 2 and "70000 is not a TCP port (1..65535)" in result.stderr
+
+
+def test_demo_runs_everything_and_stops_cleanly_on_ctrl_c():
+    import json
+    import queue
+    import signal
+    import threading
+    import urllib.request
+    robot_port, hmi_port = free_port(), free_port()
+    demo = subprocess.Popen([sys.executable, str(DEMO), "--robot-port", str(robot_port), "--hmi-port",
+                             str(hmi_port)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    lines: queue.Queue = queue.Queue()
+    reader = threading.Thread(target=lambda: [lines.put(line) for line in demo.stdout], daemon=True)
+    reader.start()
+    try:
+        banner = []
+        while not banner or not banner[-1].startswith("Press Ctrl-C"):
+            try:
+                banner.append(lines.get(timeout=60).strip())
+            except queue.Empty:
+                raise AssertionError(f"no complete banner from the demo within 60 s: {banner}") from None
+        text = "\n".join(banner)
+        assert f"1 robot on 127.0.0.1:{robot_port}" in text and "1 ms task" in text
+        assert f"http://127.0.0.1:{hmi_port}/" in text
+        with urllib.request.urlopen(f"http://127.0.0.1:{hmi_port}/api/read?names=PnP_Segment", timeout=5) as r:
+            assert json.loads(r.read())["ok"] is True
+        with socket.create_connection(("127.0.0.1", robot_port), timeout=5):
+            pass
+        demo.send_signal(signal.SIGINT)
+        demo.wait(timeout=30)
+        reader.join(timeout=5)
+        err = demo.stderr.read()
+        out = "".join(lines.queue)
+    finally:
+        if demo.poll() is None:
+            demo.kill()
+            demo.wait(timeout=10)
+    assert demo.returncode == 0, err
+    assert "Demo stopped" in out and "Traceback" not in err

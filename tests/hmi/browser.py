@@ -1,0 +1,103 @@
+"""Headless Chromium for the HMI tests: Debian's chromium + chromedriver, an 800x480 viewport, screenshots."""
+from __future__ import annotations
+
+import pathlib
+import shutil
+import tempfile
+
+from selenium import webdriver
+from selenium.common.exceptions import TimeoutException
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import WebDriverWait
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SCREENSHOTS = ROOT / "artifacts" / "screenshots"
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync",
+         "--disable-dev-shm-usage"]
+WAIT_S = 15
+
+
+def chromium_paths() -> tuple[str, str] | None:
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    driver = shutil.which("chromedriver")
+    return (browser, driver) if browser and driver else None
+
+
+class Browser:
+    """A Chrome session sized so the page viewport is exactly 800x480, like the touch panel."""
+
+    def __init__(self):
+        paths = chromium_paths()
+        if paths is None:
+            raise RuntimeError("chromium and chromedriver are needed: run `make browser` (Debian packages)")
+        self.profile = tempfile.mkdtemp(prefix="hmi-chromium-")
+        options = webdriver.ChromeOptions()
+        options.binary_location = paths[0]
+        for flag in FLAGS + [f"--user-data-dir={self.profile}", "--window-size=800,480"]:
+            options.add_argument(flag)
+        self.driver = webdriver.Chrome(options=options, service=Service(paths[1]))
+        self.driver.set_window_size(800, 480)
+        dw, dh = self.driver.execute_script(
+            "return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
+        self.driver.set_window_size(800 + dw, 480 + dh)
+
+    def close(self):
+        self.driver.quit()
+        shutil.rmtree(self.profile, ignore_errors=True)
+
+    def open(self, url: str):
+        self.driver.get(url)
+        self.wait_for(lambda d: d.execute_script("return document.querySelector('#message') !== null "
+                                                 "&& document.querySelector('#pill-plc').textContent "
+                                                 "=== 'PLC online'"), "the page to load and go online")
+
+    def wait_for(self, condition, what: str, timeout: float = WAIT_S):
+        try:
+            return WebDriverWait(self.driver, timeout, poll_frequency=0.05).until(condition)
+        except TimeoutException:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}; "
+                                 f"message line: {self.message()!r}") from None
+
+    def field(self, path: str):
+        return self.driver.find_element(By.CSS_SELECTOR, f'[data-path="{path}"]')
+
+    def type_into(self, path: str, text: str):
+        element = self.field(path)
+        element.clear()
+        element.send_keys(text)
+
+    def click(self, element_id: str):
+        self.driver.find_element(By.ID, element_id).click()
+
+    def status(self, variable: str) -> str:
+        cell = self.driver.find_element(By.CSS_SELECTOR, f'[data-status="{variable}"]')
+        return cell.get_attribute("data-value") or cell.text
+
+    def wait_status(self, variable: str, expected: str, timeout: float = WAIT_S):
+        self.wait_for(lambda d: self.status(variable) == expected, f"{variable} = {expected}", timeout)
+
+    def message(self) -> str:
+        try:
+            return self.driver.find_element(By.ID, "message").text
+        except Exception:  # noqa: BLE001 - only used to enrich a failure message
+            return ""
+
+    def viewport_overflow(self) -> list[str]:
+        """Ids/classes of visible elements that stick out of the 800x480 viewport (layout check)."""
+        return self.driver.execute_script("""
+            const out = [];
+            for (const el of document.querySelectorAll('button, a, input, select, .status, canvas, svg')) {
+              const r = el.getBoundingClientRect();
+              if (r.width === 0 || el.closest('dialog:not([open])') || el.closest('.params')) continue;
+              if (r.right > window.innerWidth + 1 || r.bottom > window.innerHeight + 1)
+                out.push(el.id || el.className.baseVal || el.className || el.tagName);
+            }
+            return out;""")
+
+    def screenshot(self, name: str) -> pathlib.Path:
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        path = SCREENSHOTS / f"{name}.png"
+        self.driver.save_screenshot(str(path))
+        return path

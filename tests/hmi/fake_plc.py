@@ -1,0 +1,110 @@
+"""A small stand-in for the Contract A PLC object: read/write/var_type/lock/now_ns over the mapped variables.
+
+Used by the HTTP API tests so they do not depend on the ST toolchain. Values live in nested dicts/lists
+built from hmi/mapping.json; scan() advances the clock and runs an optional program callback.
+"""
+from __future__ import annotations
+
+import re
+import threading
+
+from vplc.hmi_server import INT_RANGES, Mapping
+
+_STEP = re.compile(r"\.?([A-Za-z_]\w*)|\[(\d+)\]")
+
+
+def _default(type_name: str, types: dict):
+    definition = types.get(type_name)
+    if definition and "fields" in definition:
+        return {name: _default(spec["type"], types) for name, spec in definition["fields"].items()}
+    if definition and "enum" in definition:
+        return min(definition["enum"].values())
+    if type_name == "BOOL":
+        return False
+    if type_name in ("REAL", "LREAL"):
+        return 0.0
+    if type_name.startswith("STRING"):
+        return ""
+    if type_name in ("DATE_AND_TIME", "DT"):
+        return 0
+    return 0
+
+
+class FakePlc:
+    def __init__(self, mapping: Mapping, program=None):
+        self.lock = threading.RLock()
+        self.now_ns = 0
+        self.period_ns = 1_000_000
+        self.program = program
+        self.writes: list[tuple[str, object]] = []
+        types = mapping.document["types"]
+        self.vars = {}
+        self.types = {}
+        for name, spec in mapping.document["variables"].items():
+            if "array" in spec:
+                low, high = spec["array"]
+                self.vars[name] = [_default(spec["type"], types) for _ in range(low, high + 1)]
+            else:
+                self.vars[name] = _default(spec["type"], types)
+        for path, leaf in mapping.leaves.items():
+            self.types[path] = leaf.type
+
+    def _walk(self, path: str):
+        steps = [m.group(1) if m.group(1) else int(m.group(2)) for m in _STEP.finditer(path)]
+        container, key = self.vars, steps[0]
+        if key not in container:
+            raise KeyError(f"unknown variable '{path}'")
+        for step in steps[1:]:
+            container, key = container[key], step
+        return container, key
+
+    def read(self, path: str):
+        with self.lock:
+            container, key = self._walk(path)
+            return container[key]
+
+    def write(self, path: str, value) -> None:
+        with self.lock:
+            kind = self.types.get(path)
+            if kind is None:
+                raise ValueError(f"'{path}' is not a writable scalar")
+            if kind in INT_RANGES and not isinstance(value, int):
+                raise ValueError(f"'{path}' expects an integer")
+            container, key = self._walk(path)
+            container[key] = value
+            self.writes.append((path, value))
+
+    def var_type(self, path: str) -> str:
+        if path not in self.types:
+            raise KeyError(f"unknown variable '{path}'")
+        return self.types[path]
+
+    def scan(self, now_ns: int | None = None) -> None:
+        with self.lock:
+            self.now_ns = self.now_ns + self.period_ns if now_ns is None else now_ns
+            if self.program:
+                self.program(self)
+
+
+def command_program(plc: FakePlc) -> None:
+    """Every <Group>_Execute rising edge turns into Done on the next scan, like a quick FB."""
+    state = plc.__dict__.setdefault("_edges", {})
+    for name in [n for n in plc.vars if n.endswith("_Execute") and n != "PnP_Example_Execute"]:
+        group = name[: -len("_Execute")]
+        execute = plc.vars[name]
+        if execute and not state.get(group):
+            plc.vars[f"{group}_Busy"] = True
+            if f"{group}_CmdID_Ack" in plc.vars:
+                plc.vars[f"{group}_CmdID_Ack"] += 1
+        elif execute and plc.vars.get(f"{group}_Busy"):
+            plc.vars[f"{group}_Busy"] = False
+            if f"{group}_Done" in plc.vars:
+                plc.vars[f"{group}_Done"] = True
+            if group == "Connect":
+                plc.vars["Connect_Connected"] = True
+        elif not execute:
+            if f"{group}_Done" in plc.vars:
+                plc.vars[f"{group}_Done"] = False
+            if group == "Connect":
+                plc.vars["Connect_Connected"] = False
+        state[group] = execute

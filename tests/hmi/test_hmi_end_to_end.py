@@ -1,0 +1,249 @@
+"""The whole system from the operator's seat: headless Chromium at 800x480 -> HMI server -> the example programs
+and the real library on the virtual PLC in real time -> the robot simulator over loopback.
+
+Each test drives the pages like an operator and checks the robot side in the simulator's event log.
+"""
+from __future__ import annotations
+
+import pathlib
+import threading
+import time
+
+import pytest
+from selenium.webdriver.common.by import By
+
+from browser import Browser
+from sim.server import SimServer
+from vplc.api import load_plc
+from vplc.hmi_server import HmiServer, Mapping
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
+MOVE_WAIT_S = 30
+SIM_SPEEDUP = 4.0     # the robot model runs 4x faster than the wall clock; PLC timers stay real time
+
+
+class System:
+    def __init__(self):
+        self.mapping = Mapping.load()
+        self.sim = SimServer(port=0, robots=1, speedup=SIM_SPEEDUP)
+        self.sim.start_background()
+        self.robot = self.sim.robots[0]
+        self.plc = load_plc(SOURCES)
+        self.mapping.check_against_plc(self.plc)
+        with self.plc.lock:
+            self.plc.write("Connect_AddressIP", "127.0.0.1")
+            self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
+        self.stop_event = threading.Event()
+        self.plc_thread = threading.Thread(target=self.plc.run_realtime, args=(self.stop_event,), daemon=True)
+        self.plc_thread.start()
+        self.hmi = HmiServer(self.plc, self.mapping, port=0)
+        self.hmi.start()
+        self.browser = Browser()
+
+    def close(self):
+        self.browser.close()
+        self.hmi.stop()
+        self.stop_event.set()
+        self.plc_thread.join(timeout=5)
+        self.plc.close()
+        self.sim.close()
+
+    def read(self, name):
+        with self.plc.lock:
+            return self.plc.read(name)
+
+    def events(self, kind: str, since: float = -1.0) -> list[dict]:
+        """Events of one kind logged after the robot-clock time ``since`` (the in-memory log is capped, so
+        positions in it shift; times do not)."""
+        with self.sim.lock:
+            return [e for e in self.robot.events if e["kind"] == kind and e["t"] > since]
+
+    def event_count(self) -> float:
+        """A mark for events(): the robot clock of the newest event."""
+        with self.sim.lock:
+            return self.robot.events[-1]["t"] if self.robot.events else -1.0
+
+    def wait(self, predicate, what: str, timeout: float = MOVE_WAIT_S):
+        done = threading.Event()
+        deadline = time.monotonic() + timeout
+        while not predicate():
+            if time.monotonic() > deadline:
+                raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+            done.wait(0.02)
+
+    def open(self, page: str) -> Browser:
+        self.browser.open(f"{self.hmi.url}{page}.html")
+        return self.browser
+
+    def robot_state(self) -> dict:
+        with self.sim.lock:
+            return self.robot.state()
+
+
+@pytest.fixture(scope="module")
+def system():
+    stack = System()
+    yield stack
+    stack.close()
+
+
+@pytest.fixture(scope="module")
+def connected(system):
+    browser = system.open("connect")
+    browser.type_into("Connect_AddressIP", "127.0.0.1")
+    browser.type_into("Connect_Dest_PortIP", str(system.sim.ports[0]))
+    browser.type_into("Connect_Time_Out", "10")
+    browser.click("btn-execute")
+    browser.wait_status("Connect_Connected", "true")
+    browser.wait_for(lambda d: "DT#" in browser.status("Connect_LastConnTime")
+                     or browser.status("Connect_LastConnTime") != "", "LastConnTime")
+    browser.screenshot("e2e_connect")
+    return system
+
+
+def script_texts(system, since: float) -> list[str]:
+    """Script lines the robot executed, without the position polling of CBT_ReadActualPosition (ListenSend)."""
+    return [e["text"] for e in system.events("script_line", since) if not e["text"].startswith("ListenSend(")]
+
+
+def commands(system, since: float) -> list[str]:
+    """Script lines without the QueueTag(n) the library appends to every non-blended move."""
+    return [t for t in script_texts(system, since) if not t.startswith("QueueTag(")]
+
+
+def execute_and_wait_done(system, browser, group: str) -> None:
+    browser.click("btn-execute")
+    browser.wait_status(f"{group}_Done", "true", timeout=MOVE_WAIT_S)
+    assert browser.status(f"{group}_Error") == "false"
+
+
+def test_main_page_shows_the_live_tcp_position(connected):
+    browser = connected.open("index")
+    browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text.startswith("X "), "the TCP position")
+    x = float(browser.driver.find_element(By.ID, "tcp-pos").text.split()[1])
+    assert abs(x - connected.robot_state()["tcp"][0]) < 1.0
+    browser.screenshot("e2e_main")
+
+
+def test_move_absolute_page_moves_the_robot_to_the_entered_target(connected):
+    browser = connected.open("moveabs")
+    browser.click("btn-preset")
+    for axis, value in zip(("X", "Y", "Z"), ("380", "-50", "420")):
+        browser.type_into(f"MoveAbs_Param.TargetPosition.{axis}", value)
+    since = connected.event_count()
+    execute_and_wait_done(connected, browser, "MoveAbs")
+    assert commands(connected, since) == ['PTP("CPP",380,-50,420,180,0,90,50,200,0,true)']
+    assert connected.robot_state()["tcp"][:3] == pytest.approx([380, -50, 420], abs=0.5)
+    browser.screenshot("e2e_moveabs_done")
+
+
+def test_move_relative_page_moves_by_the_offset(connected):
+    browser = connected.open("moverel")
+    browser.click("btn-preset")
+    browser.type_into("MoveRel_Param.TargetPosition.Z", "-30")
+    start = connected.robot_state()["tcp"][2]
+    since = connected.event_count()
+    execute_and_wait_done(connected, browser, "MoveRel")
+    assert commands(connected, since) == ['Move_Line("CPP",0,0,-30,0,0,0,20,200,0,true)']
+    connected.wait(lambda: not connected.robot_state()["moving"], "the relative move to end")
+    assert connected.robot_state()["tcp"][2] == pytest.approx(start - 30, abs=0.5)
+    browser.screenshot("e2e_moverel_done")
+
+
+def test_move_circle_page_sends_a_circle(connected):
+    browser = connected.open("movecircle")
+    browser.click("btn-preset")
+    since = connected.event_count()
+    execute_and_wait_done(connected, browser, "MoveCircle")
+    assert commands(connected, since) == [
+        'Circle("CPP",450,50,400,180,0,90,400,100,400,180,0,90,30,200,0,0,true)']
+    browser.screenshot("e2e_movecircle_done")
+
+
+def test_change_base_page_sets_the_robot_base(connected):
+    browser = connected.open("changebase")
+    browser.click("btn-preset")
+    since = connected.event_count()
+    execute_and_wait_done(connected, browser, "ChangeBase")
+    assert commands(connected, since) == ["ChangeBase(0,0,0,0,0,0)"]
+    browser.screenshot("e2e_changebase_done")
+
+
+def test_change_tcp_page_sets_the_tool(connected):
+    browser = connected.open("changetcp")
+    browser.click("btn-preset")
+    browser.type_into("ChangeTCP_Param.TCPOffset.Z", "100")
+    browser.type_into("ChangeTCP_Param.Weight", "1.5")
+    since = connected.event_count()
+    execute_and_wait_done(connected, browser, "ChangeTCP")
+    assert commands(connected, since) == ["ChangeTCP(0,0,100,0,0,0,1.5,0,0,0,0,0,0,0,0,0)"]
+    browser.click("btn-preset")      # back to no tool for the following tests
+    execute_and_wait_done(connected, browser, "ChangeTCP")
+    browser.screenshot("e2e_changetcp_done")
+
+
+def test_out_of_range_entry_shows_the_error_and_nothing_reaches_the_robot(connected):
+    browser = connected.open("moveabs")
+    browser.type_into("MoveAbs_Param.AccelTime", "10000")
+    since = connected.event_count()
+    browser.click("btn-execute")
+    browser.wait_for(lambda d: "out of range" in browser.message(), "the range error")
+    assert "Accel Time: 10000 is out of range 0..9999 ms" in browser.message()
+    assert connected.read("MoveAbs_Param.AccelTime") != 10000
+    moves = [t for t in script_texts(connected, since) if t.startswith(("PTP(", "Line(", "Move_", "Circle("))]
+    assert moves == [] and connected.events("motion_start", since) == []
+    browser.screenshot("e2e_moveabs_range_error")
+
+
+def test_two_pnp_cycles_with_pause_and_resume(connected):
+    browser = connected.open("pnp")
+    browser.click("btn-preset")
+    browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset")
+    browser.driver.find_element(By.ID, "edit-4").click()        # slow "place" move: a sure window to pause in
+    browser.wait_for(lambda d: d.find_element(By.ID, "seg-dialog").get_attribute("open") is not None, "the dialog")
+    browser.type_into("PnP_MoveParameters[4].Speed", "1")
+    browser.click("seg-apply")
+    browser.wait_for(lambda d: "Segment 5 updated" in browser.message(), "the segment update")
+    targets = [[p["TargetPosition"][k] for k in ("X", "Y", "Z")] for p in connected.read("PnP_MoveParameters")]
+    cycles = connected.read("PnP_CycleCount")
+    since = connected.event_count()
+    browser.click("btn-execute")
+    connected.wait(lambda: connected.read("PnP_Segment") == 4 and connected.robot_state()["moving"]
+                   and connected.robot_state()["tcp"][2] < targets[3][2] - 5, "the place move in progress")
+    browser.click("btn-pause")
+    connected.wait(lambda: connected.robot_state()["paused"], "the robot to pause")
+    browser.screenshot("e2e_pnp_paused")
+    paused_mark = connected.event_count()
+    assert connected.robot.wait_event("motion_end", timeout=1.0, since=len(connected.robot.events)) is None
+    assert connected.read("PnP_Segment") == 4, "the sequence must wait while the robot is paused"
+    assert connected.robot_state()["tcp"][2] > targets[4][2] + 1, "paused before reaching the place point"
+    browser.click("btn-resume")
+    connected.wait(lambda: not connected.robot_state()["paused"], "the robot to resume")
+    connected.wait(lambda: connected.read("PnP_CycleCount") >= cycles + 2, "two complete cycles", timeout=90)
+    browser.wait_for(lambda d: int(browser.status("PnP_CycleCount") or 0) >= cycles + 2, "the cycle count")
+    browser.screenshot("e2e_pnp_running")
+    browser.click("btn-stop")
+    connected.wait(lambda: not connected.read("PnP_MoveBusy") and connected.read("PnP_Segment") == 0,
+                   "the sequence to stop")
+    ends = [e["pose"][:3] for e in connected.events("motion_end", since)]
+    for segment in range(6):
+        reached = [end for end in ends if end == pytest.approx(targets[segment], abs=0.5)]
+        assert len(reached) >= 2, f"segment {segment + 1} reached {len(reached)} times"
+    assert connected.events("motion_end", paused_mark)[0]["pose"][:3] == pytest.approx(targets[4], abs=0.5)
+    sent = commands(connected, since)
+    assert sent.count("Pause()") == 1 and sent.count("Resume()") == 1
+    assert sent.index("Pause()") < sent.index("Resume()")
+    assert connected.read("PnP_MoveError") is False
+
+
+def test_connection_loss_shows_on_the_connect_page(connected):
+    browser = connected.open("connect")
+    browser.wait_status("Connect_Connected", "true")
+    lost_before = browser.status("Connect_LastLostTime")
+    with connected.sim.lock:
+        connected.robot.inject("disconnect")
+    browser.wait_status("Connect_Connected", "false")
+    browser.wait_for(lambda d: browser.status("Connect_LastLostTime") != lost_before, "LastLostTime to change")
+    browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot not connected", "the pill")
+    browser.screenshot("e2e_connect_lost")

@@ -1,0 +1,144 @@
+"""The HMI pages in headless Chromium at 800x480 against a fake PLC: layout, entry checks, Execute, PnP edit."""
+from __future__ import annotations
+
+import threading
+
+import pytest
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import Select
+
+from browser import Browser
+from fake_plc import FakePlc, command_program
+from vplc.hmi_server import HmiServer, Mapping
+
+PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "pnp"]
+
+
+@pytest.fixture(scope="module")
+def stack():
+    mapping = Mapping.load()
+    plc = FakePlc(mapping, command_program)
+    stop = threading.Event()
+
+    def scanning():
+        while not stop.wait(0.001):
+            plc.scan()
+
+    thread = threading.Thread(target=scanning, daemon=True)
+    thread.start()
+    server = HmiServer(plc, mapping, port=0)
+    server.start()
+    browser = Browser()
+    yield plc, server, browser
+    browser.close()
+    server.stop()
+    stop.set()
+    thread.join(timeout=5)
+
+
+@pytest.fixture
+def page(stack):
+    plc, server, browser = stack
+    plc.writes.clear()
+
+    def open_page(name: str):
+        browser.open(f"{server.url}{name}.html")
+        return browser
+    return plc, open_page
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_every_page_fits_the_800x480_panel(page, name):
+    _, open_page = page
+    browser = open_page(name)
+    assert browser.driver.execute_script("return [innerWidth, innerHeight]") == [800, 480]
+    assert browser.viewport_overflow() == []
+    assert browser.screenshot(f"fake_{name}").stat().st_size > 0
+
+
+def test_main_page_opens_every_command_page(page):
+    _, open_page = page
+    browser = open_page("index")
+    for target in PAGES[1:]:
+        link = browser.driver.find_element(By.ID, f"nav-{target}")
+        assert link.get_attribute("href").endswith(f"/{target}.html")
+
+
+def test_enumerations_are_drop_down_lists_with_the_library_names(page):
+    _, open_page = page
+    browser = open_page("moverel")
+    options = [o.text for o in browser.field("MoveRel_Param.DataFormat").find_elements(By.TAG_NAME, "option")]
+    assert options == ["JPP_Rel", "CPP_Rel", "CPR_Rel", "CAP_Rel", "CAR_Rel", "TPP_Rel", "TPR_Rel", "TAP_Rel",
+                       "TAR_Rel"]
+
+
+def test_out_of_range_speed_shows_the_error_and_sends_nothing(page):
+    plc, open_page = page
+    browser = open_page("moveabs")
+    Select(browser.field("MoveAbs_Param.DataFormat")).select_by_visible_text("CAP_Abs")
+    browser.type_into("MoveAbs_Param.Speed", "5000")
+    browser.click("btn-execute")
+    browser.wait_for(lambda d: "out of range" in browser.message(), "the range error")
+    assert "Speed: 5000 is out of range 1..4500" in browser.message()
+    assert "invalid" in browser.field("MoveAbs_Param.Speed").get_attribute("class")
+    assert plc.writes == []
+    browser.screenshot("fake_moveabs_range_error")
+
+
+def test_speed_in_percent_formats_is_limited_to_100(page):
+    plc, open_page = page
+    browser = open_page("moveabs")
+    Select(browser.field("MoveAbs_Param.DataFormat")).select_by_visible_text("CPP_Abs")
+    browser.type_into("MoveAbs_Param.Speed", "150")
+    browser.click("btn-execute")
+    browser.wait_for(lambda d: "out of range" in browser.message(), "the range error")
+    assert "Speed: 150 is out of range 1..100" in browser.message()
+    assert plc.writes == []
+
+
+def test_text_in_a_number_field_is_refused_before_sending(page):
+    plc, open_page = page
+    browser = open_page("changetcp")
+    browser.type_into("ChangeTCP_Param.Weight", "heavy")
+    browser.click("btn-execute")
+    browser.wait_for(lambda d: "enter a number" in browser.message(), "the number error")
+    assert plc.writes == []
+
+
+def test_preset_and_execute_show_done(page):
+    plc, open_page = page
+    browser = open_page("changebase")
+    browser.type_into("ChangeBase_Param.Transformation.X", "12.5")
+    browser.click("btn-preset")
+    assert browser.field("ChangeBase_Param.Transformation.X").get_attribute("value") == "0"
+    browser.click("btn-execute")
+    browser.wait_status("ChangeBase_Done", "true")
+    assert ("ChangeBase_Execute", True) in plc.writes
+    assert ("ChangeBase_Param.Transformation.X", 0) in plc.writes or ("ChangeBase_Param.Transformation.X", 0.0) in plc.writes
+
+
+def test_connect_and_disconnect_update_the_connection_status(page):
+    plc, open_page = page
+    browser = open_page("connect")
+    browser.click("btn-preset")
+    browser.click("btn-execute")
+    browser.wait_status("Connect_Connected", "true")
+    browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the header pill")
+    browser.click("btn-disconnect")
+    browser.wait_status("Connect_Connected", "false")
+
+
+def test_pnp_segment_edit_writes_only_that_segment(page):
+    plc, open_page = page
+    browser = open_page("pnp")
+    browser.click("btn-preset")
+    browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset confirmation")
+    plc.writes.clear()
+    browser.driver.find_element(By.ID, "edit-4").click()
+    browser.wait_for(lambda d: d.find_element(By.ID, "seg-dialog").get_attribute("open") is not None, "the dialog")
+    browser.type_into("PnP_MoveParameters[4].TargetPosition.Z", "180")
+    browser.screenshot("fake_pnp_edit_dialog")
+    browser.click("seg-apply")
+    browser.wait_for(lambda d: "Segment 5 updated" in browser.message(), "the update confirmation")
+    assert plc.vars["PnP_MoveParameters"][4]["TargetPosition"]["Z"] == 180
+    assert {path.split("]")[0] for path, _ in plc.writes} == {"PnP_MoveParameters[4"}
