@@ -124,6 +124,12 @@ class Plc:
         return self.engine.now_ns
 
     @property
+    def task_cycles(self) -> tuple[int, ...]:
+        """Completed cycles of every task, in task order. A scan call runs only the tasks that are due, so
+        code that must know its writes were seen by the programs waits until every count has advanced."""
+        return tuple(task.cycles for task in self.engine.tasks)
+
+    @property
     def statements_executed(self) -> int:
         return self.engine.stmt_counter[0]
 
@@ -172,10 +178,11 @@ class Plc:
             while time.monotonic_ns() < due:
                 pass
             start = time.monotonic_ns()
+            tick = due - base          # the task clock is the scheduled tick: lateness never makes a task skip
             if on_scan is not None:
-                on_scan(start - base)
+                on_scan(tick)
             c0 = self.statements_executed
-            self.scan(start - base)
+            self.scan(tick)
             end = time.monotonic_ns()
             if stats is not None:
                 stats.record(start - due, end - start, self.statements_executed - c0)

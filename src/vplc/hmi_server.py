@@ -247,6 +247,7 @@ class HmiServer:
         self._httpd: ThreadingHTTPServer | None = None
         self._thread: threading.Thread | None = None
         self.requests = 0
+        self._execute_lock = threading.Lock()
 
     @property
     def port(self) -> int:
@@ -322,13 +323,26 @@ class HmiServer:
             raise RequestError(f'"execute" must name an Execute variable of the table, not {name!r}')
         values = body.get("values") or {}
         checked = self._checked(values) if values else []
-        written_at = self._write_all(checked + [(name, False)])
+        # A clean rising edge: every task completes a cycle with Execute FALSE, then one with it TRUE, before
+        # the answer goes back. A scan that only advances the clock (no task due) does not count, and
+        # Execute requests are taken one at a time, so no command is ever merged with another or lost.
+        with self._execute_lock:
+            with self.plc.lock:
+                self._write_all(checked + [(name, False)])
+            self._await_task_cycles("Execute was not reset")
+            with self.plc.lock:
+                now = self._write_all([(name, True)])
+            self._await_task_cycles("Execute was not seen")
+        return {"ok": True, "time_ns": now}
+
+    def _await_task_cycles(self, what: str) -> None:
+        with self.plc.lock:
+            cycles_at = self.plc.task_cycles
         deadline = time.monotonic() + SCAN_WAIT_S
-        while self.plc.now_ns == written_at:
+        while not all(now > then for now, then in zip(self.plc.task_cycles, cycles_at)):
             if time.monotonic() > deadline:
-                raise RequestError("the PLC is not scanning: Execute was not set", HTTPStatus.SERVICE_UNAVAILABLE)
+                raise RequestError(f"the PLC is not scanning: {what}", HTTPStatus.SERVICE_UNAVAILABLE)
             time.sleep(0.0005)
-        return {"ok": True, "time_ns": self._write_all([(name, True)])}
 
 
 class _Handler(BaseHTTPRequestHandler):

@@ -35,6 +35,9 @@ class FakePlc:
         self.lock = threading.RLock()
         self.now_ns = 0
         self.period_ns = 1_000_000
+        self.task_cycles = (0,)
+        self.scans = 0
+        self.task_every = 1               # the task runs in every n-th scan only
         self.program = program
         self.writes: list[tuple[str, object]] = []
         types = mapping.document["types"]
@@ -82,8 +85,12 @@ class FakePlc:
     def scan(self, now_ns: int | None = None) -> None:
         with self.lock:
             self.now_ns = self.now_ns + self.period_ns if now_ns is None else now_ns
+            self.scans += 1
+            if self.scans % self.task_every:
+                return                      # like the engine: the clock moved but the task was not due
             if self.program:
                 self.program(self)
+            self.task_cycles = (self.task_cycles[0] + 1,)
 
 
 def command_program(plc: FakePlc) -> None:

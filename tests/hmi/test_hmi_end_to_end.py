@@ -69,8 +69,21 @@ class System:
         deadline = time.monotonic() + timeout
         while not predicate():
             if time.monotonic() > deadline:
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+                raise AssertionError(f"timed out after {timeout} s waiting for {what}\n{self.snapshot()}")
             done.wait(0.02)
+
+    def snapshot(self) -> str:
+        """What the robot and the PLC were doing, for the message of a failed wait."""
+        with self.sim.lock:
+            tail = [{k: v for k, v in e.items() if k != "pose"} for e in self.robot.events[-25:]]
+            state = self.robot.state()
+        names = ("PnP_Segment", "PnP_MoveBusy", "ProgramControl_Execute", "ProgramControl_Busy",
+                 "ProgramControl_Done", "ProgramControl_Error", "ProgramControl_ErrorDescrip",
+                 "ProgramControl_Param.Command", "Cobot.QueueDepth", "Cobot.Connected")
+        with self.plc.lock:
+            plc = {n: self.plc.read(n) for n in names}
+        lines = [f"robot state: {state}", f"PLC: {plc}", "last robot events:"] + [f"  {e}" for e in tail]
+        return "\n".join(lines)
 
     def open(self, page: str) -> Browser:
         self.browser.open(f"{self.hmi.url}{page}.html")

@@ -130,6 +130,18 @@ def test_execute_writes_parameters_then_gives_a_clean_rising_edge(client, fake_p
     assert fake_plc.writes[0] == ("MoveAbs_Param.Speed", 35)
 
 
+def test_execute_edge_is_seen_by_the_task_even_when_scans_skip_it(client, fake_plc):
+    seen = []
+    fake_plc.task_every = 3               # two of three scans only advance the clock
+    fake_plc.program = lambda plc: seen.append(plc.vars["ProgramControl_Execute"])
+    for _ in range(20):
+        status, answer = client.json("/api/execute", {"execute": "ProgramControl_Execute"})
+        assert status == 200 and answer["ok"] is True
+    seen.append(fake_plc.vars["ProgramControl_Execute"])
+    edges = sum(1 for before, after in zip(seen, seen[1:]) if after and not before)
+    assert edges == 20, "every Execute request must reach the program as its own rising edge"
+
+
 def test_execute_refuses_a_variable_that_is_not_an_execute_bit(client):
     status, answer = client.json("/api/execute", {"execute": "MoveAbs_Param.BlendingEnable"})
     assert status == 400 and "must name an Execute variable" in answer["error"]

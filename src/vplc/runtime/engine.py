@@ -23,6 +23,7 @@ class Task:
     priority: int
     programs: list = field(default_factory=list)      # (instance, body function)
     next_due: int | None = None
+    cycles: int = 0                                   # completed executions of the task's programs
 
 
 class Engine:
@@ -82,6 +83,7 @@ class Engine:
                     continue
                 for inst, body in task.programs:
                     body(inst)
+                task.cycles += 1
                 missed = (now_ns - task.next_due) // task.period_ns
                 task.next_due += (missed + 1) * task.period_ns
         except Exception as exc:          # noqa: BLE001 - every Python error becomes a PLC major fault
