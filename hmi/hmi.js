@@ -576,7 +576,11 @@ async function pnpPage() {
 }
 
 async function boot() {
-  const key = document.body.dataset.page;
+  // One page shell (index.html) serves every page: the file name in the address names the page.
+  const file = decodeURIComponent(location.pathname.split("/").pop() || "index.html");
+  const name = file.replace(/\.html$/, "");
+  const key = name === "index" ? "main" : name;
+  document.body.dataset.page = key;
   try {
     MAP = await api("/api/mapping");
   } catch (e) {

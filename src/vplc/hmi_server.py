@@ -91,6 +91,7 @@ class Mapping:
         self.leaves: dict[str, Leaf] = {}
         self.roots: dict[str, dict] = {}
         try:
+            self.pages = frozenset(document.get("pages", ["index"]))
             types = document["types"]
             for name, spec in document["variables"].items():
                 self.roots[name] = spec
@@ -414,6 +415,8 @@ class _Handler(BaseHTTPRequestHandler):
 
     def _static(self, path: str) -> None:
         relative = "index.html" if path in ("", "/") else path.lstrip("/")
+        if relative.endswith(".html") and relative[:-5] in self.hmi.mapping.pages:
+            relative = "index.html"          # one page shell; hmi.js builds the page named in the address
         target = (self.hmi.root / relative).resolve()
         if self.hmi.root not in target.parents or not target.is_file():
             raise RequestError(f"no such page: {path}", HTTPStatus.NOT_FOUND)

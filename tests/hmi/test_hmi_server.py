@@ -12,10 +12,17 @@ from vplc.hmi_server import MAX_BODY, HmiServer, Mapping, MappingError
 
 def test_main_page_and_script_are_served_with_text_types(client):
     status, body, headers = client.request("/")
-    assert status == 200 and b'data-page="main"' in body
+    assert status == 200 and b'<script src="hmi.js"' in body
     assert headers["Content-Type"].startswith("text/html")
     status, _, headers = client.request("/hmi.js")
     assert status == 200 and "javascript" in headers["Content-Type"]
+
+
+@pytest.mark.parametrize("page", ["index", "connect", "pnp"])
+def test_every_listed_page_is_served_from_the_one_page_shell(client, page):
+    _, shell, _ = client.request("/")
+    status, body, headers = client.request(f"/{page}.html")
+    assert status == 200 and body == shell and headers["Content-Type"].startswith("text/html")
 
 
 @pytest.mark.parametrize("path", ["/nothing.html", "/../src/vplc/hmi_server.py", "/%2e%2e/Makefile"])
