@@ -22,6 +22,17 @@ class LoadError(Exception):
     """The sources could not be loaded: ``str()`` is the rendered diagnostics."""
 
 
+def parse_task(task: str) -> tuple[str, int]:
+    """``"Main@1ms"`` -> ("Main", 1_000_000); LoadError with the reason for anything else."""
+    m = re.fullmatch(r"\s*([A-Za-z_]\w*)\s*@\s*(.+)", task or "")
+    if not m:
+        raise LoadError(f"error: task `{task}` is not of the form Name@period (e.g. Main@1ms)")
+    period = parse_duration(m.group(2))
+    if period is None or period <= 0:
+        raise LoadError(f"error: task period `{m.group(2)}` is not a duration like 1ms, 500us or 0.01s")
+    return m.group(1), period
+
+
 def load_plc(paths, task: str = "Main@1ms", programs=None, *, dialect: str = "sysmac",
              watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
              count_statements: bool = False, clock_base_ns: int | None = None) -> "Plc":
@@ -57,6 +68,8 @@ class Plc:
             ns["G"] = self.globals
             self.instances: dict[str, object] = ns["_PROGRAMS"]
             self._setup_tasks(task, programs)
+        except LoadError:
+            raise
         except Exception as exc:   # noqa: BLE001 - an initial value that faults
             raise LoadError(f"error: initialising the variables failed: {self.engine.make_fault(exc)}") from None
         self._resolver = Resolver(self)
@@ -96,13 +109,7 @@ class Plc:
                             t = self.engine.tasks[0]
                         t.programs.append(self._instance(pi.name, self._program(pi.program.text())))
         else:
-            m = re.fullmatch(r"\s*([A-Za-z_]\w*)\s*@\s*(.+)", task or "")
-            if not m:
-                raise LoadError(f"error: task `{task}` is not of the form Name@period (e.g. Main@1ms)")
-            period = parse_duration(m.group(2))
-            if period is None or period <= 0:
-                raise LoadError(f"error: task period `{m.group(2)}` is not a duration like 1ms, 500us or 0.01s")
-            t = Task(m.group(1), period, 0)
+            t = Task(*parse_task(task), 0)
             pts = [self._program(p) for p in programs] if programs else list(self.project.programs)
             if not pts:
                 raise LoadError("error: the sources contain no PROGRAM to run")

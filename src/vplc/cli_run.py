@@ -18,7 +18,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("run", help="run ST programs on the virtual PLC",
                               description="Load, compile and run ST programs cyclically like an NJ/NX controller.")
     p.add_argument("paths", nargs="+", metavar="PATH", help="ST file or folder (recursive *.st)")
-    p.add_argument("--task", default="Main@1ms",
+    p.add_argument("--task",
                    help="task NAME@PERIOD running every PROGRAM when the sources have no CONFIGURATION "
                         "(default Main@1ms)")
     p.add_argument("--program", action="append", metavar="NAME", help="run only this PROGRAM (repeatable)")
@@ -41,7 +41,7 @@ def _err(msg: str) -> int:
 
 
 def run_cmd(args) -> int:
-    from .api import LoadError, PlcFault, load_plc
+    from .api import LoadError, PlcFault, load_plc, parse_task
     from .runtime.stats import ScanStats
     from .runtime.values import PathError
     from .trace import Recorder, write_trace
@@ -58,11 +58,16 @@ def run_cmd(args) -> int:
     if wd is None or wd <= 0:
         return _err(f"--watchdog {args.watchdog!r} is not a duration like 500ms")
     try:
-        plc = load_plc(args.paths, task=args.task, programs=args.program, watchdog_ms=wd / 1e6,
+        if args.task is not None:
+            parse_task(args.task)
+        plc = load_plc(args.paths, task=args.task or "Main@1ms", programs=args.program, watchdog_ms=wd / 1e6,
                        count_statements=args.stats)
     except LoadError as exc:
         print(str(exc), file=sys.stderr)
         return 2
+    if args.task is not None and plc.project.configurations:
+        print(f"vplc run: note: --task {args.task} is not used: the sources define their own CONFIGURATION",
+              file=sys.stderr)
     rec = None
     if args.trace:
         try:

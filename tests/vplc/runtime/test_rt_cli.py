@@ -49,6 +49,30 @@ def test_run_usage_errors_exit_2(tmp_path):
     assert r.returncode == 2 and "zz" in r.stderr
 
 
+def test_run_refuses_a_malformed_task_option_cleanly(tmp_path):
+    src = tmp_path / "m.st"
+    src.write_text(PROG)
+    r = vplc("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main")
+    assert r.returncode == 2 and "task `Main` is not of the form Name@period" in r.stderr
+    r = vplc("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main@0ms")
+    assert r.returncode == 2 and "task period `0ms` is not a duration" in r.stderr
+    assert "Traceback" not in r.stderr and "internal" not in r.stderr
+
+
+def test_run_says_when_the_task_option_gives_way_to_a_configuration(tmp_path):
+    src = tmp_path / "m.st"
+    src.write_text(PROG + """CONFIGURATION Cfg
+RESOURCE Res ON PLC
+TASK Fast(INTERVAL := T#2ms, PRIORITY := 1);
+PROGRAM Inst WITH Fast : Main;
+END_RESOURCE
+END_CONFIGURATION
+""")
+    r = vplc("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Other@5ms")
+    assert r.returncode == 0, r.stderr
+    assert "--task Other@5ms is not used: the sources define their own CONFIGURATION" in r.stderr
+
+
 def test_test_command_reports_failures_with_location_and_writes_junit(tmp_path):
     (tmp_path / "suite.st").write_text("""FUNCTION_BLOCK Demo_Test
 VAR n : INT; END_VAR
