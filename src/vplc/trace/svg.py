@@ -5,6 +5,7 @@ from __future__ import annotations
 from xml.sax.saxutils import escape
 
 ROW, LABEL_W, WIDTH, HIGH = 34, 220, 900, 18
+RIGHT = 30                     # room for the last time label, centred on the end of the plot
 
 
 def _fmt(v) -> str:
@@ -16,7 +17,7 @@ def _fmt(v) -> str:
 def write_svg(rec, filename: str) -> None:
     t0 = min((ch[0][0] for ch in rec.changes if ch), default=0)
     span = max(rec.end_ns - t0, 1)
-    x = lambda t: LABEL_W + (t - t0) * (WIDTH - LABEL_W - 10) / span   # noqa: E731
+    x = lambda t: LABEL_W + (t - t0) * (WIDTH - LABEL_W - RIGHT) / span   # noqa: E731
     h = ROW * len(rec.paths) + 40
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{h}" font-family="sans-serif" '
            f'font-size="12">', f'<rect width="{WIDTH}" height="{h}" fill="white"/>']
@@ -24,7 +25,7 @@ def write_svg(rec, filename: str) -> None:
         top = 10 + i * ROW
         base, hi = top + ROW - 8, top + ROW - 8 - HIGH
         out.append(f'<text x="6" y="{base - 4}">{escape(p)}</text>')
-        out.append(f'<line x1="{LABEL_W}" y1="{base + 4}" x2="{WIDTH - 10}" y2="{base + 4}" stroke="#ddd"/>')
+        out.append(f'<line x1="{LABEL_W}" y1="{base + 4}" x2="{WIDTH - RIGHT}" y2="{base + 4}" stroke="#ddd"/>')
         ch = rec.changes[i] + [(rec.end_ns, None)]
         if kind == "bool":
             pts = []
