@@ -2,8 +2,13 @@
 
     PYTHONPATH=src:. python bench/bench_lib.py
 
-Figures (issue 6): scans from Execute to the frame handed to the socket, scans from reply bytes to Done,
-sustained blended commands per FB instance, library cost per scan with 7 idle / 7 busy FBs.
+Figures (issue 6), each printed with its target, in two call orders (docs/library/design.md, "Latency"):
+documented = command FBs, then CBT_Connect; fast = CBT_Connect, command FBs, CBT_Connect (same instance).
+  (1) scans from the Execute edge to the frame handed to SktTCPSend      target: 0 (same scan)
+  (2) scans from the reply on the socket to Done                         target: 0 (same scan)
+  (3) sustained blended commands, scans per command per FB instance      target: <= 2
+      and per robot with 4 instances; library cost per scan with 7 idle / 7 busy FBs.
+Before issue 6 (documented order, Execute held): (1) 0, (2) 1, (3) 6.00 per instance, 1.50 with 4 instances.
 """
 import statistics
 import sys
@@ -14,72 +19,46 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "src"), str(ROOT), str(ROOT / "tests" / "lib")]
 
 from rig import Rig, move_abs  # noqa: E402
+from latency import ORDERS, execute_to_socket, reply_to_done, scan, sustained  # noqa: E402
 
 
-def scan(r):
-    now = r.plc.now_ns + r.plc.period_ns
-    r.pump(now)
-    r.plc.scan(now)
+def mark(value, target):
+    return "ok " if value <= target + 1e-9 else "-- "
 
 
-def execute_to_socket(r):
-    r.set_struct("MParam[1]", move_abs(BlendingEnable=True))
-    before = r.read("Cobot.FramesOut")
-    r.write("MExec[1]", True)
-    n = 0
-    while r.read("Cobot.FramesOut") == before:
-        scan(r)
-        n += 1
-    return n - 1          # 0 = the scan that saw the rising edge
-
-
-def reply_to_done(r):
-    """Scans between the scan in whose input phase the robot's reply was on the socket and the scan
-    in which the FB shows Done."""
-    seen = None
-    k = 0
-    n_out = len(r.events("frame_out"))
-    while not r.read("movers[1].Done"):
-        scan(r)
-        k += 1
-        if seen is None and any(e.get("header") == "TMSCT" for e in r.events("frame_out")[n_out:]):
-            seen = k
-    r.write("MExec[1]", False)
-    scan(r)
-    return k - seen
-
-
-def sustained(r, count=200):
-    start = r.plc.now_ns
-    done = 0
-    while done < count:
-        r.set_struct("MParam[1].TargetPosition", dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=float(done % 20)))
-        r.write("MExec[1]", True)
-        while not r.read("movers[1].Done"):
-            scan(r)
-        r.write("MExec[1]", False)
-        scan(r)
-        done += 1
-    return (r.plc.now_ns - start) / r.plc.period_ns / count
-
-
-def sustained_rotating(r, count=400):
-    """Four FB instances, each re-triggered as soon as it is Done: commands per scan for one robot."""
-    for k in range(1, 5):
-        r.set_struct(f"MParam[{k}]", move_abs(BlendingEnable=True))
-        r.write(f"MExec[{k}]", False)
-    scan(r)
-    start = r.plc.now_ns
-    done = 0
-    while done < count:
-        for k in range(1, 5):
-            if r.read(f"movers[{k}].Done"):
-                done += 1
-                r.write(f"MExec[{k}]", False)
-            elif not r.read(f"movers[{k}].Busy"):
-                r.write(f"MExec[{k}]", True)
-        scan(r)
-    return (r.plc.now_ns - start) / r.plc.period_ns / count
+def latency_table():
+    res = {}
+    for order, program in ORDERS.items():
+        r = Rig(program=program)
+        try:
+            res[order] = dict(edge=execute_to_socket(r), reply=reply_to_done(r),
+                              held1=sustained(r, 1, pulse=False), pulse1=sustained(r, 1, pulse=True),
+                              held4=sustained(r, 4, pulse=False, count=400), pulse4=sustained(r, 4, pulse=True, count=400))
+        finally:
+            r.close()
+    d, t = res["documented"], res["twice"]
+    print("CBT_Commands_Lib latency in scans (virtual PLC, 1 ms task, simulator on loopback)")
+    print("  orders: documented = FBs, then CBT_Connect; fast = CBT_Connect, FBs, CBT_Connect (same instance); ok = target met")
+    print(f"  {'figure':<58}{'target':>10}{'documented':>12}{'fast':>10}")
+    rows = [
+        ("(1) Execute edge -> frame handed to SktTCPSend (scans)", 0, "edge", "{:.0f}"),
+        ("(2) reply on the socket -> FB Done (scans)", 0, "reply", "{:.0f}"),
+        ("(3) one FB instance, Execute held until Done (scans/cmd)", 2, "held1", "{:.2f}"),
+        ("(3) one FB instance, Execute pulse (scans/cmd)", 2, "pulse1", "{:.2f}"),
+        ("    4 FB instances, one robot, held (scans/cmd)", None, "held4", "{:.2f}"),
+        ("    4 FB instances, one robot, pulse (scans/cmd)", None, "pulse4", "{:.2f}"),
+    ]
+    for label, target, key, fmt in rows:
+        cells = []
+        for v in (d[key], t[key]):
+            text = fmt.format(v)
+            cells.append((mark(v, target) if target is not None else "   ") + text)
+        tgt = "-" if target is None else ("same scan" if target == 0 else f"<= {target}")
+        print(f"  {label:<58}{tgt:>10}{cells[0]:>12}{cells[1]:>10}")
+    print(f"  per robot with 4 instances: {1 / d['pulse4']:.2f} (documented) / {1 / t['pulse4']:.2f} (fast) "
+          "commands per scan, Execute pulse")
+    print("  structural minimum per FB instance (design.md, Latency): documented 3 (pulse) / 4 (held), "
+          "fast 2 (pulse) / 3 (held)")
 
 
 def cost(r, n=400):
@@ -96,34 +75,26 @@ def cost(r, n=400):
 
 
 def main():
-    r = Rig(program="Main_Bench.st")
-    try:
-        print("CBT_Commands_Lib benchmarks (virtual PLC, 1 ms task, simulator on loopback)")
-        print(f"  Execute rising -> frame handed to SktTCPSend : {execute_to_socket(r)} scan(s) after the edge scan")
-        print(f"  reply on the socket -> FB Done              : {reply_to_done(r)} scan(s)")
-        print(f"  sustained blended commands, one FB instance  : one per {sustained(r):.2f} scans")
-        print(f"  sustained blended commands, 4 FB instances   : one per {sustained_rotating(r):.2f} scans (per robot)")
-    finally:
-        r.close()
-    r = Rig(program="Main_Bench.st", load_args=dict(count_statements=True))
-    plc = r.plc
-    try:
-        idle_us, idle_st = cost(r)
-        for k in range(1, 5):
-            r.set_struct(f"MParam[{k}]", move_abs(Speed=5, TargetPosition=dict(X=60.0 + k, Y=0, Z=90, RX=0, RY=90, RZ=0)))
-            r.write(f"MExec[{k}]", True)
-        r.set_struct("RelParam", dict(MovementCommand=0, DataFormat=1, Speed=5, AccelTime=200,
-                                      TargetPosition=dict(X=0, Y=0, Z=-10, RX=0, RY=0, RZ=0)))
-        r.write("RelExec", True)
-        r.write("BaseExec", True)
-        r.write("PrgParam.Command", 1)
-        r.write("PrgExec", True)
-        scan(r)
-        busy_us, busy_st = cost(r)
-        print(f"  library cost per scan, 7 idle FBs + Connect  : {idle_us:.0f} us, {idle_st:.0f} statements (median)")
-        print(f"  library cost per scan, 7 busy FBs + Connect  : {busy_us:.0f} us, {busy_st:.0f} statements (median)")
-    finally:
-        r.close()
+    latency_table()
+    for order, program in ORDERS.items():
+        r = Rig(program=program, load_args=dict(count_statements=True))
+        try:
+            idle_us, idle_st = cost(r)
+            for k in range(1, 5):
+                r.set_struct(f"MParam[{k}]", move_abs(Speed=5, TargetPosition=dict(X=60.0 + k, Y=0, Z=90, RX=0, RY=90, RZ=0)))
+                r.write(f"MExec[{k}]", True)
+            r.set_struct("RelParam", dict(MovementCommand=0, DataFormat=1, Speed=5, AccelTime=200,
+                                          TargetPosition=dict(X=0, Y=0, Z=-10, RX=0, RY=0, RZ=0)))
+            r.write("RelExec", True)
+            r.write("BaseExec", True)
+            r.write("PrgParam.Command", 1)
+            r.write("PrgExec", True)
+            scan(r)
+            busy_us, busy_st = cost(r)
+            print(f"  library cost per scan ({'fast' if order == 'twice' else order:>10}), 7 idle FBs : {idle_us:4.0f} us, {idle_st:4.0f} statements (median)")
+            print(f"  library cost per scan ({'fast' if order == 'twice' else order:>10}), 7 busy FBs : {busy_us:4.0f} us, {busy_st:4.0f} statements (median)")
+        finally:
+            r.close()
 
 
 if __name__ == "__main__":

@@ -148,9 +148,11 @@ class Plc:
         with self.lock:
             return self._resolver.read(path)
 
-    def write(self, path: str, value) -> None:
+    def write(self, path: str, value, raw: bool = False) -> None:
+        """Type-checked write of one elementary variable; ``raw=True`` also lets an enumeration variable
+        take an integer that is not one of its values (fault tests: an HMI or memory copy writing a number)."""
         with self.lock:
-            self._resolver.write(path, value)
+            self._resolver.write(path, value, raw)
 
     def var_type(self, path: str) -> str:
         return self._resolver.type_text(path)

@@ -32,8 +32,9 @@ class Rig:
     def read(self, path):
         return self.plc.read("Main." + path)
 
-    def write(self, path, value):
-        self.plc.write("Main." + path, value)
+    def write(self, path, value, raw=False):
+        """raw=True: an integer into an enumeration, also an undefined one (an HMI writing a number)."""
+        self.plc.write("Main." + path, value, raw=raw)
 
     def set_struct(self, path, values: dict):
         for key, value in values.items():

@@ -111,6 +111,12 @@ class SktTCPSend(_SocketFB):
             self.i__err = S.ERR_CLOSED
         if not self.i__err:
             c.tx += bytes(self.SendDat[k] & 0xFF for k in range(self.Size))
+            # the controller's socket service transmits in the background as soon as the send is started;
+            # only Done waits for the next call (what the OS does not take now goes out when polled)
+            try:
+                c.flush()
+            except OSError:
+                self.i__err = S.ERR_CLOSED
 
     def poll(self):
         if self.i__err:

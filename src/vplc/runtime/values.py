@@ -104,9 +104,9 @@ class Resolver:
     def type_text(self, path: str) -> str:
         return type_text(self._locate(path)[2])
 
-    def write(self, path: str, value) -> None:
+    def write(self, path: str, value, raw: bool = False) -> None:
         c, k, t = self._locate(path)
-        c[k] = from_python(value, t, path)
+        c[k] = from_python(value, t, path, raw)
 
 
 def to_python(v, t):
@@ -124,10 +124,16 @@ def to_python(v, t):
     return v
 
 
-def from_python(value, t, path: str):
+def from_python(value, t, path: str, raw: bool = False):
+    """Checked conversion of an API value; ``raw`` lets an enumeration take any integer of its storage
+    type, declared or not (what an HMI or a memory copy can put there on the controller)."""
     u = T.base_of(t)
     tn = type_text(t)
     bad = PathError(f"cannot write {value!r} to {path} of type {tn}")
+    if isinstance(u, T.EnumType) and raw:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise PathError(f"a raw write to {path} ({tn}) takes an integer, not {value!r}")
+        return from_python(value, u.base, path)
     if isinstance(u, T.EnumType):
         if isinstance(value, str):
             name = u.lookup(value.split("#")[-1])

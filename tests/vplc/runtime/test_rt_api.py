@@ -69,3 +69,22 @@ def test_run_realtime_scans_until_the_stop_event(tmp_path):
     th.join(10)
     assert not th.is_alive()
     assert plc.read("Main.n") >= 5
+
+
+def test_raw_write_puts_an_undefined_value_into_an_enumeration(tmp_path):
+    body = "CASE m OF Off: k := 1; Auto: k := 2; ELSE k := 99; END_CASE;"
+    plc = plc_from(tmp_path, body, "m : eMode; k : INT; i : INT;", TYPES)
+    with pytest.raises(ValueError, match="cannot write 7"):
+        plc.write("Main.m", 7)                          # checked write: only declared values
+    plc.write("Main.m", 7, raw=True)
+    plc.scan(0)
+    assert plc.read("Main.m") == 7 and plc.read("Main.k") == 99   # read back as the bare integer
+    plc.write("Main.m", 1, raw=True)
+    plc.scan(1_000_000)
+    assert plc.read("Main.m") == "Auto" and plc.read("Main.k") == 2
+    with pytest.raises(ValueError, match="takes an integer"):
+        plc.write("Main.m", "Auto", raw=True)
+    with pytest.raises(ValueError, match="outside the range"):
+        plc.write("Main.m", 40000, raw=True)            # still within the storage type (INT)
+    with pytest.raises(ValueError, match="outside the range"):
+        plc.write("Main.i", 40000, raw=True)            # other types keep their normal checks

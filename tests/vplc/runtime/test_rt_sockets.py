@@ -71,6 +71,18 @@ def test_connect_is_busy_for_a_scan_then_done_with_a_handle(tmp_path, server):
     plc.close()
 
 
+def test_send_leaves_in_the_scan_it_is_started_done_comes_a_call_later(tmp_path, server):
+    plc, peer = _connected(tmp_path, server)
+    plc.write("Main.DoSend", True)
+    plc.scan(plc.now_ns + plc.period_ns)
+    assert plc.read("Main.snd.Busy") and not plc.read("Main.snd.Done")
+    assert peer.recv(10) == b"BC"                   # on the wire before the instruction is called again
+    plc.scan(plc.now_ns + plc.period_ns)
+    assert plc.read("Main.snd.Done") and not plc.read("Main.snd.Busy")
+    plc.close()
+    peer.close()
+
+
 def test_send_array_from_an_element_reaches_the_peer(tmp_path, server):
     plc, peer = _connected(tmp_path, server)
     busy, ok = _pulse(plc, "Main.DoSend", "Main.snd.Done")
