@@ -251,7 +251,17 @@ class _LineChecker:
         overloads = SIGNATURES.get(node.name)
         if overloads is None:
             raise CheckError(f"unknown function '{node.name}'")
-        arg_types = [self.argument(arg) for arg in node.args]
+        arg_types = []
+        for arg in node.args:                    # literals inline: motion lines are all literals
+            kind = type(arg)
+            if kind is ast.Num:
+                arg_types.append(F if arg.is_float else I)
+            elif kind is ast.Str:
+                arg_types.append(S)
+            elif kind is ast.Bool:
+                arg_types.append(B)
+            else:
+                arg_types.append(self.argument(arg))
         candidates = [(params, ret) for params, ret in overloads if len(params) == len(arg_types)]
         if not candidates:
             counts = sorted({len(p) for p, _ in overloads})

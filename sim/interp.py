@@ -127,6 +127,8 @@ def _store(target, value, ctx, line):
         if member.startswith("Instant"):
             ctx.robot.io[key.replace("Instant", "")] = level
         else:
+            if not ctx.robot.has_room:
+                yield ("room", None, None)        # the FIFO is full: wait until an item has run
             ctx.robot.enqueue_setting("io", (key, level))
         return
     if isinstance(target, ast.Member):          # Robot[0].CameraLight
@@ -139,6 +141,10 @@ def _store(target, value, ctx, line):
     while len(array) <= index:
         array.append(_DEFAULTS.get(ctx.types[target.obj.id][:-2], 0))
     array[index] = _coerce(ctx.types[target.obj.id][:-2], value)
+
+
+_LITERALS = frozenset({ast.Num, ast.Str, ast.Bool})
+_QUEUED = frozenset(MOTIONS + ("ChangeBase", "ChangeTCP", "ChangeLoad", "QueueTag"))
 
 
 def _eval(node, ctx, line):
@@ -167,7 +173,10 @@ def _eval(node, ctx, line):
     if isinstance(node, ast.Call):
         args = []
         for arg in node.args:
-            args.append((yield from _eval(arg, ctx, line)))
+            if type(arg) in _LITERALS:             # no generator for a literal (motion lines are all literals)
+                args.append(arg.value)
+            else:
+                args.append((yield from _eval(arg, ctx, line)))
         return (yield from _call(node, args, ctx, line))
     if _is_io(node):
         key, _member = yield from _io_key(node, ctx, line)
@@ -209,7 +218,7 @@ def _motion(name, args, line):
         if len(via) != 6 or len(end) != 6:
             raise ScriptRuntimeError("Circle points need 6 values each")
         speed, accel, blend, arc, disable = rest
-        return MotionRequest(name, fmt, [float(v) for v in via + end], speed, accel, blend, not disable,
+        return MotionRequest(name, fmt, tuple(float(v) for v in via + end), speed, accel, blend, not disable,
                              arc_angle=float(arc), line=line.text)
     if isinstance(rest[0], list):
         target, rest = rest[0], rest[1:]
@@ -227,13 +236,15 @@ def _motion(name, args, line):
             config = tuple(int(v) for v in (rest[4] if isinstance(rest[4], list) else rest[4:7]))
             if len(config) != 3 or config[0] not in (0, 1) or config[1] not in (2, 3) or config[2] not in (4, 5):
                 raise ScriptRuntimeError(f"arm configuration {list(config)} is not {{0|1, 2|3, 4|5}}")
-    return MotionRequest(name, fmt, [float(v) for v in target], speed, accel, blend, not disable,
+    return MotionRequest(name, fmt, tuple(float(v) for v in target), speed, accel, blend, not disable,
                          config=config, line=line.text)
 
 
 def _call(node, args, ctx, line):
     name = node.name
     robot = ctx.robot
+    if name in _QUEUED and not robot.has_room:
+        yield ("room", None, None)                # the FIFO is full: wait until an item has run
     if name in MOTIONS:
         if not isinstance(args[0], str):
             raise ScriptRuntimeError("data format must be a string")

@@ -44,8 +44,11 @@ class KinematicsError(Exception):
 
 
 def matmul(m, n):
-    return [[m[i][0] * n[0][j] + m[i][1] * n[1][j] + m[i][2] * n[2][j] + m[i][3] * n[3][j]
-             for j in range(4)] for i in range(4)]
+    """4x4 product, unrolled (the planner's hot spot); same operation order as the textbook loop."""
+    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3) = n
+    return [[r0 * a0 + r1 * b0 + r2 * c0 + r3 * d0, r0 * a1 + r1 * b1 + r2 * c1 + r3 * d1,
+             r0 * a2 + r1 * b2 + r2 * c2 + r3 * d2, r0 * a3 + r1 * b3 + r2 * c3 + r3 * d3]
+            for r0, r1, r2, r3 in m]
 
 
 def inverse(m):
@@ -93,8 +96,18 @@ def _frames(joints):
 
 
 def forward(joints, tool=None):
-    """Flange (or TCP when ``tool`` matrix given) pose matrix in the robot base frame."""
-    m = _frames(joints)[6]
+    """Flange (or TCP when ``tool`` matrix given) pose matrix in the robot base frame.
+
+    The loop of ``_frames`` without keeping the intermediate frames (same arithmetic)."""
+    rows = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0))
+    for i in range(6):
+        th = math.radians(joints[i] + OFFSET[i])
+        ct, st, ca, sa, a, d = math.cos(th), math.sin(th), _COS_ALPHA[i], _SIN_ALPHA[i], A[i], D[i]
+        rows = [(r0 * ct + r1 * st,
+                 -r0 * st * ca + r1 * ct * ca + r2 * sa,
+                 r0 * st * sa - r1 * ct * sa + r2 * ca,
+                 (r0 * ct + r1 * st) * a + r2 * d + r3) for r0, r1, r2, r3 in rows]
+    m = [list(r) for r in rows] + [[0.0, 0.0, 0.0, 1.0]]
     return matmul(m, tool) if tool is not None else m
 
 
@@ -202,12 +215,13 @@ def _analytic(target):
         if abs(c5) > 1.0 - 1e-9:
             continue
         z1_6 = [sum(target[k][j] * z1[k] for k in range(3)) for j in range(3)]   # R^T z1
+        m1t = matmul(inv_a1, target)
         for t5 in (math.acos(c5), -math.acos(c5)):
             s5 = math.sin(t5)
             t6 = math.atan2(-z1_6[1] / s5, z1_6[0] / s5)
             # frame 4 in frame 1: inverse(A1) * target * inverse(A5 * A6)
             a5a6 = _chain(4, [math.degrees(t5), math.degrees(t6)])
-            m14 = matmul(matmul(inv_a1, target), inverse(a5a6))
+            m14 = matmul(m1t, inverse(a5a6))
             x, y = m14[0][3], m14[1][3]
             c3 = (x * x + y * y - A[1] ** 2 - A[2] ** 2) / (2 * A[1] * A[2])
             if abs(c3) > 1.0:

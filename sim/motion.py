@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from . import kinematics as kin
 
@@ -58,12 +59,14 @@ def trapezoid_fraction(t, total, ta):
     return 1.0 - 0.5 * vmax * rest * rest / ta
 
 
-@dataclass
-class MotionRequest:
-    """One queued motion as written in the script (values already evaluated)."""
+class MotionRequest(NamedTuple):
+    """One queued motion as written in the script (values already evaluated).
+
+    A tuple of plain values: a long motion FIFO costs ~250 bytes per motion and nothing at garbage
+    collection (the collector stops tracking tuples that hold no containers)."""
     function: str             # PTP, Line, Circle, PLine, Move_PTP, Move_Line, Move_PLine
     fmt: str
-    target: list              # 6 values (or 12 for Circle: via point then end point)
+    target: tuple             # 6 values (or 12 for Circle: via point then end point)
     speed: float
     accel_ms: float
     blend: float
@@ -161,15 +164,15 @@ class Planner:
         return kin.matmul(self.base, kin.pose_to_matrix(pose_in_base))
 
     def plan(self, req: MotionRequest, joints: list) -> Plan:
-        plan = self._plan(req, joints)
-        plan.start_pose = kin.matrix_to_pose(kin.matmul(self.base_inverse, kin.forward(joints, self.tool)))
+        start_tcp = kin.forward(joints, self.tool)
+        plan = self._plan(req, joints, start_tcp)
+        plan.start_pose = kin.matrix_to_pose(kin.matmul(self.base_inverse, start_tcp))
         return plan
 
-    def _plan(self, req: MotionRequest, joints: list) -> Plan:
+    def _plan(self, req: MotionRequest, joints: list, start_tcp) -> Plan:
         _check_common(req)
         relative = req.function.startswith("Move_")
         frame = req.fmt[0]
-        start_tcp = kin.forward(joints, self.tool)
         if req.function == "Circle":
             return self._plan_circle(req, joints, start_tcp)
         if frame == "J":

@@ -12,6 +12,7 @@ from . import kinematics as kin
 from .motion import MotionError, MotionRequest, Planner
 
 HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)
+FIFO_LIMIT = 1000       # queued items (motions, tags, settings) per robot; a script waits while it is full
 _MATRICES: dict[tuple, list] = {}          # pose -> matrix of bases and tools in use (never modified)
 IDENTITY_POSE = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
@@ -51,6 +52,11 @@ class RobotModel:
     @property
     def queue_length(self):
         return len(self.fifo) + (1 if self.active else 0)
+
+    @property
+    def has_room(self) -> bool:
+        """False while the FIFO holds FIFO_LIMIT items (bounded memory; the script queueing more waits)."""
+        return len(self.fifo) < FIFO_LIMIT
 
     @property
     def idle(self):

@@ -12,6 +12,7 @@ Limits (per robot unless noted):
 """
 from __future__ import annotations
 
+import gc
 import json
 import selectors
 import socket
@@ -28,8 +29,11 @@ MAX_CLIENTS = 256
 MAX_PENDING = 1000
 MAX_OUTBOX = 1 << 20
 RECV_SIZE = 65536
-EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all)
-IO_SLICE_S = 0.0005
+EVENT_BUDGET = 40_000       # events kept in memory (~0.5 KB each), shared by all robots (the JSONL file gets all)
+POLL_BUDGET_S = 0.004       # after this long, one poll() stops serving sockets in between and ends
+GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...
+GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
+IO_SLICE_S = 0.0003          # at most this much work (planning, advancing) between two socket polls
 
 
 class _Conn:
@@ -66,10 +70,11 @@ class Robot:
         event = {"t": round(session.now, 6) if session is not None else 0.0, "robot": self.index, "kind": kind,
                  **fields}
         self.events.append(event)
-        for predicate, flag, found in list(self._waiters):
-            if not flag.is_set() and predicate(event):
-                found.append(event)
-                flag.set()
+        if self._waiters:
+            for predicate, flag, found in list(self._waiters):
+                if not flag.is_set() and predicate(event):
+                    found.append(event)
+                    flag.set()
         if len(self.events) > self._server.event_limit:
             del self.events[: len(self.events) // 2]
         if self._server.log_file is not None:
@@ -156,14 +161,15 @@ class Robot:
 class SimServer:
     def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
                  send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
-                 control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None):
+                 control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None,
+                 manage_gc=False):
         if not 1 <= robots <= 512:
             raise ValueError(f"robots must be 1..512, got {robots}")
         if speedup <= 0:
             raise ValueError(f"speedup must be positive, got {speedup}")
         self.host, self.speedup, self.auto_enter = host, speedup, auto_enter
         self.lock = threading.RLock()
-        self.event_limit = event_limit or max(1000, EVENT_BUDGET // robots)    # per robot
+        self.event_limit = event_limit or EVENT_BUDGET // robots    # per robot: all robots together keep <= 40,000
         try:
             self.log_file = open(log_path, "a", encoding="utf-8", buffering=1) if log_path else None
         except OSError as exc:
@@ -176,7 +182,11 @@ class SimServer:
         self._stop = threading.Event()
         self._now = 0.0
         self._dispatch = {"listen": self._accept, "conn": self._read}
+        self._touched: list[Robot] = []       # robots that received data and still have to advance
+        self._starting = False
+        self._slice_start = self._poll_end = 0.0
         self.started = False
+        self.manage_gc = manage_gc            # the CLI: garbage collection between bursts, see _collect_garbage
         self.control = None
         self._control_port = control_port
 
@@ -274,30 +284,43 @@ class SimServer:
     def poll(self, now_s: float, timeout: float = 0.0):
         """Advance to ``now_s`` and serve every socket that is ready; never blocks unless timeout>0.
 
-        Planning a motion (inverse kinematics) can take a millisecond; when advancing the robots
-        takes longer than IO_SLICE_S the sockets are served in between, so replies never wait for
-        the motion planning of all other robots.
+        Replies leave as soon as their request is processed (before the motions it queued are
+        started). Planning a motion (inverse kinematics, ~0.2 ms) happens when the motion starts;
+        every IO_SLICE_S of such work the sockets are served in between, so a reply never waits for
+        the planning of all robots (and the pushes of a tag reached leave robot by robot).
         """
         with self.lock:
             self._now = max(self._now, now_s)
-            slice_start = time.perf_counter()
-            advanced = []
+            self._slice_start = time.perf_counter()
+            self._poll_end = self._slice_start + POLL_BUDGET_S
             for robot in self.robots:
-                robot.session.advance(self._now)
-                advanced.append(robot)
-                if time.perf_counter() - slice_start > IO_SLICE_S:
-                    for done in advanced:          # pushes (tag reached) leave without waiting
-                        self._flush(done)
-                    advanced.clear()
-                    self._serve(0.0)
-                    slice_start = time.perf_counter()
-            self._serve(timeout)
+                session = robot.session
+                session.advance(self._now)
+                if any(client.outbox for client in session.clients.values()) and not robot.faults.active:
+                    self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
+                self._breathe()
+            ready = self._serve(timeout)
+            self._start_touched()
             for robot in self.robots:
                 self._flush(robot)
                 if robot.session.state == STOPPED and (robot.listener is not None or robot.conns):
                     self._close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
                 if robot.reading_paused and len(robot.session.pending) < MAX_PENDING // 2:
                     self._set_reading(robot, True)
+            if self.manage_gc:
+                _collect_garbage(idle=not ready)
+
+    def _breathe(self, budgeted=False):
+        """Between two pieces of work: serve the sockets when IO_SLICE_S has passed since they were
+        served. ``budgeted``: not after POLL_BUDGET_S (work that new requests extend - a flood of
+        requests must not hold the clock)."""
+        clock = time.perf_counter()
+        if clock - self._slice_start <= IO_SLICE_S or (budgeted and clock > self._poll_end):
+            return
+        self._serve(0.0)
+        self._slice_start = time.perf_counter()
+        if not self._starting:
+            self._start_touched()
 
     def _set_reading(self, robot, reading: bool):
         """Back-pressure: stop reading this robot's clients while its script buffer is full."""
@@ -315,10 +338,11 @@ class SimServer:
                 pass
 
     def _serve(self, timeout):
-        touched = set()
-        for key, _mask in self.selector.select(timeout):
+        """Accept and read every ready socket; the replies are written at once. Robots that received
+        something are remembered in ``_touched`` for ``_start_touched``."""
+        ready = self.selector.select(timeout)
+        for key, _mask in ready:
             kind, robot, conn = key.data
-            touched.add(robot)
             try:
                 self._dispatch[kind](robot, conn)
             except Exception as exc:          # safety net: one bad client never stops the others
@@ -326,10 +350,24 @@ class SimServer:
                     raise
                 robot._log("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
                 self._drop(robot, conn, "internal error while handling this client")
-        for robot in touched:
             if robot is not None:
-                robot.session.advance(self._now)      # start what the new scripts queued
+                if robot not in self._touched:
+                    self._touched.append(robot)
+                if not robot.faults.active:
+                    self._flush(robot)
+        return len(ready)
+
+    def _start_touched(self):
+        """Advance the robots that received scripts with dt = 0, so a motion queued now starts now."""
+        self._starting = True
+        try:
+            while self._touched:
+                robot = self._touched.pop(0)
+                robot.session.advance(self._now)
                 self._flush(robot)
+                self._breathe(budgeted=True)
+        finally:
+            self._starting = False
 
     def _accept(self, robot, _conn):
         for _ in range(64):
@@ -387,20 +425,23 @@ class SimServer:
                 return
 
     def _flush(self, robot):
+        if not robot.conns:                       # (the session has no client without a connection)
+            return
         now = self._now
+        faulty = robot.faults.active
         for conn_id, client in list(robot.session.clients.items()):
             conn = robot.conns.get(conn_id)
             if conn is None:
                 continue
             if client.outbox:
-                frames, client.outbox[:] = list(client.outbox), []
+                frames, client.outbox = client.outbox, []
                 for frame in frames:
                     header, _, rest = frame[1:].partition(b",")
-                    robot._log("frame_out", conn=conn_id, raw=_text(frame), header=_text(header),
+                    robot._log("frame_out", conn=conn_id, raw=_text(frame), header=_header_text(header),
                                data=_text(rest.partition(b",")[2][:-6]))
             else:
-                frames = []
-            if robot.faults.active:
+                frames = ()
+            if faulty:
                 robot.faults.queue(conn_id, frames, now)
                 chunks, close = robot.faults.take(conn_id, now)
             elif not frames and not conn.wbuf and not conn.eof:
@@ -447,6 +488,16 @@ class SimServer:
         robot._log("closed", conn=conn.id, reason=reason)
 
 
+def _collect_garbage(idle: bool):
+    """Run the collector between bursts of requests, not in the middle of one (SimServer(manage_gc=True),
+    the CLI, which also switches the automatic collector off): young objects when a poll found no
+    socket ready, or at the latest after GC_FORCE allocations; older generations as CPython would
+    (every 10 collections of the one below). Start-up objects are frozen (gc.freeze) by the CLI."""
+    young, middle, old = gc.get_count()
+    if young >= (GC_IDLE if idle else GC_FORCE):
+        gc.collect(2 if old >= 10 else 1 if middle >= 10 else 0)
+
+
 def _send(sock, data) -> int:
     try:
         return sock.send(data)
@@ -458,6 +509,14 @@ def _has_work_for(session, conn_id):
     if session.running is not None and session.running.packet.conn == conn_id:
         return True
     return any(p.conn == conn_id for p in session.pending)
+
+
+_HEADERS = {b"TMSCT": "TMSCT", b"TMSTA": "TMSTA", b"CPERR": "CPERR"}
+
+
+def _header_text(raw: bytes) -> str:
+    """The header as text; the three known headers share one string each (the event log keeps many)."""
+    return _HEADERS.get(raw) or _text(raw)
 
 
 def _text(raw: bytes) -> str:

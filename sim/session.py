@@ -51,7 +51,7 @@ class Running:
     packet: Packet
     gen: object
     warnings: list
-    wait: tuple | None = None          # ("tag", tag, deadline or None)
+    wait: tuple | None = None          # ("tag", tag, deadline or None) or ("room", None, None)
 
 
 @dataclass
@@ -294,13 +294,19 @@ class ListenSession:
             self.log("runtime_error", id=run.packet.id, reason=str(exc))
             self._reply(run.packet, "ERROR;" + line)
             return
-        _kind, tag, timeout = request
-        run.wait = ("tag", tag, None if timeout is None else self.now + timeout)
+        kind, tag, timeout = request
+        run.wait = (kind, tag, None if timeout is None else self.now + timeout)
 
     def _resume_waits(self):
         """Resume the running script if what it waits for has happened."""
         while self.running is not None and self.running.wait is not None:
-            _kind, tag, deadline = self.running.wait
+            kind, tag, deadline = self.running.wait
+            if kind == "room":                  # a queued statement waits for room in the full FIFO
+                if not self.robot.has_room:
+                    return
+                self.running.wait = None
+                self._step(None)
+                continue
             status = self.robot.tag_status(tag)
             if status == "true":
                 result = 1

@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import signal
 import sys
@@ -73,7 +74,8 @@ def main(argv=None) -> int:
                            log_path=args.log, tag_history=args.tag_history,
                            control_port=None if args.no_control else args.control_port,
                            data_timeout=args.data_timeout if args.data_timeout > 0 else None,
-                           connection_timeout=args.connection_timeout if args.connection_timeout > 0 else None)
+                           connection_timeout=args.connection_timeout if args.connection_timeout > 0 else None,
+                           manage_gc=True)
         server.start()
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)
@@ -86,6 +88,8 @@ def main(argv=None) -> int:
     if args.speedup != 1.0:
         print(f"robot clock runs {args.speedup:g} x faster than real time", flush=True)
     print("Press Ctrl-C to stop.", flush=True)
+    gc.disable()     # the server collects between bursts of requests (SimServer(manage_gc=True))
+    gc.freeze()      # what start-up built lives for good: keep it out of every later collection
     done = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: done.set())
     try:

@@ -121,3 +121,19 @@ def test_parser_builds_calls_and_declarations():
 def test_deeply_nested_expression_is_an_error_not_a_crash():
     errors, _, lines = check("int x = " + "(" * 5000 + "1" + ")" * 5000)
     assert errors == [1]
+
+
+@pytest.mark.parametrize("text", [
+    'Line("CAR",380,-100,350,180,0,90,400,100,50,true)', ' PTP ( "JPP" , -0.5 ,1e3, .5, 2., - 4, 1E-2 ) ',
+    'QueueTag(1)', 'ScriptExit()', 'F( )', 'F(true,false,"")', 'F("a,b")', 'F("x\\"y")', "F('s')", 'F(0x1F)',
+    'F(+3)', 'F(--3)', 'F(5x)', 'F(truex)', 'F(1,)', 'F(,1)', 'F({1,2})', 'F(1+2)', 'F(x)', 'true(1)',
+    'F(1) // note', 'F(1));', 'F(-0)', 'F(-0.0)', 'F(007)', 'F(.e5)', 'F(1.e5)', 'int(3)',
+])
+def test_fast_path_for_literal_calls_gives_the_same_tree_as_the_parser(text):
+    from sim.script import ScriptSyntaxError, _Parser, _simple_call, tokenize
+    fast = _simple_call(text)
+    try:
+        full = repr(_Parser(tokenize(text)).line())
+    except ScriptSyntaxError:
+        full = None
+    assert fast is None or repr(fast) == full

@@ -356,3 +356,19 @@ def test_wait_event_returns_an_event_logged_by_the_background_thread():
         sock.close()
     finally:
         srv.close()
+
+
+def test_event_log_is_bounded_per_robot_and_overall():
+    srv = SimServer(port=0, robots=32)
+    try:
+        assert srv.event_limit * 32 <= 40_000
+        robot = srv.robots[0]
+        for n in range(3 * srv.event_limit):
+            robot._log("io", point="x", value=n)
+        assert srv.event_limit // 2 <= len(robot.events) <= srv.event_limit
+        assert robot.events[-1]["value"] == 3 * srv.event_limit - 1      # the newest are kept
+    finally:
+        srv.close()
+    single = SimServer(port=0, robots=1)
+    assert single.event_limit == 40_000
+    single.close()

@@ -346,3 +346,31 @@ def test_connection_timeout_leaves_the_node_when_nobody_connects():
     m.connect(1)
     m.advance(3.0)
     assert m.s.state == IN_NODE
+
+
+def frame(header, data):
+    return codec.encode(header, data).decode()
+
+
+def test_full_motion_fifo_makes_the_script_wait_for_room(monkeypatch):
+    monkeypatch.setattr("sim.robot.FIFO_LIMIT", 4)
+    node = S()
+    node.connect()
+    script = "\r\n".join(f'PTP("JPP",0,0,90,0,90,{k},100,0,0,false)' for k in range(6))
+    assert node.send(1, sct("A", script)) == []              # 4 queued, the 5th waits for room
+    assert len(node.s.robot.fifo) == 4 and node.s.running is not None
+    assert node.send(1, codec.encode("TMSTA", "00")) == [frame("TMSTA", "00,true,Listen1")]   # still answered
+    node.advance(5.0)
+    assert node.out() == [frame("TMSCT", "A,OK")]               # all 6 queued once items had run
+    assert node.s.robot.queue_length <= 4
+
+
+def test_stop_and_clear_buffer_frees_a_script_waiting_for_room(monkeypatch):
+    monkeypatch.setattr("sim.robot.FIFO_LIMIT", 2)
+    node = S()
+    node.connect()
+    script = "\r\n".join(f"QueueTag({k})" for k in (1, 2, 3))
+    node.s.robot.pause()                                       # nothing runs: the FIFO stays full
+    assert node.send(1, sct("A", script)) == []
+    # the priority command clears the FIFO and is answered; the third tag then finds room and A ends
+    assert node.send(1, sct("P", "StopAndClearBuffer(0)")) == [frame("TMSCT", "P,OK"), frame("TMSCT", "A,OK")]
