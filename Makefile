@@ -8,7 +8,7 @@ STAMP    := $(VENV)/.deps-stamp
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 export PYTHONPATH := $(CURDIR)/src:$(CURDIR)
 
-.PHONY: demo test bench check clean venv test-deps browser
+.PHONY: demo test bench check package clean venv test-deps browser
 
 ## demo: robot simulator + virtual PLC running the examples + web HMI (Ctrl-C stops everything)
 demo: venv
@@ -26,6 +26,12 @@ bench: venv
 check: venv
 	$(VPY) -m vplc check lib/ examples/
 	$(VPY) -m vplc check --portable --warnings-as-errors lib/CBT_Commands_Lib
+
+## package: the library for Sysmac Studio: build/CBT_Commands_Lib.xml (IEC 61131-10 import) and build/paste/
+package: venv
+	@mkdir -p build
+	$(VPY) -m vplc export lib/CBT_Commands_Lib --format iec61131-10 -o build/CBT_Commands_Lib.xml
+	$(VPY) -m vplc export lib/CBT_Commands_Lib --format paste -o build/paste
 
 clean:
 	rm -rf $(VENV) .pytest_cache artifacts build

@@ -1,8 +1,9 @@
 """Command line: ``python -m vplc <command> ...``.
 
 Subcommands live in a registry: this module registers ``check``; the back end's modules
-``vplc.cli_run`` and ``vplc.cli_test`` register ``run`` and ``test`` through their ``register(subparsers)``
-function when they are importable. Exit codes: 0 success, 1 errors found, 2 usage error.
+``vplc.cli_run`` and ``vplc.cli_test`` register ``run`` and ``test``, the package ``vplc.export`` registers
+``export``, each through its ``register(subparsers)`` function when it is importable. Exit codes: 0 success,
+1 errors found, 2 usage error.
 """
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import sys
 
 from .diagnostics import ERROR, NOTE, WARNING, to_json
 
-EXTENSION_MODULES = ("vplc.cli_run", "vplc.cli_test")
+EXTENSION_MODULES = ("vplc.cli_run", "vplc.cli_test", "vplc.export")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,0 +1,110 @@
+"""``python -m vplc export PATH... --format iec61131-10|paste -o OUT [--flat]``: hand the library to
+Sysmac Studio.
+
+* ``iec61131-10`` writes one IEC 61131-10 Ed.1 XML file for Tools > IEC 61131-10 XML > Import
+  (:mod:`vplc.export.iec61131_10`);
+* ``paste`` writes a folder of clipboard-ready variable tables and bodies plus ORDER.txt for CPU units
+  without that menu (:mod:`vplc.export.paste`).
+
+The sources are loaded and checked by the front end first; nothing is written while there are errors.
+Exit codes: 0 written, 1 errors in the sources (diagnostics printed), 2 usage error (one-line message).
+Documentation: docs/toolchain/export.md.
+"""
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+
+FORMATS = ("iec61131-10", "paste")
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "export", help="export ST sources for Sysmac Studio (IEC 61131-10 XML or paste kit)",
+        description="Check the ST sources, then write them as one IEC 61131-10 XML file (Sysmac Studio: "
+                    "Tools > IEC 61131-10 XML > Import) or as a paste kit folder. Exit 0 written, 1 errors in "
+                    "the sources, 2 usage error.")
+    p.add_argument("paths", nargs="+", metavar="PATH", help="ST file or folder (recursive *.st)")
+    p.add_argument("--format", default="iec61131-10", metavar="FORMAT",
+                   help="iec61131-10 (default): one XML file; paste: a folder per data type and POU")
+    p.add_argument("-o", "--output", metavar="OUT", help="XML file (iec61131-10) or folder (paste); required")
+    p.add_argument("--flat", action="store_true",
+                   help="write every object in the global namespace (no NamespaceDecl), for importers "
+                        "that do not take namespaces")
+    p.add_argument("--dialect", choices=("sysmac", "iec"), default="sysmac", help="language dialect (default: sysmac)")
+    p.set_defaults(handler=run_export)
+
+
+def _usage(msg: str) -> int:
+    print(f"vplc export: error: {msg}", file=sys.stderr)
+    return 2
+
+
+def run_export(args) -> int:
+    from ..diagnostics import ERROR, NOTE
+    from ..project import load_project
+    from .iec61131_10 import render
+    from .model import ExportError, collect
+    from .paste import PasteTargetError, write as write_paste
+
+    if args.format not in FORMATS:
+        return _usage(f"unknown format `{args.format}`; use {' or '.join(FORMATS)}")
+    if not args.output:
+        return _usage("no output given; add -o FILE.xml (iec61131-10) or -o FOLDER (paste)")
+    missing = [p for p in args.paths if not os.path.exists(p)]
+    if missing:
+        return _usage(f"file or folder `{missing[0]}` does not exist")
+    out = args.output
+    if args.format == "iec61131-10":
+        parent = os.path.dirname(os.path.abspath(out))
+        if os.path.isdir(out):
+            return _usage(f"output `{out}` is a folder; give a file name such as {os.path.join(out, 'Lib.xml')}")
+        if not os.path.isdir(parent):
+            return _usage(f"cannot write `{out}`: folder `{parent}` does not exist")
+
+    proj = load_project(args.paths, dialect=args.dialect)
+    shown = [d for d in proj.diagnostics if d.severity != NOTE]
+    errors = sum(1 for d in shown if d.severity == ERROR)
+    if shown:
+        for d in shown:
+            print(d.render(), file=sys.stderr)
+    if errors:
+        print(f"vplc export: {errors} error(s) in the sources; nothing written", file=sys.stderr)
+        return 1
+    export = collect(proj)
+    if not export.items:
+        return _usage("the sources declare no data type and no POU; nothing to export")
+    try:
+        if args.format == "iec61131-10":
+            data = render(export, proj, flat=args.flat)
+            _write_atomic(out, data)
+        else:
+            write_paste(export, proj, out, flat=args.flat)
+    except ExportError as exc:
+        print(f"vplc export: error: {exc}", file=sys.stderr)
+        return 1
+    except PasteTargetError as exc:
+        return _usage(str(exc))
+    except OSError as exc:
+        return _usage(f"cannot write `{out}`: {exc.strerror or exc}")
+    print(f"{out}: {len(export.types)} data type(s), {len(export.pous)} POU(s)"
+          + (f", {sum(len(s.vars) for g in export.globals for s in g.gvl.sections)} global variable(s)"
+             if export.globals else "")
+          + (" (flat)" if args.flat else ""))
+    return 0
+
+
+def _write_atomic(path: str, data: bytes) -> None:
+    """Write next to the target and rename, so a failed run never leaves half a file behind."""
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".vplc-export-", suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise

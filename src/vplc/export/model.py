@@ -1,0 +1,248 @@
+"""What an export contains: the user's data types and POUs, taken from a checked project.
+
+``collect(project)`` returns an :class:`ExportSet` in dependency order (see :mod:`vplc.export.order`).
+Each item keeps its AST node, its namespace and the text the writers need and the AST does not carry:
+the header comment above it, the comment at the end of each declaration line and, for POUs, the body
+text exactly as written between the last ``END_VAR`` and ``END_FUNCTION_BLOCK`` (comments included).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from .. import ast as A
+from .. import printer
+from .order import dependency_order
+
+class ExportError(Exception):
+    """The sources are valid ST but use something the chosen export format cannot express."""
+
+
+@dataclass
+class TypeItem:
+    decl: A.TypeDecl
+    namespace: str | None
+    comment: str
+    source_text: str                 # the TYPE ... END_TYPE block as written
+    path: str
+    member_comments: dict[int, str] = field(default_factory=dict)   # id(VarDecl | EnumValueDecl) -> comment
+
+    @property
+    def name(self) -> str:
+        return self.decl.name
+
+    @property
+    def kind(self) -> str:
+        spec = self.decl.spec
+        if isinstance(spec, A.StructTypeRef):
+            return "STRUCT"
+        if isinstance(spec, A.EnumTypeRef):
+            return "ENUM"
+        if isinstance(spec, A.ArrayTypeRef):
+            return "ARRAY"
+        return "ALIAS"
+
+
+@dataclass
+class PouItem:
+    pou: A.Pou
+    namespace: str | None
+    comment: str
+    body: str
+    path: str
+    var_comments: dict[int, str] = field(default_factory=dict)      # id(VarDecl) -> comment
+
+    @property
+    def name(self) -> str:
+        return self.pou.name
+
+    @property
+    def kind(self) -> str:
+        return self.pou.kind
+
+
+@dataclass
+class GlobalItem:
+    gvl: A.GlobalVarList
+    path: str
+    var_comments: dict[int, str] = field(default_factory=dict)
+
+
+@dataclass
+class ExportSet:
+    types: list[TypeItem]            # dependency order: every type after the types it uses
+    pous: list[PouItem]              # dependency order: every POU after the POUs it calls or instantiates
+    globals: list[GlobalItem]
+    namespaces: list[str]            # library namespaces present, sorted
+
+    @property
+    def items(self) -> list:
+        return [*self.types, *self.pous]
+
+    @property
+    def name(self) -> str:
+        """Content name: the library namespace when there is exactly one, else ``Project``."""
+        return self.namespaces[0] if len(self.namespaces) == 1 else "Project"
+
+
+# ---- comments ------------------------------------------------------------------------------------
+
+def comment_text(raw: str) -> str:
+    """Text of one comment without its delimiters, whitespace folded to single spaces."""
+    if raw.startswith("//"):
+        raw = raw[2:]
+    elif raw[:2] in ("(*", "/*"):
+        raw = raw[2:-2]
+    return " ".join(raw.split())
+
+
+class _Comments:
+    def __init__(self, unit: A.CompilationUnit) -> None:
+        self.text = unit.span.file.text
+        self.spans = sorted((s, e) for _style, s, e in (unit.comments or []))
+
+    def between(self, start: int, end: int) -> str:
+        """All comments fully inside ``[start, end)``, joined."""
+        parts = [comment_text(self.text[s:e]) for s, e in self.spans if s >= start and e <= end]
+        return " ".join(p for p in parts if p)
+
+    def trailing(self, end: int) -> str:
+        """The comments on the rest of the line after offset ``end`` (a declaration's line comment)."""
+        line_end = self.text.find("\n", end)
+        line_end = len(self.text) if line_end < 0 else line_end
+        parts = []
+        for s, e in self.spans:
+            if end <= s < line_end and not self.text[end:s].strip(" \t,;\r"):
+                parts.append(comment_text(self.text[s:e]))
+                end = e
+        return " ".join(p for p in parts if p)
+
+
+# ---- POU body ------------------------------------------------------------------------------------
+
+def body_text(pou: A.Pou) -> str:
+    """The statement part of ``pou`` exactly as written (comments kept, line ends normalised to LF).
+
+    It runs from the line after the last declaration (``END_VAR`` or the header) to the line before
+    ``END_FUNCTION`` / ``END_FUNCTION_BLOCK`` / ``END_PROGRAM``; leading blank lines and trailing white
+    space are dropped.
+    """
+    text = pou.span.file.text
+    header_end = max([pou.name_span.end]
+                     + ([pou.return_type.span.end] if pou.return_type is not None and pou.return_type.span else [])
+                     + [s.span.end for s in pou.sections if s.span is not None])
+    tail = text[header_end:pou.span.end]
+    m = None
+    for m in re.finditer(r"(?i)\bEND_" + pou.kind + r"\b", tail):
+        pass
+    stop = header_end + (m.start() if m else len(tail))
+    raw = text[header_end:stop].replace("\r\n", "\n").replace("\r", "\n")
+    first_nl = raw.find("\n")
+    if first_nl >= 0 and not raw[:first_nl].strip():
+        raw = raw[first_nl + 1:]
+    lines = raw.split("\n")
+    while lines and not lines[0].strip():
+        lines.pop(0)
+    return "\n".join(lines).rstrip()
+
+
+# ---- collection ----------------------------------------------------------------------------------
+
+def collect(project) -> ExportSet:
+    """The exportable content of ``project`` (which must have no errors), prelude excluded."""
+    types: list[TypeItem] = []
+    pous: list[PouItem] = []
+    globals_: list[GlobalItem] = []
+    namespaces: set[str] = set()
+    for unit in project.units:
+        if getattr(unit, "in_prelude", False):
+            continue
+        comments = _Comments(unit)
+        path = unit.span.file.path
+        prev_end = 0
+        for item in unit.items:
+            header = comments.between(prev_end, item.span.start)
+            prev_end = item.span.end
+            if isinstance(item, A.TypeBlock):
+                block_text = unit.span.file.text[item.span.start:item.span.end]
+                for i, decl in enumerate(item.decls):
+                    ns = unit.namespace
+                    t = TypeItem(decl, ns, header if i == 0 else "", block_text, path)
+                    spec = decl.spec
+                    if isinstance(spec, A.StructTypeRef):
+                        t.member_comments = {id(f): comments.trailing(f.span.end) for f in spec.fields}
+                    elif isinstance(spec, A.EnumTypeRef):
+                        t.member_comments = {id(v): comments.trailing(v.span.end) for v in spec.values}
+                    types.append(t)
+                    if ns:
+                        namespaces.add(ns)
+            elif isinstance(item, A.Pou):
+                p = PouItem(item, unit.namespace, header, body_text(item), path,
+                            {id(d): comments.trailing(d.span.end) for s in item.sections for d in s.vars})
+                pous.append(p)
+                if unit.namespace:
+                    namespaces.add(unit.namespace)
+            elif isinstance(item, A.GlobalVarList):
+                globals_.append(GlobalItem(item, path, {id(d): comments.trailing(d.span.end)
+                                                        for s in item.sections for d in s.vars}))
+    types = dependency_order(types, lambda t: _type_deps(project, t), key=lambda t: (t.namespace, t.name.upper()))
+    pous = dependency_order(pous, lambda p: _pou_deps(project, p), key=lambda p: (p.namespace, p.name.upper()))
+    return ExportSet(types, pous, globals_, sorted(namespaces))
+
+
+def _named_refs(ref: A.TypeRef):
+    """Every named type referenced by a type specification."""
+    if isinstance(ref, A.NamedTypeRef):
+        yield ref.name.text()
+    elif isinstance(ref, A.ArrayTypeRef):
+        yield from _named_refs(ref.element)
+    elif isinstance(ref, A.SubrangeTypeRef):
+        yield from _named_refs(ref.base)
+    elif isinstance(ref, A.EnumTypeRef) and ref.base is not None:
+        yield from _named_refs(ref.base)
+    elif isinstance(ref, A.StructTypeRef):
+        for f in ref.fields:
+            yield from _named_refs(f.type)
+
+
+def _type_deps(project, item: TypeItem):
+    for name in _named_refs(item.decl.spec):
+        t = project.lookup_type(name, item.namespace)
+        if t is not None:
+            yield getattr(t, "namespace", None), t.name.upper()
+
+
+def _pou_deps(project, item: PouItem):
+    pou = item.pou
+    for section in pou.sections:
+        for d in section.vars:
+            for name in _named_refs(d.type):
+                pt = project.lookup_pou(name, item.namespace)
+                if pt is not None:
+                    yield pt.namespace, pt.name.upper()
+    for node in (n for stmt in pou.body for n in A.walk(stmt)):
+        if isinstance(node, A.Call):
+            callee = getattr(getattr(node, "binding", None), "pou", None)
+            if callee is not None:
+                yield callee.namespace, callee.name.upper()
+
+
+def enum_values(project, item: TypeItem) -> dict[str, int]:
+    """Value of every enumerator (implicit values counted on from the previous one, as the checker does)."""
+    t = project.lookup_type(item.decl.name, item.namespace)
+    known = {k.upper(): v for k, v in getattr(t, "values", {}).items()}
+    out, nxt = {}, 0
+    for v in item.decl.spec.values:
+        value = known.get(v.name.upper(), nxt)
+        out[v.name.upper()] = value
+        nxt = value + 1
+    return out
+
+
+def type_text(ref: A.TypeRef) -> str:
+    """A type specification as Sysmac Studio's tables show it (``STRING[80]``, ``ARRAY[1..6] OF REAL``)."""
+    return printer.type_ref(ref)
+
+
+def expr_text(e: A.Expr) -> str:
+    return printer.expr(e)

@@ -1,0 +1,75 @@
+"""Error handling: sources with errors, missing paths, bad format, unwritable output. Never a traceback."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from conftest import LIB, ROOT, run
+
+BAD = "FUNCTION_BLOCK Broken\nVAR\n    x : INT;\nEND_VAR\nx := y;\nEND_FUNCTION_BLOCK\n"
+
+
+def _one_line(err: str) -> None:
+    assert err.count("\n") == 1 and err.startswith("vplc export: error: ") and "Traceback" not in err
+
+
+def test_source_with_an_error_prints_diagnostics_and_writes_nothing(tmp_path, capsys):
+    src = tmp_path / "broken.st"
+    src.write_text(BAD, encoding="utf-8")
+    for fmt, out in (("iec61131-10", tmp_path / "out.xml"), ("paste", tmp_path / "kit")):
+        code, stdout, err = run(capsys, "export", str(src), "--format", fmt, "-o", str(out))
+        assert code == 1 and not out.exists()
+        assert f"{src}:5:6: error[ST1001]: `y` is not declared" in err
+        assert err.rstrip().endswith("1 error(s) in the sources; nothing written")
+
+
+def test_missing_path_is_a_usage_error(tmp_path, capsys):
+    code, _, err = run(capsys, "export", str(tmp_path / "nope"), "-o", str(tmp_path / "x.xml"))
+    assert code == 2
+    _one_line(err)
+    assert "does not exist" in err
+
+
+def test_unknown_format_is_a_usage_error(tmp_path, capsys):
+    code, _, err = run(capsys, "export", str(LIB), "--format", "plcopen", "-o", str(tmp_path / "x.xml"))
+    assert code == 2
+    _one_line(err)
+    assert "unknown format `plcopen`" in err
+
+
+def test_unwritable_output_is_a_usage_error(tmp_path, capsys):
+    code, _, err = run(capsys, "export", str(LIB), "-o", str(tmp_path / "no" / "such" / "dir" / "x.xml"))
+    assert code == 2
+    _one_line(err)
+    code, _, err = run(capsys, "export", str(LIB), "-o", str(tmp_path))
+    assert code == 2 and "is a folder" in err
+    _one_line(err)
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code, _, err = run(capsys, "export", str(LIB), "--format", "paste", "-o", str(blocker / "kit"))
+    assert code == 2
+    _one_line(err)
+
+
+def test_missing_output_is_a_usage_error(capsys):
+    code, _, err = run(capsys, "export", str(LIB))
+    assert code == 2 and "-o" in err
+    _one_line(err)
+
+
+def test_folder_without_sources_exports_nothing(tmp_path, capsys):
+    (tmp_path / "empty").mkdir()
+    code, _, err = run(capsys, "export", str(tmp_path / "empty"), "-o", str(tmp_path / "x.xml"))
+    assert code == 2 and "nothing to export" in err and not (tmp_path / "x.xml").exists()
+
+
+def test_command_is_registered_with_python_m_vplc(tmp_path):
+    env_path = f"{ROOT / 'src'}"
+    r = subprocess.run([sys.executable, "-m", "vplc", "export", "--help"], capture_output=True, text=True,
+                       env={"PYTHONPATH": env_path, "PATH": "/usr/bin:/bin"}, cwd=ROOT)
+    assert r.returncode == 0 and "--format" in r.stdout and "--flat" in r.stdout
+    r = subprocess.run([sys.executable, "-m", "vplc", "export", str(LIB), "-o", str(tmp_path / "l.xml")],
+                       capture_output=True, text=True, env={"PYTHONPATH": env_path, "PATH": "/usr/bin:/bin"},
+                       cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    assert "data type(s)" in r.stdout and "POU(s)" in r.stdout
