@@ -209,7 +209,11 @@ def default_string(dialect: str, wide: bool = False) -> T.StringType:
 
 CONVERTIBLE = {**{k: v for k, v in T.ELEMENTARY.items()}, "STRING": None, "WSTRING": None}
 _CONV_RE = re.compile(r"^([A-Z_]+?)_TO_([A-Z_]+)$")
-_BCD_RE = re.compile(r"^(?:BCD_TO_[A-Z]+|[A-Z]+_TO_BCD)$")
+# BCD conversions: IEC 2nd edition BCD_TO_<int> / <int>_TO_BCD, and the typed names of the 3rd edition and
+# Sysmac, <bits>_BCD_TO_<int> / <int>_TO_BCD_<bits> (e.g. WORD_BCD_TO_UINT, UINT_TO_BCD_WORD).
+_BCD_DECODE_RE = re.compile(r"^(?:(BYTE|WORD|DWORD|LWORD)_)?BCD_TO_([A-Z]+)$")
+_BCD_ENCODE_RE = re.compile(r"^([A-Z]+)_TO_BCD(?:_(BYTE|WORD|DWORD|LWORD))?$")
+_BITS_OF_WIDTH = {8: "BYTE", 16: "WORD", 32: "DWORD", 64: "LWORD"}
 
 
 def _conversion(src_name: str, dst_name: str) -> Builtin | None:
@@ -229,6 +233,36 @@ def _conversion(src_name: str, dst_name: str) -> Builtin | None:
         conv = None if (src is None or T.is_error(a) or T.same_type(T.base_of(a), src)) else src
         return result, [conv]
     return Builtin(f"{src_name}_TO_{dst_name}", 1, 1, resolve, ("IN",))
+
+
+def _bcd(name: str) -> Builtin | None:
+    """BCD_TO_x / x_TO_BCD builtins, or None when ``name`` is not one. The integer side must be an integer
+    type; the bit-string side is the one named, or (2nd edition) any bit string when decoding and the bit
+    string of the integer's width when encoding."""
+    m = _BCD_DECODE_RE.match(name)
+    if m and T.is_int(T.ELEMENTARY.get(m.group(2), T.BOOL)):
+        bits_name, result = m.group(1), T.ELEMENTARY[m.group(2)]
+
+        def decode(args, dialect):
+            a = args[0]
+            if bits_name is None:
+                _need(lambda t: T.base_of(t).kind == "bit", a, 0, "a bit string (BYTE, WORD, DWORD, LWORD)")
+                return result, [None]
+            want = T.ELEMENTARY[bits_name]
+            _need(lambda t: T.same_type(T.base_of(t), want) or T.widens_to(t, want), a, 0, f"a {bits_name}")
+            return result, [None if T.is_error(a) or T.same_type(T.base_of(a), want) else want]
+        return Builtin(name, 1, 1, decode, ("IN",))
+    m = _BCD_ENCODE_RE.match(name)
+    if m and T.is_int(T.ELEMENTARY.get(m.group(1), T.BOOL)):
+        source = T.ELEMENTARY[m.group(1)]
+        result = T.ELEMENTARY[m.group(2) or _BITS_OF_WIDTH[source.bits]]
+
+        def encode(args, dialect):
+            a = args[0]
+            _need(lambda t: T.same_type(T.base_of(t), source) or T.widens_to(t, source), a, 0, f"a {source.name}")
+            return result, [None if T.is_error(a) or T.same_type(T.base_of(a), source) else source]
+        return Builtin(name, 1, 1, encode, ("IN",))
+    return None
 
 
 def _trunc(args, dialect):
@@ -291,11 +325,23 @@ BUILTINS: dict[str, Builtin] = {b.name: b for b in [
 EDITION3 = frozenset({"LOWER_BOUND", "UPPER_BOUND", "ATAN2"})
 
 
+def is_edition3(builtin: Builtin) -> bool:
+    """True for builtins of the 3rd edition only: EDITION3, the generic TO_x, the typed BCD names."""
+    name = builtin.name
+    return (name in EDITION3 or name.startswith("TO_") or "_BCD_TO_" in name
+            or (name.rpartition("_TO_")[2].startswith("BCD_")))
+
+
 def lookup(name: str) -> Builtin | None:
     """The builtin called ``name`` (case-insensitive), including every ``X_TO_Y`` conversion."""
     up = name.upper()
     b = BUILTINS.get(up)
     if b is not None:
+        return b
+    if "BCD" in up:
+        b = _bcd(up)
+        if b is not None:
+            BUILTINS[up] = b
         return b
     m = _CONV_RE.match(up)
     if m:

@@ -63,7 +63,7 @@ def check_call(ck, e: A.Call, expected, statement: bool) -> T.Type:
                 return bind_pou(ck, e, pou, "function" if pou.kind == "function" else "program", None)
             builtin = B.lookup(qn.name) if not qn.namespace else None
             if builtin is not None:
-                if builtin.name in B.EDITION3 or builtin.name.startswith("TO_"):
+                if B.is_edition3(builtin):
                     ctx.note_edition3(f"the function {builtin.name}", callee.span)
                 callee.sym = BuiltinSymbol(builtin)
                 callee.ty = T.VOID

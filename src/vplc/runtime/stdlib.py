@@ -33,6 +33,29 @@ def _mux(k, values):
     return values[k]
 
 
+def _bcd_decode(value: int, name: str, hi: int) -> int:
+    """Packed BCD bit string -> integer; a nibble above 9 (not BCD) or a result above ``hi`` is a fault."""
+    result, scale, rest = 0, 1, value
+    while rest:
+        digit = rest & 0xF
+        if digit > 9:
+            raise RuntimeFaultError(f"{name}: 16#{value:X} is not a BCD value (digit 16#{digit:X})")
+        result += digit * scale
+        scale *= 10
+        rest >>= 4
+    if result > hi:
+        raise RuntimeFaultError(f"{name}: BCD 16#{value:X} = {result} is out of the result's range (max {hi})")
+    return result
+
+
+def _bcd_encode(value: int, bits: int, name: str) -> int:
+    """Integer -> packed BCD of ``bits`` bits; a negative value or one with too many digits is a fault."""
+    if value < 0 or value >= 10 ** (bits // 4):
+        raise RuntimeFaultError(f"{name}: {value} cannot be written as BCD in {bits} bits "
+                                f"(0..{10 ** (bits // 4) - 1})")
+    return int(str(value), 16)
+
+
 def _left(s: str, n: int) -> str:
     return s[:max(n, 0)]
 
@@ -85,7 +108,7 @@ MATH = {name: _nan_on_domain(fn) for name, fn in {
     "TAN": math.tan, "ASIN": math.asin, "ACOS": math.acos, "ATAN": math.atan}.items()}
 
 NAMESPACE = {
-    "_fmod": _fmod, "_mux": _mux, "_left": _left, "_right": _right, "_mid": _mid, "_insert": _insert,
+    "_fmod": _fmod, "_mux": _mux, "_bcd_decode": _bcd_decode, "_bcd_encode": _bcd_encode, "_left": _left, "_right": _right, "_mid": _mid, "_insert": _insert,
     "_delete": _delete, "_replace": _replace, "_find": _find, "_sinit": _sinit, "_fill": _fill,
     "_round": iec.round_half_even, "_trunc": iec.trunc, "_shl": iec.shl, "_shr": iec.shr, "_rol": iec.rol,
     "_ror": iec.ror, "_lbound": iec.lower_bound, "_ubound": iec.upper_bound, "_atan2": _nan_on_domain(lambda yx: math.atan2(*yx)),
@@ -200,6 +223,10 @@ def gen_builtin(gen, b) -> str:
             return iec.wrap_expr(code, bits, signed)
         return code
 
+    if "BCD" in name:
+        if name.partition("_TO_")[0].endswith("BCD"):
+            return f"_bcd_decode({args[0]}, {name!r}, {rt.hi})"
+        return f"_bcd_encode({args[0]}, {bits}, {name!r})"
     if "_TO_" in name or name.startswith("TO_"):
         if name.startswith("TRUNC_"):
             return fix(f"_trunc({args[0]})")

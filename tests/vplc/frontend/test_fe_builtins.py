@@ -19,6 +19,9 @@ RESULTS = [
     ("ADD_DT_TIME(dt1, t)", T.DT), ("SUB_DT_DT(dt1, dt1)", T.TIME), ("CONCAT_DATE_TOD(day, tod1)", T.DT),
     ("UPPER_BOUND(arr, 1)", T.DINT), ("TO_INT(r)", T.INT), ("ADD(i, i, d)", T.DINT), ("MOD(d, 3)", T.DINT),
     ("dt1 - dt1", T.TIME), ("tod1 + t", T.TOD), ("t * 2", T.TIME), ("t / r", T.TIME),
+    ("BCD_TO_INT(w)", T.INT), ("BCD_TO_UDINT(b)", T.UDINT), ("WORD_BCD_TO_UINT(w)", T.UINT),
+    ("INT_TO_BCD(i)", T.WORD), ("DINT_TO_BCD(d)", T.DWORD), ("UINT_TO_BCD_WORD(u)", T.WORD),
+    ("USINT_TO_BCD_DWORD(1)", T.DWORD),
 ]
 
 
@@ -40,7 +43,8 @@ def test_string_functions_return_strings(tmp_path, expr):
 
 
 @pytest.mark.parametrize("expr", ["SQRT(s)", "SHL(r, 1)", "LEN(i)", "MAX(s, i)", "INT_TO_REAL(s)", "MOD(r, 2)",
-                                  "SEL(i, 1, 2)", "CONCAT(s, i)"])
+                                  "SEL(i, 1, 2)", "CONCAT(s, i)", "BCD_TO_INT(i)", "INT_TO_BCD(r)",
+                                  "WORD_BCD_TO_INT(d)", "UINT_TO_BCD_BYTE(d)"])
 def test_wrong_argument_types_are_refused(tmp_path, expr):
     proj = check_text(tmp_path, program(f"x := {expr} = {expr};", DECLS))
     assert "ST1103" in codes(proj), proj.render_diagnostics()
@@ -51,3 +55,12 @@ def test_conversion_names_are_generated_for_every_elementary_pair():
     assert B.lookup("WSTRING_TO_STRING") is not None
     assert B.lookup("FOO_TO_BAR") is None
     assert "CONCAT" in B.names() and "ROL" in B.names()
+
+
+def test_bcd_names_resolve_only_for_integer_and_bit_string_sides():
+    assert B.lookup("bcd_to_dint").name == "BCD_TO_DINT"
+    assert B.lookup("LWORD_BCD_TO_ULINT") is not None and B.lookup("LINT_TO_BCD_LWORD") is not None
+    assert B.lookup("BCD_TO_REAL") is None and B.lookup("REAL_TO_BCD") is None
+    assert B.lookup("INT_TO_BCD_REAL") is None and B.lookup("BOOL_BCD_TO_INT") is None
+    assert not B.is_edition3(B.lookup("BCD_TO_INT")) and not B.is_edition3(B.lookup("INT_TO_BCD"))
+    assert B.is_edition3(B.lookup("WORD_BCD_TO_UINT")) and B.is_edition3(B.lookup("UINT_TO_BCD_WORD"))

@@ -2,7 +2,10 @@
 import math
 import struct
 
-from rt_helpers import run1
+import pytest
+
+from rt_helpers import plc_from, run1
+from vplc.api import PlcFault
 
 
 def f32(x):
@@ -89,3 +92,22 @@ def test_bit_string_to_string_is_hexadecimal_in_the_sysmac_dialect(tmp_path):
     plc = run1(tmp_path, "a := WORD_TO_STRING(WORD#16#ABCD); b := BYTE_TO_STRING(BYTE#16#41); c := UINT_TO_STRING(65);",
                "a, b, c : STRING[10];")
     assert (plc.read("Main.a"), plc.read("Main.b"), plc.read("Main.c")) == ("abcd", "41", "65")
+
+
+def test_bcd_conversions_pack_and_unpack_decimal_digits(tmp_path):
+    plc = run1(tmp_path, "a := BCD_TO_INT(WORD#16#1234); b := WORD_BCD_TO_UINT(WORD#16#9999); c := INT_TO_BCD(42);"
+                         "d := UDINT_TO_BCD_DWORD(12345678); e := BCD_TO_SINT(BYTE#16#99);",
+               "a : INT; b : UINT; c : WORD; d : DWORD; e : SINT;")
+    assert [plc.read(f"Main.{v}") for v in "abcde"] == [1234, 9999, 0x42, 0x12345678, 99]
+
+
+@pytest.mark.parametrize("body,message", [
+    ("i := BCD_TO_INT(w);", r"BCD_TO_INT: 16#12A4 is not a BCD value \(digit 16#A\)"),
+    ("w := INT_TO_BCD(-1);", r"INT_TO_BCD: -1 cannot be written as BCD in 16 bits \(0\.\.9999\)"),
+    ("w := UINT_TO_BCD(UINT#10000);", r"UINT_TO_BCD: 10000 cannot be written as BCD"),
+    ("s := BCD_TO_SINT(BYTE#16#99); s := BCD_TO_SINT(WORD#16#0128);", r"= 128 is out of the result's range \(max 127\)"),
+])
+def test_a_value_that_is_not_bcd_is_a_runtime_fault(tmp_path, body, message):
+    plc = plc_from(tmp_path, body, "w : WORD := WORD#16#12A4; i : INT; s : SINT;")
+    with pytest.raises(PlcFault, match=message):
+        plc.scan(0)
