@@ -28,6 +28,7 @@ STEPS = {
     "CBT_ChangeTCP": [("ChangeTCPExec", "fbChangeTCP.Done")],
     "CBT_ProgramControl": [("PauseButton", "fbPause.Done"), ("ResumeButton", "fbResume.Done")],
     "CBT_Stop": [("StopButton", "fbStop.Done")],
+    "CBT_SetOutput": [("CloseGripper", "fbGripper.Done")],
     "CBT_ReadActualPosition": [(None, "fbReadPos.Valid")],
 }
 

@@ -1,6 +1,6 @@
 """ErrorIDs that need a value no checked write can produce, raised through the real FBs against the simulator:
-an enumeration input holding an undefined integer (16#1010, 16#1019, 16#101C, 16#1022, 16#1023; put there with
-a raw write, as an HMI or a memory copy can on the controller) and a position reply whose data cannot be read
+an enumeration input holding an undefined integer (16#1010, 16#1019, 16#101C, 16#1022, 16#1023, 16#1024; put
+there with a raw write, as an HMI or a memory copy can on the controller) and a position reply whose data cannot be read
 (16#3006; the simulator's corrupt_checksum fault makes the library drop one of the two ListenSend frames)."""
 import pytest
 
@@ -12,6 +12,7 @@ TEXT = {
     0x101C: "DataFormat invalid for Circle: CPP_Circle or CAP_Circle",
     0x1022: "Command invalid: Pause or Resume",
     0x1023: "Mode invalid: StopNormal/StopImmediate/StopAbortScript/StopDiscardAll",
+    0x1024: "Module invalid: ControlBox or EndModule",
     0x3006: "Reply data invalid (position not readable)",
 }
 
@@ -34,6 +35,7 @@ CASES = [
     ("prg", "PrgExec", "PrgParam", dict(Command=0), "Command", 2, 0x1022),
     ("stop", "StopExec", "StopParam", dict(Mode=0), "Mode", 4, 0x1023),
     ("stop", "StopExec", "StopParam", dict(Mode=0), "Mode", -32768, 0x1023),
+    ("dout", "OutExec", "OutParam", dict(Module=0, Channel=1), "Module", 2, 0x1024),
 ]
 
 
