@@ -13,6 +13,8 @@ const LABELS = {
   DataFormat: "Data Format", AccelTime: "Accel Time", BlendingEnable: "Enable Blending",
   BlendingValue: "Blending", PrecisePositioning: "Enable Precise Point", RobotPoseEnable: "Enable Robot Pose",
   ExitNode: "Exit Listen Node", ArcAngle: "Arc Angle", Command: "Command",
+  Module: "I/O Module", Channel: "Output Number", Value: "Output ON", Immediate: "Immediate (not queued)",
+  WaitUntilSet: "Done when set", Mode: "Stop Mode",
   Connect_AddressIP: "Robot IP Address", Connect_Dest_PortIP: "Port", Connect_Time_Out: "Timeout",
 };
 
@@ -50,6 +52,13 @@ const PAGES = {
     presets: { "Preset Values": { DataFormat: 0, ArcPoint: T(450, 50, 400), EndPoint: T(400, 100, 400),
       Speed: 30, AccelTime: 200, BlendingEnable: false, BlendingValue: 0, ArcAngle: 0,
       PrecisePositioning: false, ExitNode: false } } },
+  setoutput: { title: "Digital Output", group: "SetOutput", param: "SetOutput_Param", legend: "Output Settings",
+    presets: { "Close Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: true, Immediate: false,
+      WaitUntilSet: true, ExitNode: false },
+      "Open Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: false, Immediate: false,
+      WaitUntilSet: true, ExitNode: false } } },
+  stop: { title: "Stop Motion", group: "Stop", param: "Stop_Param", legend: "Stop Settings", execLabel: "Stop",
+    presets: { "Stop Immediately": { Mode: 1 }, "Stop and Discard All": { Mode: 3 } } },
 };
 const DEFAULT_STATUS = ["Busy", "Done", "Error", "ErrorID", "ErrorDescrip", "CmdID_Ack"];
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy"]);
@@ -350,10 +359,11 @@ function mainPage() {
   main.innerHTML = `<div class="areas">
     <div class="area"><h2>Configuration</h2><div class="tiles">
       <a href="connect.html" id="nav-connect">Connect</a><a href="changebase.html" id="nav-changebase">Change Base</a>
-      <a href="changetcp.html" id="nav-changetcp">Change TCP</a><span>Reserved</span></div></div>
+      <a href="changetcp.html" id="nav-changetcp">Change TCP</a><a href="setoutput.html" id="nav-setoutput">Digital Output</a></div></div>
     <div class="area"><h2>Motion</h2><div class="tiles">
       <a href="moverel.html" id="nav-moverel">Move Relative</a><a href="moveabs.html" id="nav-moveabs">Move Absolute</a>
-      <a href="movecircle.html" id="nav-movecircle">Move Circle</a><a href="pnp.html" id="nav-pnp">PnP Sequence</a></div></div>
+      <a href="movecircle.html" id="nav-movecircle">Move Circle</a><a href="pnp.html" id="nav-pnp">PnP Sequence</a>
+      <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>
     </div><div class="robotview" id="robotview"></div>`;
   robotView(document.getElementById("robotview"));
   startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position"]);
@@ -388,18 +398,18 @@ async function fbPage(key) {
   side.className = "side";
   const buttons = document.createElement("div");
   buttons.className = "buttons";
-  for (const name of Object.keys(page.presets)) {
+  Object.keys(page.presets).forEach((name, i) => {
     const b = document.createElement("button");
-    b.className = "wide"; b.id = "btn-preset"; b.textContent = name;
+    b.className = "wide"; b.id = i ? `btn-preset-${i + 1}` : "btn-preset"; b.textContent = name;
     b.onclick = () => {
       if (page.param) fillFrom(params, page.param, page.presets[name]);
       else for (const [v, val] of Object.entries(page.presets[name])) setInput(params.querySelector(`[data-path="${v}"]`), val);
       message(`${name}: fields filled, press ${page.execLabel || "Execute"} to send.`);
     };
     buttons.append(b);
-  }
+  });
   const exec = document.createElement("button");
-  exec.className = "primary" + (key === "connect" ? "" : " wide");
+  exec.className = (key === "stop" ? "danger" : "primary") + (key === "connect" ? "" : " wide");
   exec.id = "btn-execute"; exec.textContent = page.execLabel || "Execute";
   exec.onclick = () => {
     const result = collect(params, page.param || "");

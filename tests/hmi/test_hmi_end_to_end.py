@@ -196,6 +196,38 @@ def test_change_tcp_page_sets_the_tool(connected):
     browser.screenshot("e2e_changetcp_done")
 
 
+def test_digital_output_page_switches_the_gripper_output(connected):
+    browser = connected.open("setoutput")
+    browser.click("btn-preset")                                  # Gripper Close: End Module DO0 on, wait
+    since = connected.event_count()
+    execute_and_wait_done(connected, browser, "SetOutput")
+    assert commands(connected, since) == ['IO["EndModule"].DO[0]=1']
+    assert connected.robot_state()["io"]["EndModule.DO[0]"] == 1
+    browser.screenshot("e2e_setoutput_done")
+    browser.click("btn-preset-2")                                # Gripper Open
+    execute_and_wait_done(connected, browser, "SetOutput")
+    assert connected.robot_state()["io"]["EndModule.DO[0]"] == 0
+
+
+def test_stop_page_stops_a_running_move_and_aborts_it(connected):
+    browser = connected.open("moveabs")
+    browser.click("btn-preset")
+    for axis, value in zip(("X", "Y", "Z", "Speed"), ("300", "250", "300", "5")):
+        browser.type_into(f"MoveAbs_Param.{'' if axis == 'Speed' else 'TargetPosition.'}{axis}", value)
+    browser.click("btn-execute")
+    connected.wait(lambda: connected.robot_state()["moving"], "the slow move to start")
+    browser = connected.open("stop")
+    browser.click("btn-preset")                                  # Stop Immediately
+    since = connected.event_count()
+    execute_and_wait_done(connected, browser, "Stop")
+    assert [e["command"] for e in connected.events("priority", since)] == ["StopAndClearBuffer(0)"]
+    connected.wait(lambda: connected.read("Commands.fbMoveAbs.CommandAborted"), "the move to be aborted")
+    state = connected.robot_state()
+    assert not state["moving"] and state["queue_length"] == 0
+    assert state["tcp"][:3] != pytest.approx([300, 250, 300], abs=1.0)    # stopped on the way
+    browser.screenshot("e2e_stop_done")
+
+
 def test_out_of_range_entry_shows_the_error_and_nothing_reaches_the_robot(connected):
     browser = connected.open("moveabs")
     browser.type_into("MoveAbs_Param.AccelTime", "10000")

@@ -11,7 +11,7 @@ from browser import Browser
 from fake_plc import FakePlc, command_program
 from vplc.hmi_server import HmiServer, Mapping
 
-PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "pnp"]
+PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "setoutput", "stop", "pnp"]
 
 
 @pytest.fixture(scope="module")
