@@ -67,6 +67,7 @@ class Plc:
             self.globals = module.globals_cls()
             ns["G"] = self.globals
             self.instances: dict[str, object] = ns["_PROGRAMS"]
+            self.type_named_instances: dict[str, list[str]] = {}   # see _setup_tasks
             self._setup_tasks(task, programs)
         except LoadError:
             raise
@@ -117,9 +118,15 @@ class Plc:
                 t.programs.append(self._instance(pt.name, pt))
             self.engine.tasks.append(t)
         self.engine.tasks.sort(key=lambda t: t.priority)
+        scheduled: dict[str, list[str]] = {}        # PROGRAM type -> names of its instances in the tasks
+        for task in self.engine.tasks:
+            for inst, _body in task.programs:
+                scheduled.setdefault(inst.i__type.name.upper(), []).append(inst.i__path)
         for pt in self.project.programs:            # programs called from other programs need an instance
             if pt.name.upper() not in self.instances:
                 self._instance(pt.name, pt)
+                if pt.name.upper() in scheduled:    # reading it by the type name is a mistake: say so
+                    self.type_named_instances[pt.name.upper()] = scheduled[pt.name.upper()]
 
     # ---- Contract A -----------------------------------------------------------------------------
     @property

@@ -56,6 +56,12 @@ class Resolver:
             raise PathError(f"`{segs[0]}` is not a variable name (in {path!r})")
         head = first.group(1).upper()
         obj, ty, rest = None, None, segs
+        if head in plc.type_named_instances and not first.group(2):
+            names = " and ".join(f"`{n}`" for n in plc.type_named_instances[head])
+            tail = ".".join(segs[1:])
+            example = f"{plc.type_named_instances[head][0]}.{tail}" if tail else plc.type_named_instances[head][0]
+            raise PathError(f"`{segs[0]}` is a PROGRAM type; the configuration runs it as the instance {names}: "
+                            f"use `{example}`")
         if head in plc.instances and not first.group(2):
             obj, ty, rest = plc.instances[head], plc.instances[head].i__type, segs[1:]
         elif head in self.list_names and not first.group(2) and len(segs) > 1:

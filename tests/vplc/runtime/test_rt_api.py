@@ -88,3 +88,21 @@ def test_raw_write_puts_an_undefined_value_into_an_enumeration(tmp_path):
         plc.write("Main.m", 40000, raw=True)            # still within the storage type (INT)
     with pytest.raises(ValueError, match="outside the range"):
         plc.write("Main.i", 40000, raw=True)            # other types keep their normal checks
+
+
+def test_reading_through_the_program_type_name_points_to_the_configured_instance(tmp_path):
+    config = """CONFIGURATION Cfg
+    RESOURCE R ON PLC
+        TASK Fast (INTERVAL := T#1ms, PRIORITY := 1);
+        PROGRAM Cell1 WITH Fast : Main;
+    END_RESOURCE
+END_CONFIGURATION
+"""
+    plc = plc_from(tmp_path, "n := n + 1;", "n : INT;", config)
+    plc.scan(0)
+    assert plc.read("Cell1.n") == 1
+    with pytest.raises(ValueError, match=r"`Main` is a PROGRAM type; the configuration runs it as the instance "
+                                         r"`Cell1`: use `Cell1\.n`"):
+        plc.read("Main.n")
+    with pytest.raises(ValueError, match="PROGRAM type"):
+        plc.write("Main.n", 5)
