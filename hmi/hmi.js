@@ -451,8 +451,8 @@ function buildPnP() {
       <div class="actions"><button id="seg-cancel">Cancel</button><button class="primary" id="seg-apply">Apply</button></div></dialog>`;
   const statusBox = document.getElementById("pnp-status");
   statusBox.append(statusTable("Cycle Status", [["Execute", "PnP_Example_Execute"], ["Segment", "PnP_Segment"],
-    ["Waiting", "PnP_Waiting"], ["Cycles", "PnP_CycleCount"], ["Busy", "PnP_MoveBusy"], ["Done", "PnP_MoveDone"],
-    ["Error", "PnP_MoveError"], ["ErrorID", "PnP_MoveErrorID"], ["ErrorDescrip", "PnP_MoveErrorDescrip"],
+    ["Waiting", "PnP_Waiting"], ["Gripper closed", "PnP_GripperClosed"], ["Cycles", "PnP_CycleCount"],
+    ["Busy", "PnP_MoveBusy"], ["Error", "PnP_MoveError"], ["ErrorID", "PnP_MoveErrorID"], ["ErrorDescrip", "PnP_MoveErrorDescrip"],
     ["CmdID_Ack", "PnP_Move_CmdID_Ack"]]));
   statusBox.append(statusTable("Program Control", [["Busy", "ProgramControl_Busy"], ["Done", "ProgramControl_Done"],
     ["Error", "ProgramControl_Error"], ["ErrorDescrip", "ProgramControl_ErrorDescrip"]]));
@@ -579,8 +579,8 @@ async function pnpPage() {
   document.getElementById("btn-resume").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Resume, "Resume");
   live.listeners.push(updatePnP);
   try { await loadPnP(); } catch (e) { message("Cannot read the PnP parameters: " + e.message, "error"); }
-  startPolling(["PnP_Example_Execute", "PnP_Segment", "PnP_Waiting", "PnP_CycleCount", "PnP_MoveBusy",
-    "PnP_MoveDone", "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",
+  startPolling(["PnP_Example_Execute", "PnP_Segment", "PnP_Waiting", "PnP_GripperClosed", "PnP_CycleCount", "PnP_MoveBusy",
+    "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",
     "ProgramControl_Busy", "ProgramControl_Done", "ProgramControl_Error", "ProgramControl_ErrorDescrip",
     "Connect_Connected", "ReadPos_Valid", "ReadPos_Position"]);
 }

@@ -147,3 +147,10 @@ def test_pnp_runs_two_cycles_with_dwell_pause_resume_and_stops_cleanly(rig):
         reached = [end for end in ends if end == pytest.approx(target, abs=0.5)]
         assert len(reached) >= 2, f"segment {segment} reached {len(reached)} times"
     assert rig.read("PnP_MoveError") is False
+    # the gripper closed at every pick and opened at every place, each after the robot had arrived there
+    gripper = [e for e in rig.robot.events[since:] if e["kind"] == "io" and e["point"] == "EndModule.DO[0]"]
+    assert len(gripper) >= 4 and [e["value"] for e in gripper] == [1, 0] * (len(gripper) // 2)
+    for event in gripper:
+        arrived = [e for e in rig.robot.events[since:] if e["kind"] == "motion_end" and e["t"] <= event["t"]][-1]
+        assert arrived["pose"][:3] == pytest.approx(targets[1 if event["value"] else 4], abs=0.5)
+    assert rig.read("PnP_GripperClosed") is False
