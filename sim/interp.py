@@ -28,13 +28,14 @@ class ScriptRuntimeError(Exception):
 class Context:
     """What a running script may touch; the session fills it in."""
 
-    def __init__(self, robot, variables, types, listen_send, stop_and_clear, log_line):
+    def __init__(self, robot, variables, types, listen_send, stop_and_clear, log_line, log_event=None):
         self.robot = robot
         self.vars = variables
         self.types = types
         self.listen_send = listen_send          # (ip_filter or None, sub, payload bytes) -> None
         self.stop_and_clear = stop_and_clear    # () -> None
         self.log_line = log_line                # (line) -> None
+        self.log_event = log_event or (lambda kind, **fields: None)     # (kind, **fields) -> None
 
 
 def run_script(lines, ctx: Context):
@@ -125,7 +126,9 @@ def _store(target, value, ctx, line):
         key, member = yield from _io_key(target, ctx, line)
         level = int(value) if IO_WRITABLE[member] == "int" else float(value)
         if member.startswith("Instant"):
-            ctx.robot.io[key.replace("Instant", "")] = level
+            point = key.replace("Instant", "")
+            ctx.robot.io[point] = level
+            ctx.log_event("io", point=point, value=level, instant=True)
         else:
             if not ctx.robot.has_room:
                 yield ("room", None, None)        # the FIFO is full: wait until an item has run

@@ -273,7 +273,8 @@ class ListenSession:
         warnings = [line.number for line in lines if line.warnings]
         ctx = Context(self.robot, self.variables, self.types, self._listen_send, self._stop_robot,
                       lambda line, p=packet: self.log("script_line", conn=p.conn, id=p.id,
-                                                      line=line.number, text=line.text))
+                                                      line=line.number, text=line.text),
+                      self.log)
         self.running = Running(packet, run_script(lines, ctx), warnings)
         self._step(None)
 

@@ -303,6 +303,8 @@ def test_robot_reads_and_io_writes(node):
     assert node.s.robot.io["ControlBox.DO[3]"] == 1
     assert node.s.variables["p"][:3] == pytest.approx([417.5, -122.3, 359.7])
     assert node.s.variables["n"] == "RobotBase"
+    io = [f for kind, f in node.events if kind == "io"]
+    assert io == [dict(point="ControlBox.DO[4]", value=1, instant=True), dict(point="ControlBox.DO[3]", value=1)]
 
 
 def test_reply_error_fault_rejects_next_script_without_running_it(node):
