@@ -66,6 +66,7 @@ class Plc:
         try:
             self.globals = module.globals_cls()
             ns["G"] = self.globals
+            self.engine.bind_system_vars(self.globals)
             self.instances: dict[str, object] = ns["_PROGRAMS"]
             self.type_named_instances: dict[str, list[str]] = {}   # see _setup_tasks
             self._setup_tasks(task, programs)

@@ -16,7 +16,7 @@ from .parser import parse
 from .source import SourceFile, Span
 
 PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
-VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st")
+VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st")
 
 
 @dataclass
@@ -34,7 +34,8 @@ class Context:
 
     def note_vendor(self, obj, span) -> None:
         if id(obj) in self.vendor_objects and span is not None:
-            self.vendor_uses.append((span, obj.name))
+            what = "system-defined variable" if getattr(obj, "section", None) == "VAR_GLOBAL" else "instruction or type"
+            self.vendor_uses.append((span, obj.name, what))
 
     def note_edition3(self, what: str, span) -> None:
         """Record a use of an IEC 61131-3 3rd-edition-only feature (reported by --portable)."""
@@ -196,7 +197,8 @@ def check_units(ctx: Context, proj: Project) -> None:
     dec.complete_pous()
     for gl, unit in ctx.global_lists:
         dec.declare_globals(gl.sections, unit, gl.name)
-        proj.global_lists.append(gl)
+        if not getattr(unit, "in_prelude", False):      # the user's lists (system-defined variables are not)
+            proj.global_lists.append(gl)
     for cfg, unit in ctx.configurations:
         dec.declare_globals(cfg.sections, unit, cfg.name)
         for res in cfg.resources:

@@ -42,6 +42,10 @@ def check_write(ck, target: A.Expr, what: str = "assignment") -> None:
             ctx.diags.error("ST1205", f"cannot assign to `{ck.text(target)}`; it is not a variable", target.span)
         return
     effective = sym.target if sym.section == "VAR_EXTERNAL" and sym.target is not None else sym
+    if id(effective) in ctx.vendor_objects:
+        ctx.diags.error("ST1301", f"`{sym.name}` is a Sysmac system-defined variable and is read-only; use a "
+                        "variable of your own", target.span)
+        return
     if sym.constant or effective.constant:
         ctx.diags.error("ST1301", f"`{sym.name}` is a CONSTANT and cannot be written; remove CONSTANT from its "
                         "section or use another variable", target.span)

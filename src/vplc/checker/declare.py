@@ -218,6 +218,8 @@ class Declarer:
                 sym = VarSymbol(decl.name, vt, "VAR_GLOBAL", None, decl, section.constant, section.retain,
                                 global_list=list_name)
                 decl.sym = sym
+                if getattr(unit, "vendor", False):           # Sysmac system-defined variables (P_On ...)
+                    self.ctx.vendor_objects.add(id(sym))
                 prev = self.tables.globals.get(decl.name.upper())
                 if prev is not None:
                     duplicates.report(self.ctx, "global variable", decl.name, decl.name_span, prev)

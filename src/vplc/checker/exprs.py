@@ -67,6 +67,8 @@ class ExprChecker:
             if sym is not None:
                 e.sym = sym
                 self.mark_used(sym)
+                if sym.section == "VAR_GLOBAL":
+                    self.ctx.note_vendor(sym, e.span)
                 return sym.type
             vals = self.ctx.tables.enum_values.get(qn.name.upper())
             if vals:

@@ -48,7 +48,7 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
     for span, what in ctx.edition3_uses:
         if span.file is unit.span.file:
             ctx.diags.warning("ST2003", f"{what} is not IEC 61131-3 2nd edition", span)
-    for span, name in ctx.vendor_uses:
+    for span, name, what in ctx.vendor_uses:
         if span.file is unit.span.file:
-            ctx.diags.warning("ST2001", f"`{name}` is an Omron Sysmac instruction or type, not IEC 61131-3; keep "
+            ctx.diags.warning("ST2001", f"`{name}` is an Omron Sysmac {what}, not IEC 61131-3; keep "
                               "vendor calls in the library's platform/ folder", span)

@@ -40,6 +40,18 @@ class Engine:
         self.scan_count = 0
         self.deadline = module.namespace["_DL"]
         self.stmt_counter = module.namespace["_NST"]
+        self.system_vars = None           # (globals dict, first-run attrs, [(attr, period ns)]): see bind_system_vars
+
+    def bind_system_vars(self, globals_obj) -> None:
+        """Let the scan update the Sysmac system-defined variables of prelude/sysmac_sysvars.st that the
+        program can see (first-scan flags, clock pulses)."""
+        info = getattr(type(globals_obj), "i__vars", {})
+        first = [info[n][0] for n in ("P_FIRST_RUN", "P_FIRST_RUNMODE") if n in info]
+        clocks = [(info[n][0], period) for n, period in (("P_0_02S", 20_000_000), ("P_0_1S", 100_000_000),
+                                                         ("P_0_2S", 200_000_000), ("P_1S", 1_000_000_000),
+                                                         ("P_1MIN", 60_000_000_000)) if n in info]
+        if first or clocks:
+            self.system_vars = (globals_obj.__dict__, first, clocks)
 
     # ---- services used by native POUs -----------------------------------------------------------
     def new_struct(self, name: str):
@@ -81,6 +93,12 @@ class Engine:
                     task.next_due = now_ns
                 if now_ns < task.next_due:
                     continue
+                if self.system_vars is not None:
+                    values, first, clocks = self.system_vars
+                    for attr in first:
+                        values[attr] = task.cycles == 0
+                    for attr, period in clocks:
+                        values[attr] = now_ns % period < period // 2
                 for inst, body in task.programs:
                     body(inst)
                 task.cycles += 1

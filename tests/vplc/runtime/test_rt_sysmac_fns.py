@@ -54,3 +54,56 @@ def test_time_instructions(tmp_path):
     assert plc.read("Main.s") == 86410
     assert plc.read("Main.t") == 1_500_000 and plc.read("Main.ns") == 2_000_000
     assert plc.read("Main.now") == 1_700_000_000_000_000_000
+
+
+SYSVARS = """
+IF P_First_RunMode THEN firsts := firsts + 1; END_IF;
+IF P_First_Run THEN runs := runs + 1; END_IF;
+IF P_0_1s AND NOT prev THEN pulses := pulses + 1; END_IF;
+prev := P_0_1s;
+on := P_On AND NOT P_Off;
+"""
+
+
+def test_system_defined_variables_first_scan_flags_and_clock_pulses(tmp_path):
+    from rt_helpers import plc_from
+    plc = plc_from(tmp_path, SYSVARS, "firsts, runs, pulses : INT; prev, on : BOOL;")
+    for n in range(1000):                                   # 1 s of 1 ms scans
+        plc.scan(n * 1_000_000)
+    assert plc.read("Main.firsts") == 1 and plc.read("Main.runs") == 1
+    assert plc.read("Main.pulses") == 10                   # 100 ms period: 10 rising edges in 1 s
+    assert plc.read("Main.on") is True
+    plc.scan(1_060_000_000)                                 # 60 ms into a 100 ms period, 60 ms into a 1 s period
+    assert plc.read("P_0_1s") is False and plc.read("P_1s") is True and plc.read("P_1min") is True
+
+
+def test_first_run_flag_is_per_task(tmp_path):
+    from rt_helpers import plc_from
+    config = """PROGRAM Slow
+VAR firsts : INT; END_VAR
+IF P_First_RunMode THEN firsts := firsts + 1; END_IF;
+END_PROGRAM
+CONFIGURATION Cfg
+    RESOURCE R ON PLC
+        TASK Fast (INTERVAL := T#1ms, PRIORITY := 1);
+        TASK Periodic (INTERVAL := T#10ms, PRIORITY := 2);
+        PROGRAM A WITH Fast : Main;
+        PROGRAM B WITH Periodic : Slow;
+    END_RESOURCE
+END_CONFIGURATION
+"""
+    plc = plc_from(tmp_path, "IF P_First_RunMode THEN firsts := firsts + 1; END_IF;", "firsts : INT;", config)
+    for n in range(50):
+        plc.scan(n * 1_000_000)
+    assert plc.read("A.firsts") == 1 and plc.read("B.firsts") == 1
+
+
+def test_system_defined_variables_are_read_only_and_vendor(tmp_path):
+    from vplc.project import load_project
+    src = tmp_path / "w.st"
+    src.write_text("PROGRAM Main\nVAR x : BOOL; END_VAR\nP_On := FALSE;\nx := P_1s;\nEND_PROGRAM\n")
+    proj = load_project([str(src)], portable=True)
+    messages = [(d.code, d.message) for d in proj.diagnostics]
+    assert ("ST1301", "`P_On` is a Sysmac system-defined variable and is read-only; use a variable of your own") \
+        in messages
+    assert any(code == "ST2001" and "`P_1s` is an Omron Sysmac system-defined variable" in m for code, m in messages)
