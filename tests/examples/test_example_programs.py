@@ -154,3 +154,20 @@ def test_pnp_runs_two_cycles_with_dwell_pause_resume_and_stops_cleanly(rig):
         arrived = [e for e in rig.robot.events[since:] if e["kind"] == "motion_end" and e["t"] <= event["t"]][-1]
         assert arrived["pose"][:3] == pytest.approx(targets[1 if event["value"] else 4], abs=0.5)
     assert rig.read("PnP_GripperClosed") is False
+
+
+def test_stop_during_pnp_halts_the_cycle_until_the_start_is_removed(rig):
+    rig.connect()
+    rig.plc.write("PnP_Example_Execute", True)
+    rig.until(lambda: rig.read("PnP_Segment") == 1 and rig.robot.state()["moving"], "the pick move", 30)
+    rig.command("Stop")                                        # Stop_Param: StopImmediate (rung 8)
+    rig.until(lambda: not rig.robot.state()["moving"], "the robot to stop", 2)
+    starts = len([e for e in rig.robot.events if e["kind"] == "motion_start"])
+    rig.run_for(5)                                             # PnP_Example_Execute is still TRUE
+    assert len([e for e in rig.robot.events if e["kind"] == "motion_start"]) == starts, "no move after the stop"
+    assert rig.read("PnP_Segment") == 1 and not rig.read("PnP_MoveBusy") and not rig.read("PnP_MoveError")
+    rig.plc.write("PnP_Example_Execute", False)                # the operator removes the start ...
+    rig.until(lambda: rig.read("PnP_Segment") == 0, "the sequence to return to idle", 1)
+    rig.plc.write("PnP_Example_Execute", True)                 # ... and starts again at segment 0
+    rig.until(lambda: rig.read("PnP_Segment") == 1, "a new cycle", 30)
+    assert rig.read("PnP_MoveError") is False
