@@ -60,8 +60,8 @@ const PAGES = {
   stop: { title: "Stop Motion", group: "Stop", param: "Stop_Param", legend: "Stop Settings", execLabel: "Stop",
     presets: { "Stop Immediately": { Mode: 1 }, "Stop and Discard All": { Mode: 3 } } },
 };
-const DEFAULT_STATUS = ["Busy", "Done", "Error", "ErrorID", "ErrorDescrip", "CmdID_Ack"];
-const BAD = new Set(["Error"]), BUSY = new Set(["Busy"]);
+const DEFAULT_STATUS = ["Busy", "Done", "CommandAborted", "Error", "ErrorID", "ErrorDescrip", "CmdID_Ack"];
+const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
 let MAP = null;
 const live = { values: {}, online: false, trail: [], listeners: [], kick: null };

@@ -221,11 +221,14 @@ def test_stop_page_stops_a_running_move_and_aborts_it(connected):
     since = connected.event_count()
     execute_and_wait_done(connected, browser, "Stop")
     assert [e["command"] for e in connected.events("priority", since)] == ["StopAndClearBuffer(0)"]
-    connected.wait(lambda: connected.read("Commands.fbMoveAbs.CommandAborted"), "the move to be aborted")
+    browser.screenshot("e2e_stop_done")
+    connected.wait(lambda: connected.read("MoveAbs_CommandAborted"), "the move to be aborted")
+    browser = connected.open("moveabs")
+    browser.wait_status("MoveAbs_CommandAborted", "true")        # the operator sees why the move ended
     state = connected.robot_state()
     assert not state["moving"] and state["queue_length"] == 0
-    assert state["tcp"][:3] != pytest.approx([300, 250, 300], abs=1.0)    # stopped on the way
-    browser.screenshot("e2e_stop_done")
+    assert state["tcp"][:3] != pytest.approx([300, 250, 300], abs=1.0)       # stopped on the way
+    browser.screenshot("e2e_stop_aborted_move")
 
 
 def test_out_of_range_entry_shows_the_error_and_nothing_reaches_the_robot(connected):
