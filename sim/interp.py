@@ -147,7 +147,8 @@ def _store(target, value, ctx, line):
 
 
 _LITERALS = frozenset({ast.Num, ast.Str, ast.Bool})
-_QUEUED = frozenset(MOTIONS + ("ChangeBase", "ChangeTCP", "ChangeLoad", "QueueTag"))
+_QUEUED = frozenset(MOTIONS + ("ChangeBase", "ChangeTCP", "ChangeLoad", "QueueTag", "PVTEnter", "PVTPoint",
+                                "PVTExit"))
 
 
 def _eval(node, ctx, line):
@@ -267,6 +268,28 @@ def _call(node, args, ctx, line):
         if args[0] < 0:
             raise ScriptRuntimeError("load must not be negative")
         robot.enqueue_setting("load", float(args[0]))
+        return True
+    if name == "PVTEnter":
+        mode = int(args[0]) if args else 0
+        if mode not in (0, 1):
+            raise ScriptRuntimeError(f"PVT mode {mode} is not 0 (joint) or 1 (Cartesian)")
+        robot.enqueue_setting("pvt", mode)
+        return True
+    if name == "PVTExit":
+        robot.enqueue_setting("pvt", None)
+        return True
+    if name == "PVTPoint":
+        if len(args) == 3:
+            pos, vel, duration = args
+        else:
+            pos, vel, duration = list(args[:6]), list(args[6:12]), args[12]
+        if len(pos) != 6 or len(vel) != 6:
+            raise ScriptRuntimeError("PVTPoint needs 6 positions and 6 velocities")
+        robot.enqueue_motion(MotionRequest("PVTPoint", "", tuple(float(v) for v in pos + vel), 0.0, 0.0, 0.0,
+                                           False, line=line.text, duration=float(duration)))
+        return True
+    if name in ("PVTPause", "PVTResume"):
+        (robot.pause if name == "PVTPause" else robot.resume)()
         return True
     if name == "QueueTag":
         tag = int(args[0])

@@ -14,6 +14,12 @@ Duration of one motion (trapezoidal speed profile):
 * Blending (blend > 0) overlaps the deceleration with the next motion:
   T -= b * min(ta, T/2), b = blend% / 100, or for radius formats b = min(1, radius / (d / 2)).
 * Precise positioning (last argument false) adds SETTLE_S of fine settling at the end.
+* PVTPoint (between PVTEnter and PVTExit): the duration is given; every coordinate follows the cubic
+  Hermite curve from the current position and velocity to the point's position and velocity
+  (joint mode: the six joints, deg and deg/s; Cartesian mode: X, Y, Z, RX, RY, RZ in the current base,
+  mm and deg per s, converted to joints by inverse kinematics along the way). A curve whose joint speed
+  exceeds JOINT_SPEED (checked at 50 samples), or whose target is outside the joint limits or out of
+  reach, fails like any other motion.
 """
 from __future__ import annotations
 
@@ -74,6 +80,7 @@ class MotionRequest(NamedTuple):
     config: tuple | None = None
     arc_angle: float = 0.0
     line: str = ""
+    duration: float = 0.0     # PVTPoint only: the given duration in s (target = 6 positions + 6 velocities)
 
 
 @dataclass
@@ -100,6 +107,38 @@ class Plan:
             return kin.inverse_kinematics(self.cartesian(s), self.tool, reference=reference or self.start_joints)
         except kin.KinematicsError:
             return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints)]
+
+
+def hermite(p0, v0, p1, v1, T, t):
+    """Position and velocity at time t of the cubic Hermite curve p0,v0 (t=0) -> p1,v1 (t=T), per coordinate."""
+    s = min(max(t / T, 0.0), 1.0)
+    s2, s3 = s * s, s * s * s
+    h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2
+    d00, d10, d01, d11 = 6 * s2 - 6 * s, 3 * s2 - 4 * s + 1, -6 * s2 + 6 * s, 3 * s2 - 2 * s
+    pos = [h00 * a + h10 * T * va + h01 * b + h11 * T * vb for a, va, b, vb in zip(p0, v0, p1, v1)]
+    vel = [(d00 * a + d01 * b) / T + d10 * va + d11 * vb for a, va, b, vb in zip(p0, v0, p1, v1)]
+    return pos, vel
+
+
+@dataclass
+class PvtPlan(Plan):
+    """One PVTPoint: a Hermite curve in joint space (coords = joints) or in the base frame (coords = pose)."""
+    p0: tuple = ()
+    v0: tuple = ()
+    p1: tuple = ()
+    v1: tuple = ()
+    to_joints: object = None   # Cartesian mode: callable (pose, reference joints) -> joints
+
+    def joints_at(self, t, reference=None):
+        if t >= self.duration:
+            return list(self.end_joints)
+        pos, _vel = hermite(self.p0, self.v0, self.p1, self.v1, self.duration, t)
+        if self.to_joints is None:
+            return pos
+        try:
+            return self.to_joints(pos, reference or self.start_joints)
+        except kin.KinematicsError:
+            return list(reference or self.start_joints)
 
 
 def _rot(m):
@@ -209,6 +248,46 @@ class Planner:
             path = None if frame == "J" else (lambda s, a=start_tcp, b=end_tcp: _slerp_matrix(a, b, s))
         return self._finish(req, joints, end_joints, duration, ta, distance, path)
 
+    def plan_pvt(self, req: MotionRequest, joints: list, mode: int, velocity) -> PvtPlan:
+        """One PVTPoint from the current joints and velocity (joint mode 0, Cartesian mode 1)."""
+        T = req.duration
+        if not 0 < T <= 3600:
+            raise MotionError(f"PVTPoint duration {T:g} s is outside 0..3600 s")
+        p1, v1 = tuple(req.target[:6]), tuple(req.target[6:12])
+        start_tcp = kin.forward(joints, self.tool)
+        start_pose = kin.matrix_to_pose(kin.matmul(self.base_inverse, start_tcp))
+        if mode == 0:
+            p0, to_joints = tuple(joints), None
+            end_joints = list(p1)
+            if not kin.within_limits(end_joints):
+                raise MotionError("PVTPoint target joints exceed the joint limits")
+        else:
+            p0 = tuple(start_pose)
+            p1 = tuple(a + _unwrap(b - a) if i >= 3 else b for i, (a, b) in enumerate(zip(p0, p1)))
+
+            def to_joints(pose, reference, planner=self):
+                return kin.inverse_kinematics(planner.flange_target(pose), planner.tool, reference=reference)
+            try:
+                end_joints = to_joints(list(p1), joints)
+            except kin.KinematicsError as exc:
+                raise MotionError(f"PVTPoint: {exc}") from None
+        plan = PvtPlan(req, list(joints), list(end_joints), T, 0.0, T, None,
+                       kin.matrix_to_pose(self.tcp_in_base(end_joints)), self.tool, start_pose,
+                       p0=p0, v0=tuple(velocity), p1=p1, v1=v1, to_joints=to_joints)
+        previous = list(joints)
+        for k in range(1, 51):                        # speed check along the curve, in joint space
+            t = T * k / 50
+            try:
+                current = plan.joints_at(t, previous)
+            except kin.KinematicsError:
+                raise MotionError("PVTPoint: the path leaves the reach of the arm") from None
+            for i, (a, b) in enumerate(zip(previous, current)):
+                if abs(b - a) / (T / 50) > JOINT_SPEED[i] * 1.001:
+                    raise MotionError(f"PVTPoint: joint {i + 1} would move at {abs(b - a) / (T / 50):.0f} deg/s, "
+                                      f"above its limit of {JOINT_SPEED[i]:g} deg/s")
+            previous = current
+        return plan
+
     def _linear_time(self, req, distance, angle, ta):
         if req.fmt[1] == "P":
             v, w = TCP_SPEED * req.speed / 100.0, ROT_SPEED * req.speed / 100.0
@@ -264,6 +343,11 @@ class Planner:
         distance = abs(sweep) * radius
         duration = self._linear_time(req, distance, 0.0 if keep else rotation_angle(start_tcp, end), ta)
         return self._finish(req, joints, end_joints, duration, ta, distance, tcp)
+
+
+def _unwrap(delta):
+    """An angle difference brought into -180..180 deg (orientation targets take the short way)."""
+    return (delta + 180.0) % 360.0 - 180.0
 
 
 def _cross(a, b):

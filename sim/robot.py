@@ -36,6 +36,8 @@ class RobotModel:
         self.tag_history = tag_history
         self.tags = {}             # tag -> "true" | "false" in order of last change
         self.fault = None
+        self.pvt_mode = None       # None outside PVTEnter .. PVTExit, else 0 (joint) / 1 (Cartesian)
+        self.pvt_velocity = (0.0,) * 6   # end velocity of the last PVTPoint (start velocity of the next)
 
     # ---- queue --------------------------------------------------------------------------------
     def enqueue_motion(self, request: MotionRequest):
@@ -82,6 +84,7 @@ class RobotModel:
             if self.tags.get(tag) == "false":
                 del self.tags[tag]
         self.fifo.clear()
+        self.pvt_mode, self.pvt_velocity = None, (0.0,) * 6       # a stop also ends PVT mode
         return dropped
 
     # ---- time ---------------------------------------------------------------------------------
@@ -114,7 +117,15 @@ class RobotModel:
     def _run_motion(self, request):
         planner = Planner(self._matrix(self.base_pose), self._matrix(self.tool_pose))    # cached matrices
         try:
-            plan = planner.plan(request, self.joints)
+            if request.function == "PVTPoint":
+                if self.pvt_mode is None:
+                    raise MotionError("PVTPoint outside PVTEnter() ... PVTExit()")
+                plan = planner.plan_pvt(request, self.joints, self.pvt_mode, self.pvt_velocity)
+                self.pvt_velocity = tuple(request.target[6:12])
+            elif self.pvt_mode is not None:
+                raise MotionError(f"{request.function} inside PVT mode; call PVTExit() first")
+            else:
+                plan = planner.plan(request, self.joints)
         except MotionError as exc:
             self.fault = str(exc)
             self.stop_and_clear()
@@ -155,6 +166,13 @@ class RobotModel:
     def _run_load(self, value):
         self.load = value
         return {"kind": "setting", "what": "load", "value": value}
+
+    def _run_pvt(self, mode):
+        """PVTEnter(mode) (0 joint, 1 Cartesian) or PVTExit() (mode None), in queue order."""
+        if mode is not None and self.pvt_mode is not None:
+            return self._fault_event("PVTEnter", "PVTEnter while already in PVT mode")
+        self.pvt_mode, self.pvt_velocity = mode, (0.0,) * 6
+        return {"kind": "setting", "what": "pvt", "value": {None: "exit", 0: "joint", 1: "cartesian"}[mode]}
 
     def _run_io(self, value):
         key, level = value
@@ -209,7 +227,8 @@ class RobotModel:
                 "tool": {"name": self.tool_name, "pose": _round(self.tool_pose), "mass": self.tool_mass},
                 "load": self.load, "io": dict(self.io), "queue_length": self.queue_length,
                 "moving": self.active is not None, "paused": self.paused,
-                "tags": {str(k): v for k, v in self.tags.items()}, "fault": self.fault}
+                "tags": {str(k): v for k, v in self.tags.items()}, "fault": self.fault,
+                "pvt": {None: None, 0: "joint", 1: "cartesian"}[self.pvt_mode]}
 
 
 def _round(values):
