@@ -39,6 +39,7 @@ SIGNATURES: dict[str, list[tuple[tuple[str, ...], str]]] = {
     "ScriptExit": [((), B), ((I,), B)],
     "ListenSend": [((I, ANY), I), ((S, I, ANY), I)],
     "GetString": [((ANY,), S), ((ANY, I), S), ((ANY, I, I), S)],
+    "ListenPacket": [((S,), S), ((S, S), S)],
 }
 
 FORMATS = {

@@ -15,6 +15,7 @@ import struct
 
 from . import script as ast
 from .checker import IO_WRITABLE
+from .codec import encode as encode_frame
 from .motion import MotionRequest
 
 MOTIONS = ("PTP", "Line", "Circle", "PLine", "Move_PTP", "Move_Line", "Move_PLine")
@@ -318,6 +319,11 @@ def _call(node, args, ctx, line):
         value_type = ctx.types.get(node.args[-1].id) if isinstance(node.args[-1], ast.Name) else None
         ctx.listen_send(ip_filter, sub, encode_value(value, value_type))
         return 0
+    if name == "ListenPacket":             # the frame text, as in the manual: no CR LF at the end
+        header, data = ("TMSCT", args[0]) if len(args) == 1 else args
+        if header not in ("TMSCT", "TMSTA", "CPERR"):
+            raise ScriptRuntimeError(f"ListenPacket header {header!r} is not TMSCT, TMSTA or CPERR")
+        return encode_frame(header, data).decode("utf-8")[:-2]
     if name == "GetString":
         return to_text(args[0])
     raise ScriptRuntimeError(f"function {name} cannot run here")

@@ -376,3 +376,17 @@ def test_stop_and_clear_buffer_frees_a_script_waiting_for_room(monkeypatch):
     assert node.send(1, sct("A", script)) == []
     # the priority command clears the FIFO and is answered; the third tag then finds room and A ends
     assert node.send(1, sct("P", "StopAndClearBuffer(0)")) == [frame("TMSCT", "P,OK"), frame("TMSCT", "A,OK")]
+
+
+@pytest.mark.parametrize("call,frame", [
+    ('ListenPacket("1,var_i++")', "$TMSCT,9,1,var_i++,*06"),
+    ('ListenPacket("TMSCT", "2,Techman Robot")', "$TMSCT,15,2,Techman Robot,*57"),
+    ('ListenPacket("TMSTA", "00")', "$TMSTA,2,00,*41"),
+])
+def test_listen_packet_builds_the_manual_frames(node, call, frame):
+    node.send(1, sct("1", f"string p = {call}"))
+    assert node.s.variables["p"] == frame
+
+
+def test_listen_packet_with_an_unknown_header_is_a_runtime_error(node):
+    assert node.send(1, sct("1", 'string p = ListenPacket("TMXYZ", "1,x")')) == [sct("1", "ERROR;1").decode()]
