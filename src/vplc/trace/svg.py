@@ -14,6 +14,15 @@ def _fmt(v) -> str:
     return str(v)
 
 
+def time_label(t_ns: float, step_ns: float) -> str:
+    """Axis label of a PLC time: unit chosen by the grid step (µs, ms or s), as few decimals as the step needs."""
+    unit, scale = ("s", 1e9) if step_ns >= 1e9 else ("ms", 1e6) if step_ns >= 1e6 else ("µs", 1e3)
+    step = step_ns / scale
+    whole = step >= 10 or (step >= 1 and abs(step - round(step)) < 1e-9)
+    decimals = 0 if whole else 1 if step >= 1 else 2 if step >= 0.1 else 3
+    return f"{t_ns / scale:.{decimals}f} {unit}"
+
+
 def write_svg(rec, filename: str) -> None:
     t0 = min((ch[0][0] for ch in rec.changes if ch), default=0)
     span = max(rec.end_ns - t0, 1)
@@ -43,7 +52,8 @@ def write_svg(rec, filename: str) -> None:
     axis = 10 + ROW * len(rec.paths) + 14
     for k in range(6):
         t = t0 + span * k / 5
-        out.append(f'<text x="{x(t):.1f}" y="{axis}" font-size="10" text-anchor="middle">{t / 1e6:.3g} ms</text>')
+        out.append(f'<text x="{x(t):.1f}" y="{axis}" font-size="10" text-anchor="middle">'
+                   f'{escape(time_label(t, span / 5))}</text>')
     out.append("</svg>")
     with open(filename, "w", encoding="utf-8") as f:
         f.write("\n".join(out) + "\n")

@@ -114,3 +114,10 @@ END_FUNCTION_BLOCK
     assert "s.st:4: FAIL Faulty_Test.divides: major fault in VPLC_TestRunner.Faulty_Test: integer division by zero" \
         in r.stdout
     assert r.stdout.strip().splitlines()[-1] == "1 passed, 1 failed"
+
+
+def test_svg_time_axis_labels_read_like_a_timing_chart():
+    from vplc.trace.svg import time_label
+    assert [time_label(t, 600e6) for t in (2150, 600e6, 1.2e9)] == ["0 ms", "600 ms", "1200 ms"]
+    assert [time_label(t, 2e9) for t in (0, 4e9)] == ["0 s", "4 s"]
+    assert time_label(5e6, 2.5e6) == "5.0 ms" and time_label(3e5, 150e3) == "300 µs"
