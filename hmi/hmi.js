@@ -58,13 +58,14 @@ const PAGES = {
       "Open Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: false, Immediate: false,
       WaitUntilSet: true, ExitNode: false } } },
   stop: { title: "Stop Motion", group: "Stop", param: "Stop_Param", legend: "Stop Settings", execLabel: "Stop",
+    release: true,           // a push button: Execute is reset once the stop is done, which releases the robot
     presets: { "Stop Immediately": { Mode: 1 }, "Stop and Discard All": { Mode: 3 } } },
 };
 const DEFAULT_STATUS = ["Busy", "Done", "CommandAborted", "Error", "ErrorID", "ErrorDescrip", "CmdID_Ack"];
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
 let MAP = null;
-const live = { values: {}, online: false, trail: [], listeners: [], kick: null };
+const live = { values: {}, online: false, trail: [], listeners: [], kick: null, polls: 0 };
 
 /* ---------- server access ---------- */
 async function api(path, body) {
@@ -283,6 +284,7 @@ function startPolling(names) {
     try {
       const data = await readVars(names);
       Object.assign(live.values, data.values);
+      live.polls += 1;
       live.online = true;
       const p = live.values.ReadPos_Position && live.values.ReadPos_Position.TCP;
       if (live.values.ReadPos_Valid && p) {
@@ -375,7 +377,24 @@ async function executeCommand(execVar, values, what) {
     await api("/api/execute", { execute: execVar, values });
     if (live.kick) live.kick();
     message(`${what}: command sent to the PLC.`, "ok");
-  } catch (e) { message(`${what}: ${e.message}`, "error"); }
+    return true;
+  } catch (e) { message(`${what}: ${e.message}`, "error"); return false; }
+}
+
+/* Push-button commands (CBT_Stop): reset Execute once Done or Error shows, within 10 s. */
+function releaseWhenFinished(group, what) {
+  const deadline = Date.now() + 10000, firstPoll = live.polls + 2;   // values read after the command was sent
+  const check = async () => {
+    const v = live.values;
+    const finished = live.polls >= firstPoll && (v[`${group}_Done`] === true || v[`${group}_Error`] === true);
+    if (!finished && Date.now() < deadline) { setTimeout(check, POLL_MS); return; }
+    try {
+      await api("/api/write", { values: { [`${group}_Execute`]: false } });
+      if (finished) message(`${what}: done, Execute reset (the robot accepts motions again).`, "ok");
+      else message(`${what}: no answer within 10 s; Execute reset.`, "error");
+    } catch (e) { message(`${what}: cannot reset Execute: ${e.message}`, "error"); }
+  };
+  setTimeout(check, POLL_MS);
 }
 
 async function fbPage(key) {
@@ -414,7 +433,9 @@ async function fbPage(key) {
   exec.onclick = () => {
     const result = collect(params, page.param || "");
     if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
-    executeCommand(`${group}_Execute`, result.values, page.title);
+    executeCommand(`${group}_Execute`, result.values, page.title).then((sent) => {
+      if (sent && page.release) releaseWhenFinished(group, page.title);
+    });
   };
   buttons.append(exec);
   if (key === "connect") {

@@ -171,3 +171,21 @@ def test_stop_during_pnp_halts_the_cycle_until_the_start_is_removed(rig):
     rig.plc.write("PnP_Example_Execute", True)                 # ... and starts again at segment 0
     rig.until(lambda: rig.read("PnP_Segment") == 1, "a new cycle", 30)
     assert rig.read("PnP_MoveError") is False
+
+
+def test_pnp_started_while_a_stop_is_held_waits_without_moving(rig):
+    rig.connect()
+    rig.plc.write("Stop_Execute", True)                        # the stop button is held
+    rig.until(lambda: rig.read("Stop_Done"), "the stop", 2)
+    rig.plc.write("PnP_Example_Execute", True)
+    rig.run_for(1)
+    assert rig.read("Cobot.Stopping") and not rig.read("PnP_MoveBusy")
+    assert not [e for e in rig.robot.events if e["kind"] == "motion_start"]
+    assert rig.read("PnP_MoveError") is False                  # refused by the stop, not a failure of the cycle
+    rig.plc.write("Stop_Execute", False)
+    rig.run_for(1)
+    assert not [e for e in rig.robot.events if e["kind"] == "motion_start"], "waits for the start to be removed"
+    rig.plc.write("PnP_Example_Execute", False)
+    rig.run_for(0.01)
+    rig.plc.write("PnP_Example_Execute", True)
+    rig.until(lambda: rig.read("PnP_Segment") == 1, "a new cycle", 30)

@@ -221,6 +221,8 @@ def test_stop_page_stops_a_running_move_and_aborts_it(connected):
     since = connected.event_count()
     execute_and_wait_done(connected, browser, "Stop")
     assert [e["command"] for e in connected.events("priority", since)] == ["StopAndClearBuffer(0)"]
+    browser.wait_for(lambda d: "Execute reset" in browser.message(), "the push button to release")
+    assert connected.read("Stop_Execute") is False and connected.read("Cobot.Stopping") is False
     browser.screenshot("e2e_stop_done")
     connected.wait(lambda: connected.read("MoveAbs_CommandAborted"), "the move to be aborted")
     browser = connected.open("moveabs")

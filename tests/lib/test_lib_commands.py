@@ -137,3 +137,37 @@ def test_read_actual_position_reports_tcp_and_joints(rig):
     rig.write("ReadEnable", False)
     rig.scans(2)
     assert not rig.read("rd.Valid") and not rig.read("rd.Busy")
+
+
+def test_stop_holds_the_stopping_state_while_execute_is_true(rig):
+    """PLCopen MC_GroupStop: while CBT_Stop's Execute stays TRUE the robot is Stopping and motion FBs are refused
+    (16#4005, nothing sent); other commands still run; releasing Execute allows motions again."""
+    run(rig, "stop", "StopExec", "StopParam", dict(Mode=1))
+    assert rig.read("stop.Done") and rig.read("Cobot.Stopping")
+    frames_out = rig.read("Cobot.FramesOut")
+    rig.set_struct("MoveParam", move_abs())
+    rig.write("MoveExec", True)
+    rig.scans(1)
+    assert rig.read("mover.Error") and rig.read("mover.ErrorID") == 0x4005
+    assert rig.read("mover.ErrorDescrip") == "Robot stopping: a CBT_Stop Execute is TRUE, motion rejected"
+    rig.set_struct("RelParam", rel())
+    rig.write("RelExec", True)
+    rig.scans(1)
+    assert rig.read("rel.ErrorID") == 0x4005
+    assert rig.read("Cobot.FramesOut") == frames_out                   # nothing reached the robot
+    script = run(rig, "dout", "OutExec", "OutParam", dict(Module=0, Channel=2, Value=True))
+    assert rig.read("dout.Done") and script == 'IO["ControlBox"].DO[2]=1'   # not a motion: allowed
+    rig.write("StopExec", False)
+    rig.write("MoveExec", False)
+    rig.scans(2)
+    assert not rig.read("Cobot.Stopping")
+    rig.write("MoveExec", True)
+    assert rig.until(lambda: rig.read("mover.Done") or rig.read("mover.Error"), 5)
+    assert rig.read("mover.Done")
+
+
+def test_a_stop_that_could_not_be_sent_does_not_hold_the_robot(rig):
+    rig.write("StopParam.Mode", 9, raw=True)                           # undefined mode: 16#1023
+    rig.write("StopExec", True)
+    rig.scans(2)
+    assert rig.read("stop.ErrorID") == 0x1023 and not rig.read("Cobot.Stopping")

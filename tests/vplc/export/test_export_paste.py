@@ -22,6 +22,7 @@ STOP_VARIABLES = [
     ["Err", "WORD", "", "", "False", "False", ""],
     ["Script", "STRING[256]", "", "", "False", "False", ""],
     ["Mode", "USINT", "", "", "False", "False", "1..4 = eCBT_StopMode + 1"],
+    ["Holding", "BOOL", "", "", "False", "False", "this instance holds CBT in the Stopping state"],
 ]
 
 
@@ -50,7 +51,7 @@ def test_cbt_stop_variable_table_line_by_line(lib_paste):
 def test_cbt_stop_body_is_the_source_body(lib_paste):
     body = (lib_paste / "CBT_Stop" / "body.st").read_text(encoding="utf-8").splitlines()
     source = (LIB / "CBT_Stop.st").read_text(encoding="utf-8").splitlines()
-    start = source.index("Core(CBT := CBT, Execute := Execute, Submit := FALSE);")
+    start = source.index("IF Holding AND NOT Execute THEN                       (* Execute fell: release the Stopping state *)")
     assert body == source[start:source.index("END_FUNCTION_BLOCK")]
     assert "    P := Parameters;                                  (* R4: latched at the rising edge *)" in body
 
@@ -61,8 +62,8 @@ def test_data_type_folders_hold_members_and_declaration(lib_paste):
                                      ["StopDiscardAll", "3"]]
     assert enum[0][2].startswith("StopAndClearBuffer()")
     conn = _rows(lib_paste / "stCBT_Connection" / "members.tsv")
-    assert conn[4][:3] == ["ReplyTimeout", "TIME", "T#5s"]
-    assert ["Req", "ARRAY[1..16] OF stCBT_Request"] == conn[8][:2]
+    assert conn[5][:3] == ["ReplyTimeout", "TIME", "T#5s"]
+    assert ["Req", "ARRAY[1..16] OF stCBT_Request"] == conn[9][:2]
     decl = (lib_paste / "stCBT_Connection" / "declaration.st").read_text(encoding="utf-8")
     assert decl.startswith("TYPE\n    stCBT_Connection : STRUCT") and decl.endswith("END_TYPE\n")
 
