@@ -51,7 +51,7 @@ def test_cbt_stop_variable_table_line_by_line(lib_paste):
 def test_cbt_stop_body_is_the_source_body(lib_paste):
     body = (lib_paste / "CBT_Stop" / "body.st").read_text(encoding="utf-8").splitlines()
     source = (LIB / "CBT_Stop.st").read_text(encoding="utf-8").splitlines()
-    start = source.index("IF Holding AND NOT Execute THEN                       (* Execute fell: release the Stopping state *)")
+    start = next(i for i, line in enumerate(source) if line.startswith("IF Holding AND NOT Execute THEN"))
     assert body == source[start:source.index("END_FUNCTION_BLOCK")]
     assert "    P := Parameters;                                  (* R4: latched at the rising edge *)" in body
 
