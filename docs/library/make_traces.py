@@ -55,7 +55,7 @@ def main():
     r.set_struct("MParam[1]", move_abs(Speed=20, TargetPosition=dict(X=40, Y=0, Z=90, RX=0, RY=90, RZ=0)))
     r.set_struct("StopParam", dict(Mode=1))
     record(r, ["MExec[1]", "movers[1].Busy", "movers[1].Active", "movers[1].CommandAborted",
-               "StopExec", "stop.Busy", "stop.Done"],
+               "StopExec", "stop.Busy", "stop.Done", "Cobot.Stopping"],
            [(lambda: r.write("MExec[1]", True), 0.1), (lambda: r.write("StopExec", True), 0.03),
             (lambda: (r.write("StopExec", False), r.write("MExec[1]", False)), 0.02)], "stop.svg")
     r.set_struct("MParam[2]", move_abs(Speed=20, TargetPosition=dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=0)))
