@@ -176,6 +176,8 @@ def rotation_angle(m0, m1):
 
 
 def _check_common(req):
+    if not all(math.isfinite(v) for v in req.target + (req.speed, req.accel_ms, req.blend)):
+        raise MotionError(f"{req.function}: a value is not a finite number")
     if req.fmt[1:2] == "P" or req.function.startswith(("PTP", "Move_PTP")):
         if not 0 < req.speed <= 100:
             raise MotionError(f"{req.function} speed {req.speed:g} % is outside 1..100 %")
@@ -253,6 +255,8 @@ class Planner:
         T = req.duration
         if not 0 < T <= 3600:
             raise MotionError(f"PVTPoint duration {T:g} s is outside 0..3600 s")
+        if not all(math.isfinite(v) for v in req.target):
+            raise MotionError("PVTPoint: a position or velocity is not a finite number")
         p1, v1 = tuple(req.target[:6]), tuple(req.target[6:12])
         start_tcp = kin.forward(joints, self.tool)
         start_pose = kin.matrix_to_pose(kin.matmul(self.base_inverse, start_tcp))
@@ -283,7 +287,7 @@ class Planner:
                 raise MotionError("PVTPoint: the path leaves the reach of the arm") from None
             for i, (a, b) in enumerate(zip(previous, current)):
                 if abs(b - a) / (T / 50) > JOINT_SPEED[i] * 1.001:
-                    raise MotionError(f"PVTPoint: joint {i + 1} would move at {abs(b - a) / (T / 50):.0f} deg/s, "
+                    raise MotionError(f"PVTPoint: joint {i + 1} would move at {abs(b - a) / (T / 50):.4g} deg/s, "
                                       f"above its limit of {JOINT_SPEED[i]:g} deg/s")
             previous = current
         return plan

@@ -6,6 +6,7 @@ queued before it has finished. Durations come from ``sim.motion`` (documented fo
 """
 from __future__ import annotations
 
+import math
 from collections import deque
 
 from . import kinematics as kin
@@ -126,7 +127,7 @@ class RobotModel:
                 raise MotionError(f"{request.function} inside PVT mode; call PVTExit() first")
             else:
                 plan = planner.plan(request, self.joints)
-        except MotionError as exc:
+        except (MotionError, kin.KinematicsError, ValueError, ArithmeticError) as exc:   # never the server's end
             self.fault = str(exc)
             self.stop_and_clear()
             return {"kind": "motion_failed", "function": request.function, "line": request.line,
@@ -164,6 +165,8 @@ class RobotModel:
         return {"kind": "setting", "what": "tcp", "name": name, "pose": _frozen(pose)}
 
     def _run_load(self, value):
+        if not 0 <= value < 1e6:
+            return self._fault_event("ChangeLoad", f"load {value:g} kg is not a valid mass")
         self.load = value
         return {"kind": "setting", "what": "load", "value": value}
 
@@ -190,7 +193,10 @@ class RobotModel:
             if value not in table:
                 return None, f"{what} '{value}' is not defined on the robot"
             return value, list(table[value])
-        return "(custom)", [float(v) for v in value[:6]]
+        pose = [float(v) for v in value[:6]]
+        if len(pose) != 6 or not all(math.isfinite(v) for v in pose):
+            return None, f"{what} frame needs 6 finite numbers"
+        return "(custom)", pose
 
     @staticmethod
     def _matrix(pose):

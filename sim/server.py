@@ -295,7 +295,7 @@ class SimServer:
             self._poll_end = self._slice_start + POLL_BUDGET_S
             for robot in self.robots:
                 session = robot.session
-                session.advance(self._now)
+                self._advance(robot)
                 if any(client.outbox for client in session.clients.values()) and not robot.faults.active:
                     self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
                 self._breathe()
@@ -357,13 +357,24 @@ class SimServer:
                     self._flush(robot)
         return len(ready)
 
+    def _advance(self, robot):
+        """Advance one robot's session; an unexpected error becomes a robot error of that robot (its project
+        stops, event ``internal_error``) instead of ending the thread that serves every robot."""
+        try:
+            robot.session.advance(self._now)
+        except Exception as exc:          # noqa: BLE001 - safety net, see docstring
+            robot._log("internal_error", conn=None, error=f"{type(exc).__name__}: {exc}")
+            robot.session.robot.stop_and_clear()
+            if robot.session.state != STOPPED:
+                robot.session.fire("robot_fault", reason=f"internal error of the simulator ({type(exc).__name__})")
+
     def _start_touched(self):
         """Advance the robots that received scripts with dt = 0, so a motion queued now starts now."""
         self._starting = True
         try:
             while self._touched:
                 robot = self._touched.pop(0)
-                robot.session.advance(self._now)
+                self._advance(robot)
                 self._flush(robot)
                 self._breathe(budgeted=True)
         finally:

@@ -151,3 +151,52 @@ def test_full_script_buffer_pauses_reading_and_resumes_when_it_drains(harness):
     assert h.until(lambda: len(peer.frames) >= 1202, timeout=30, dt=0.01)
     assert not h.robot.reading_paused
     assert peer.texts()[-1] == ("TMSCT", "C99,OK")
+
+
+NON_FINITE = [
+    'Line("CPP",1e309,0,300,180,0,90,100,200,0,false)',
+    'PTP("CPP",417,0,300,180,0,90,1e309,200,0,false)',
+    'Circle("CPP",417,0,300,180,0,90,1e309,0,300,180,0,90,50,200,0,0,false)',
+    'Move_Line("CPP",0,0,-1e309,0,0,0,100,200,0,false)',
+    'ChangeBase(1e309,0,0,0,0,0)',
+    'ChangeTCP(0,0,1e309,0,0,0)',
+    'ChangeLoad(1e309)',
+    'PVTEnter(1)\r\nPVTPoint(417,0,300,180,0,90,0,0,0,0,0,-1e309,1)',
+]
+
+
+def test_non_finite_numbers_are_robot_errors_and_the_other_robots_keep_being_served():
+    h = Harness(robots=2)
+    try:
+        for n, script in enumerate(NON_FINITE):
+            if h.robot.state()["node_state"] == "project_stopped":     # the previous robot error stopped it
+                h.robot.start_project()
+                h.run(0.05)
+            peer = h.connect()
+            peer.send(sct(str(n), script))
+            assert h.until(lambda: any(e["kind"] == "motion_failed" for e in h.robot.events[-20:]), timeout=2), script
+            failed = [e for e in h.robot.events if e["kind"] == "motion_failed"][-1]
+            assert "finite" in failed["reason"] or "valid mass" in failed["reason"], failed
+            other = h.connect(robot=1)
+            assert h.request(other, sta("00")) == [("TMSTA", "00,true,Listen1")]   # robot 1 unaffected
+        assert not [e for e in h.robot.events if e["kind"] == "internal_error"]
+    finally:
+        h.close()
+
+
+def test_an_unexpected_error_while_advancing_stops_that_robot_only(monkeypatch):
+    h = Harness(robots=2)
+    try:
+        broken = h.srv.robots[0].session
+
+        def explode(now):
+            raise RuntimeError("boom")
+        monkeypatch.setattr(broken, "advance", explode)
+        h.run(0.05)                                           # the serving loop survives
+        (event,) = [e for e in h.srv.robots[0].events if e["kind"] == "internal_error"][:1]
+        assert event["error"] == "RuntimeError: boom"
+        assert h.srv.robots[0].state()["node_state"] == "project_stopped"
+        peer = h.connect(robot=1)
+        assert h.request(peer, sta("00")) == [("TMSTA", "00,true,Listen1")]
+    finally:
+        h.close()
