@@ -176,7 +176,7 @@ def rotation_angle(m0, m1):
 
 
 def _check_common(req):
-    if not all(math.isfinite(v) for v in req.target + (req.speed, req.accel_ms, req.blend)):
+    if not all(math.isfinite(v) for v in (*req.target, req.speed, req.accel_ms, req.blend)):
         raise MotionError(f"{req.function}: a value is not a finite number")
     if req.fmt[1:2] == "P" or req.function.startswith(("PTP", "Move_PTP")):
         if not 0 < req.speed <= 100:
