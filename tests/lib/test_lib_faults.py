@@ -25,10 +25,14 @@ def test_stream_faults_still_complete_every_command_once(rig, fault, params):
     rig.robot.inject(fault, **params)
     for k in range(1, 5):
         go(rig, k, blend=k % 2 == 0, rz=5.0 * k)
-    assert rig.until(lambda: all(rig.read(f"movers[{k}].Done") for k in range(1, 5)), 10)
+    done = rig.until(lambda: all(rig.read(f"movers[{k}].Done") for k in range(1, 5)), 10)
+    state = {k: (rig.read(f"movers[{k}].Done"), rig.read(f"movers[{k}].ErrorID")) for k in range(1, 5)}
     lines = executed_lines(rig)
-    assert len(lines) == 4 and len(set(lines)) == 4
-    assert rig.read("Cobot.BadFrames") == 0
+    detail = f"movers (Done, ErrorID): {state}; executed: {lines}; connection: " \
+             f"{ {n: rig.read('Cobot.' + n) for n in ('Connected', 'LastErrorID', 'BadFrames', 'FramesIn')} }"
+    assert done, detail
+    assert len(lines) == 4 and len(set(lines)) == 4, detail
+    assert rig.read("Cobot.BadFrames") == 0, detail
 
 
 def test_corrupt_checksum_reply_is_dropped_and_ends_in_reply_timeout(rig):
