@@ -6,6 +6,7 @@ the real-time drivers (``run_until`` / ``run_realtime`` in vplc.api) call the sa
 """
 from __future__ import annotations
 
+import gc
 import math
 import time
 import traceback
@@ -24,6 +25,27 @@ class Task:
     programs: list = field(default_factory=list)      # (instance, body function)
     next_due: int | None = None
     cycles: int = 0                                   # completed executions of the task's programs
+
+
+_SCANNING: dict = {}          # id -> watchdog deadline list of every scan in progress (any thread)
+_GC_START = [0.0]
+
+
+def _gc_pause(phase: str, _info) -> None:
+    """Python's garbage collector is the host's time, not the program's: a collection during a scan moves
+    the watchdog deadline of every scan in progress by its duration (it must not look like an endless loop)."""
+    if not _SCANNING:
+        return
+    if phase == "start":
+        _GC_START[0] = time.perf_counter()
+    elif _GC_START[0]:
+        pause = time.perf_counter() - _GC_START[0]
+        _GC_START[0] = 0.0
+        for deadline in list(_SCANNING.values()):
+            deadline[0] += pause
+
+
+gc.callbacks.append(_gc_pause)
 
 
 class Engine:
@@ -87,6 +109,7 @@ class Engine:
         self.started = True
         self.now_ns = now_ns
         self.deadline[0] = time.perf_counter() + self.watchdog_ns / 1e9
+        _SCANNING[id(self)] = self.deadline
         try:
             for task in self.tasks:
                 if task.next_due is None:
@@ -110,6 +133,7 @@ class Engine:
             raise self.fault from None
         finally:
             self.deadline[0] = math.inf
+            _SCANNING.pop(id(self), None)
         self.scan_count += 1
 
     def make_fault(self, exc: BaseException) -> PlcFault:

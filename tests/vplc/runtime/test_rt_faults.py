@@ -49,3 +49,37 @@ def test_scan_time_going_backwards_is_rejected(tmp_path):
     plc.scan(5_000_000)
     with pytest.raises(ValueError, match="backwards"):
         plc.scan(1_000_000)
+
+
+def _pausing(plc, seconds, as_gc):
+    """Make the program pause ``seconds`` of wall time before its body, reported as a GC pause or not."""
+    import gc
+    import time
+    task = plc.engine.tasks[0]
+    inst, body = task.programs[0]
+
+    def paused(s):
+        if as_gc:
+            for callback in gc.callbacks:
+                callback("start", {})
+        time.sleep(seconds)
+        if as_gc:
+            for callback in gc.callbacks:
+                callback("stop", {})
+        body(s)
+    task.programs[0] = (inst, paused)
+
+
+def test_a_garbage_collection_during_a_scan_does_not_count_against_the_watchdog(tmp_path):
+    """The watchdog guards the program; a pause of Python's collector (host time) moves the deadline."""
+    plc = plc_from(tmp_path, "FOR i := 1 TO 10 DO n := n + 1; END_FOR;", "n, i : INT;", watchdog_ms=50)
+    _pausing(plc, 0.2, as_gc=True)                             # a 200 ms collection inside a 50 ms watchdog
+    plc.scan(0)
+    assert plc.read("Main.n") == 10
+
+
+def test_the_same_pause_in_the_program_trips_the_watchdog(tmp_path):
+    plc = plc_from(tmp_path, "FOR i := 1 TO 10 DO n := n + 1; END_FOR;", "n, i : INT;", watchdog_ms=50)
+    _pausing(plc, 0.2, as_gc=False)
+    with pytest.raises(PlcFault, match="watchdog"):
+        plc.scan(0)
