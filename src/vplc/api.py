@@ -73,6 +73,9 @@ class Plc:
             self._setup_tasks(task, programs)
         except LoadError:
             raise
+        except MemoryError:
+            raise LoadError("error: the program's variables do not fit in this computer's memory; look for very "
+                            "large arrays") from None
         except Exception as exc:   # noqa: BLE001 - an initial value that faults
             raise LoadError(f"error: initialising the variables failed: {self.engine.make_fault(exc)}") from None
         self._resolver = Resolver(self)

@@ -327,4 +327,8 @@ class ExpressionsMixin:
         if value is None:
             self.diags.error("ST0106", f"`{t.text}` is not a valid {kind.upper()} literal", span)
             value = 0
+        elif not -(1 << 63) <= value < (1 << 63):
+            self.diags.error("ST0106", f"`{t.text}` is outside the range of {kind.upper()} (64-bit nanoseconds, "
+                             "about ±106751 days)", span)
+            value = 0
         return A.Literal(kind, value, None, t.text, span=span)

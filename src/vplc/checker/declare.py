@@ -70,6 +70,7 @@ class Declarer:
                 shell.target = self.resolve(decl.spec, unit, None)
                 if isinstance(decl.spec, A.SubrangeTypeRef) and isinstance(shell.target, T.SubrangeType):
                     shell.target.alias = decl.name
+        self.struct_cycles()
         for decl, shell, unit in self.ctx.type_decls:   # alias cycles
             if isinstance(shell, T.AliasType):
                 seen, t = set(), shell
@@ -101,6 +102,42 @@ class Declarer:
             enum.values[v.name] = next_value
             next_value += 1
         self.tables.add_enum(enum)
+
+    def struct_cycles(self) -> None:
+        """ST1004 for structures that contain themselves through other structures or arrays (A has a B, B has an
+        A): such a value would be infinitely large. Reported once per cycle, at the member that closes it."""
+        def contained(t):
+            t = T.unalias(t)
+            while isinstance(t, T.ArrayType):
+                t = T.unalias(t.element)
+            return t if isinstance(t, T.StructType) else None
+
+        reported = set()
+        for _decl, shell, _unit in self.ctx.type_decls:
+            if not isinstance(shell, T.StructType) or id(shell) in reported:
+                continue
+            path, stack, visited = [shell], [iter(list(shell.fields.values()))], {id(shell)}
+            while stack:
+                f = next(stack[-1], None)
+                if f is None:
+                    stack.pop()
+                    path.pop()
+                    continue
+                inner = contained(f.type)
+                if inner is None:
+                    continue
+                if inner is shell:
+                    names = " → ".join(t.name for t in path + [shell])
+                    self.ctx.diags.error("ST1004", f"structure {shell.name} contains itself ({names}, member "
+                                         f"{f.name}); a value of it would be infinitely large", f.decl.name_span)
+                    for t in path:
+                        reported.add(id(t))
+                    f.type = T.ERROR
+                    break
+                if id(inner) not in visited:
+                    visited.add(id(inner))
+                    path.append(inner)
+                    stack.append(iter(list(inner.fields.values())))
 
     def fill_struct(self, st: T.StructType, spec: A.StructTypeRef, unit) -> None:
         for f in spec.fields:

@@ -1,12 +1,16 @@
 """Expression typing: sets ``expr.ty`` / ``expr.conv`` / ``sym`` and binds calls (see frontend_api.md)."""
 from __future__ import annotations
 
+import math
+
 from .. import ast as A
 from .. import builtins as B
 from .. import types as T
 from . import array_bounds, calls, undeclared
 from .scope import Ambiguous, is_generic
 from .symbols import EnumValueSymbol, PouSymbol, VarSymbol
+
+_REAL_ROUNDS_TO_MAX = 3.4028235677973366e38     # from here on a value rounds to infinity in 32 bits
 
 COMPARE = {"=", "<>", "<", ">", "<=", ">="}
 LOGIC = {"AND", "OR", "XOR"}
@@ -124,13 +128,26 @@ class ExprChecker:
             t = T.ELEMENTARY[e.type_prefix]
             if e.kind == "int" and not T.literal_fits(e.value, t):
                 self.ctx.diags.error("ST1107", f"{e.value} does not fit in {t.name} ({t.lo}..{t.hi})", e.span)
+            elif e.kind == "real":
+                self.real_fits(e, t)
             return t
         return self.untyped_number(e, e.value, expected)
+
+    def real_fits(self, e, t) -> None:
+        """ST1107 for a real literal that overflows its type (REAL ±3.4028235E38, LREAL ±1.7976931E308)."""
+        value = e.value
+        limit = _REAL_ROUNDS_TO_MAX if T.is_real(t) and T.base_of(t).bits == 32 else math.inf
+        if isinstance(value, float) and (math.isinf(value) or abs(value) >= limit):
+            rt = T.base_of(t) if T.is_real(t) else T.LREAL
+            self.ctx.diags.error("ST1107", f"{e.text or value} does not fit in {rt.name} (±{rt.hi:.8g})", e.span)
 
     def untyped_number(self, e, value, expected):
         exp = T.unalias(expected) if expected is not None else None
         if isinstance(e, A.Literal) and e.kind == "real" or isinstance(value, float):
-            return T.base_of(exp) if exp is not None and T.is_real(exp) else T.LREAL
+            t = T.base_of(exp) if exp is not None and T.is_real(exp) else T.LREAL
+            if isinstance(e, A.Literal):
+                self.real_fits(e, t)
+            return t
         if exp is not None and isinstance(T.base_of(exp), T.ElementaryType) and \
                 T.base_of(exp).kind in ("int", "uint", "bit", "real"):
             if not T.literal_fits(value, exp):

@@ -28,6 +28,14 @@ CASES = [
     ("ST1105", program("IF i THEN i := 0; END_IF;", "i : INT;"), program("IF i > 0 THEN i := 0; END_IF;", "i : INT;")),
     ("ST1106", program("i := i[0];", "i : INT;"), program("i := a[0];", "i : INT; a : ARRAY[0..1] OF INT;")),
     ("ST1107", program("s := 300;", "s : SINT;"), program("s := 100;", "s : SINT;")),
+    ("ST1107", program("r := 1.0E39;", "r : REAL;"), program("r := 3.4028235E38;", "r : REAL;")),
+    ("ST1107", program("l := 1.0E309;", "l : LREAL;"), program("l := 1.0E308;", "l : LREAL;")),
+    ("ST1107", program("r := REAL#-4.0E38;", "r : REAL;"), program("r := REAL#-3.0E38;", "r : REAL;")),
+    ("ST0106", program("t := T#200000d;", "t : TIME;"), program("t := T#100000d;", "t : TIME;")),
+    ("ST1004", "TYPE A : STRUCT b : ARRAY[1..2] OF B; END_STRUCT; B : STRUCT a : A; END_STRUCT; END_TYPE\n"
+     + program("x.b[1] := x.b[2];", "x : A;"),
+     "TYPE A : STRUCT b : ARRAY[1..2] OF B; END_STRUCT; B : STRUCT n : INT; END_STRUCT; END_TYPE\n"
+     + program("x.b[1].n := 1;", "x : A;")),
     ("ST1201", FB + program("m(CBT := c, Exec := TRUE);", "m : Mover; c : INT;"),
      FB + program("m(CBT := c, Execute := TRUE);", "m : Mover; c : INT;")),
     ("ST1202", FB + program("m(Execute := TRUE);", "m : Mover;"),
