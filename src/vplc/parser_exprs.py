@@ -330,5 +330,4 @@ class ExpressionsMixin:
         elif not -(1 << 63) <= value < (1 << 63):
             self.diags.error("ST0106", f"`{t.text}` is outside the range of {kind.upper()} (64-bit nanoseconds, "
                              "about ±106751 days)", span)
-            value = 0
         return A.Literal(kind, value, None, t.text, span=span)
