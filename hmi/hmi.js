@@ -335,7 +335,12 @@ function drawView(canvas, h, v, title) {
 function robotView(container) {
   container.innerHTML = `<h2>Live robot view: TCP path from CBT_ReadActualPosition</h2>
     <div class="views"><canvas id="view-top"></canvas><canvas id="view-side"></canvas></div>
-    <div class="pos" id="tcp-pos">X — Y — Z —</div>`;
+    <div class="pos" id="tcp-pos">X — Y — Z —</div>
+    <div class="robot-status">
+      <span>In Listen node <span data-status="Robot_InListenNode"><span class="led"></span></span></span>
+      <span>Stopping <span data-status="Robot_Stopping"><span class="led busy"></span></span></span>
+      <span>Queue <b data-status="Robot_QueueDepth"></b></span>
+      <span>Last ErrorID <b data-status="Robot_LastErrorID"></b></span></div>`;
   live.listeners.push(() => {
     drawView(document.getElementById("view-top"), "X", "Y", "Top view");
     drawView(document.getElementById("view-side"), "X", "Z", "Side view");
@@ -368,7 +373,8 @@ function mainPage() {
       <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>
     </div><div class="robotview" id="robotview"></div>`;
   robotView(document.getElementById("robotview"));
-  startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position"]);
+  startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", "Robot_InListenNode", "Robot_QueueDepth",
+    "Robot_Stopping", "Robot_LastErrorID"]);
 }
 
 async function executeCommand(execVar, values, what) {

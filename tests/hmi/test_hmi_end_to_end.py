@@ -136,6 +136,8 @@ def test_main_page_shows_the_live_tcp_position(connected):
     browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text.startswith("X "), "the TCP position")
     x = float(browser.driver.find_element(By.ID, "tcp-pos").text.split()[1])
     assert abs(x - connected.robot_state()["tcp"][0]) < 1.0
+    browser.wait_status("Robot_InListenNode", "true")                     # the robot status strip
+    assert browser.status("Robot_Stopping") == "false" and browser.status("Robot_LastErrorID").startswith("16#")
     browser.screenshot("e2e_main")
 
 
