@@ -54,6 +54,9 @@ def load_plc(paths, task: str = "Main@1ms", programs=None, *, dialect: str = "sy
                socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns)
 
 
+_HEAP_FROZEN: list = []      # once per process: see Plc.run_realtime
+
+
 class Plc:
     def __init__(self, proj, module, task, programs, *, watchdog_ms, socket_limit, socket_latency_ns,
                  clock_base_ns) -> None:
@@ -187,10 +190,10 @@ class Plc:
 
         The driver sleeps until ``spin_ns`` before the due time, then spins: a longer spin lowers the
         lateness on a busy machine at the cost of CPU time (``spin_ns`` = period gives a busy-waiting task)."""
-        if not getattr(Plc, "_frozen", False):  # what loading built lives for good: keep it out of every later
+        if not _HEAP_FROZEN:                   # what loading built lives for good: keep it out of every later
             gc.collect()                       # collection, so the collector's pauses stay short while scanning
             gc.freeze()
-            Plc._frozen = True
+            _HEAP_FROZEN.append(True)
         period = self.period_ns
         base = time.monotonic_ns() - (self.engine.now_ns + period if self.engine.started else 0)
         due = time.monotonic_ns()

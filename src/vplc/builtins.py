@@ -235,6 +235,13 @@ def _conversion(src_name: str, dst_name: str) -> Builtin | None:
     return Builtin(f"{src_name}_TO_{dst_name}", 1, 1, resolve, ("IN",))
 
 
+def bcd_kind(name: str) -> str | None:
+    """"decode" for BCD_TO_x / <bits>_BCD_TO_x, "encode" for x_TO_BCD / x_TO_BCD_<bits>, else None (upper case)."""
+    if _BCD_DECODE_RE.match(name):
+        return "decode"
+    return "encode" if _BCD_ENCODE_RE.match(name) else None
+
+
 def _bcd(name: str) -> Builtin | None:
     """BCD_TO_x / x_TO_BCD builtins, or None when ``name`` is not one. The integer side must be an integer
     type; the bit-string side is the one named, or (2nd edition) any bit string when decoding and the bit

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+from .. import builtins as B
 from .. import types as T
 from . import iec
 from .faults import RuntimeFaultError
@@ -108,7 +109,8 @@ MATH = {name: _nan_on_domain(fn) for name, fn in {
     "TAN": math.tan, "ASIN": math.asin, "ACOS": math.acos, "ATAN": math.atan}.items()}
 
 NAMESPACE = {
-    "_fmod": _fmod, "_mux": _mux, "_bcd_decode": _bcd_decode, "_bcd_encode": _bcd_encode, "_left": _left, "_right": _right, "_mid": _mid, "_insert": _insert,
+    "_fmod": _fmod, "_mux": _mux, "_bcd_decode": _bcd_decode, "_bcd_encode": _bcd_encode,
+    "_left": _left, "_right": _right, "_mid": _mid, "_insert": _insert,
     "_delete": _delete, "_replace": _replace, "_find": _find, "_sinit": _sinit, "_fill": _fill,
     "_round": iec.round_half_even, "_trunc": iec.trunc, "_shl": iec.shl, "_shr": iec.shr, "_rol": iec.rol,
     "_ror": iec.ror, "_lbound": iec.lower_bound, "_ubound": iec.upper_bound, "_atan2": _nan_on_domain(lambda yx: math.atan2(*yx)),
@@ -223,9 +225,10 @@ def gen_builtin(gen, b) -> str:
             return iec.wrap_expr(code, bits, signed)
         return code
 
-    if "BCD" in name:
-        if name.partition("_TO_")[0].endswith("BCD"):
-            return f"_bcd_decode({args[0]}, {name!r}, {rt.hi})"
+    bcd = B.bcd_kind(name)
+    if bcd == "decode":
+        return f"_bcd_decode({args[0]}, {name!r}, {rt.hi})"
+    if bcd == "encode":
         return f"_bcd_encode({args[0]}, {bits}, {name!r})"
     if "_TO_" in name or name.startswith("TO_"):
         if name.startswith("TRUNC_"):
