@@ -1,0 +1,103 @@
+"""The one ErrorID table (docs/library/errors.tsv): the files generated from it are up to date, the library raises
+only ErrorIDs of the table, every row has a cause and a remedy, and the ST text function compiled on the virtual
+PLC returns exactly the table's text for every ID."""
+import json
+import re
+import subprocess
+import sys
+
+import pytest
+
+from rig import LIB, ROOT
+from vplc.api import load_plc
+
+sys.path.insert(0, str(ROOT / "docs" / "library"))
+import make_error_tables as tables  # noqa: E402
+
+LITERAL = re.compile(r"WORD#16#([0-9A-Fa-f]{1,4})\b")
+
+
+def library_literals():
+    """Every non-zero WORD#16#... literal of the library outside the generated text function and platform/
+    (where Sysmac socket service codes are compared), with the file and line it stands in."""
+    found = []
+    for path in sorted(LIB.rglob("*.st")):
+        if path == tables.ST_FILE or path.parent.name == "platform":
+            continue
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+            for m in LITERAL.finditer(line.split("(*")[0]):
+                value = int(m.group(1), 16)
+                if value:
+                    found.append((f"16#{value:04X}", f"{path.relative_to(ROOT)}:{number}"))
+    return found
+
+
+def test_generated_files_agree_with_the_table():
+    result = subprocess.run([sys.executable, str(ROOT / "docs" / "library" / "make_error_tables.py"), "--check"],
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_every_row_has_text_cause_and_remedy():
+    rows = tables.load()
+    assert len(rows) >= 49
+    for code, row in rows.items():
+        assert row["text"] and row["cause"] and row["remedy"] and row["raised_by"], code
+        assert len(row["text"]) <= 79, code
+
+
+def test_the_library_raises_only_ids_of_the_table():
+    rows = tables.load()
+    unknown = [f"{where}: {code}" for code, where in library_literals() if code not in rows]
+    assert unknown == [], "ErrorIDs missing from docs/library/errors.tsv:\n" + "\n".join(unknown)
+
+
+def test_every_id_of_the_table_is_raised_somewhere_in_the_library():
+    raised = {code for code, _ in library_literals()}
+    assert [code for code in tables.load() if code not in raised] == []
+
+
+def test_hmi_texts_are_the_table():
+    hmi = json.loads((ROOT / "hmi" / "errors.json").read_text(encoding="utf-8"))
+    rows = tables.load()
+    assert list(hmi) == list(rows)
+    assert all(hmi[c]["text"] == rows[c]["text"] and hmi[c]["remedy"] == rows[c]["remedy"] for c in rows)
+
+
+def test_st_text_function_returns_the_table_text_for_every_id(tmp_path):
+    rows = tables.load()
+    n = len(rows)
+    ids = ", ".join(f"WORD#{c}" for c in rows)
+    (tmp_path / "Texts.st").write_text(f"""PROGRAM Main
+VAR
+    Ids : ARRAY[1..{n}] OF WORD := [{ids}];
+    Texts : ARRAY[1..{n}] OF STRING[80];
+    Unknown : STRING[80];
+    I : UINT;
+END_VAR
+FOR I := 1 TO {n} DO
+    Texts[I] := CBT_ErrorText(Ids[I]);
+END_FOR;
+Unknown := CBT_ErrorText(WORD#16#4FFF);
+END_PROGRAM
+""", encoding="utf-8")
+    with load_plc([str(LIB), str(tmp_path / "Texts.st")], task="Main@1ms") as plc:
+        plc.scan(plc.period_ns)
+        got = [plc.read(f"Main.Texts[{i}]") for i in range(1, n + 1)]
+        assert got == [row["text"] for row in rows.values()]
+        assert plc.read("Main.Unknown") == "Unknown ErrorID 16#4fff"
+
+
+@pytest.mark.parametrize("line,message", [
+    ("16#1001\tCBT_Connect\tText\t\tRemedy", "has no cause"),
+    ("16#0001\tCBT_Connect\tText\tCause\tRemedy", "is not 16#1xxx..16#4xxx"),
+    ("16#1001\tCBT_Connect\t" + "x" * 80 + "\tCause\tRemedy", "text is 80 characters"),
+    ("16#1001\tCBT_Connect\tText\tCause", "4 fields, expected 5"),
+    ("16#1001\tCBT_Connect\tA | B\tCause\tRemedy", "'|' in text"),
+])
+def test_a_malformed_table_is_named_with_its_line(tmp_path, line, message):
+    bad = tmp_path / "errors.tsv"
+    bad.write_text("\t".join(tables.COLUMNS) + "\n" + line + "\n", encoding="utf-8")
+    with pytest.raises(tables.TableError, match=re.escape(message)) as info:
+        tables.load(bad)
+    assert str(info.value).startswith("errors.tsv:2: ")
