@@ -18,7 +18,7 @@ for entry in (ROOT / "src", ROOT):
         sys.path.insert(0, str(entry))
 
 from sim.server import SimServer  # noqa: E402
-from vplc.hmi_server import HmiServer, Mapping, MappingError  # noqa: E402
+from vplc.hmi.server import HmiServer, Mapping, MappingError  # noqa: E402
 
 SOURCES = [ROOT / "lib" / "CBT_Commands_Lib", ROOT / "examples"]
 

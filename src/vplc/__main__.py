@@ -1,6 +1,6 @@
-"""``python -m vplc``: see vplc.cli."""
+"""``python -m vplc``: see vplc.cli.main."""
 import sys
 
-from .cli import main
+from .cli.main import main
 
 sys.exit(main())

@@ -10,8 +10,8 @@ import re
 import threading
 import time
 
-from . import types as T
-from .codegen import CodeGen, bind_natives
+from .frontend import types as T
+from .compiler.codegen import CodeGen, bind_natives
 from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
 from .runtime.values import PathError, Resolver, parse_duration

@@ -5,15 +5,15 @@ import gc
 import os
 from dataclasses import dataclass, field
 
-from . import ast as A
-from . import types as T
+from .frontend import ast as A
+from .frontend import types as T
 from .checker import calls, portable as portable_rule, recursion
 from .checker.body import BodyChecker
 from .checker.declare import Declarer
 from .checker.scope import Ambiguous, Tables
-from .diagnostics import DiagnosticBag, Diagnostic, render_all, sort_key
-from .parser import parse
-from .source import SourceFile, Span
+from .frontend.diagnostics import DiagnosticBag, Diagnostic, render_all, sort_key
+from .frontend.parser import parse
+from .frontend.source import SourceFile, Span
 
 PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
 VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st")

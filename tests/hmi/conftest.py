@@ -11,7 +11,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 from fake_plc import FakePlc, command_program  # noqa: E402
 from hmi_http import Client  # noqa: E402
-from vplc.hmi_server import HmiServer, Mapping  # noqa: E402
+from vplc.hmi.server import HmiServer, Mapping  # noqa: E402
 
 
 @pytest.fixture

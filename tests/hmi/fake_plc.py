@@ -8,7 +8,7 @@ from __future__ import annotations
 import re
 import threading
 
-from vplc.hmi_server import INT_RANGES, Mapping
+from vplc.hmi.server import INT_RANGES, Mapping
 
 _STEP = re.compile(r"\.?([A-Za-z_]\w*)|\[(\d+)\]")
 

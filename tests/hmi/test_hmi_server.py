@@ -7,7 +7,7 @@ import pytest
 
 from fake_plc import FakePlc
 from hmi_http import Client
-from vplc.hmi_server import MAX_BODY, HmiServer, Mapping, MappingError
+from vplc.hmi.server import MAX_BODY, HmiServer, Mapping, MappingError
 
 
 def test_main_page_and_script_are_served_with_text_types(client):
@@ -25,7 +25,7 @@ def test_every_listed_page_is_served_from_the_one_page_shell(client, page):
     assert status == 200 and body == shell and headers["Content-Type"].startswith("text/html")
 
 
-@pytest.mark.parametrize("path", ["/nothing.html", "/../src/vplc/hmi_server.py", "/%2e%2e/Makefile"])
+@pytest.mark.parametrize("path", ["/nothing.html", "/../src/vplc/hmi/server.py", "/%2e%2e/Makefile"])
 def test_unknown_or_escaping_paths_are_not_found(client, path):
     status, answer = client.json(path)
     assert status == 404 and answer["ok"] is False and "no such page" in answer["error"]

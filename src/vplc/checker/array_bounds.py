@@ -27,7 +27,7 @@ def check(ck, e, array_type) -> None:
 
 def check_slice(ck, element, param_type, param_name: str) -> None:
     """Sysmac "array element passed to an array parameter": enough elements must remain from that element."""
-    from .. import types as T
+    from ..frontend import types as T
     base = T.unalias(element.base.ty) if element.base.ty is not None else None
     if param_type.open or not isinstance(base, T.ArrayType) or base.open or len(base.dims) != 1:
         return

@@ -19,8 +19,8 @@ Failing::
 """
 from __future__ import annotations
 
-from .. import ast as A
-from .. import types as T
+from ..frontend import ast as A
+from ..frontend import types as T
 from .symbols import VarSymbol
 
 

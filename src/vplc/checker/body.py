@@ -1,8 +1,8 @@
 """Statement checking for one POU body (typing, call binding and the statement-level rules)."""
 from __future__ import annotations
 
-from .. import ast as A
-from .. import types as T
+from ..frontend import ast as A
+from ..frontend import types as T
 from . import assign_target, calls, case_labels, duplicates, function_result, unused
 from .exprs import ExprChecker
 from .symbols import VarSymbol

@@ -17,8 +17,8 @@ Failing::
 """
 from __future__ import annotations
 
-from .. import ast as A
-from .. import types as T
+from ..frontend import ast as A
+from ..frontend import types as T
 from .consteval import const_int
 from .symbols import EnumValueSymbol
 

@@ -1,7 +1,7 @@
 """Constant folding of integer expressions (array bounds, string lengths, enum values, CASE labels)."""
 from __future__ import annotations
 
-from .. import ast as A
+from ..frontend import ast as A
 
 
 def const_int(e: A.Expr, ctx, scope, _depth: int = 0) -> int | None:

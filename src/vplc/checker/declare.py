@@ -4,9 +4,9 @@ Runs before any body is checked, so declarations may appear in any order and any
 """
 from __future__ import annotations
 
-from .. import ast as A
-from .. import types as T
-from ..builtins import default_string
+from ..frontend import ast as A
+from ..frontend import types as T
+from ..frontend.builtins import default_string
 from . import duplicates, undeclared
 from .consteval import const_int
 from .scope import GENERIC_TYPES, Ambiguous

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import math
 
-from .. import ast as A
-from .. import builtins as B
-from .. import types as T
+from ..frontend import ast as A
+from ..frontend import builtins as B
+from ..frontend import types as T
 from . import array_bounds, calls, undeclared
 from .scope import Ambiguous, is_generic
 from .symbols import EnumValueSymbol, PouSymbol, VarSymbol

@@ -17,8 +17,8 @@ Failing (portable)::
 """
 from __future__ import annotations
 
-from .. import ast as A
-from ..source import Span
+from ..frontend import ast as A
+from ..frontend.source import Span
 
 
 def exempt(path: str) -> bool:

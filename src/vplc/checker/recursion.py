@@ -15,7 +15,7 @@ Failing::
 """
 from __future__ import annotations
 
-from .. import types as T
+from ..frontend import types as T
 
 
 def check(ctx, edges: dict) -> None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .. import types as T
+from ..frontend import types as T
 from .symbols import EnumValueSymbol, VarSymbol
 
 GENERIC_TYPES: dict[str, T.SpecialType] = {}

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..types import EnumType, Param, PouType, Type
+from ..frontend.types import EnumType, Param, PouType, Type
 
 
 @dataclass(eq=False)
@@ -48,7 +48,7 @@ class PouSymbol:
 
 @dataclass(eq=False)
 class BuiltinSymbol:
-    """A standard function from vplc.builtins (``builtin`` is a builtins.Builtin)."""
+    """A standard function from vplc.frontend.builtins (``builtin`` is a builtins.Builtin)."""
     builtin: Any
 
 
@@ -70,7 +70,7 @@ class BoundArg:
 class CallBinding:
     """How a call was resolved.
 
-    kind: 'function' (user or prelude FUNCTION), 'fb' (FB instance call), 'builtin' (vplc.builtins
+    kind: 'function' (user or prelude FUNCTION), 'fb' (FB instance call), 'builtin' (vplc.frontend.builtins
     standard function), 'program' (a PROGRAM called from a program).
     ``args`` lists the supplied arguments in parameter-declaration order (for POU calls) or in call order
     (for builtins, where ``param`` is a synthetic Param named IN1..INn). Missing function inputs take the

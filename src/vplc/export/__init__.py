@@ -42,7 +42,7 @@ def _usage(msg: str) -> int:
 
 
 def run_export(args) -> int:
-    from ..diagnostics import ERROR, NOTE
+    from ..frontend.diagnostics import ERROR, NOTE
     from ..project import load_project
     from .iec61131_10 import render
     from .model import ExportError, collect

@@ -29,7 +29,7 @@ import time
 import xml.etree.ElementTree as ET
 
 from .. import __version__
-from .. import ast as A
+from ..frontend import ast as A
 from .model import ExportError, ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 
 IEC_NS = "www.iec.ch/public/TC65SC65BWG7TF10"

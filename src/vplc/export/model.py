@@ -10,8 +10,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from .. import ast as A
-from .. import printer
+from ..frontend import ast as A
+from ..frontend import printer
 from .order import dependency_order
 
 class ExportError(Exception):

@@ -20,7 +20,7 @@ from __future__ import annotations
 import os
 import shutil
 
-from .. import ast as A
+from ..frontend import ast as A
 from .. import __version__
 from .model import ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 

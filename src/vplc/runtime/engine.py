@@ -12,7 +12,7 @@ import time
 import traceback
 from dataclasses import dataclass, field
 
-from ..types import StructType
+from ..frontend.types import StructType
 from .faults import PlcFault, RuntimeFaultError, WatchdogError
 from .sockets import SocketManager
 
@@ -137,7 +137,7 @@ class Engine:
         self.scan_count += 1
 
     def make_fault(self, exc: BaseException) -> PlcFault:
-        from ..codegen import GEN_FILE
+        from ..compiler.codegen import GEN_FILE
         loc, inst = None, None
         for frame, lineno in traceback.walk_tb(exc.__traceback__):
             if frame.f_code.co_filename == GEN_FILE:

@@ -1,4 +1,4 @@
-"""IEC standard functions (vplc.builtins) for generated code: code templates and Python helpers.
+"""IEC standard functions (vplc.frontend.builtins) for generated code: code templates and Python helpers.
 
 ``gen_builtin(gen, binding)`` returns the Python expression for a builtin call; the helpers below are put
 in the namespace of the generated module (``NAMESPACE``).
@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import math
 
-from .. import builtins as B
-from .. import types as T
+from ..frontend import builtins as B
+from ..frontend import types as T
 from . import iec
 from .faults import RuntimeFaultError
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import struct
 
-from .. import types as T
+from ..frontend import types as T
 from .faults import RuntimeFaultError
 
 LOW_HIGH, HIGH_LOW = 0, 1

@@ -38,7 +38,7 @@ class Collector:
 
 
 def _where(rt):
-    from ..codegen import GEN_FILE
+    from ..compiler.codegen import GEN_FILE
     f = sys._getframe(2)
     while f is not None and f.f_code.co_filename != GEN_FILE:
         f = f.f_back

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import re
 
-from .. import types as T
+from ..frontend import types as T
 from . import iec
 
 

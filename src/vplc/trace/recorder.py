@@ -1,7 +1,7 @@
 """Record chosen variables after every scan (only changes are stored)."""
 from __future__ import annotations
 
-from .. import types as T
+from ..frontend import types as T
 
 
 class Recorder:

@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from vplc import cli
+from vplc.cli import main as cli
 from vplc.project import load_project
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]

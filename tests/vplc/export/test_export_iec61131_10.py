@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from vplc import ast as A
-from vplc import printer
-from vplc.diagnostics import DiagnosticBag
-from vplc.parser import parse
-from vplc.source import SourceFile
+from vplc.frontend import ast as A
+from vplc.frontend import printer
+from vplc.frontend.diagnostics import DiagnosticBag
+from vplc.frontend.parser import parse
+from vplc.frontend.source import SourceFile
 
 from conftest import LIB, NS, XSI_TYPE, local, q
 

@@ -1,7 +1,7 @@
 """Paste kit (fallback for CPU units without the IEC 61131-10 import): files, columns, order."""
 from __future__ import annotations
 
-from vplc import ast as A
+from vplc.frontend import ast as A
 
 from conftest import LIB, run
 

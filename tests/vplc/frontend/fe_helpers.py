@@ -7,10 +7,10 @@ import subprocess
 import sys
 import textwrap
 
-from vplc.diagnostics import DiagnosticBag
-from vplc.parser import parse
+from vplc.frontend.diagnostics import DiagnosticBag
+from vplc.frontend.parser import parse
 from vplc.project import load_project
-from vplc.source import SourceFile
+from vplc.frontend.source import SourceFile
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parents[2]

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import pytest
 
-from vplc import builtins as B
-from vplc import types as T
+from vplc.frontend import builtins as B
+from vplc.frontend import types as T
 from fe_helpers import check_text, codes, program
 
 DECLS = ("i : INT; d : DINT; u : UINT; r : REAL; lr : LREAL; w : WORD; b : BYTE; s : STRING[20]; "

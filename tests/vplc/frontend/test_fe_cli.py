@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import json
 
-from vplc import cli
+from vplc.cli import main as cli
 from fe_helpers import program, run_cli
 
 
@@ -58,14 +58,14 @@ def test_subcommand_registry_includes_check_and_optional_backend_modules(monkeyp
     import sys
     import types
 
-    fake = types.ModuleType("vplc.cli_run")
+    fake = types.ModuleType("vplc.cli.run")
 
     def register(sub):
         p = sub.add_parser("run")
         p.set_defaults(handler=lambda args: 0)
 
     fake.register = register
-    monkeypatch.setitem(sys.modules, "vplc.cli_run", fake)
+    monkeypatch.setitem(sys.modules, "vplc.cli.run", fake)
     parser = cli.build_parser()
     assert cli.main(["run"]) == 0
     assert "check" in parser.format_help()

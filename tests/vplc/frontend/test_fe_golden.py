@@ -9,11 +9,11 @@ import os
 
 import pytest
 
-from vplc import ast as A
-from vplc.diagnostics import DiagnosticBag
-from vplc.lexer import tokenize
+from vplc.frontend import ast as A
+from vplc.frontend.diagnostics import DiagnosticBag
+from vplc.frontend.lexer import tokenize
 from vplc.project import load_project
-from vplc.source import SourceFile
+from vplc.frontend.source import SourceFile
 from fe_helpers import HERE, ROOT
 
 UPDATE = os.environ.get("UPDATE_GOLDEN") == "1"

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import pytest
 
-from vplc.diagnostics import DiagnosticBag
-from vplc.lexer import decode_string, tokenize
-from vplc.source import SourceFile
+from vplc.frontend.diagnostics import DiagnosticBag
+from vplc.frontend.lexer import decode_string, tokenize
+from vplc.frontend.source import SourceFile
 
 
 def toks(text: str):

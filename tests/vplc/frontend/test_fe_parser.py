@@ -1,7 +1,7 @@
 """Parser: AST shapes for the grammar corners, precedence, recovery and depth limits."""
 from __future__ import annotations
 
-from vplc import ast as A
+from vplc.frontend import ast as A
 from fe_helpers import parse_text, program
 
 

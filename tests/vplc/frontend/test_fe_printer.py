@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from vplc.printer import print_unit
+from vplc.frontend.printer import print_unit
 from fe_helpers import HERE, ROOT, parse_text
 
 FILES = sorted(

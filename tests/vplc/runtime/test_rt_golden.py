@@ -5,7 +5,7 @@ Refresh only on purpose: VPLC_UPDATE_GOLDEN=1 pytest tests/vplc/runtime/test_rt_
 import os
 import re
 
-from vplc.codegen import CodeGen
+from vplc.compiler.codegen import CodeGen
 from vplc.project import load_project
 
 HERE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "golden")

@@ -1,7 +1,7 @@
 """Command line: ``python -m vplc <command> ...``.
 
 Subcommands live in a registry: this module registers ``check``; the back end's modules
-``vplc.cli_run`` and ``vplc.cli_test`` register ``run`` and ``test``, the package ``vplc.export`` registers
+``vplc.cli.run`` and ``vplc.cli.test`` register ``run`` and ``test``, the package ``vplc.export`` registers
 ``export``, each through its ``register(subparsers)`` function when it is importable. Exit codes: 0 success,
 1 errors found, 2 usage error.
 """
@@ -11,9 +11,9 @@ import argparse
 import importlib
 import sys
 
-from .diagnostics import ERROR, NOTE, WARNING, to_json
+from ..frontend.diagnostics import ERROR, NOTE, WARNING, to_json
 
-EXTENSION_MODULES = ("vplc.cli_run", "vplc.cli_test", "vplc.export")
+EXTENSION_MODULES = ("vplc.cli.run", "vplc.cli.test", "vplc.export")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -39,7 +39,7 @@ def register_check(subparsers) -> None:
 
 
 def run_check(args) -> int:
-    from .project import load_project
+    from ..project import load_project
     proj = load_project(args.paths, dialect=args.dialect, portable=args.portable)
     diags = [d for d in proj.diagnostics if not (args.no_notes and d.severity == NOTE)]
     errors = sum(1 for d in diags if d.severity == ERROR)

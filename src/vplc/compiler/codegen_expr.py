@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import keyword
 
-from . import ast as A
-from . import types as T
-from .runtime import iec
+from ..frontend import ast as A
+from ..frontend import types as T
+from ..runtime import iec
 
 _PY_RESERVED = set(keyword.kwlist) | {"None", "True", "False", "s", "G"}
 
@@ -353,7 +353,7 @@ class ExprGen:
     def call_expr(self, e) -> str:
         b = e.binding
         if b.kind == "builtin":
-            from .runtime.stdlib import gen_builtin
+            from ..runtime.stdlib import gen_builtin
             return gen_builtin(self, b)
         pt = b.pou
         by_param = {ba.param.name.upper(): ba for ba in b.args}

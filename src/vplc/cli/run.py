@@ -11,7 +11,7 @@ import sys
 import threading
 import time
 
-from .runtime.values import parse_duration
+from ..runtime.values import parse_duration
 
 
 def register(subparsers) -> None:
@@ -41,10 +41,10 @@ def _err(msg: str) -> int:
 
 
 def run_cmd(args) -> int:
-    from .api import LoadError, PlcFault, load_plc, parse_task
-    from .runtime.stats import ScanStats
-    from .runtime.values import PathError
-    from .trace import Recorder, write_trace
+    from ..api import LoadError, PlcFault, load_plc, parse_task
+    from ..runtime.stats import ScanStats
+    from ..runtime.values import PathError
+    from ..trace import Recorder, write_trace
     if bool(args.trace) != bool(args.trace_out):
         return _err("--trace and --trace-out go together")
     if args.trace_out and not args.trace_out.lower().endswith((".vcd", ".svg")):

@@ -1,4 +1,4 @@
-"""Parser: tokens → AST (vplc.ast) for one file, reporting syntax errors as diagnostics.
+"""Parser: tokens → AST (vplc.frontend.ast) for one file, reporting syntax errors as diagnostics.
 
 Entry point: :func:`parse`. The grammar is split by area: expressions in parser_exprs.py, statements in
 parser_stmts.py, declarations and top-level items here. Recursion is depth-guarded (ST0203).

@@ -1,12 +1,12 @@
 """AST of IEC 61131-3 Structured Text (with the Omron Sysmac dialect).
 
-Every node has a ``span`` (see :mod:`vplc.source`). Spans and checker annotations are excluded from
+Every node has a ``span`` (see :mod:`vplc.frontend.source`). Spans and checker annotations are excluded from
 equality, so two parses of equivalent text compare equal (used by the printer round-trip test).
 
 Checker annotations (set by :mod:`vplc.checker`, ``None`` before checking), documented in
 docs/toolchain/frontend_api.md:
 
-* every :class:`Expr` gets ``ty`` (its resolved :mod:`vplc.types` type) and ``conv`` (the type it is
+* every :class:`Expr` gets ``ty`` (its resolved :mod:`vplc.frontend.types` type) and ``conv`` (the type it is
   implicitly widened to by its context, or ``None``);
 * :class:`Name` gets ``sym`` (a :mod:`vplc.checker.symbols` symbol);
 * :class:`Call` gets ``binding`` (a :class:`vplc.checker.symbols.CallBinding`).
@@ -121,7 +121,7 @@ class StructTypeRef(TypeRef):
 class Expr(Node):
     _: KW_ONLY
     span: Span = _ann()
-    ty: Any = _ann()     # resolved type (vplc.types.Type), set by the checker
+    ty: Any = _ann()     # resolved type (vplc.frontend.types.Type), set by the checker
     conv: Any = _ann()   # implicit conversion target type, or None
 
 

@@ -26,7 +26,7 @@ from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import parse_qs, urlsplit
 
-HMI_DIR = pathlib.Path(__file__).resolve().parents[2] / "hmi"
+HMI_DIR = pathlib.Path(__file__).resolve().parents[3] / "hmi"
 DEFAULT_MAPPING = HMI_DIR / "mapping.json"
 MAX_BODY = 16 * 1024
 MAX_NAMES = 400

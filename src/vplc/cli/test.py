@@ -13,8 +13,8 @@ import tempfile
 import time
 from xml.sax.saxutils import escape, quoteattr
 
-from . import ast as A
-from .runtime.values import parse_duration
+from ..frontend import ast as A
+from ..runtime.values import parse_duration
 
 RUNNER = "VPLC_TestRunner"
 
@@ -60,8 +60,8 @@ def _inst(suite: str) -> str:
 
 
 def run_tests(args) -> int:
-    from .api import LoadError, PlcFault, load_plc
-    from .project import load_project
+    from ..api import LoadError, PlcFault, load_plc
+    from ..project import load_project
     timeout = parse_duration(args.timeout)
     if timeout is None:
         print(f"vplc test: error: --timeout {args.timeout!r} is not a duration like 10s or 500ms", file=sys.stderr)
@@ -122,7 +122,7 @@ def _inst_of(path: str | None):
 
 
 def _fault_failure(fault):
-    from .runtime.testing import Failure
+    from ..runtime.testing import Failure
     text = str(fault).split(": major fault in ", 1)[-1]
     return Failure(fault.file or "<unknown>", fault.line or 0, f"major fault in {text}")
 
@@ -157,7 +157,7 @@ def report(results, errors, args, elapsed: float) -> int:
 
 
 def _unfinished(tc):
-    from .runtime.testing import Failure
+    from ..runtime.testing import Failure
     return Failure("<runner>", 0, "test did not call TEST_FINISHED() before the timeout")
 
 

@@ -1,0 +1,1 @@
+"""Command line: ``python -m vplc`` (main: registry and ``check``; run; test)."""

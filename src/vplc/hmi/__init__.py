@@ -1,0 +1,1 @@
+"""HMI server: serves hmi/ and maps web fields to PLC variables."""
