@@ -105,7 +105,7 @@ def feed(rig, raw: bytes):
     """Puts raw bytes into the receive stream as if the socket had delivered them."""
     n = rig.read("Cobot.RxLen")
     for i, b in enumerate(raw):
-        rig.write(f"Cobot.RxBuf[{n + i}]", b)
+        rig.write(f"Cobot.RxBuf.Bytes[{n + i}]", b)
     rig.write("Cobot.RxLen", n + len(raw))
 
 
