@@ -85,8 +85,9 @@ def parse_length(field: bytes) -> int | None:
     return value if value >= 0 else None
 
 
-def decode(buf: bytes | bytearray) -> tuple[Frame | Garbage | BadFrame | None, int]:
-    """Decode the packet at the front of ``buf``.
+def decode(buf: bytes | bytearray, headers=HEADERS) -> tuple[Frame | Garbage | BadFrame | None, int]:
+    """Decode the packet at the front of ``buf``; ``headers`` are the ones this port serves (the Ethernet
+    Slave passes {"TMSVR"}, TMscript 2.24 §17.3); any other is a header error (CPERR 03).
 
     Resynchronisation: on a packet error only the leading '$' is consumed, so the rest of the
     bad packet is skipped as garbage up to the next '$'.
@@ -126,16 +127,16 @@ def decode(buf: bytes | bytearray) -> tuple[Frame | Garbage | BadFrame | None, i
     if received != checksum(raw[1:data_end + 1]):
         return BadFrame(CPERR_CHECKSUM, "checksum mismatch", raw), total
     header = raw[1:comma1].decode("ascii", "replace")
-    if header not in HEADERS:
+    if header not in headers:
         return BadFrame(CPERR_HEADER, f"unknown header {header!r}", raw), total
     return Frame(header, raw[comma2 + 1:data_end], raw), total
 
 
-def decode_all(buf: bytearray) -> list[Frame | Garbage | BadFrame]:
+def decode_all(buf: bytearray, headers=HEADERS) -> list[Frame | Garbage | BadFrame]:
     """Decode every complete item at the front of ``buf`` and remove it from the buffer."""
     items = []
     while buf:
-        item, used = decode(buf)
+        item, used = decode(buf, headers)
         if not used:
             break
         del buf[:used]

@@ -11,6 +11,7 @@ from collections import deque
 
 from . import kinematics as kin
 from .motion import MotionError, MotionRequest, Planner
+from .robot_errors import classify
 
 HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)
 FIFO_LIMIT = 1000       # queued items (motions, tags, settings) per robot; a script waits while it is full
@@ -39,6 +40,12 @@ class RobotModel:
         self.fault = None
         self.pvt_mode = None       # None outside PVTEnter .. PVTExit, else 0 (joint) / 1 (Cartesian)
         self.pvt_velocity = (0.0,) * 6   # end velocity of the last PVTPoint (start velocity of the next)
+        # status read over the Ethernet Slave (TMflow 2.24 software manual, Appendix D)
+        self.error_active = False        # Robot_Error: set by a robot error, cleared by Play or Stop
+        self.error_code, self.error_text, self.error_time = 0, "", None    # the last error, kept
+        self.estop = False               # ESTOP: pressed stops the project; Play is refused while pressed
+        self.auto_mode = True            # Operation_Mode: True auto, False manual
+        self.project_speed = 100         # Project_Speed in %: motions advance at this share of time
 
     # ---- queue --------------------------------------------------------------------------------
     def enqueue_motion(self, request: MotionRequest):
@@ -88,9 +95,15 @@ class RobotModel:
         self.pvt_mode, self.pvt_velocity = None, (0.0,) * 6       # a stop also ends PVT mode
         return dropped
 
+    def latch_error(self, text: str, now: float):
+        """A robot error (its project stops): shown in Robot_Error, Error_Code, Error_Content."""
+        self.error_active = True
+        self.error_code, self.error_text, self.error_time = classify(text)[0], text, now
+
     # ---- time ---------------------------------------------------------------------------------
     def tick(self, dt: float) -> list[dict]:
         events = []
+        dt *= self.project_speed / 100.0
         while not self.paused:
             if self.active is not None:
                 remaining = self.active.total - self.active_t

@@ -21,6 +21,7 @@ import time
 
 from . import codec
 from .control import ControlChannel
+from .ethernet_slave import EthernetSlave
 from .faults import KNOWN as KNOWN_FAULTS, FaultState
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
@@ -162,7 +163,7 @@ class SimServer:
     def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
                  send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
                  control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None,
-                 manage_gc=False):
+                 manage_gc=False, svr_port=None, svr_options=None):
         if not 1 <= robots <= 512:
             raise ValueError(f"robots must be 1..512, got {robots}")
         if speedup <= 0:
@@ -189,6 +190,8 @@ class SimServer:
         self.manage_gc = manage_gc            # the CLI: garbage collection between bursts, see _collect_garbage
         self.control = None
         self._control_port = control_port
+        self.svr = None                       # Ethernet Slave (sim/ethernet_slave.py) when svr_port is not None
+        self._svr = (svr_port, svr_options or {})
 
     @property
     def ports(self) -> list[int]:
@@ -202,6 +205,8 @@ class SimServer:
                     self._listen(robot)
                 if self._control_port is not None:
                     self.control = ControlChannel(self, self.host, self._control_port)
+                if self._svr[0] is not None:
+                    self.svr = EthernetSlave(self, self._svr[0], **self._svr[1])
             except OSError:
                 self.close()
                 raise
@@ -250,6 +255,9 @@ class SimServer:
             if self.control is not None:
                 self.control.close()
                 self.control = None
+            if self.svr is not None:
+                self.svr.close()
+                self.svr = None
             self.selector.close()
             if self.log_file is not None:
                 self.log_file.close()
@@ -299,6 +307,8 @@ class SimServer:
                 if any(client.outbox for client in session.clients.values()) and not robot.faults.active:
                     self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
                 self._breathe()
+            if self.svr is not None:
+                self.svr.poll(self._now)
             ready = self._serve(timeout)
             self._start_touched()
             for robot in self.robots:

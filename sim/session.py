@@ -113,6 +113,7 @@ class ListenSession:
 
     def _on_robot_fault(self, reason="", **_):
         self.last_error = reason
+        self.robot.latch_error(reason, self.now)
         self._on_stop_project()
 
     def _on_leave_node(self, path="Pass", **_):

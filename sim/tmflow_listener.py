@@ -5,6 +5,8 @@
                                   [--no-auto-enter] [--send-message Listen1]
                                   [--control-port 5889 | --no-control] [--tag-history 4]
                                   [--data-timeout S] [--connection-timeout S]
+                                  [--svr-port PORT | --no-svr] [--svr-period S]
+                                  [--svr-format binary|string|json] [--svr-items A,B,...]
 """
 from __future__ import annotations
 
@@ -19,6 +21,9 @@ if __package__ in (None, ""):
     sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from sim.server import SimServer  # noqa: E402
+from sim.svr_session import DEFAULT_STREAM, SvrConfigError  # noqa: E402
+
+SVR_FORMATS = {"binary": 1, "string": 2, "json": 3}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -47,6 +52,18 @@ def build_parser() -> argparse.ArgumentParser:
                         help="leave the node via Fail when no client connected within S seconds (0 = none)")
     parser.add_argument("--tag-history", type=int, default=4, metavar="N",
                         help="number of reached queue tags the robot remembers (default 4)")
+    svr = parser.add_argument_group("Ethernet Slave ($TMSVR, TMscript manual chapter 17)")
+    svr.add_argument("--svr-port", type=int, default=None, metavar="PORT",
+                     help="Ethernet Slave port of robot 1, further robots the next ports "
+                          "(default: the port after the last Listen node port, 5891 for one robot; 0 = any free port)")
+    svr.add_argument("--no-svr", action="store_true", help="do not open the Ethernet Slave")
+    svr.add_argument("--svr-period", type=float, default=0.1, metavar="S",
+                     help="period of the data table sent to every client (default 0.1 s, 0 = not sent)")
+    svr.add_argument("--svr-format", choices=sorted(SVR_FORMATS), default="binary",
+                     help="format of the periodic data table (default binary, as the Techman ROS driver reads it)")
+    svr.add_argument("--svr-items", metavar="A,B,...", default=",".join(DEFAULT_STREAM),
+                     help="items of the periodic data table, comma separated (default: the ROS driver's items "
+                          "plus the status items; see docs/simulator.md)")
     return parser
 
 
@@ -64,6 +81,13 @@ def main(argv=None) -> int:
         problems.append(f"--control-port must be 0..65535 (got {args.control_port})")
     if args.tag_history < 1:
         problems.append(f"--tag-history must be at least 1 (got {args.tag_history})")
+    svr_port = None if args.no_svr else args.port + args.robots if args.svr_port is None and args.port else \
+        (args.svr_port or 0)
+    if svr_port is not None and not (0 <= svr_port and (not svr_port or svr_port + args.robots - 1 <= 65535)):
+        problems.append(f"--svr-port {svr_port} with {args.robots} robot(s) leaves the port range 1..65535")
+    if not 0 <= args.svr_period <= 3600:
+        problems.append(f"--svr-period must be 0 (off) .. 3600 s (got {args.svr_period:g})")
+    svr_items = [name.strip() for name in args.svr_items.split(",") if name.strip()]
     if problems:
         for problem in problems:
             print(f"tmflow_listener: error: {problem}", file=sys.stderr)
@@ -75,14 +99,22 @@ def main(argv=None) -> int:
                            control_port=None if args.no_control else args.control_port,
                            data_timeout=args.data_timeout if args.data_timeout > 0 else None,
                            connection_timeout=args.connection_timeout if args.connection_timeout > 0 else None,
-                           manage_gc=True)
+                           manage_gc=True, svr_port=svr_port,
+                           svr_options=dict(period=args.svr_period, mode=SVR_FORMATS[args.svr_format],
+                                            items=svr_items))
         server.start()
+    except SvrConfigError as exc:
+        print(f"tmflow_listener: error: {exc}", file=sys.stderr)
+        return 2
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)
         return 1
     for robot in server.robots:
         node = "in Listen node" if robot.session.state == "in_node" else "project running, not in Listen node"
         print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node})", flush=True)
+        if server.svr is not None:
+            print(f"robot {robot.index + 1}: Ethernet Slave on {args.host}:{robot.svr_port} "
+                  f"(data table every {args.svr_period:g} s, {args.svr_format})", flush=True)
     if server.control is not None:
         print(f"control channel: {args.host}:{server.control.port} (JSON lines)", flush=True)
     if args.speedup != 1.0:

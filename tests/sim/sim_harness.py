@@ -9,7 +9,8 @@ from sim.server import SimServer
 class Peer:
     """A raw TCP client of one simulated robot; collects decoded frames."""
 
-    def __init__(self, port):
+    def __init__(self, port, headers=codec.HEADERS):
+        self.headers = headers          # the Ethernet Slave's peers decode {"TMSVR", "CPERR"}
         self.sock = socket.create_connection(("127.0.0.1", port), timeout=5)
         self.sock.setblocking(False)
         self.rbuf = bytearray()
@@ -38,7 +39,7 @@ class Peer:
                 return
             self.raw_reads.append(data)
             self.rbuf += data
-            self.frames.extend(item for item in codec.decode_all(self.rbuf) if isinstance(item, codec.Frame))
+            self.frames.extend(item for item in codec.decode_all(self.rbuf, self.headers) if isinstance(item, codec.Frame))
 
     def texts(self):
         return [(f.header, f.data.decode("utf-8", "replace")) for f in self.frames]
@@ -60,6 +61,13 @@ class Harness:
 
     def connect(self, robot=0):
         peer = Peer(self.srv.ports[robot])
+        self.peers.append(peer)
+        self.step()
+        return peer
+
+    def connect_svr(self, robot=0):
+        """A client of the robot's Ethernet Slave (the Harness needs svr_port=0)."""
+        peer = Peer(self.srv.robots[robot].svr_port, headers={"TMSVR", "CPERR"})
         self.peers.append(peer)
         self.step()
         return peer

@@ -1,0 +1,171 @@
+"""TCP adapter of the Ethernet Slave ($TMSVR): one listening port per robot, served by the SimServer's
+selector and clock (thin: bytes in and out; the protocol is ``sim.svr_session``).
+
+TMscript 2.24 chapter 17: the robot's Ethernet Slave listens on port 5891; the simulator gives robot i
+the port ``svr_port + i`` (the CLI's default ``svr_port`` is the first port after the Listen node ports,
+so one robot gets 5890 and 5891). The Ethernet Slave keeps serving while the project is stopped; it is
+a service of the controller, not of the project.
+
+Limits: a received frame's DATA <= codec.MAX_DATA (longer: CPERR 01); MAX_CLIENTS connections per robot;
+a client that leaves more than MAX_OUTBOX bytes unread is dropped.
+"""
+from __future__ import annotations
+
+import selectors
+import socket
+
+from . import codec
+from .svr_session import DEFAULT_STREAM, HEADERS, SvrSession
+from .svr_source import RobotDataSource
+
+MAX_CLIENTS = 64
+MAX_OUTBOX = 1 << 20
+RECV_SIZE = 65536
+
+
+class _Conn:
+    __slots__ = ("sock", "id", "rbuf", "wbuf", "robot")
+
+    def __init__(self, sock, conn_id, robot):
+        self.sock, self.id, self.robot = sock, conn_id, robot
+        self.rbuf = bytearray()
+        self.wbuf = bytearray()
+
+
+class EthernetSlave:
+    """Ethernet Slave of every robot of ``server``; ``port`` 0 = ephemeral ports."""
+
+    def __init__(self, server, port=0, period=0.1, mode=1, items=DEFAULT_STREAM):
+        self.server = server
+        self.listeners = []
+        self._next_conn = 1
+        server._dispatch["svr_listen"] = self._accept
+        server._dispatch["svr_conn"] = self._read
+        try:
+            for robot in server.robots:
+                robot.svr_source = RobotDataSource(robot, robot._log)
+                robot.svr = SvrSession(robot.svr_source, robot._log, items, mode, period)
+                robot.svr_conns = {}
+                self._listen(robot, port + robot.index if port else 0)
+        except OSError:
+            self.close()
+            raise
+
+    def _listen(self, robot, port):
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            sock.bind((self.server.host, port))
+        except OSError as exc:
+            sock.close()
+            raise OSError(exc.errno, f"cannot open the Ethernet Slave of robot {robot.index} on "
+                                     f"{self.server.host}:{port}: {exc.strerror}") from None
+        sock.listen(16)
+        sock.setblocking(False)
+        robot.svr_port = sock.getsockname()[1]
+        robot.svr_listener = sock
+        self.listeners.append(sock)
+        self.server.selector.register(sock, selectors.EVENT_READ, ("svr_listen", None, robot))
+        robot._log("svr_listening", host=self.server.host, port=robot.svr_port)
+
+    # ---- per poll -----------------------------------------------------------------------------
+    def poll(self, now):
+        """Stream the data tables that are due and send what is waiting (called by SimServer.poll)."""
+        for robot in self.server.robots:
+            robot.svr.advance(now)
+            self._flush(robot)
+
+    def _accept(self, _none, robot):
+        for _ in range(16):
+            try:
+                sock, addr = robot.svr_listener.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                robot._log("svr_accept_error", reason=exc.strerror)
+                return
+            if len(robot.svr_conns) >= MAX_CLIENTS:
+                robot._log("svr_rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")
+                sock.close()
+                continue
+            sock.setblocking(False)
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            conn = _Conn(sock, self._next_conn, robot)
+            self._next_conn += 1
+            robot.svr_conns[conn.id] = conn
+            robot.svr.connect(conn.id, addr[0])
+            self.server.selector.register(sock, selectors.EVENT_READ, ("svr_conn", None, conn))
+
+    def _read(self, _none, conn):
+        robot = conn.robot
+        if conn.id not in robot.svr_conns:
+            return
+        try:
+            data = conn.sock.recv(RECV_SIZE)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:
+            self._drop(robot, conn, f"receive failed: {exc.strerror}")
+            return
+        if not data:
+            self._drop(robot, conn, "peer closed")
+            return
+        conn.rbuf += data
+        try:
+            for item in codec.decode_all(conn.rbuf, HEADERS):
+                robot.svr.handle(conn.id, item)
+        except Exception as exc:          # noqa: BLE001 - safety net: one bad client never stops the others
+            robot._log("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
+            self._drop(robot, conn, "internal error while handling this Ethernet Slave client")
+            return
+        self._flush(robot)
+
+    def _flush(self, robot):
+        for conn_id, client in list(robot.svr.clients.items()):
+            conn = robot.svr_conns.get(conn_id)
+            if conn is None or (not client.outbox and not conn.wbuf):
+                continue
+            frames, client.outbox = client.outbox, []
+            try:
+                for frame in frames:
+                    if conn.wbuf:
+                        conn.wbuf += frame
+                    else:
+                        conn.wbuf += frame[_send(conn.sock, frame):]
+                if conn.wbuf:
+                    del conn.wbuf[:_send(conn.sock, conn.wbuf)]
+            except OSError as exc:
+                self._drop(robot, conn, f"send failed: {exc.strerror}")
+                continue
+            if len(conn.wbuf) > MAX_OUTBOX:
+                self._drop(robot, conn, f"client does not read (more than {MAX_OUTBOX} bytes waiting)")
+
+    def _drop(self, robot, conn, reason):
+        if robot.svr_conns.pop(conn.id, None) is None:
+            return
+        try:
+            self.server.selector.unregister(conn.sock)
+        except (KeyError, ValueError):
+            pass
+        conn.sock.close()
+        robot.svr.disconnect(conn.id)
+        robot._log("svr_closed", conn=conn.id, reason=reason)
+
+    def close(self):
+        for robot in self.server.robots:
+            for conn in list(getattr(robot, "svr_conns", {}).values()):
+                self._drop(robot, conn, "simulator closed")
+        for sock in self.listeners:
+            try:
+                self.server.selector.unregister(sock)
+            except (KeyError, ValueError):
+                pass
+            sock.close()
+        self.listeners = []
+
+
+def _send(sock, data) -> int:
+    try:
+        return sock.send(data)
+    except (BlockingIOError, InterruptedError):
+        return 0

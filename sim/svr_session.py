@@ -1,0 +1,225 @@
+"""Ethernet Slave session of one robot ($TMSVR): a sans-I/O state machine (frames and time in, frames out).
+
+TMscript 2.24 chapter 17. Data of a $TMSVR packet is ``TransactionID , Mode , Content`` (§17.4):
+
+    mode 1 / 2 / 3     client writes items (binary / string / JSON); the server answers in mode 0
+    mode 11 / 12 / 13  client reads items; the server answers in the same mode, or in mode 0 on failure
+    mode 0             server status ``ID,0,EE,Text`` with EE 00..07 (§17.4.1)
+
+The server also sends the configured data table to every client periodically, transaction IDs 0..9 in turn
+(§17.4 "ID Transaction Number"). A write is checked in the manual's order (§17.4 "Writing or Reading
+Confirmation": mode, write permission, content vs mode, item exists, not read only, M/A mode, value type)
+and performed only when every item passes.
+
+``source`` gives the values and performs writes (``sim.svr_source.RobotDataSource``): ``values(names)``
+-> {name: value}, ``write({name: value})``, ``auto_mode``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from . import codec
+from . import svr_table as table
+from .svr_table import ITEMS, SvrContentError, SvrValueError
+
+HEADERS = frozenset({"TMSVR"})
+
+# §17.4.1 status codes and their texts
+OK, NOT_SUPPORT, WRITE_PERMISSION, INVALID_DATA, NOT_EXIST, READ_ONLY, MODE_ERROR, VALUE_ERROR = range(8)
+STATUS_TEXT = ("OK", "NotSupport", "WritePermission", "InvalidData", "NotExist", "ReadOnly", "ModeError",
+               "ValueError")
+
+WRITE_MODES = {1: "binary", 2: "string", 3: "json"}
+READ_MODES = {11: "binary", 12: "string", 13: "json"}
+
+# The data table streamed by default: every item the official Techman ROS driver requires
+# (tmr_ros2 tm_robot_state.cpp, TmDataTable), then the status items the PLC library reads.
+DEFAULT_STREAM = (
+    "Robot_Link", "Robot_Error", "Project_Run", "Project_Pause", "Safeguard_A", "ESTOP", "Camera_Light",
+    "Error_Code", "Joint_Angle", "Coord_Robot_Flange", "Coord_Robot_Tool", "TCP_Force", "TCP_Force3D",
+    "TCP_Speed", "TCP_Speed3D", "Joint_Speed", "Joint_Torque", "Project_Speed", "MA_Mode", "Robot_Light",
+    *(f"Ctrl_DO{i}" for i in range(8)), *(f"Ctrl_DI{i}" for i in range(8)), "Ctrl_AO0", "Ctrl_AI0",
+    *(f"End_DO{i}" for i in range(4)), *(f"End_DI{i}" for i in range(3)), "End_AI0",
+    "Coord_Base_Tool", "Operation_Mode", "Robot_State", "Error_Content",
+)
+
+
+class SvrConfigError(ValueError):
+    """A stream configuration the simulator cannot serve (unknown item, mode, period)."""
+
+
+@dataclass
+class Client:
+    peer: str
+    outbox: list = field(default_factory=list)
+
+
+class SvrSession:
+    def __init__(self, source, log=None, stream_items=DEFAULT_STREAM, stream_mode=1, period=0.1,
+                 write_permission=True):
+        self.source = source
+        self.log = log or (lambda kind, **fields: None)
+        self.clients: dict[int, Client] = {}
+        self.now = 0.0
+        self.write_permission = write_permission   # §17.1 IP filter "Write Permission" of the clients
+        self.configure(stream_items, stream_mode, period)
+        self.next_stream = 0.0
+        self.stream_id = 0
+        self.streams_sent = 0
+
+    def configure(self, items=None, mode=None, period=None):
+        """Set the streamed data table (TransmitFile, §17.2): items in order, mode 1/2/3, period in s (0 = off)."""
+        items = list(self.stream_items if items is None else items)
+        mode = self.stream_mode if mode is None else mode
+        period = self.period if period is None else period
+        unknown = [name for name in items if name not in ITEMS]
+        if unknown:
+            raise SvrConfigError(f"unknown data table item(s): {', '.join(unknown)}")
+        if mode not in WRITE_MODES:
+            raise SvrConfigError(f"stream mode must be 1 (binary), 2 (string) or 3 (JSON), got {mode}")
+        if not 0 <= period <= 3600:
+            raise SvrConfigError(f"stream period must be 0 (off) .. 3600 s, got {period:g}")
+        if "Robot_Link" in items:                       # §17.2: always there, first
+            items.remove("Robot_Link")
+        self.stream_items = ["Robot_Link", *dict.fromkeys(items)]
+        self.stream_mode, self.period = mode, period
+
+    # ---- connections --------------------------------------------------------------------------
+    def connect(self, conn: int, peer="127.0.0.1"):
+        self.clients[conn] = Client(peer)
+        self.log("svr_connect", conn=conn, peer=peer)
+
+    def disconnect(self, conn: int):
+        if self.clients.pop(conn, None) is not None:
+            self.log("svr_disconnect", conn=conn)
+
+    def _send(self, conn, data):
+        client = self.clients.get(conn)
+        if client is not None:
+            client.outbox.append(codec.encode("TMSVR", data))
+
+    def _status(self, conn, ident, code, item=None):
+        text = STATUS_TEXT[code] + (f";{item}" if item is not None else "")
+        self._send(conn, f"{ident},0,{code:02d},{text}")
+        if code != OK:
+            self.log("svr_status", conn=conn, id=ident, code=f"{code:02d}", text=text)
+
+    # ---- time ---------------------------------------------------------------------------------
+    def advance(self, now: float):
+        """Send the data table to every client when a period is due (one frame, however late we are)."""
+        self.now = max(self.now, now)
+        if not self.period or not self.clients or self.now < self.next_stream:
+            return
+        self.next_stream = max(self.next_stream + self.period, self.now)
+        if self.next_stream <= self.now:
+            self.next_stream = self.now + self.period
+        frame = codec.encode("TMSVR", f"{self.stream_id},{self.stream_mode},".encode()
+                             + self._content(self.stream_mode, self.stream_items))
+        self.stream_id = (self.stream_id + 1) % 10
+        self.streams_sent += 1
+        for client in self.clients.values():
+            client.outbox.append(frame)
+
+    def _content(self, mode, names) -> bytes:
+        values = self.source.values(names)
+        pairs = [(ITEMS[name], values[name]) for name in names]
+        kind = WRITE_MODES.get(mode) or READ_MODES[mode]
+        if kind == "binary":
+            return table.encode_binary(pairs)
+        if kind == "string":
+            return table.encode_string(pairs).encode("utf-8")
+        return table.encode_json(pairs).encode("utf-8")
+
+    # ---- input --------------------------------------------------------------------------------
+    def handle(self, conn: int, item):
+        """One decoded item (codec.Frame / BadFrame / Garbage, decoded with HEADERS) from ``conn``."""
+        if isinstance(item, codec.Garbage):
+            self.log("svr_garbage", conn=conn, bytes=len(item.raw))
+        elif isinstance(item, codec.BadFrame):
+            self.log("svr_bad_frame", conn=conn, code=item.code, reason=item.reason)
+            self._send_cperr(conn, item.code)
+        else:
+            self._tmsvr(conn, item.data)
+
+    def _send_cperr(self, conn, code):
+        client = self.clients.get(conn)
+        if client is not None:
+            client.outbox.append(codec.encode("CPERR", code))
+
+    def _tmsvr(self, conn, data: bytes):
+        ident, comma1, rest = data.partition(b",")
+        mode_field, comma2, content = rest.partition(b",")
+        if not comma1 or not ident.isalnum() or not ident.isascii():
+            self.log("svr_bad_frame", conn=conn, code=codec.CPERR_DATA, reason="transaction ID is not alphanumeric")
+            self._send_cperr(conn, codec.CPERR_DATA)          # §17.4 "ID": CPERR 04 for a non-alphanumeric byte
+            return
+        ident = ident.decode("ascii")
+        mode = int(mode_field) if mode_field.isdigit() and len(mode_field) <= 3 else None
+        if not comma2 or (mode not in WRITE_MODES and mode not in READ_MODES):
+            self._status(conn, ident, NOT_SUPPORT)
+            return
+        if mode in WRITE_MODES:
+            self._write(conn, ident, mode, content)
+        else:
+            self._read(conn, ident, mode, content)
+
+    def _pairs(self, kind, content, with_values):
+        if kind == "binary":
+            return table.split_binary(content, with_values)
+        try:
+            text = content.decode("utf-8")
+        except UnicodeDecodeError:
+            raise SvrContentError("the content is not UTF-8 text") from None
+        return (table.split_string if kind == "string" else table.split_json)(text, with_values)
+
+    def _read(self, conn, ident, mode, content):
+        try:
+            names = [name for name, _ in self._pairs(READ_MODES[mode], content, False)]
+        except SvrContentError as exc:
+            self.log("svr_invalid", conn=conn, id=ident, reason=str(exc))
+            self._status(conn, ident, INVALID_DATA)
+            return
+        for name in names:
+            if name not in ITEMS:
+                self._status(conn, ident, NOT_EXIST, name)
+                return
+        self.log("svr_read", conn=conn, id=ident, mode=mode, items=names)
+        self._send(conn, f"{ident},{mode},".encode() + self._content(mode, names))
+
+    def _write(self, conn, ident, mode, content):
+        if not self.write_permission:
+            self._status(conn, ident, WRITE_PERMISSION)
+            return
+        kind = WRITE_MODES[mode]
+        try:
+            pairs = self._pairs(kind, content, True)
+        except SvrContentError as exc:
+            self.log("svr_invalid", conn=conn, id=ident, reason=str(exc))
+            self._status(conn, ident, INVALID_DATA)
+            return
+        checks = ((NOT_EXIST, lambda item: item is None),
+                  (READ_ONLY, lambda item: not item.writable),
+                  (MODE_ERROR, lambda item: item.writable == "A" and not self.source.auto_mode))
+        for code, failed in checks:
+            for name, _ in pairs:
+                if failed(ITEMS.get(name)):
+                    self._status(conn, ident, code, name)
+                    return
+        values = {}
+        for name, raw in pairs:
+            item = ITEMS[name]
+            try:
+                if kind == "binary":
+                    value = table.decode_binary_value(item, raw)
+                elif kind == "string":
+                    value = table.parse_string_value(item, raw)
+                else:
+                    value = raw
+                values[name] = table.check_value(item, value)
+            except SvrValueError as exc:
+                self.log("svr_invalid", conn=conn, id=ident, reason=str(exc))
+                self._status(conn, ident, VALUE_ERROR, name)
+                return
+        self.log("svr_write", conn=conn, id=ident, mode=mode, items=values)
+        self._status(conn, ident, OK)
+        self.source.write(values)

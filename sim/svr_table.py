@@ -1,0 +1,312 @@
+"""Ethernet Slave data table: the items, their types and permissions, and their three encodings (pure).
+
+Item names, types, sizes, read/write access and writable mode follow the TMflow 2.24 software manual,
+Appendix D "Ethernet Slave Data Table"; ``Robot_Link`` is the predefined item of TMscript 2.24 §17.2.
+Three items come from older TMflow tables that the official Techman ROS driver (TechmanRobotInc/tmr_ros2,
+``tm_robot_state.cpp``) still asks for: ``Safeguard_A``, ``MA_Mode`` and ``Error_Content``.
+
+Encodings (TMscript 2.24 §17.4.2-17.4.4):
+
+* binary (mode 1/11): per item ``len(name) u16 LE | name UTF-8 | len(value) u16 LE | value``; bool and byte
+  one byte, int int32 LE, float float32 LE, string UTF-8 (string arrays joined by 00 00).
+* string (mode 2/12): ``Item=Value`` lines joined by CR LF; arrays ``{a,b,c}``, strings in double quotes.
+  The manual shows no bool value in this mode; the simulator writes ``true``/``false`` (TMscript's bool
+  text, and what techmanpy's parser expects) and accepts 1/0/true/false.
+* JSON (mode 3/13): ``[{"Item": name, "Value": value}, ...]``.
+
+Values that do not fit the item raise ``SvrValueError`` (status 07); malformed content raises
+``SvrContentError`` (status 03).
+"""
+from __future__ import annotations
+
+import json
+import math
+import struct
+from dataclasses import dataclass
+
+MAX_STRING = 256          # bytes in a written string value; longer is status 07 (our limit, the manual gives none)
+
+_WIDTH = {"bool": 1, "byte": 1, "int": 4, "float": 4}
+_PACK = {"bool": "B", "byte": "B", "int": "i", "float": "f"}
+
+
+class SvrContentError(ValueError):
+    """The content does not match its mode (status 03 InvalidData)."""
+
+
+class SvrValueError(ValueError):
+    """A value does not match the item's type or size (status 07 ValueError)."""
+
+
+@dataclass(frozen=True)
+class Item:
+    name: str
+    type: str              # bool | byte | int | float | string
+    size: int = 1          # elements; > 1 is an array
+    writable: str = ""     # "" read only, "MA" writable in manual and auto mode, "A" in auto mode only
+    low: float | None = None       # value range of a writable number (None: the type's range)
+    high: float | None = None
+    step: int | None = None        # written values must be multiples of this (Project_Speed)
+
+
+def _items():
+    f6 = dict(type="float", size=6)
+    table = [
+        Item("Robot_Link", "byte"),                                   # §17.2: always sent, read only
+        # Appendix D, system items
+        Item("Get_UI_Control", "bool"), Item("Robot_Error", "bool"), Item("Error_Code", "int"),
+        Item("Error_Time", "string"), Item("Warning_Code", "int"), Item("Warning_Time", "string"),
+        Item("Camera_Light", "byte", writable="MA", low=0, high=1),
+        Item("Project_Speed", "byte", writable="MA", low=5, high=100, step=5),   # "multiples of five, 5..100"
+        Item("Project_Name", "string", writable="A"), Item("Project_Run_Time", "string"),
+        Item("Project_Run", "bool"), Item("Project_Edit", "bool"), Item("Project_Pause", "bool"),
+        Item("Coord_Base_Flange", **f6), Item("Joint_Angle", **f6), Item("Coord_Base_Tool", **f6),
+        Item("Coord_Robot_Flange", **f6), Item("Coord_Robot_Tool", **f6),
+        Item("TCP_Force", "float", 3), Item("TCP_Force3D", "float"), Item("TCP_Speed", **f6),
+        Item("TCP_Speed3D", "float"), Item("Joint_Speed", **f6), Item("Joint_Torque", **f6),
+        Item("TCP_Name", "string"), Item("TCP_Value", **f6), Item("TCP_Mass", "float"),
+        Item("Base_Name", "string"), Item("Base_Value", **f6),
+        Item("Stick_MA", "bool"),
+        *(Item(f"Stick_{b}", "bool", writable="MA", low=0, high=1)      # "W: Triggered as 1 received"
+          for b in ("Play", "Stop", "Plus", "Minus", "Pause", "PlayPause")),
+        Item("Stick_ESTOP", "bool"), Item("Robot_Model", "string"), Item("ControlBox_SN", "string"),
+        Item("TMflow_Version", "string"), Item("Robot_Light", "byte"), Item("ESTOP", "bool"),
+        Item("Ext_Safeguard", "bool"), Item("Robot_State", "byte"), Item("Operation_Mode", "int"),
+        # Appendix D, IO items (Ctrl_/End_ DO, DI, AO, AI); AO/AI carry volts as float
+        *(Item(f"Ctrl_DO{i}", "byte", writable="MA", low=0, high=1) for i in range(16)),
+        *(Item(f"Ctrl_DI{i}", "byte") for i in range(16)),
+        *(Item(f"Ctrl_AO{i}", "float", writable="MA", low=-10, high=10) for i in range(2)),
+        *(Item(f"Ctrl_AI{i}", "float") for i in range(2)),
+        *(Item(f"End_DO{i}", "byte", writable="MA", low=0, high=1) for i in range(4)),
+        *(Item(f"End_DI{i}", "byte") for i in range(4)),
+        *(Item(f"End_AO{i}", "float", writable="MA", low=-10, high=10) for i in range(2)),
+        *(Item(f"End_AI{i}", "float") for i in range(2)),
+        # older tables, read by tmr_ros2
+        Item("Safeguard_A", "bool"), Item("MA_Mode", "int"), Item("Error_Content", "string"),
+    ]
+    return {item.name: item for item in table}
+
+
+ITEMS: dict[str, Item] = _items()
+
+
+# ---- checking a value against its item ------------------------------------------------------------
+def check_value(item: Item, value):
+    """The value coerced to the item's type (lists for arrays); raises SvrValueError when it does not fit."""
+    if item.size > 1:
+        if not isinstance(value, (list, tuple)) or len(value) != item.size:
+            raise SvrValueError(f"{item.name} needs {item.size} values")
+        return [_scalar(item, v) for v in value]
+    if isinstance(value, (list, tuple)):
+        raise SvrValueError(f"{item.name} takes one value, not an array")
+    return _scalar(item, value)
+
+
+def _scalar(item, value):
+    kind = item.type
+    if kind == "string":
+        if not isinstance(value, str) or len(value.encode("utf-8")) > MAX_STRING:
+            raise SvrValueError(f"{item.name} needs a text of at most {MAX_STRING} bytes")
+        return value
+    if isinstance(value, bool):
+        value = int(value)
+    if kind == "float":
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or abs(value) > 3.4e38:
+            raise SvrValueError(f"{item.name} needs a finite number")
+        value = float(value)
+    else:
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if not isinstance(value, int):
+            raise SvrValueError(f"{item.name} needs a whole number")
+        low, high = {"bool": (0, 1), "byte": (0, 255), "int": (-2 ** 31, 2 ** 31 - 1)}[kind]
+        if not low <= value <= high:
+            raise SvrValueError(f"{item.name} value {value} is outside {low}..{high}")
+    if item.low is not None and not item.low <= value <= item.high:
+        raise SvrValueError(f"{item.name} value {value:g} is outside {item.low:g}..{item.high:g}")
+    if item.step and value % item.step:
+        raise SvrValueError(f"{item.name} value {value:g} is not a multiple of {item.step}")
+    return value
+
+
+# ---- binary (mode 1 / 11) --------------------------------------------------------------------------
+def binary_value(item: Item, value) -> bytes:
+    if item.type == "string":
+        return value.encode("utf-8")
+    values = value if item.size > 1 else [value]
+    fmt = "<%d%s" % (len(values), _PACK[item.type])
+    if item.type == "float":
+        return struct.pack(fmt, *(float(v) for v in values))
+    return struct.pack(fmt, *(int(v) for v in values))
+
+
+def encode_binary(pairs) -> bytes:
+    """``pairs``: (Item, value) in table order -> mode 1 content."""
+    out = bytearray()
+    for item, value in pairs:
+        name, data = item.name.encode("utf-8"), binary_value(item, value)
+        out += struct.pack("<H", len(name)) + name + struct.pack("<H", len(data)) + data
+    return bytes(out)
+
+
+def split_binary(content: bytes, with_values: bool) -> list[tuple[str, bytes | None]]:
+    """Mode 1 content -> [(name, value bytes)]; mode 11 (``with_values`` False) -> [(name, None)]."""
+    out, pos = [], 0
+    while pos < len(content):
+        name, pos = _chunk(content, pos)
+        try:
+            text = name.decode("utf-8")
+        except UnicodeDecodeError:
+            raise SvrContentError("an item name is not UTF-8") from None
+        value = None
+        if with_values:
+            value, pos = _chunk(content, pos)
+        out.append((text, value))
+    if not out:
+        raise SvrContentError("no item in the content")
+    return out
+
+
+def _chunk(content, pos):
+    if pos + 2 > len(content):
+        raise SvrContentError("a length field is cut off")
+    (length,) = struct.unpack_from("<H", content, pos)
+    end = pos + 2 + length
+    if end > len(content):
+        raise SvrContentError("a length field points past the end of the content")
+    return content[pos + 2:end], end
+
+
+def decode_binary_value(item: Item, data: bytes):
+    if item.type == "string":
+        try:
+            return data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise SvrValueError(f"{item.name} is not UTF-8 text") from None
+    width = _WIDTH[item.type]
+    if len(data) != width * item.size:
+        raise SvrValueError(f"{item.name} needs {width * item.size} bytes, got {len(data)}")
+    values = list(struct.unpack("<%d%s" % (item.size, _PACK[item.type]), data))
+    if item.type == "float":
+        values = [float(v) for v in values]
+    return values if item.size > 1 else values[0]
+
+
+# ---- string (mode 2 / 12) --------------------------------------------------------------------------
+def string_value(item: Item, value) -> str:
+    if item.size > 1:
+        return "{" + ",".join(_string_scalar(item, v) for v in value) + "}"
+    return _string_scalar(item, value)
+
+
+def _string_scalar(item, value):
+    if item.type == "string":
+        return '"' + value.replace('"', "'") + '"'
+    if item.type == "bool":
+        return "true" if value else "false"
+    if item.type == "float":
+        return _float_text(value)
+    return str(int(value))
+
+
+def _float_text(value) -> str:
+    """The float32 value with the digits it carries (7 significant), no exponent for usual values."""
+    (single,) = struct.unpack("<f", struct.pack("<f", float(value)))
+    text = "%.7g" % single
+    return "0" if text in ("-0", "0") else text
+
+
+def encode_string(pairs) -> str:
+    return "\r\n".join(f"{item.name}={string_value(item, value)}" for item, value in pairs)
+
+
+def split_string(content: str, with_values: bool) -> list[tuple[str, str | None]]:
+    """Mode 2 content -> [(name, value text)]; mode 12 -> [(name, None)]."""
+    out = []
+    for line in content.split("\r\n"):
+        if with_values:
+            name, eq, value = line.partition("=")
+            if not eq or not name.strip():
+                raise SvrContentError(f"line {line[:40]!r} is not Item=Value")
+            out.append((name.strip(), value.strip()))
+        else:
+            if not line.strip() or "=" in line:
+                raise SvrContentError(f"line {line[:40]!r} is not an item name")
+            out.append((line.strip(), None))
+    return out
+
+
+def parse_string_value(item: Item, text: str):
+    """``Value`` text of mode 2 -> Python value (not yet range-checked); SvrValueError when unreadable."""
+    if item.size > 1:
+        if not (text.startswith("{") and text.endswith("}")):
+            raise SvrValueError(f"{item.name} needs {{...}} with {item.size} values")
+        inner = text[1:-1].strip()
+        return [_parse_scalar(item, part.strip()) for part in _split_elements(inner)] if inner else []
+    return _parse_scalar(item, text)
+
+
+def _split_elements(inner):
+    parts, current, quoted = [], [], False
+    for ch in inner:
+        if ch == '"':
+            quoted = not quoted
+        if ch == "," and not quoted:
+            parts.append("".join(current))
+            current = []
+        else:
+            current.append(ch)
+    parts.append("".join(current))
+    return parts
+
+
+def _parse_scalar(item, text):
+    if item.type == "string":
+        if len(text) < 2 or text[0] != '"' or text[-1] != '"':
+            raise SvrValueError(f"{item.name} needs a text in double quotes")
+        return text[1:-1]
+    lowered = text.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        if item.type == "float":
+            return float(text)
+        if lowered.startswith("0x"):
+            return int(text, 16)
+        return int(text)
+    except ValueError:
+        raise SvrValueError(f"{item.name} value {text[:40]!r} is not a {item.type}") from None
+
+
+# ---- JSON (mode 3 / 13) ----------------------------------------------------------------------------
+def json_value(item: Item, value):
+    if item.type == "bool":
+        return [bool(v) for v in value] if item.size > 1 else bool(value)
+    if item.type == "float":
+        return [float(_float_text(v)) for v in value] if item.size > 1 else float(_float_text(value))
+    return value
+
+
+def encode_json(pairs) -> str:
+    return json.dumps([{"Item": item.name, "Value": json_value(item, value)} for item, value in pairs],
+                      separators=(",", ":"), ensure_ascii=False)
+
+
+def split_json(content: str, with_values: bool) -> list[tuple[str, object]]:
+    """Mode 3 content -> [(name, value)]; mode 13 -> [(name, None)] (a single object is one item)."""
+    try:
+        data = json.loads(content)
+    except ValueError:
+        raise SvrContentError("the content is not JSON") from None
+    if isinstance(data, dict):
+        data = [data]
+    if not isinstance(data, list) or not data:
+        raise SvrContentError("the content is not a JSON array of items")
+    out = []
+    for entry in data:
+        if not isinstance(entry, dict) or not isinstance(entry.get("Item"), str):
+            raise SvrContentError('each entry needs an "Item" name')
+        if with_values and "Value" not in entry:
+            raise SvrContentError(f'item {entry["Item"]!r} has no "Value"')
+        out.append((entry["Item"], entry.get("Value") if with_values else None))
+    return out
