@@ -67,6 +67,8 @@ class Demo:
 
     def start(self) -> None:
         check_port_free(self.host, self.robot_port, "robot simulator", "--robot-port")
+        if self.robot_port < 65535:
+            check_port_free(self.host, self.robot_port + 1, "robot Ethernet Slave", "--robot-port")
         check_port_free(self.host, self.hmi_port, "web HMI", "--hmi-port")
         try:
             mapping = Mapping.load()
@@ -87,7 +89,8 @@ class Demo:
         with self.plc.lock:
             self.plc.write("Connect_AddressIP", self.host)
             self.plc.write("Connect_Dest_PortIP", self.robot_port)
-        self.sim = SimServer(host=self.host, port=self.robot_port, robots=1)
+        self.sim = SimServer(host=self.host, port=self.robot_port, robots=1,
+                             svr_port=self.robot_port + 1 if self.robot_port < 65535 else 0)
         try:
             self.sim.start_background()
         except OSError as exc:
@@ -112,7 +115,8 @@ class Demo:
         period_ms = self.plc.period_ns / 1e6
         return "\n".join([
             "CBT_Commands_Lib demo is running:",
-            f"  robot simulator   TM Listen Node, 1 robot on {self.host}:{self.robot_port}",
+            f"  robot simulator   TM Listen Node, 1 robot on {self.host}:{self.robot_port}, "
+            f"Ethernet Slave on {self.host}:{self.sim.robots[0].svr_port}",
             f"  virtual PLC       PnP_Example + Commands_Example in a {period_ms:g} ms task (real time)",
             f"  web HMI           {self.hmi.url}",
             "",

@@ -10,6 +10,9 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "enter_listen_node" | "leave_listen_node" | "stop_project" | "start_project", "robot": 0}
     {"cmd": "inject", "robot": 0, "fault": "reply_delay", "params": {"seconds": 0.5}}
     {"cmd": "clear_faults", "robot": 0}
+    {"cmd": "estop", "robot": 0, "pressed": true}             Ethernet Slave: the operator at the robot
+    {"cmd": "operation_mode", "robot": 0, "mode": "manual"}
+    {"cmd": "svr_config", "robot": 0, "period": 0.1, "mode": 1, "items": [...], "write_permission": true}
 """
 from __future__ import annotations
 
@@ -42,8 +45,8 @@ class ControlChannel:
         server.selector.register(sock, selectors.EVENT_READ, ("control_listen", None, None))
         self._commands = {
             "ping": lambda robot, req: "pong",
-            "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.state}
-                                          for r in server.robots],
+            "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.state,
+                                           "svr_port": getattr(r, "svr_port", None)} for r in server.robots],
             "state": lambda robot, req: robot.state(),
             "events": self._events,
             "enter_listen_node": lambda robot, req: robot.enter_listen_node(),
@@ -52,6 +55,9 @@ class ControlChannel:
             "start_project": lambda robot, req: robot.start_project(),
             "inject": lambda robot, req: robot.inject(str(req.get("fault", "")), **dict(req.get("params") or {})),
             "clear_faults": lambda robot, req: robot.clear_faults(),
+            "estop": lambda robot, req: _svr(robot).set_estop(bool(req.get("pressed", True))),
+            "operation_mode": lambda robot, req: _svr(robot).set_auto_mode(_mode(req.get("mode"))),
+            "svr_config": self._svr_config,
         }
 
     def _accept(self, _robot, _conn):
@@ -104,6 +110,15 @@ class ControlChannel:
         except (ValueError, TypeError, TransitionError) as exc:
             return {"ok": False, "error": str(exc)}
 
+    def _svr_config(self, robot, request):
+        _svr(robot)
+        with self.server.lock:
+            robot.svr.configure(request.get("items"), request.get("mode"), request.get("period"))
+            if "write_permission" in request:
+                robot.svr.write_permission = bool(request["write_permission"])
+        return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
+                "write_permission": robot.svr.write_permission}
+
     def _events(self, robot, request):
         since = max(0, int(request.get("since", 0)))
         events = robot.events[since:]
@@ -125,6 +140,19 @@ class ControlChannel:
         except (KeyError, ValueError):
             pass
         self.sock.close()
+
+
+def _svr(robot):
+    source = getattr(robot, "svr_source", None)
+    if source is None:
+        raise ValueError("the Ethernet Slave is not running (simulator started with --no-svr)")
+    return source
+
+
+def _mode(text):
+    if text not in ("auto", "manual"):
+        raise ValueError(f"operation mode must be \"auto\" or \"manual\", got {text!r}")
+    return text == "auto"
 
 
 def request(port: int, payload: dict, host="127.0.0.1", timeout=5.0) -> dict:

@@ -111,12 +111,13 @@ def main(argv=None) -> int:
         return 1
     for robot in server.robots:
         node = "in Listen node" if robot.session.state == "in_node" else "project running, not in Listen node"
-        print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node})", flush=True)
-        if server.svr is not None:
-            print(f"robot {robot.index + 1}: Ethernet Slave on {args.host}:{robot.svr_port} "
-                  f"(data table every {args.svr_period:g} s, {args.svr_format})", flush=True)
+        slave = f", Ethernet Slave on {args.host}:{robot.svr_port}" if server.svr is not None else ""
+        print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node}){slave}", flush=True)
     if server.control is not None:
         print(f"control channel: {args.host}:{server.control.port} (JSON lines)", flush=True)
+    if server.svr is not None:
+        print(f"Ethernet Slave data table: every {args.svr_period:g} s, {args.svr_format}, "
+              f"{len(server.robots[0].svr.stream_items)} items", flush=True)
     if args.speedup != 1.0:
         print(f"robot clock runs {args.speedup:g} x faster than real time", flush=True)
     print("Press Ctrl-C to stop.", flush=True)
