@@ -6,17 +6,20 @@
 from __future__ import annotations
 
 import gc
+import hashlib
+import os
 import re
 import threading
 import time
+from collections import OrderedDict
 
 from .frontend import types as T
-from .compiler.codegen import CodeGen, bind_natives
+from .compiler.codegen import CodeGen
 from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
 from .runtime.values import PathError, Resolver, parse_duration
 
-__all__ = ["load_plc", "LoadError", "PlcFault", "Plc"]
+__all__ = ["load_plc", "compile_program", "LoadError", "PlcFault", "Plc"]
 
 
 class LoadError(Exception):
@@ -37,35 +40,86 @@ def parse_task(task: str) -> tuple[str, int]:
 def load_plc(paths, task: str = "Main@1ms", programs=None, *, dialect: str = "sysmac",
              watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
              count_statements: bool = False, clock_base_ns: int | None = None) -> "Plc":
+    """A new PLC instance (its own variables, tasks and sockets) running the compiled ``paths``."""
+    program = compile_program(paths, dialect=dialect, count_statements=count_statements)
+    return Plc(program, task, programs, watchdog_ms=watchdog_ms, socket_limit=socket_limit,
+               socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns)
+
+
+_COMPILED: OrderedDict = OrderedDict()      # source fingerprint -> Program, most recently used last
+_COMPILED_MAX = 8
+_COMPILE_LOCK = threading.Lock()
+
+
+def compile_program(paths, *, dialect: str = "sysmac", count_statements: bool = False):
+    """Parse, check and compile ``paths`` once: the result serves any number of PLC instances.
+
+    Programs are kept by a fingerprint of every source file's name and bytes (prelude included), so loading
+    unchanged sources again costs a file read, and an edited file is always compiled afresh."""
     from .project import load_project
     if isinstance(paths, str):
         paths = [paths]
-    proj = load_project(list(paths), dialect=dialect)
+    paths = list(paths)
+    key = _fingerprint(paths, dialect, count_statements)
+    with _COMPILE_LOCK:
+        if key is not None and key in _COMPILED:
+            _COMPILED.move_to_end(key)
+            return _COMPILED[key]
+    proj = load_project(paths, dialect=dialect)
     if proj.has_errors:
         raise LoadError(proj.render_diagnostics())
     try:
-        module = CodeGen(proj, count_statements).generate()
+        program = CodeGen(proj, count_statements).generate()
     except (NotImplementedError, RecursionError, SyntaxError, MemoryError) as exc:
         raise LoadError(f"error: the runtime cannot compile this program: {getattr(exc, 'msg', None) or exc}") from None
     except Exception as exc:    # noqa: BLE001 - a code generator defect must not show a traceback
         raise LoadError(f"error: internal error of the code generator ({type(exc).__name__}: {exc}); "
                         "please report it with the ST source") from None
-    return Plc(proj, module, task, programs, watchdog_ms=watchdog_ms, socket_limit=socket_limit,
-               socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns)
+    if key is not None:
+        with _COMPILE_LOCK:
+            _COMPILED[key] = program
+            while len(_COMPILED) > _COMPILED_MAX:
+                _COMPILED.popitem(last=False)
+    return program
+
+
+def _fingerprint(paths, dialect: str, count_statements: bool):
+    """Digest of the files ``load_project`` would read, or None when any of them is unreadable (the front
+    end then reports it)."""
+    from .frontend.diagnostics import DiagnosticBag
+    from .project import PRELUDE_DIR, collect_files
+    diags = DiagnosticBag()
+    files = collect_files(paths, diags)
+    if diags.items:
+        return None
+    digest = hashlib.blake2b(f"{dialect}|{count_statements}|{PRELUDE_DIR}".encode())
+    try:
+        prelude = sorted(n for n in os.listdir(PRELUDE_DIR) if n.endswith(".st"))
+        for path in [os.path.join(PRELUDE_DIR, n) for n in prelude] + files:
+            with open(path, "rb") as fh:
+                data = fh.read()
+            digest.update(f"\0{path}\0{len(data)}\0".encode())
+            digest.update(data)
+    except OSError:
+        return None
+    return digest.digest()
 
 
 _HEAP_FROZEN: list = []      # once per process: see Plc.run_realtime
 
 
 class Plc:
-    def __init__(self, proj, module, task, programs, *, watchdog_ms, socket_limit, socket_latency_ns,
-                 clock_base_ns) -> None:
-        self.project = proj
-        self.module = module
+    """One virtual controller: its own copy of a compiled program's variables, its tasks and its sockets."""
+
+    def __init__(self, program, task="Main@1ms", programs=None, *, watchdog_ms: float = 500.0,
+                 socket_limit: int = 30, socket_latency_ns: int = 0, clock_base_ns: int | None = None) -> None:
+        self.program = program
+        self.project = program.project
+        self.module = module = program.load()
         self.engine = Engine(module, watchdog_ns=int(watchdog_ms * 1e6), socket_limit=socket_limit,
                              socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns)
         ns = module.namespace
-        bind_natives(ns, self.engine)
+        module.bind_natives(self.engine)
         self.lock = threading.RLock()
         try:
             self.globals = module.globals_cls()

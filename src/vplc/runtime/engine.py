@@ -13,7 +13,7 @@ import traceback
 from dataclasses import dataclass, field
 
 from ..frontend.types import StructType
-from .faults import PlcFault, RuntimeFaultError, WatchdogError
+from .faults import GEN_FILE, PlcFault, RuntimeFaultError, WatchdogError
 from .sockets import SocketManager
 
 
@@ -137,7 +137,6 @@ class Engine:
         self.scan_count += 1
 
     def make_fault(self, exc: BaseException) -> PlcFault:
-        from ..compiler.codegen import GEN_FILE
         loc, inst = None, None
         for frame, lineno in traceback.walk_tb(exc.__traceback__):
             if frame.f_code.co_filename == GEN_FILE:
@@ -156,10 +155,3 @@ class Engine:
         msg = f"{where}: major fault in {inst or '<unknown instance>'}: {what}"
         return PlcFault(msg, file=loc[0] if loc else None, line=loc[1] if loc else None, instance=inst, kind=kind)
 
-
-def watchdog() -> None:
-    raise WatchdogError("a loop did not finish")
-
-
-def fault(message: str) -> None:
-    raise RuntimeFaultError(message)

@@ -2,6 +2,8 @@
 names the ST location, the POU instance path and the offending values."""
 from __future__ import annotations
 
+GEN_FILE = "<vplc generated>"      # file name of generated code in tracebacks: frames with it run ST
+
 
 class RuntimeFaultError(Exception):
     """Raised by runtime helpers (division by zero, index out of range, ...) inside generated code."""

@@ -10,6 +10,8 @@ import math
 import sys
 from dataclasses import dataclass, field
 
+from .faults import GEN_FILE
+
 
 @dataclass
 class Failure:
@@ -38,7 +40,6 @@ class Collector:
 
 
 def _where(rt):
-    from ..compiler.codegen import GEN_FILE
     f = sys._getframe(2)
     while f is not None and f.f_code.co_filename != GEN_FILE:
         f = f.f_back

@@ -1,0 +1,112 @@
+"""A compiled program and its loaded images.
+
+The compiler produces a :class:`Program` once: the generated Python source, its code object, the map from
+generated lines to ST lines and the variable tables of every class. A PLC instance loads it with
+:meth:`Program.load`, which runs the code object in a fresh namespace: each instance gets its own classes,
+globals, program instances, watchdog deadline and sockets, and none of the front end or code generator runs
+again. One compile serves any number of instances.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import time
+from dataclasses import dataclass, field
+from types import CodeType
+
+from . import iec, natives, stdlib
+from .faults import GEN_FILE, RuntimeFaultError, WatchdogError
+
+__all__ = ["GEN_FILE", "HELPERS", "Image", "PouClass", "Program"]
+
+
+def watchdog() -> None:
+    raise WatchdogError("a loop did not finish")
+
+
+def fault(message: str) -> None:
+    raise RuntimeFaultError(message)
+
+
+# helpers every generated module calls by these names
+HELPERS = {
+    "_f32": iec.f32, "_idiv": iec.idiv, "_imod": iec.imod, "_rdiv": iec.rdiv, "_expt": iec.expt,
+    "_ix1": iec.ix1, "_ixn": iec.ixn, "_ixo": iec.ixo, "_View": iec.ArrView,
+    "_assign": iec.assign_into, "_copy": iec.copy_value,
+    "_pc": time.perf_counter, "_watchdog": watchdog, "_fault": fault,
+}
+
+
+@dataclass
+class PouClass:
+    """What the generated module defines for one POU (native POUs have no class of their own)."""
+    pou: object               # the checked PouType
+    cls_name: str
+    body_name: str | None
+    vars: dict                # upper variable name -> (attribute, type)
+    native: bool = False
+
+
+@dataclass
+class Program:
+    project: object                                     # the checked project it was compiled from
+    source: str
+    code: CodeType
+    linemap: dict                                       # python line -> (st file, st line)
+    consts: dict                                        # constant names of the generated code -> values
+    pous: dict = field(default_factory=dict)            # upper POU qualified name -> PouClass
+    structs: list = field(default_factory=list)         # (class name, vars, StructType)
+    globals_vars: dict = field(default_factory=dict)
+
+    def load(self) -> "Image":
+        """Run the compiled code in a fresh namespace: the classes and state of one PLC instance."""
+        ns = dict(stdlib.NAMESPACE)
+        ns.update(HELPERS)
+        ns.update(self.consts)
+        ns.update({"_DL": [math.inf], "_NST": [0], "_PROGRAMS": {}})
+        exec(self.code, ns)
+        image = Image(self, ns)
+        for key, info in self.pous.items():
+            if info.native:
+                cls = natives.NATIVE_FBS.get(info.pou.name)
+                if cls is not None:
+                    cls.i__vars, cls.i__type = info.vars, info.pou
+                continue
+            cls = ns.get(info.cls_name)
+            if cls is None:
+                continue
+            cls.i__vars, cls.i__type = info.vars, info.pou
+            image.classes[key] = cls
+            if info.body_name is not None:
+                image.bodies[key] = ns[info.body_name]
+        for name, fields, t in self.structs:
+            ns[name].i__vars, ns[name].i__type = fields, t
+        image.globals_cls = ns["Globals"]
+        image.globals_cls.i__vars = self.globals_vars
+        return image
+
+
+@dataclass
+class Image:
+    """One loaded copy of a program: the namespace its code runs in, per PLC instance."""
+    program: Program
+    namespace: dict
+    classes: dict = field(default_factory=dict)          # upper POU qualified name -> class
+    bodies: dict = field(default_factory=dict)           # upper POU qualified name -> body function
+    globals_cls: type | None = None
+
+    @property
+    def source(self) -> str:
+        return self.program.source
+
+    @property
+    def linemap(self) -> dict:
+        return self.program.linemap
+
+    def bind_natives(self, rt) -> None:
+        """Make the native POUs of this image use the controller ``rt`` (sockets, clock)."""
+        ns = self.namespace
+        for name, cls in natives.NATIVE_FBS.items():
+            ns["N_" + name] = functools.partial(cls, rt)
+        for name, fn in natives.NATIVE_FUNCTIONS.items():
+            ns["NF_" + name] = functools.partial(fn, rt)
