@@ -160,7 +160,8 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
         have = ck.expr(value)
         if not is_lvalue(value):
             ctx.diags.error("ST1205", f"the output `{p.name}` must be read into a variable", value.span)
-        elif not T.is_error(have) and not _compatible(p.type, have):
+        elif not T.is_error(have) and not _compatible(p.type, have) and not (
+                ctx.dialect == "sysmac" and T.sysmac_assignable(p.type, have)):
             ctx.diags.error("ST1103", f"{what}: output of type {p.type.name} cannot be stored in `{ck.text(value)}` "
                             f"of type {have.name}", value.span)
         else:

@@ -277,6 +277,18 @@ class ExprChecker:
             return hint if hint is not None and T.is_real(hint) else None
         return other
 
+    def literal_context(self, e: A.Expr, other: T.Type, hint: T.Type | None) -> T.Type | None:
+        """context_type, except that on Sysmac an integer literal too large for the other operand keeps a type of
+        its own (W501 6-106: `UintVar * 100000000` is a DINT expression, not an out-of-range UINT)."""
+        ctx = self.context_type(e, other, hint)
+        inner = e.operand if isinstance(e, A.Unary) else e
+        if self.ctx.dialect == "sysmac" and ctx is not None and isinstance(inner, A.Literal) and inner.kind == "int" \
+                and T.is_int(ctx):
+            value = -inner.value if isinstance(e, A.Unary) and e.op == "-" else inner.value
+            if not T.literal_fits(value, ctx):
+                return None
+        return ctx
+
     def needs_context(self, e: A.Expr) -> bool:
         if is_untyped_literal(e):
             return True
@@ -287,10 +299,10 @@ class ExprChecker:
         hint = None if op in COMPARE else expected
         if self.needs_context(e.left) and not self.needs_context(e.right):
             rt = self.expr(e.right, hint)
-            lt = self.expr(e.left, self.context_type(e.left, rt, hint) if op != "**" else None)
+            lt = self.expr(e.left, self.literal_context(e.left, rt, hint) if op != "**" else None)
         else:
             lt = self.expr(e.left, hint)
-            rt = self.expr(e.right, self.context_type(e.right, lt, hint)
+            rt = self.expr(e.right, self.literal_context(e.right, lt, hint)
                            if (self.needs_context(e.right) and op != "**") else hint)
         if T.is_error(lt) or T.is_error(rt):
             return T.BOOL if op in COMPARE else T.ERROR
@@ -314,11 +326,29 @@ class ExprChecker:
                 return T.BOOL
             return self.op_error(e, lt, rt, "values of the same enumeration")
         if isinstance(a, T.ElementaryType) and isinstance(b, T.ElementaryType):
-            c = T.common_type(a, b)
+            c = self.numeric_common(e, a, b)
             if c is not None:
                 self.widen_both(e, lt, rt, c)
                 return T.BOOL
         return self.op_error(e, lt, rt, "comparable values of the same type")
+
+    def numeric_common(self, e, a: T.Type, b: T.Type) -> T.Type | None:
+        """Common type of two operands. Sysmac (W501 6-106): the operand of highest rank, unsigned at equal
+        rank. Where Sysmac would take an integer above a REAL operand (DINT, LINT rank above REAL), vplc keeps
+        the floating-point type and warns (ST1108): the controller drops the fraction there."""
+        c = T.common_type(a, b)
+        if self.ctx.dialect != "sysmac" or not (T.is_num(a) and T.is_num(b)):
+            return c
+        s = T.sysmac_common(a, b)
+        if s is None:
+            return c
+        if T.is_int(s) and (T.is_real(a) or T.is_real(b)):
+            self.ctx.diags.warning("ST1108", f"Sysmac types this {T.base_of(a).name}/{T.base_of(b).name} expression "
+                                   f"as {s.name} (W501 6-106: {s.name} ranks above REAL) and drops the fraction; "
+                                   f"vplc computes it as {c.name if c else 'LREAL'}: convert explicitly so both agree",
+                                   e.span)
+            return c
+        return s
 
     def arithmetic(self, e, lt, rt):
         op = e.op
@@ -331,7 +361,7 @@ class ExprChecker:
                 return r
             if op == "MOD" and (ka == "real" or kb == "real"):
                 return self.op_error(e, lt, rt, "integer operands")
-            c = T.common_type(a, b)
+            c = self.numeric_common(e, a, b)
             if c is not None:
                 self.widen_both(e, lt, rt, c)
                 return c
@@ -388,7 +418,7 @@ class ExprChecker:
             self.ctx.diags.error("ST1101", f"{what}: function block instances cannot be assigned or copied",
                                  value.span)
             return
-        if not compatible(have, want):
+        if not compatible(have, want) and not (self.ctx.dialect == "sysmac" and T.sysmac_assignable(have, want)):
             hint = ""
             a, b = T.base_of(have), T.base_of(want)
             if isinstance(a, T.ElementaryType) and isinstance(b, T.ElementaryType):

@@ -5,6 +5,10 @@
 * ST2003 a construct outside the 2nd edition is used (CONTINUE, LTIME/LDATE/..., `ARRAY[*]`, VAR_STAT,
   `//` and `/* */` comments, TO_xxx / LOWER_BOUND / UPPER_BOUND / ATAN2).
 
+The other ``--portable`` rules have one module each, run from here: ST2004 portable_enum_values, ST2005
+portable_keywords, ST2006 portable_case_labels, ST2007 portable_discarded_result, ST2008 portable_enum_order,
+ST2009 portable_empty_call, ST2010 portable_len_type, ST2011 portable_array_types.
+
 Files below a folder named ``platform`` are exempt: that is where a portable library keeps its vendor calls.
 
 Passing (portable)::
@@ -19,6 +23,11 @@ from __future__ import annotations
 
 from ..frontend import ast as A
 from ..frontend.source import Span
+from . import (portable_array_types, portable_case_labels, portable_discarded_result, portable_empty_call,
+               portable_enum_order, portable_enum_values, portable_keywords, portable_len_type)
+
+RULES = (portable_enum_values, portable_keywords, portable_case_labels, portable_discarded_result,
+         portable_enum_order, portable_empty_call, portable_len_type, portable_array_types)
 
 
 def exempt(path: str) -> bool:
@@ -30,6 +39,8 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
     path = unit.span.file.path
     if getattr(unit, "in_prelude", False) or exempt(path):
         return
+    for rule in RULES:
+        rule.check_unit(ctx, unit)
     for node in A.walk(unit):
         if isinstance(node, A.QualName) and node.namespace:
             ctx.diags.warning("ST2002", f"namespace qualifier in `{node.text()}` is a vendor extension; use the bare "

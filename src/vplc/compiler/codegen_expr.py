@@ -151,7 +151,7 @@ class ExprGen:
             return f"_f32({code})" if d.bits == 32 else f"float({code})"
         if isinstance(s, T.ElementaryType) and s.kind == "bool" and d.kind != "bool":
             return f"int({code})"
-        return code
+        return _sign_cast(code, s, d)
 
     def store_conv(self, code: str, e, t) -> str:
         """Value ``code`` of expression ``e`` converted for storing into type ``t``."""
@@ -168,7 +168,7 @@ class ExprGen:
             return f"_f32({code})" if tt.bits == 32 else f"float({code})"
         if isinstance(tt, (T.StructType, T.ArrayType)):
             return f"_copy({code})"
-        return code
+        return _sign_cast(code, et, tt)
 
     def ex_Literal(self, e) -> str:
         t = T.base_of(e.ty) if e.ty is not None else None
@@ -380,6 +380,15 @@ class ExprGen:
                 args.append(self.const(ba.expr.ty, "_ty"))
         fn = f"NF_{pt.name}" if pt.native else f"F{self.cls_name(pt)[1:]}"
         return f"{fn}({', '.join(args)})"
+
+
+def _sign_cast(code: str, src, dst) -> str:
+    """Sysmac implicit cast between integers of other signedness (W501 6-107: INT -1 -> UINT 16#FFFF): the
+    bits are kept, so the value is wrapped to the destination; widenings need no code."""
+    if isinstance(src, T.ElementaryType) and isinstance(dst, T.ElementaryType) and src.kind in ("int", "uint") \
+            and dst.kind in ("int", "uint") and not T.widens_to(src, dst):
+        return iec.wrap_expr(code, dst.bits, dst.kind == "int")
+    return code
 
 
 def _cell(sym) -> tuple[str, str]:

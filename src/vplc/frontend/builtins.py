@@ -192,7 +192,7 @@ def _fixed(params: tuple[T.Type, ...], result: T.Type) -> Callable:
     def resolve(args, dialect):
         convs = []
         for i, (a, p) in enumerate(zip(args, params)):
-            if not T.widens_to(a, p):
+            if not (T.widens_to(a, p) or (dialect == "sysmac" and T.sysmac_assignable(a, p))):
                 raise SignatureError(f"argument {i + 1} must be {p.name}, not {a.name}", i)
             convs.append(None if T.same_type(a, p) or T.is_error(a) else p)
         return result, convs
@@ -226,7 +226,8 @@ def _conversion(src_name: str, dst_name: str) -> Builtin | None:
         if not T.is_error(a):
             ok = (T.is_string(a) if src is None else
                   (T.same_type(T.base_of(a), src) or T.widens_to(a, src) or
-                   (isinstance(T.base_of(a), T.EnumType) and T.is_int(src))))
+                   (isinstance(T.base_of(a), T.EnumType) and T.is_int(src)) or
+                   (dialect == "sysmac" and T.sysmac_assignable(a, src))))   # W501 6-107: INT_TO_STRING(LEN(s))
             if not ok:
                 raise SignatureError(f"{src_name}_TO_{dst_name} expects a {src_name}, not {a.name}", 0)
         result = default_string(dialect, dst_name == "WSTRING") if dst is None else dst

@@ -345,6 +345,52 @@ def common_type(a: Type, b: Type) -> Type | None:
     return None
 
 
+# Omron Sysmac implicit casts (W501 6-5-3 "Implicit Casts", page 6-106/6-107), dialect sysmac only.
+# Expressions: the operand of highest rank gives the type; at equal rank an unsigned integer wins.
+SYSMAC_RANK = {"USINT": 1, "SINT": 1, "BYTE": 1, "UINT": 2, "INT": 2, "WORD": 2, "REAL": 3,
+               "DINT": 4, "UDINT": 4, "DWORD": 4, "LREAL": 5, "LINT": 6, "ULINT": 6, "LWORD": 6}
+# Assignments and input arguments: the arrows of the W501 6-107 chart. Besides the widenings above, an integer
+# goes to the other-signed integer of the same size (the value may change: INT -1 -> UINT 16#FFFF), so chains
+# such as SINT -> USINT -> UINT -> UDINT -> ULINT are allowed (W501: "ULINT := SINT").
+_SIGN_SWAP = {"SINT": "USINT", "USINT": "SINT", "INT": "UINT", "UINT": "INT", "DINT": "UDINT", "UDINT": "DINT",
+              "LINT": "ULINT", "ULINT": "LINT"}
+
+
+def _sysmac_reach(name: str) -> frozenset:
+    seen, todo = {name}, [name]
+    while todo:
+        n = todo.pop()
+        for m in _WIDEN.get(n, ()) + ((_SIGN_SWAP[n],) if n in _SIGN_SWAP else ()):
+            if m not in seen:
+                seen.add(m)
+                todo.append(m)
+    return frozenset(seen)
+
+
+_SYSMAC_REACH = {n: _sysmac_reach(n) for n in list(_WIDEN) + list(_SIGN_SWAP)}
+
+
+def sysmac_assignable(src: Type, dst: Type) -> bool:
+    """W501 6-107: may a value of ``src`` be assigned (or passed as an input) to ``dst`` on Sysmac?"""
+    s, d = base_of(src), base_of(dst)
+    if isinstance(s, ElementaryType) and isinstance(d, ElementaryType):
+        return d.name in _SYSMAC_REACH.get(s.name, ())
+    return False
+
+
+def sysmac_common(a: Type, b: Type) -> Type | None:
+    """W501 6-106: type of an arithmetic expression of two numeric operands on Sysmac, or None."""
+    a0, b0 = base_of(a), base_of(b)
+    if not (isinstance(a0, ElementaryType) and isinstance(b0, ElementaryType)):
+        return None
+    ra, rb = SYSMAC_RANK.get(a0.name), SYSMAC_RANK.get(b0.name)
+    if ra is None or rb is None or (a0.kind == "bit") != (b0.kind == "bit"):
+        return None
+    if ra != rb:
+        return a0 if ra > rb else b0
+    return b0 if b0.kind == "uint" else a0
+
+
 def literal_fits(value: int, t: Type) -> bool:
     t = unalias(t)
     if isinstance(t, SubrangeType):

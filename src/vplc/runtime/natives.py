@@ -161,7 +161,9 @@ class SktTCPRcv(_SocketFB):
             return 0
         if c.eof:
             return S.ERR_CLOSED
-        if self.TimeOut == 0 or rt.now_ns - self.i__t0 >= self.TimeOut * 100_000_000:
+        # TimeOut in 0.1 s; 0 = no timeout: the receive stays Busy until data arrives (W506 9-2, receive
+        # timeout monitoring; field evidence: Sysmac code waits seconds in a TimeOut 0 receive)
+        if self.TimeOut and rt.now_ns - self.i__t0 >= self.TimeOut * 100_000_000:
             return S.ERR_TIMEOUT
         return None
 

@@ -17,7 +17,7 @@ ERR_ADDRESS = 0x2002          # destination address is not a valid IPv4 address
 ERR_HANDLE = 0x2003           # the socket does not exist (never opened, or already closed)
 ERR_RESOURCES = 0x2004        # no free socket: the controller's socket limit is reached
 ERR_PORT_IN_USE = 0x2005      # SktTCPAccept: the local port cannot be opened (already in use)
-ERR_TIMEOUT = 0x2006          # SktTCPRcv: nothing received within TimeOut (TimeOut = 0: nothing waiting)
+ERR_TIMEOUT = 0x2006          # SktTCPRcv / SktTCPAccept: nothing within TimeOut (never for TimeOut 0)
 ERR_CLOSED = 0x2007           # connection closed or reset by the remote node
 ERR_REFUSED = 0x2008          # connection refused / remote node unreachable
 ERRORS = {ERR_PARAM: "input value out of range", ERR_ADDRESS: "invalid destination IP address",

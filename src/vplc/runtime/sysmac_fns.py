@@ -49,12 +49,12 @@ def ToAryByte(rt, In, In_t, Order, AryOut) -> int:
     return len(data)
 
 
-def AryByteTo(rt, Size, Order, In, Out, Out_t) -> bool:
+def AryByteTo(rt, In, Size, Order, OutVal, OutVal_t) -> bool:
     if Size > len(In):
         raise RuntimeFaultError(f"AryByteTo: Size {Size} exceeds the {len(In)} bytes of the array")
     data = bytes(In[i] & 0xFF for i in range(Size))
-    container, key = Out
-    b = T.base_of(Out_t)
+    container, key = OutVal
+    b = T.base_of(OutVal_t)
     if isinstance(b, T.EnumType):
         b = T.base_of(b.base)
     if isinstance(b, T.StringType):
@@ -81,25 +81,29 @@ def StringToAry(rt, In, AryOut) -> int:
     return len(data)
 
 
-def AryToString(rt, Size, In) -> str:
+def AryToString(rt, In, Size) -> str:
     if Size > len(In):
         raise RuntimeFaultError(f"AryToString: Size {Size} exceeds the {len(In)} bytes of the array")
     data = bytes(In[i] & 0xFF for i in range(Size))
     return data.split(b"\0", 1)[0].decode("latin-1")[:1985]
 
 
-def _format(x: float, Exp: bool, Sign: bool, Width: int, Decimals: int) -> str:
-    d = max(0, min(int(Decimals), 30))
-    text = f"{x:{'+' if Sign else ''}.{d}{'e' if Exp else 'f'}}"
-    return text.rjust(int(Width))
+def _format(x: float, Exponent: bool, Sign: bool, MinLen: int, DecPlace: int) -> str:
+    """W502 2-269: DecPlace greater than MinLen is an error (the controller leaves Out unchanged and sets ENO
+    FALSE; vplc functions have no ENO, so the result is the empty string); the fraction is rounded half to
+    even (1.5 -> 2, 2.5 -> 2), which Python's formatting of the binary value does."""
+    if DecPlace > MinLen:
+        return ""
+    text = f"{x:{'+' if Sign else ''}.{int(DecPlace)}{'e' if Exponent else 'f'}}"
+    return text.rjust(int(MinLen))
 
 
-def RealToFormatString(rt, In, Exp, Sign, Width, Decimals) -> str:
-    return _format(In, Exp, Sign, Width, Decimals)
+def RealToFormatString(rt, In, Exponent, Sign, MinLen, DecPlace) -> str:
+    return _format(In, Exponent, Sign, MinLen, DecPlace)
 
 
-def LrealToFormatString(rt, In, Exp, Sign, Width, Decimals) -> str:
-    return _format(In, Exp, Sign, Width, Decimals)
+def LrealToFormatString(rt, In, Exponent, Sign, MinLen, DecPlace) -> str:
+    return _format(In, Exponent, Sign, MinLen, DecPlace)
 
 
 def GetTime(rt) -> int:

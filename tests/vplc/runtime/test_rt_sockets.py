@@ -106,13 +106,36 @@ def test_receive_copies_waiting_bytes_and_reports_the_size(tmp_path, server):
     peer.close()
 
 
-def test_receive_with_timeout_zero_and_nothing_waiting_ends_with_2006(tmp_path, server):
+def test_receive_with_timeout_zero_waits_busy_until_data_arrives_seconds_later(tmp_path, server):
+    """W506 9-2 (SktTCPRcv monitors the receive timeout) and Sysmac field code: TimeOut 0 = no timeout."""
     plc, peer = _connected(tmp_path, server)
-    _pulse(plc, "Main.DoRcv", "Main.rcv.Done")
     plc.write("Main.DoRcv", True)
-    plc.scan(plc.now_ns + plc.period_ns)
-    assert plc.run_until(lambda: plc.read("Main.rcv.Error"), 100_000_000)
+    start = plc.now_ns
+    sent = []
+
+    def reply_after_3s(t):
+        if not sent and t - start >= 3_000_000_000:
+            peer.sendall(b"OK")
+            sent.append(t)
+    assert not plc.run_until(lambda: plc.read("Main.rcv.Done") or plc.read("Main.rcv.Error"), 2_900_000_000,
+                             on_scan=reply_after_3s)
+    assert plc.read("Main.rcv.Busy") is True
+    assert plc.run_until(lambda: plc.read("Main.rcv.Done"), 5_000_000_000, on_scan=reply_after_3s)
+    assert not plc.read("Main.rcv.Error") and plc.read("Main.rcv.RcvSize") == 2
+    assert bytes(plc.read("Main.rx")[:2]) == b"OK"
+    plc.close()
+    peer.close()
+
+
+def test_receive_with_timeout_in_tenths_of_a_second_ends_with_2006(tmp_path, server):
+    """TimeOut counts 0.1 s units: TimeOut 5 and nothing arriving ends with Error after 0.5 s, not before."""
+    plc, peer = _connected(tmp_path, server)
+    plc.write("Main.RcvTimeOut", 5)
+    plc.write("Main.DoRcv", True)
+    start = plc.now_ns
+    assert plc.run_until(lambda: plc.read("Main.rcv.Error"), 1_000_000_000)
     assert plc.read("Main.rcv.ErrorID") == 0x2006
+    assert plc.now_ns - start >= 500_000_000
     plc.close()
     peer.close()
 

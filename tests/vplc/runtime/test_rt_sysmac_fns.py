@@ -24,9 +24,9 @@ def test_to_ary_byte_of_real_writes_the_ieee_image(tmp_path):
 
 def test_ary_byte_to_is_the_inverse_of_to_ary_byte(tmp_path):
     plc = run1(tmp_path, """ToAryByte(In := d, Order := _HIGH_LOW, AryOut := b[1]);
-        AryByteTo(In := b[1], Size := 4, Order := _HIGH_LOW, Out := back);
+        AryByteTo(In := b[1], Size := 4, Order := _HIGH_LOW, OutVal := back);
         ToAryByte(In := w, Order := _LOW_HIGH, AryOut := b[5]);
-        AryByteTo(In := b[5], Size := 2, Order := _LOW_HIGH, Out := wback);""",
+        AryByteTo(In := b[5], Size := 2, Order := _LOW_HIGH, OutVal := wback);""",
                "d : DINT := -123456; back : DINT; w : UINT := 500; wback : UINT; b : ARRAY[0..9] OF BYTE;")
     assert plc.read("Main.back") == -123456 and plc.read("Main.wback") == 500
 
@@ -38,12 +38,35 @@ def test_string_to_ary_and_ary_to_string_round_trip(tmp_path):
     assert plc.read("Main.b")[2:7] == list(b"Hi TM")
 
 
-def test_real_to_format_string_width_decimals_sign_exponent(tmp_path):
-    plc = run1(tmp_path, """a := RealToFormatString(In := 3.14159, Exp := FALSE, Sign := FALSE, Width := 8, Decimals := 2);
-        b := RealToFormatString(In := 2.5, Exp := FALSE, Sign := TRUE, Width := 0, Decimals := 1);
-        c := RealToFormatString(In := 1234.5, Exp := TRUE, Sign := FALSE, Width := 0, Decimals := 3);""",
-               "a, b, c : STRING[30];")
-    assert (plc.read("Main.a"), plc.read("Main.b"), plc.read("Main.c")) == ("    3.14", "+2.5", "1.234e+03")
+def test_ary_to_string_positional_call_takes_in_then_size(tmp_path):
+    """W502 AryToString: In, Size (the order Sysmac code uses in positional calls)."""
+    plc = run1(tmp_path, "n := StringToAry('Hi TM', b[2]); s := AryToString(b[2], n);",
+               "b : ARRAY[0..19] OF BYTE; n : UINT; s : STRING[20];")
+    assert plc.read("Main.s") == "Hi TM"
+
+
+def test_real_to_format_string_parameters_of_w502_2_269(tmp_path):
+    """W502 2-269: In, Exponent, Sign, MinLen, DecPlace; the last four can be omitted."""
+    plc = run1(tmp_path, """a := RealToFormatString(In := 3.14159, Exponent := FALSE, Sign := FALSE, MinLen := 8,
+                                                   DecPlace := 2);
+        b := RealToFormatString(In := 2.25, Exponent := FALSE, Sign := TRUE, MinLen := 4, DecPlace := 1);
+        c := RealToFormatString(In := 1234.5, Exponent := TRUE, Sign := FALSE, MinLen := 3, DecPlace := 3);
+        d := RealToFormatString(In := 42.0, Exponent := FALSE, Sign := TRUE, MinLen := 1, DecPlace := 0);
+        e := LrealToFormatString(12.75);
+        f := RealToFormatString(7.5, FALSE, FALSE, 5, 2);""",
+               "a, b, c, d, e, f : STRING[30];")
+    assert [plc.read(f"Main.{v}") for v in "abcdef"] == ["    3.14", "+2.2", "1.234e+03", "+42", "13", " 7.50"]
+
+
+def test_real_to_format_string_rounds_half_to_even_as_w502_2_269_shows(tmp_path):
+    plc = run1(tmp_path, """a := RealToFormatString(In := 1.49); b := RealToFormatString(In := 1.5);
+        c := RealToFormatString(In := 2.5); d := RealToFormatString(In := 1.51);""", "a, b, c, d : STRING[10];")
+    assert [plc.read(f"Main.{v}") for v in "abcd"] == ["1", "2", "2", "2"]
+
+
+def test_real_to_format_string_with_dec_place_above_min_len_is_the_error_case_of_w502_2_269(tmp_path):
+    plc = run1(tmp_path, "a := RealToFormatString(In := 1.25, MinLen := 1, DecPlace := 2);", "a : STRING[10];")
+    assert plc.read("Main.a") == ""
 
 
 def test_time_instructions(tmp_path):
