@@ -39,8 +39,9 @@ PNP_PAGE_VARS = ["PnP_Example_Execute", "PnP_Segment", "PnP_Waiting", "PnP_Cycle
                  "ProgramControl_ErrorDescrip", "Connect_Connected", "ReadPos_Valid", "ReadPos_Position"]
 
 
-def post(url, body):
-    request = urllib.request.Request(url, json.dumps(body).encode(), {"Content-Type": "application/json"})
+def post(url, body, key):
+    request = urllib.request.Request(url, json.dumps(body).encode(),
+                                     {"Content-Type": "application/json", "X-HMI-Key": key})
     with urllib.request.urlopen(request, timeout=5) as response:
         return json.loads(response.read())
 
@@ -82,7 +83,7 @@ def round_trip() -> list[float]:
         read_url = hmi.url + "api/read?names=ChangeBase_Done,ChangeBase_Busy,ChangeBase_Error"
         for _ in range(ROUND_TRIPS):
             start = time.perf_counter()
-            post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}})
+            post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}}, hmi.access.keys["engineer"])
             while True:
                 values = get(read_url)["values"]
                 if values["ChangeBase_Done"] or values["ChangeBase_Error"]:
@@ -164,7 +165,7 @@ def stand_in_round_trip() -> tuple[list[float], float]:
         read_url = hmi.url + "api/read?names=ChangeBase_Done,ChangeBase_Busy,ChangeBase_Error"
         for _ in range(ROUND_TRIPS):
             start = time.perf_counter()
-            post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}})
+            post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}}, hmi.access.keys["engineer"])
             while not get(read_url)["values"]["ChangeBase_Done"]:
                 pass
             samples.append((time.perf_counter() - start) * 1000)

@@ -118,9 +118,13 @@ class Demo:
             f"  robot simulator   TM Listen Node, 1 robot on {self.host}:{self.robot_port}, "
             f"Ethernet Slave on {self.host}:{self.sim.robots[0].svr_port}",
             f"  virtual PLC       PnP_Example + Commands_Example in a {period_ms:g} ms task (real time)",
-            f"  web HMI           {self.hmi.url}",
+            f"  web HMI           {self.hmi.url} (without a key: monitor only)",
             "",
-            f"Open {self.hmi.url} in a browser, press Connect, then try the Motion pages.",
+            "Open the operator address in a browser, press Connect, then try the Motion pages:",
+            f"  operator          {self.hmi.page_url('index', 'operator')}",
+            f"  engineer          {self.hmi.page_url('index', 'engineer')}"
+            "   (also robot address, base, tool, outputs)",
+            "The keys are new at every start; keep them to the people who may move the robot.",
             "Press Ctrl-C to stop.",
         ])
 

@@ -68,9 +68,28 @@ let MAP = null;
 const live = { values: {}, online: false, trail: [], listeners: [], kick: null, polls: 0 };
 
 /* ---------- server access ---------- */
+/* The access key comes in the address printed at start-up (…/#key=…): kept for this browser tab only and
+   removed from the address bar so it is not bookmarked or shared by accident. Without a key the HMI is a
+   read-only monitor; the server checks every write again (docs/hmi.md, Access control). */
+const ACCESS = { key: "", role: "monitor" };
+function takeAccessKey() {
+  const match = /(?:^#|&)key=([A-Za-z0-9_-]+)/.exec(location.hash);
+  if (match) {
+    sessionStorage.setItem("hmi-key", match[1]);
+    history.replaceState(null, "", location.pathname + location.search);
+  }
+  ACCESS.key = sessionStorage.getItem("hmi-key") || "";
+}
+const ROLE_RANK = { monitor: 0, operator: 1, engineer: 2 };
+function mayWrite(path) {
+  const spec = MAP.variables[path.split(/[.[]/)[0]];
+  return Boolean(spec) && ROLE_RANK[ACCESS.role] >= ROLE_RANK[spec.role || "operator"];
+}
+
 async function api(path, body) {
-  const options = body === undefined ? {} :
-    { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) };
+  const headers = ACCESS.key ? { "X-HMI-Key": ACCESS.key } : {};
+  const options = body === undefined ? { headers } :
+    { method: "POST", headers: { ...headers, "Content-Type": "application/json" }, body: JSON.stringify(body) };
   let response;
   try { response = await fetch(path, options); }
   catch (e) { throw new Error("No answer from the PLC web server: check that the demo is running"); }
@@ -157,6 +176,8 @@ function makeField(path, spec, label) {
   }
   input.id = id;
   input.dataset.path = path;
+  if (!mayWrite(path)) { input.disabled = true; box.title = ACCESS.role === "monitor" ?
+    "Monitor mode: open the operator address printed at start-up to operate" : "Engineering setting (engineer access)"; }
   const lab = document.createElement("label");
   lab.htmlFor = id;
   lab.textContent = label;
@@ -231,6 +252,7 @@ function collect(root, prefix) {
   const values = {};
   let first = null;
   for (const el of els) {
+    if (el.disabled) continue;                       // a setting this role may not change is not sent
     const raw = el.type === "checkbox" ? el.checked : el.value;
     const [value, error] = checkValue(el.dataset.path, leafSpec(el.dataset.path), raw, context);
     el.classList.toggle("invalid", Boolean(error));
@@ -356,8 +378,9 @@ function frame(title, isMain) {
   document.title = "CBT HMI – " + title;
   document.body.innerHTML = `<div class="panel">
     <header>${isMain ? "" : '<a class="menu" id="btn-menu" href="index.html">◀ Main Menu</a>'}
-      <h1>${title}</h1><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span></header>
-    <main id="main"></main><div id="message">Ready.</div></div>`;
+      <h1>${title}</h1><span class="pill ${ACCESS.role === "monitor" ? "off" : "on"}" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span></header>
+    <main id="main"></main><div id="message">${ACCESS.role === "monitor" ?
+      "Monitor mode (read only): open the operator address printed at start-up to operate." : "Ready."}</div></div>`;
   return document.getElementById("main");
 }
 
@@ -436,6 +459,7 @@ async function fbPage(key) {
   const exec = document.createElement("button");
   exec.className = (key === "stop" ? "danger" : "primary") + (key === "connect" ? "" : " wide");
   exec.id = "btn-execute"; exec.textContent = page.execLabel || "Execute";
+  exec.disabled = !mayWrite(`${group}_Execute`);
   exec.onclick = () => {
     const result = collect(params, page.param || "");
     if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
@@ -618,13 +642,16 @@ async function boot() {
   const name = file.replace(/\.html$/, "");
   const key = name === "index" ? "main" : name;
   document.body.dataset.page = key;
+  takeAccessKey();
   try {
     MAP = await api("/api/mapping");
+    ACCESS.role = (await api("/api/session")).role;
   } catch (e) {
     frame("CBT HMI", true);
     message("Cannot load the variable table: " + e.message, "error");
     return;
   }
+  document.body.dataset.role = ACCESS.role;
   if (key === "main") mainPage();
   else if (key === "pnp") pnpPage();
   else fbPage(key);

@@ -45,4 +45,5 @@ def server(fake_plc, mapping):
 
 @pytest.fixture
 def client(server):
-    return Client(f"http://127.0.0.1:{server.port}")
+    """Engineer access: may change every writable variable (the role tests use their own clients)."""
+    return Client(f"http://127.0.0.1:{server.port}", server.access.keys["engineer"])

@@ -86,7 +86,7 @@ class System:
         return "\n".join(lines)
 
     def open(self, page: str) -> Browser:
-        self.browser.open(f"{self.hmi.url}{page}.html")
+        self.browser.open(self.hmi.page_url(page, "engineer"))
         return self.browser
 
     def robot_state(self) -> dict:

@@ -42,7 +42,7 @@ def page(stack):
     plc.writes.clear()
 
     def open_page(name: str):
-        browser.open(f"{server.url}{name}.html")
+        browser.open(server.page_url(name, "engineer"))
         return browser
     return plc, open_page
 

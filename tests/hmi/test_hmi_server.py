@@ -165,7 +165,7 @@ def test_execute_reports_a_plc_that_is_not_scanning(mapping):
     srv = HmiServer(plc, mapping, port=0)
     srv.start()
     try:
-        status, answer = Client(f"http://127.0.0.1:{srv.port}").json("/api/execute", {"execute": "Connect_Execute"})
+        status, answer = Client(f"http://127.0.0.1:{srv.port}", srv.access.keys["operator"]).json("/api/execute", {"execute": "Connect_Execute"})
         assert status == 503 and "the PLC is not scanning" in answer["error"]
     finally:
         srv.stop()
@@ -204,6 +204,8 @@ def test_post_without_content_length_is_refused(server):
     import http.client
     connection = http.client.HTTPConnection("127.0.0.1", server.port, timeout=5)
     connection.putrequest("POST", "/api/write")
+    connection.putheader("Content-Type", "application/json")
+    connection.putheader("X-HMI-Key", server.access.keys["operator"])
     connection.endheaders()
     response = connection.getresponse()
     answer = json.loads(response.read())

@@ -1,16 +1,22 @@
 """Web HMI server: serves hmi/ and a JSON API over the PLC-HMI variable table (hmi/mapping.json).
 
-The browser is not trusted. Every write names a variable of the mapping file, is checked against its type
-and range here again, and reaches the PLC only through Contract A (plc.write under plc.lock). Reads are
-limited to mapped variables too.
+The browser is not trusted. Every request must address this server (Host); every write must come from the
+HMI's own pages, as JSON, with an access key whose role may change that variable (vplc.hmi.access). Every
+write names a variable of the mapping file, is checked against its type and range here again, and reaches the
+PLC only through Contract A (plc.write under plc.lock), all values or none. Reads are limited to mapped
+variables too.
 
 API (all answers are JSON objects with "ok"):
-  GET  /api/mapping                         the variable table (types, ranges, enumerations)
+  GET  /api/mapping                         the variable table (types, ranges, enumerations, roles)
+  GET  /api/session                         {"ok", "role"}: the role the request's X-HMI-Key grants
   GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "values": {name: value}}
   POST /api/write   {"values": {path: v}}   validate all, then write all in one scan gap
   POST /api/execute {"execute": "X_Execute", "values": {path: v}}
                                             validate, write the values and Execute := FALSE, wait for one
                                             PLC scan, then Execute := TRUE (a clean rising edge per press)
+
+The server is a bounded pool of worker threads: a connection idle for CONNECTION_TIMEOUT_S is closed, and
+beyond WORKERS + WAITING connections a new one is answered 503 at once.
 """
 from __future__ import annotations
 
@@ -20,17 +26,27 @@ import json
 import math
 import mimetypes
 import pathlib
+import logging
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from http import HTTPStatus
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from http.server import BaseHTTPRequestHandler, HTTPServer
 from urllib.parse import parse_qs, urlsplit
+
+from .access import AccessDenied, AccessPolicy, role_at_least
 
 HMI_DIR = pathlib.Path(__file__).resolve().parents[3] / "hmi"
 DEFAULT_MAPPING = HMI_DIR / "mapping.json"
 MAX_BODY = 16 * 1024
 MAX_NAMES = 400
 SCAN_WAIT_S = 1.0
+CONNECTION_TIMEOUT_S = 10.0        # a client that sends nothing for this long is disconnected
+WORKERS = 16                       # requests served at once
+WAITING = 48                       # connections queued for a worker before new ones get 503
+LISTEN_BACKLOG = 128
+
+log = logging.getLogger("vplc.hmi")
 
 INT_RANGES = {
     "SINT": (-2**7, 2**7 - 1), "INT": (-2**15, 2**15 - 1), "DINT": (-2**31, 2**31 - 1),
@@ -56,12 +72,13 @@ class RequestError(Exception):
 class Leaf:
     """One scalar PLC variable reachable from the HMI (a mapped variable or a field inside one)."""
 
-    __slots__ = ("path", "type", "access", "min", "max", "enum", "maxlen", "pattern", "execute", "unit")
+    __slots__ = ("path", "type", "access", "role", "min", "max", "enum", "maxlen", "pattern", "execute", "unit")
 
-    def __init__(self, path: str, spec: dict, access: str, enum: dict | None = None):
+    def __init__(self, path: str, spec: dict, access: str, role: str, enum: dict | None = None):
         self.path = path
         self.type = spec["type"]
         self.access = access
+        self.role = role                  # the least role that may write it: "operator" or "engineer"
         self.enum = enum
         self.min = spec.get("min")
         self.max = spec.get("max")
@@ -98,7 +115,11 @@ class Mapping:
                 access = spec.get("access", "r")
                 if access not in ("r", "rw"):
                     raise MappingError(f"{source}: variable '{name}': access must be 'r' or 'rw', not {access!r}")
-                self._expand(name, spec, access, types)
+                role = spec.get("role", "operator")
+                if role not in ("operator", "engineer"):
+                    raise MappingError(f"{source}: variable '{name}': role must be 'operator' or 'engineer', "
+                                       f"not {role!r}")
+                self._expand(name, spec, access, role, types)
         except (KeyError, TypeError, ValueError) as exc:
             raise MappingError(f"{source}: malformed variable table ({type(exc).__name__}: {exc})") from None
 
@@ -113,27 +134,27 @@ class Mapping:
             raise MappingError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
         return cls(document, str(path))
 
-    def _expand(self, path: str, spec: dict, access: str, types: dict) -> None:
+    def _expand(self, path: str, spec: dict, access: str, role: str, types: dict) -> None:
         if "array" in spec:
             low, high = spec["array"]
             for index in range(low, high + 1):
-                self._expand_element(f"{path}[{index}]", spec, access, types)
+                self._expand_element(f"{path}[{index}]", spec, access, role, types)
         else:
-            self._expand_element(path, spec, access, types)
+            self._expand_element(path, spec, access, role, types)
 
-    def _expand_element(self, path: str, spec: dict, access: str, types: dict) -> None:
+    def _expand_element(self, path: str, spec: dict, access: str, role: str, types: dict) -> None:
         type_name = spec["type"]
         definition = types.get(type_name)
         if definition is None:
             if type_name not in INT_RANGES and type_name not in REAL_TYPES and type_name != "BOOL" \
                     and _string_length(type_name) is None and type_name not in ("DATE_AND_TIME", "DT", "TIME"):
                 raise MappingError(f"{self.source}: '{path}' has unknown type '{type_name}'")
-            self.leaves[path] = Leaf(path, spec, access)
+            self.leaves[path] = Leaf(path, spec, access, role)
         elif "enum" in definition:
-            self.leaves[path] = Leaf(path, spec, access, enum=dict(definition["enum"]))
+            self.leaves[path] = Leaf(path, spec, access, role, enum=dict(definition["enum"]))
         else:
             for field, field_spec in definition["fields"].items():
-                self._expand(f"{path}.{field}", field_spec, access, types)
+                self._expand(f"{path}.{field}", field_spec, access, role, types)
 
     def is_readable(self, name: str) -> bool:
         """A mapped variable, a leaf inside one, or an inner struct/array element of one."""
@@ -235,17 +256,58 @@ def _jsonable(value):
     return str(value)
 
 
+class _PooledHTTPServer(HTTPServer):
+    """HTTPServer whose connections are served by a bounded pool of threads (not a thread per connection)."""
+
+    request_queue_size = LISTEN_BACKLOG
+    allow_reuse_address = True
+
+    def __init__(self, address, handler):
+        super().__init__(address, handler)
+        self._pool = ThreadPoolExecutor(WORKERS, thread_name_prefix="hmi-http")
+        self._slots = threading.BoundedSemaphore(WORKERS + WAITING)
+
+    def process_request(self, request, client_address):
+        if not self._slots.acquire(blocking=False):
+            try:
+                request.sendall(b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: application/json\r\n"
+                                b"Content-Length: 58\r\nConnection: close\r\n\r\n"
+                                b'{"ok": false, "error": "the HMI server is busy, retry"}\r\n\r\n')
+            except OSError:
+                pass
+            self.shutdown_request(request)
+            return
+        self._pool.submit(self._serve, request, client_address)
+
+    def _serve(self, request, client_address):
+        try:
+            self.finish_request(request, client_address)
+        except Exception:           # noqa: BLE001 - one broken connection must never stop the server
+            self.handle_error(request, client_address)
+        finally:
+            self.shutdown_request(request)
+            self._slots.release()
+
+    def handle_error(self, request, client_address):
+        log.debug("HMI connection from %s ended abnormally", client_address[0], exc_info=True)
+
+    def server_close(self):
+        super().server_close()
+        self._pool.shutdown(wait=False, cancel_futures=True)
+
+
 class HmiServer:
     """HTTP server for one PLC. start() binds (port 0 = ephemeral), serves in a thread; stop() ends it."""
 
     def __init__(self, plc, mapping: Mapping | None = None, host: str = "127.0.0.1", port: int = 8080,
-                 root: pathlib.Path = HMI_DIR):
+                 root: pathlib.Path = HMI_DIR, access: AccessPolicy | None = None):
         self.plc = plc
         self.mapping = mapping or Mapping.load()
         self.host = host
         self.requested_port = port
         self.root = pathlib.Path(root).resolve()
-        self._httpd: ThreadingHTTPServer | None = None
+        self.access = access or AccessPolicy()
+        self._httpd: _PooledHTTPServer | None = None
         self._thread: threading.Thread | None = None
         self.requests = 0
         self._execute_lock = threading.Lock()
@@ -258,10 +320,15 @@ class HmiServer:
     def url(self) -> str:
         return f"http://{self.host}:{self.port}/"
 
+    def page_url(self, page: str = "index", role: str = "operator") -> str:
+        """The address of a page that carries the access key of ``role`` (in the fragment: never sent on)."""
+        path = "" if page == "index" else f"{page}.html"
+        return f"{self.url}{path}#key={self.access.keys[role]}"
+
     def start(self) -> None:
         handler = type("BoundHandler", (_Handler,), {"hmi": self})
-        self._httpd = ThreadingHTTPServer((self.host, self.requested_port), handler)
-        self._httpd.daemon_threads = True
+        self._httpd = _PooledHTTPServer((self.host, self.requested_port), handler)
+        self.access.bind(self.host, self.port)
         self._thread = threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.1},
                                         name="hmi-http", daemon=True)
         self._thread.start()
@@ -291,49 +358,80 @@ class HmiServer:
                 values[name] = format_dt(values[name])
         return {"ok": True, "time_ns": now, "values": _jsonable(values)}
 
-    def _checked(self, values) -> list[tuple[str, object]]:
+    def _checked(self, values, role: str) -> list[tuple[str, object]]:
         if not isinstance(values, dict) or not values:
             raise RequestError('"values" must be a non-empty object {"Variable": value, ...}')
         checked = []
         for path, value in values.items():
-            leaf = self.mapping.leaves.get(path)
-            if leaf is None:
-                raise RequestError(f"'{path}' is not in the HMI variable table", HTTPStatus.FORBIDDEN)
-            if leaf.access != "rw":
-                raise RequestError(f"'{path}' is read-only for the HMI", HTTPStatus.FORBIDDEN)
+            leaf = self._writable(path, role)
             checked.append((path, validate(leaf, value)))
         return checked
 
-    def _write_all(self, checked) -> int:
-        with self.plc.lock:
-            for path, value in checked:
-                try:
-                    self.plc.write(path, value)
-                except (ValueError, KeyError, TypeError) as exc:
-                    raise RequestError(f"the PLC refused '{path}': {exc}") from None
-            return self.plc.now_ns
+    def _writable(self, path, role: str) -> Leaf:
+        leaf = self.mapping.leaves.get(path) if isinstance(path, str) else None
+        if leaf is None:
+            raise RequestError(f"'{path}' is not in the HMI variable table", HTTPStatus.FORBIDDEN)
+        if leaf.access != "rw":
+            raise RequestError(f"'{path}' is read-only for the HMI", HTTPStatus.FORBIDDEN)
+        if not role_at_least(role, leaf.role):
+            raise RequestError(f"'{path}' is an engineering setting: open the engineer address printed at "
+                               f"start-up to change it", HTTPStatus.FORBIDDEN)
+        return leaf
 
-    def write(self, body: dict) -> dict:
-        now = self._write_all(self._checked(body.get("values")))
+    def _write_all(self, checked) -> int:
+        """Write every value or none: on a refusal the ones already written get their old values back.
+
+        The caller holds plc.lock, so no scan runs in between and the PLC never sees a partial write."""
+        before = []
+        try:
+            for path, value in checked:
+                before.append((path, self.plc.read(path)))
+                self.plc.write(path, value)
+        except (ValueError, KeyError, TypeError) as exc:
+            self._restore(before)
+            raise RequestError(f"the PLC refused '{path}': {exc}; nothing was written") from None
+        return self.plc.now_ns
+
+    def _restore(self, before) -> None:
+        for path, value in reversed(before):
+            try:
+                self.plc.write(path, value)
+            except (ValueError, KeyError, TypeError):
+                log.warning("HMI: could not restore %s after a refused write", path)
+
+    def write(self, body: dict, role: str) -> dict:
+        checked = self._checked(body.get("values"), role)
+        with self.plc.lock:
+            now = self._write_all(checked)
         return {"ok": True, "time_ns": now}
 
-    def execute(self, body: dict) -> dict:
+    def execute(self, body: dict, role: str) -> dict:
         name = body.get("execute")
         leaf = self.mapping.leaves.get(name) if isinstance(name, str) else None
         if leaf is None or not leaf.execute:
             raise RequestError(f'"execute" must name an Execute variable of the table, not {name!r}')
+        self._writable(name, role)
         values = body.get("values") or {}
-        checked = self._checked(values) if values else []
+        checked = self._checked(values, role) if values else []
         # A clean rising edge: every task completes a cycle with Execute FALSE, then one with it TRUE, before
         # the answer goes back. A scan that only advances the clock (no task due) does not count, and
         # Execute requests are taken one at a time, so no command is ever merged with another or lost.
+        # All or nothing: nothing is written unless the PLC is scanning, and if it stops scanning before it
+        # has seen Execute TRUE, every value goes back to what it was, so a 503 always means "nothing done".
         with self._execute_lock:
+            self._await_task_cycles("nothing was written")
             with self.plc.lock:
+                before = [(path, self.plc.read(path)) for path, _ in checked + [(name, False)]]
                 self._write_all(checked + [(name, False)])
-            self._await_task_cycles("Execute was not reset")
-            with self.plc.lock:
-                now = self._write_all([(name, True)])
-            self._await_task_cycles("Execute was not seen")
+            try:
+                self._await_task_cycles("nothing was written")
+                with self.plc.lock:
+                    now = self._write_all([(name, True)])
+                self._await_task_cycles("nothing was written")
+            except RequestError:
+                with self.plc.lock:
+                    self._restore(before)
+                raise
         return {"ok": True, "time_ns": now}
 
     def _await_task_cycles(self, what: str) -> None:
@@ -349,51 +447,101 @@ class HmiServer:
 class _Handler(BaseHTTPRequestHandler):
     hmi: HmiServer
     server_version = "CBT-HMI/1.0"
+    timeout = CONNECTION_TIMEOUT_S
 
     def log_message(self, format, *args):  # noqa: A002 - signature of the base class
-        """Quiet: the demo prints its own status lines."""
+        """Quiet: the demo prints its own status lines; details go to the debug log."""
+        log.debug("HMI %s: " + format, self.client_address[0], *args)
+
+    def handle(self):
+        try:
+            super().handle()
+        except (ConnectionError, TimeoutError) as exc:
+            log.debug("HMI client %s left early: %s", self.client_address[0], exc)
+
+    def send_error(self, code, message=None, explain=None):
+        """Malformed requests (bad request line, oversized headers) get a short JSON answer too."""
+        try:
+            self.close_connection = True
+            self.request_version = "HTTP/1.0"           # also when the request line itself was unreadable
+            status = HTTPStatus(code)
+            self._json(status, {"ok": False, "error": message or status.phrase})
+        except (ValueError, OSError):
+            pass
 
     def _send(self, status: HTTPStatus, payload: bytes, content_type: str) -> None:
         self.send_response(status)
         self.send_header("Content-Type", content_type)
         self.send_header("Content-Length", str(len(payload)))
         self.send_header("Cache-Control", "no-store")
+        self.send_header("X-Content-Type-Options", "nosniff")
+        self.send_header("X-Frame-Options", "DENY")
+        self.send_header("Referrer-Policy", "no-referrer")
         self.end_headers()
-        self.wfile.write(payload)
+        if self.command != "HEAD":
+            self.wfile.write(payload)
 
     def _json(self, status: HTTPStatus, obj: dict) -> None:
         self._send(status, json.dumps(obj).encode("utf-8"), "application/json")
 
-    def _fail(self, error: RequestError) -> None:
-        self._json(error.status, {"ok": False, "error": str(error)})
+    def _fail(self, error: Exception) -> None:
+        self._json(getattr(error, "status", HTTPStatus.BAD_REQUEST), {"ok": False, "error": str(error)})
+
+    def _url(self):
+        if any(ord(c) < 0x20 or ord(c) == 0x7F for c in self.path):
+            raise RequestError("the address contains control characters")
+        return urlsplit(self.path)
 
     def do_GET(self):  # noqa: N802 - http.server naming
         self.hmi.requests += 1
-        url = urlsplit(self.path)
         try:
+            self.hmi.access.check_host(self.headers)
+            url = self._url()
             if url.path == "/api/mapping":
                 self._json(HTTPStatus.OK, {"ok": True, **self.hmi.mapping.document})
+            elif url.path == "/api/session":
+                self._json(HTTPStatus.OK, {"ok": True, "role": self.hmi.access.role_of(self.headers)})
             elif url.path == "/api/read":
-                query = parse_qs(url.query)
+                query = parse_qs(url.query, max_num_fields=MAX_NAMES)
                 names = [n for part in query.get("names", []) for n in part.split(",") if n]
                 self._json(HTTPStatus.OK, self.hmi.read(names))
             elif url.path.startswith("/api/"):
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
             else:
                 self._static(url.path)
-        except RequestError as exc:
+        except (RequestError, AccessDenied) as exc:
             self._fail(exc)
+        except ValueError as exc:                       # parse_qs: too many fields
+            self._fail(RequestError(f"malformed address: {exc}"))
+
+    do_HEAD = do_GET
 
     def do_POST(self):  # noqa: N802 - http.server naming
         self.hmi.requests += 1
-        url = urlsplit(self.path)
         try:
+            self.hmi.access.check_host(self.headers)
+            url = self._url()
             operation = {"/api/write": self.hmi.write, "/api/execute": self.hmi.execute}.get(url.path)
             if operation is None:
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
-            self._json(HTTPStatus.OK, operation(self._body()))
-        except RequestError as exc:
+            role = self.hmi.access.check_write(self.headers)
+            self._json(HTTPStatus.OK, operation(self._body(), role))
+        except (RequestError, AccessDenied) as exc:
             self._fail(exc)
+
+    def _refuse_method(self):
+        """No CORS preflight is ever answered positively, and nothing but GET and POST is served."""
+        self.hmi.requests += 1
+        self.close_connection = True
+        self.send_response(HTTPStatus.METHOD_NOT_ALLOWED)
+        payload = json.dumps({"ok": False, "error": f"{self.command} is not supported: use GET or POST"}).encode()
+        self.send_header("Allow", "GET, HEAD, POST")
+        self.send_header("Content-Type", "application/json")
+        self.send_header("Content-Length", str(len(payload)))
+        self.end_headers()
+        self.wfile.write(payload)
+
+    do_OPTIONS = do_PUT = do_DELETE = do_PATCH = _refuse_method
 
     def _body(self) -> dict:
         try:
@@ -409,6 +557,10 @@ class _Handler(BaseHTTPRequestHandler):
             body = json.loads(raw.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:
             raise RequestError(f"the request body is not valid JSON ({exc})") from None
+        except ValueError as exc:                       # e.g. a number of more than 4,300 digits
+            raise RequestError(f"the request body holds a value out of range ({exc})") from None
+        except RecursionError:
+            raise RequestError("the request body is nested too deeply") from None
         if not isinstance(body, dict):
             raise RequestError("the request body must be a JSON object")
         return body

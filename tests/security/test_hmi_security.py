@@ -1,0 +1,363 @@
+"""HMI access control and server hygiene: every probe of the adversarial review, replayed on loopback.
+
+Each test names the finding it replays (issue "Nobody moves the robot who should not") and asserts the fixed
+behaviour: writes only from the HMI's own pages, as JSON, with an access key of a role allowed to change the
+variable; malformed requests answered with a clean 4xx; a bounded number of server threads.
+"""
+from __future__ import annotations
+
+import http.client
+import http.server
+import json
+import pathlib
+import socket
+import sys
+import threading
+
+import pytest
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "hmi"))
+
+from fake_plc import FakePlc, command_program  # noqa: E402
+from hmi_http import Client  # noqa: E402
+from vplc.hmi import server as hmi_server  # noqa: E402
+from vplc.hmi.server import HmiServer, Mapping  # noqa: E402
+
+MOVE = {"execute": "MoveAbs_Execute", "values": {"MoveAbs_Param.TargetPosition.Z": 300.0}}
+
+
+@pytest.fixture(scope="module")
+def mapping():
+    return Mapping.load()
+
+
+@pytest.fixture
+def plc(mapping):
+    plc = FakePlc(mapping, command_program)
+    stop = threading.Event()
+
+    def scanning():
+        while not stop.wait(0.001):
+            plc.scan()
+
+    thread = threading.Thread(target=scanning, daemon=True)
+    thread.start()
+    yield plc
+    stop.set()
+    thread.join(timeout=5)
+
+
+@pytest.fixture
+def hmi(plc, mapping):
+    server = HmiServer(plc, mapping, port=0)
+    server.start()
+    yield server
+    server.stop()
+
+
+def raw_request(port: int, method: str, path: str, body: bytes = b"", headers: dict | None = None):
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=5)
+    connection.request(method, path, body=body or None, headers=headers or {})
+    response = connection.getresponse()
+    payload = response.read()
+    connection.close()
+    return response.status, payload, response.headers
+
+
+def read_until_closed(sock) -> bytes:
+    answer = b""
+    while chunk := sock.recv(4096):
+        answer += chunk
+    return answer
+
+
+def test_write_without_an_access_key_is_refused_and_nothing_moves(hmi, plc):
+    status, answer = Client(f"http://127.0.0.1:{hmi.port}").json("/api/execute", MOVE)
+    assert status == 401 and "monitor mode" in answer["error"]
+    assert plc.writes == []
+
+
+def test_write_with_a_wrong_key_is_refused(hmi, plc):
+    status, answer = Client(f"http://127.0.0.1:{hmi.port}", "guessed-key").json("/api/execute", MOVE)
+    assert status == 401 and "not valid for this server start" in answer["error"]
+    assert plc.writes == []
+
+
+def test_operator_key_runs_a_command(hmi, plc):
+    status, answer = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["operator"]).json("/api/execute", MOVE)
+    assert status == 200 and answer["ok"]
+    assert plc.read("MoveAbs_Param.TargetPosition.Z") == 300.0
+
+
+@pytest.mark.parametrize("values", [
+    {"Connect_AddressIP": "10.0.0.99"},                       # point the PLC at another robot
+    {"Connect_Dest_PortIP": 5999},
+    {"ChangeTCP_Param.TCPOffset.Z": 250.0},                    # a different tool
+    {"ChangeBase_Param.Transformation.X": 100.0},
+    {"SetOutput_Param.Channel": 3},                          # the I/O assignment
+])
+def test_engineering_settings_need_the_engineer_key(hmi, plc, values):
+    operator = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["operator"])
+    status, answer = operator.json("/api/write", {"values": values})
+    assert status == 403 and "engineering setting" in answer["error"]
+    assert plc.writes == []
+    engineer = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["engineer"])
+    status, answer = engineer.json("/api/write", {"values": values})
+    assert status == 200, answer
+
+
+def test_engineer_only_commands_refuse_the_operator_key(hmi, plc):
+    operator = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["operator"])
+    status, answer = operator.json("/api/execute", {"execute": "ChangeTCP_Execute"})
+    assert status == 403 and plc.writes == []
+
+
+def test_session_reports_the_role_of_the_key(hmi):
+    for key, role in ((None, "monitor"), (hmi.access.keys["operator"], "operator"),
+                      (hmi.access.keys["engineer"], "engineer")):
+        status, answer = Client(f"http://127.0.0.1:{hmi.port}", key).json("/api/session")
+        assert (status, answer["role"]) == (200, role)
+
+
+@pytest.mark.parametrize("content_type", ["text/plain", "application/x-www-form-urlencoded", "multipart/form-data",
+                                          None])
+def test_a_simple_cross_site_request_type_is_refused(hmi, plc, content_type):
+    """A form or a text/plain fetch needs no CORS preflight; only application/json is accepted."""
+    headers = {"X-HMI-Key": hmi.access.keys["operator"]}
+    if content_type:
+        headers["Content-Type"] = content_type
+    status, payload, _ = raw_request(hmi.port, "POST", "/api/execute", json.dumps(MOVE).encode(), headers)
+    assert status == 415 and b"application/json" in payload
+    assert plc.writes == []
+
+
+@pytest.mark.parametrize("header, value", [("Origin", "http://attacker.example"),
+                                           ("Origin", "http://127.0.0.1:1"),
+                                           ("Origin", "null"),
+                                           ("Sec-Fetch-Site", "cross-site"),
+                                           ("Sec-Fetch-Site", "same-site")])
+def test_writes_from_another_origin_are_refused_even_with_the_key(hmi, plc, header, value):
+    headers = {"Content-Type": "application/json", "X-HMI-Key": hmi.access.keys["engineer"], header: value}
+    status, payload, _ = raw_request(hmi.port, "POST", "/api/execute", json.dumps(MOVE).encode(), headers)
+    assert status == 403 and b"own pages" in payload
+    assert plc.writes == []
+
+
+def test_same_origin_browser_write_is_accepted(hmi, plc):
+    headers = {"Content-Type": "application/json", "X-HMI-Key": hmi.access.keys["operator"],
+               "Origin": f"http://127.0.0.1:{hmi.port}", "Sec-Fetch-Site": "same-origin"}
+    status, _, _ = raw_request(hmi.port, "POST", "/api/execute", json.dumps(MOVE).encode(), headers)
+    assert status == 200
+
+
+@pytest.mark.parametrize("method", ["OPTIONS", "PUT", "DELETE", "PATCH"])
+def test_no_cors_preflight_is_ever_granted(hmi, method):
+    headers = {"Origin": "http://attacker.example", "Access-Control-Request-Method": "POST",
+               "Access-Control-Request-Headers": "content-type,x-hmi-key"}
+    status, _, answer_headers = raw_request(hmi.port, method, "/api/execute", headers=headers)
+    assert status == 405
+    assert "Access-Control-Allow-Origin" not in answer_headers
+
+
+@pytest.mark.parametrize("method", ["GET", "POST"])
+def test_dns_rebinding_host_is_refused(hmi, plc, method):
+    headers = {"Host": f"rebind.attacker.example:{hmi.port}", "Content-Type": "application/json",
+               "X-HMI-Key": hmi.access.keys["operator"]}
+    path = "/api/read?names=Connect_AddressIP" if method == "GET" else "/api/execute"
+    status, payload, _ = raw_request(hmi.port, method, path, json.dumps(MOVE).encode() if method == "POST" else b"",
+                                     headers)
+    assert status == 421 and b"addressed to this HMI" in payload
+    assert plc.writes == []
+
+
+def test_localhost_name_is_accepted_on_a_loopback_server(hmi):
+    status, _, _ = raw_request(hmi.port, "GET", "/api/session", headers={"Host": f"localhost:{hmi.port}"})
+    assert status == 200
+
+
+# --- the cross-origin attack in a real browser ---------------------------------------------------------------
+
+ATTACK_PAGE = """<!doctype html><html><body>
+<iframe name="sink1"></iframe><iframe name="sink2"></iframe><iframe name="sink3"></iframe>
+<form id="plain" method="POST" action="{hmi}api/write" enctype="text/plain" target="sink1">
+  <input name='{{"values":{{"MoveRel_Param.TargetPosition.X":50}},"pad":"' value='"}}'></form>
+<form id="urlenc" method="POST" action="{hmi}api/execute" target="sink2">
+  <input name="execute" value="MoveRel_Execute"></form>
+<form id="ip" method="POST" action="{hmi}api/write" enctype="text/plain" target="sink3">
+  <input name='{{"values":{{"Connect_AddressIP":"10.66.0.1"}},"pad":"' value='"}}'></form>
+<script>
+  const done = [];
+  fetch("{hmi}api/execute", {{method: "POST", mode: "no-cors", headers: {{"Content-Type": "text/plain"}},
+        body: JSON.stringify({move})}}).then(() => done.push("text"), () => done.push("text"));
+  fetch("{hmi}api/execute", {{method: "POST", headers: {{"Content-Type": "application/json", "X-HMI-Key": "guess"}},
+        body: JSON.stringify({move})}}).then(() => done.push("json"), () => done.push("json"));
+  document.getElementById("plain").submit();
+  document.getElementById("urlenc").submit();
+  document.getElementById("ip").submit();
+  window.attackDone = done;
+</script></body></html>"""
+
+
+@pytest.fixture
+def attacker_site(hmi):
+    page = ATTACK_PAGE.format(hmi=hmi.url, move=json.dumps(MOVE)).encode()
+
+    class Attacker(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):  # noqa: N802
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.send_header("Content-Length", str(len(page)))
+            self.end_headers()
+            self.wfile.write(page)
+
+        def log_message(self, *args):
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Attacker)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.server_address[1]}/"
+    server.shutdown()
+    server.server_close()
+
+
+def test_a_page_of_another_origin_cannot_move_the_robot_in_chromium(hmi, plc, attacker_site):
+    from browser import Browser, chromium_paths
+    if chromium_paths() is None:
+        pytest.fail("chromium and chromedriver are needed: run `make browser`")
+    browser = Browser()
+    try:
+        before = hmi.requests
+        browser.driver.get(attacker_site)
+        # three form posts, a text/plain fetch and the preflight of the JSON fetch all reach the HMI server
+        browser.wait_for(lambda d: hmi.requests - before >= 5 and
+                         d.execute_script("return window.attackDone && window.attackDone.length === 2"),
+                         "the attack page to send all its requests")
+    finally:
+        browser.close()
+    assert plc.writes == []
+    assert plc.read("Connect_AddressIP") == "" and plc.read("MoveRel_Param.TargetPosition.X") == 0.0
+
+
+# --- server hygiene ---------------------------------------------------------------------------------------------
+
+def test_a_5000_digit_number_in_a_body_is_a_clean_400(hmi, plc):
+    body = b'{"values": {"MoveAbs_Param.Speed": ' + b"9" * 5000 + b"}}"
+    status, answer = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["operator"]).json("/api/write", raw=body)
+    assert status == 400 and "out of range" in answer["error"]
+
+
+def test_a_deeply_nested_body_is_a_clean_400(hmi):
+    body = b"[" * 60000 + b"]" * 60000
+    status, answer = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["operator"]).json(
+        "/api/write", raw=body[: hmi_server.MAX_BODY])
+    assert status == 400
+
+
+def test_a_nul_in_the_address_is_a_clean_400(hmi):
+    with socket.create_connection(("127.0.0.1", hmi.port), timeout=5) as sock:
+        sock.sendall(b"GET /hmi.js\x00.png HTTP/1.0\r\nHost: 127.0.0.1:" + str(hmi.port).encode() + b"\r\n\r\n")
+        answer = read_until_closed(sock)
+    assert answer.startswith(b"HTTP/1.0 400") or answer.startswith(b"HTTP/1.1 400")
+    status, _, _ = raw_request(hmi.port, "GET", "/hmi.js%00")
+    assert status == 404
+
+
+def test_garbage_request_line_gets_a_json_4xx(hmi):
+    with socket.create_connection(("127.0.0.1", hmi.port), timeout=5) as sock:
+        sock.sendall(b"\x16\x03\x01\x02\x00 not http\r\n\r\n")
+        answer = read_until_closed(sock)
+    head, _, body = answer.partition(b"\r\n\r\n")
+    assert b" 400 " in head.split(b"\r\n")[0]
+    assert json.loads(body)["ok"] is False
+
+
+def test_stalled_connections_are_bounded_and_time_out(hmi, monkeypatch):
+    """600 stalled connections once kept 604 threads: now a fixed pool serves, idle clients are dropped."""
+    monkeypatch.setattr(hmi_server._Handler, "timeout", 0.5)
+    threads_before = threading.active_count()
+    stalled = [socket.create_connection(("127.0.0.1", hmi.port), timeout=5) for _ in range(120)]
+    try:
+        for sock in stalled:
+            sock.sendall(b"GET /api/session HTTP/1.0\r\n")          # never finishes the header
+        assert threading.active_count() <= threads_before + hmi_server.WORKERS + 1
+        for sock in stalled:                                       # every one ends: a 503 or a close at timeout
+            sock.settimeout(5)
+            while sock.recv(4096):
+                pass
+    finally:
+        for sock in stalled:
+            sock.close()
+    status, _, _ = raw_request(hmi.port, "GET", "/api/session")
+    assert status == 200
+
+
+def test_many_simultaneous_pollers_are_all_answered(hmi):
+    """The listen backlog was 5: with 50 pollers some waited for a SYN retry; now every one is answered."""
+    results = []
+
+    def poll():
+        status, _, _ = raw_request(hmi.port, "GET", "/api/read?names=MoveAbs_Busy")
+        results.append(status)
+
+    threads = [threading.Thread(target=poll) for _ in range(50)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=10)
+    assert hmi_server.LISTEN_BACKLOG >= 128
+    assert sorted(set(results)) == [200] and len(results) == 50
+
+
+def test_execute_on_a_stopped_plc_writes_nothing(mapping):
+    """/api/execute answered 503 after it had already written the values; a 503 now means nothing changed."""
+    plc = FakePlc(mapping, command_program)            # never scanned
+    server = HmiServer(plc, mapping, port=0)
+    server.start()
+    try:
+        status, answer = Client(f"http://127.0.0.1:{server.port}", server.access.keys["operator"]).json(
+            "/api/execute", MOVE)
+    finally:
+        server.stop()
+    assert status == 503 and "nothing was written" in answer["error"]
+    assert plc.read("MoveAbs_Param.TargetPosition.Z") == 0.0 and plc.read("MoveAbs_Execute") is False
+
+
+def test_execute_when_the_plc_stops_midway_restores_every_value(mapping, monkeypatch):
+    plc = FakePlc(mapping, command_program)
+    server = HmiServer(plc, mapping, port=0)
+    calls = []
+    real_wait = HmiServer._await_task_cycles
+
+    def wait_then_stop(self, what):
+        calls.append(what)
+        if len(calls) == 1:
+            plc.scan()                                  # the PLC still scans before the write ...
+            return real_wait(self, what)
+        raise hmi_server.RequestError(f"the PLC is not scanning: {what}", 503)   # ... and stops after it
+
+    monkeypatch.setattr(HmiServer, "_await_task_cycles", wait_then_stop)
+    server.start()
+    try:
+        status, _ = Client(f"http://127.0.0.1:{server.port}", server.access.keys["operator"]).json(
+            "/api/execute", MOVE)
+    finally:
+        server.stop()
+    assert status == 503
+    assert plc.read("MoveAbs_Param.TargetPosition.Z") == 0.0 and plc.read("MoveAbs_Execute") is False
+
+
+def test_a_write_the_plc_refuses_halfway_leaves_no_partial_change(hmi, plc, monkeypatch):
+    real_write = plc.write
+
+    def refuse_speed(path, value):
+        if path == "MoveAbs_Param.Speed":
+            raise ValueError("refused by the PLC")
+        real_write(path, value)
+
+    monkeypatch.setattr(plc, "write", refuse_speed)
+    client = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["operator"])
+    status, answer = client.json("/api/write", {"values": {"MoveAbs_Param.TargetPosition.X": 123.0,
+                                                           "MoveAbs_Param.Speed": 20}})
+    assert status == 400 and "nothing was written" in answer["error"]
+    assert plc.read("MoveAbs_Param.TargetPosition.X") == 0.0
