@@ -1,4 +1,4 @@
-"""Local control channel: JSON lines over TCP (127.0.0.1 only by default) for a separate process.
+"""Local control channel: JSON lines over TCP (127.0.0.1 unless ``control_host`` says otherwise).
 
 Each request is one JSON object on one line; each answer is one line ``{"ok": true, "result": ...}``
 or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
@@ -6,23 +6,49 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "ping"}
     {"cmd": "robots"}                                         ports and node state of every robot
     {"cmd": "state", "robot": 0}
-    {"cmd": "events", "robot": 0, "since": 0}                 events[since:], plus "next" index
+    {"cmd": "events", "robot": 0, "since": 0}                 up to 1,000 events from index ``since``
+                                                              on, plus "next" (the index to ask next)
     {"cmd": "enter_listen_node" | "leave_listen_node" | "stop_project" | "start_project", "robot": 0}
     {"cmd": "inject", "robot": 0, "fault": "reply_delay", "params": {"seconds": 0.5}}
     {"cmd": "clear_faults", "robot": 0}
     {"cmd": "estop", "robot": 0, "pressed": true}             Ethernet Slave: the operator at the robot
     {"cmd": "operation_mode", "robot": 0, "mode": "manual"}
     {"cmd": "svr_config", "robot": 0, "period": 0.1, "mode": 1, "items": [...], "write_permission": true}
+
+Every field is checked (type, range, finite numbers, nesting, line length: sim/limits.py); a bad
+request gets ``ok: false`` with the reason and the connection stays usable, except after a line
+longer than CONTROL_LINE_MAX (answered, then closed). Answers are written without blocking; a client
+that lets more than CONTROL_OUTBOX_MAX bytes of answers pile up is closed.
 """
 from __future__ import annotations
 
+import errno
 import json
+import math
+import re
 import selectors
 import socket
 
+from .limits import (ACCEPT_BACKOFF_S, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
+                     CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX)
 from .session import TransitionError
 
-MAX_REQUEST = 65536
+_FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission"}
+_BRACKETS = re.compile(rb'"(?:[^"\\]|\\.)*"|[\[\]{}]')
+
+
+class RequestError(ValueError):
+    """A request that is not valid; its text is the answer's ``error``."""
+
+
+class _Client:
+    __slots__ = ("sock", "rbuf", "wbuf", "closing")
+
+    def __init__(self, sock):
+        self.sock = sock
+        self.rbuf = bytearray()
+        self.wbuf = bytearray()
+        self.closing = False
 
 
 class ControlChannel:
@@ -38,10 +64,12 @@ class ControlChannel:
         sock.listen(16)
         sock.setblocking(False)
         self.sock = sock
+        self.host = host
         self.port = sock.getsockname()[1]
-        self.buffers: dict[socket.socket, bytearray] = {}
+        self.clients: dict[socket.socket, _Client] = {}
+        self._accept_paused_until = None
         server._dispatch["control_listen"] = self._accept
-        server._dispatch["control_conn"] = self._read
+        server._dispatch["control_conn"] = self._serve_client
         server.selector.register(sock, selectors.EVENT_READ, ("control_listen", None, None))
         self._commands = {
             "ping": lambda robot, req: "pong",
@@ -53,79 +81,114 @@ class ControlChannel:
             "leave_listen_node": lambda robot, req: robot.leave_listen_node(),
             "stop_project": lambda robot, req: robot.stop_project(),
             "start_project": lambda robot, req: robot.start_project(),
-            "inject": lambda robot, req: robot.inject(str(req.get("fault", "")), **dict(req.get("params") or {})),
+            "inject": lambda robot, req: robot.inject(_text_field(req, "fault"), **_params(req)),
             "clear_faults": lambda robot, req: robot.clear_faults(),
-            "estop": lambda robot, req: _svr(robot).set_estop(bool(req.get("pressed", True))),
+            "estop": lambda robot, req: _svr(robot).set_estop(_bool_field(req, "pressed", True)),
             "operation_mode": lambda robot, req: _svr(robot).set_auto_mode(_mode(req.get("mode"))),
             "svr_config": self._svr_config,
         }
 
+    # ---- sockets ------------------------------------------------------------------------------
     def _accept(self, _robot, _conn):
         try:
             sock, _addr = self.sock.accept()
-        except (BlockingIOError, InterruptedError, OSError):
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:
+            if exc.errno in (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM):
+                self._pause_accepting(exc)
+            return
+        if len(self.clients) >= CONTROL_CLIENTS_MAX:
+            sock.close()
             return
         sock.setblocking(False)
-        self.buffers[sock] = bytearray()
+        self.clients[sock] = _Client(sock)
         self.server.selector.register(sock, selectors.EVENT_READ, ("control_conn", None, sock))
 
-    def _read(self, _robot, sock):
+    def _pause_accepting(self, exc):
+        """Out of descriptors: stop watching the listener for ACCEPT_BACKOFF_S (no busy loop), say it once."""
+        self.server.selector.unregister(self.sock)
+        self._accept_paused_until = self.server._now + ACCEPT_BACKOFF_S
+        self.server._log_server("control_accept_paused", reason=exc.strerror, seconds=ACCEPT_BACKOFF_S)
+
+    def tick(self, now):
+        """Called once a poll: resume accepting after a pause."""
+        if self._accept_paused_until is not None and now >= self._accept_paused_until:
+            self._accept_paused_until = None
+            self.server.selector.register(self.sock, selectors.EVENT_READ, ("control_listen", None, None))
+
+    def _serve_client(self, _robot, sock):
+        client = self.clients.get(sock)
+        if client is None:
+            return
+        if client.wbuf and not self._write(client):
+            return
+        if client.closing:
+            return
         try:
             data = sock.recv(65536)
         except (BlockingIOError, InterruptedError):
             return
         except OSError:
             data = b""
-        buf = self.buffers.get(sock)
-        if not data or buf is None:
+        if not data:
             self._close(sock)
             return
-        buf += data
-        while b"\n" in buf:
-            line, _, rest = bytes(buf).partition(b"\n")
-            buf[:] = rest
-            answer = self.execute(line)
-            try:
-                sock.setblocking(True)
-                sock.sendall((json.dumps(answer) + "\n").encode())
-                sock.setblocking(False)
-            except OSError:
-                self._close(sock)
+        client.rbuf += data
+        while not client.closing:
+            end = client.rbuf.find(b"\n")
+            if end < 0:
+                if len(client.rbuf) > CONTROL_LINE_MAX:
+                    client.closing = True
+                    self.server._log_server("control_closed", reason="request line too long")
+                    self._answer(client, _error(f"request line longer than {CONTROL_LINE_MAX} bytes; "
+                                                f"connection closed"))
+                break
+            line = bytes(client.rbuf[:end])
+            del client.rbuf[:end + 1]
+            if len(line) > CONTROL_LINE_MAX:
+                client.closing = True
+                self.server._log_server("control_closed", reason="request line too long")
+                answer = _error(f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed")
+            else:
+                answer = self.execute(line)
+            if not self._answer(client, answer):
                 return
-        if len(buf) > MAX_REQUEST:
+        if client.closing and not client.wbuf:
             self._close(sock)
 
-    def execute(self, line: bytes) -> dict:
+    def _answer(self, client, answer) -> bool:
+        """Queue one answer and write what the socket takes; False when the client was closed."""
         try:
-            request = json.loads(line)
-            if not isinstance(request, dict):
-                raise ValueError("a request must be a JSON object")
-            command = self._commands.get(request.get("cmd"))
-            if command is None:
-                raise ValueError(f"unknown command {request.get('cmd')!r}; known: {', '.join(self._commands)}")
-            index = int(request.get("robot", 0))
-            if not 0 <= index < len(self.server.robots):
-                raise ValueError(f"robot {index} does not exist (0..{len(self.server.robots) - 1})")
-            return {"ok": True, "result": command(self.server.robots[index], request)}
-        except (ValueError, TypeError, TransitionError) as exc:
-            return {"ok": False, "error": str(exc)}
+            client.wbuf += _encode(answer)
+        except ValueError as exc:           # e.g. a value JSON cannot carry
+            client.wbuf += _encode(_error(f"the answer cannot be written as JSON ({exc})"))
+        if len(client.wbuf) > CONTROL_OUTBOX_MAX:
+            self._close(client.sock, f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)")
+            return False
+        return self._write(client)
 
-    def _svr_config(self, robot, request):
-        _svr(robot)
-        with self.server.lock:
-            robot.svr.configure(request.get("items"), request.get("mode"), request.get("period"))
-            if "write_permission" in request:
-                robot.svr.write_permission = bool(request["write_permission"])
-        return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
-                "write_permission": robot.svr.write_permission}
+    def _write(self, client) -> bool:
+        try:
+            sent = client.sock.send(client.wbuf)
+        except (BlockingIOError, InterruptedError):
+            sent = 0
+        except OSError:
+            self._close(client.sock)
+            return False
+        del client.wbuf[:sent]
+        events = selectors.EVENT_READ | (selectors.EVENT_WRITE if client.wbuf else 0)
+        key = self.server.selector.get_key(client.sock)
+        if key.events != events:
+            self.server.selector.modify(client.sock, events, key.data)
+        if client.closing and not client.wbuf:
+            self._close(client.sock)
+            return False
+        return True
 
-    def _events(self, robot, request):
-        since = max(0, int(request.get("since", 0)))
-        events = robot.events[since:]
-        return {"events": events, "next": since + len(events)}
-
-    def _close(self, sock):
-        self.buffers.pop(sock, None)
+    def _close(self, sock, reason=None):
+        if self.clients.pop(sock, None) is not None and reason:
+            self.server._log_server("control_closed", reason=reason)
         try:
             self.server.selector.unregister(sock)
         except (KeyError, ValueError):
@@ -133,26 +196,157 @@ class ControlChannel:
         sock.close()
 
     def close(self):
-        for sock in list(self.buffers):
+        for sock in list(self.clients):
             self._close(sock)
-        try:
-            self.server.selector.unregister(self.sock)
-        except (KeyError, ValueError):
-            pass
+        if self._accept_paused_until is None:
+            try:
+                self.server.selector.unregister(self.sock)
+            except (KeyError, ValueError):
+                pass
         self.sock.close()
+
+    # ---- requests -----------------------------------------------------------------------------
+    def execute(self, line: bytes) -> dict:
+        """The answer to one request line (never raises)."""
+        try:
+            request = _decode(line)
+            name = _text_field(request, "cmd")
+            command = self._commands.get(name)
+            if command is None:
+                raise RequestError(f"unknown command {name!r}; known: {', '.join(self._commands)}")
+            index = _int_field(request, "robot", 0, 0, len(self.server.robots) - 1,
+                               f"robot {{}} does not exist (0..{len(self.server.robots) - 1})")
+            return {"ok": True, "result": command(self.server.robots[index], request)}
+        except (ValueError, TypeError, TransitionError) as exc:
+            return _error(str(exc))
+        except Exception as exc:          # noqa: BLE001 - a request never ends the simulator
+            return _error(f"internal error of the simulator ({type(exc).__name__}: {exc})")
+
+    def _svr_config(self, robot, request):
+        _svr(robot)
+        items = request.get("items")
+        if items is not None and not (isinstance(items, list) and all(isinstance(i, str) for i in items)):
+            raise RequestError(f"'items' must be a list of item names, got {_show(items)}")
+        mode = request.get("mode")
+        if mode is not None and type(mode) is not int:
+            raise RequestError(f"'mode' must be an integer, got {_show(mode)}")
+        period = request.get("period")
+        if period is not None and (isinstance(period, bool) or not isinstance(period, (int, float))
+                                   or not math.isfinite(period)):
+            raise RequestError(f"'period' must be a finite number of seconds, got {_show(period)}")
+        with self.server.lock:
+            robot.svr.configure(items, mode, period)
+            if "write_permission" in request:
+                robot.svr.write_permission = _bool_field(request, "write_permission", True)
+        return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
+                "write_permission": robot.svr.write_permission}
+
+    def _events(self, robot, request):
+        since = _int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")
+        first = robot.events_dropped
+        start = max(since, first)
+        events = robot.events[start - first: start - first + CONTROL_EVENTS_MAX]
+        return {"events": events, "next": start + len(events), "first": first}
+
+
+def _decode(line: bytes) -> dict:
+    if line.count(b"[") + line.count(b"{") > CONTROL_DEPTH_MAX:
+        depth = deepest = 0
+        for match in _BRACKETS.finditer(line):
+            token = match.group()
+            if token in (b"[", b"{"):
+                depth += 1
+                deepest = max(deepest, depth)
+            elif token in (b"]", b"}"):
+                depth -= 1
+        if deepest > CONTROL_DEPTH_MAX:
+            raise RequestError(f"request nested deeper than {CONTROL_DEPTH_MAX} levels")
+    try:
+        request = json.loads(line, parse_constant=_no_constant, parse_int=_small_int)
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise RequestError(f"a request must be one JSON object on one line ({exc})") from None
+    except RecursionError:
+        raise RequestError(f"request nested deeper than {CONTROL_DEPTH_MAX} levels") from None
+    if not isinstance(request, dict):
+        raise RequestError("a request must be a JSON object")
+    unknown = sorted(set(request) - _FIELDS)
+    if unknown:
+        raise RequestError(f"unknown field {unknown[0]!r}; known: {', '.join(sorted(_FIELDS))}")
+    return request
+
+
+def _small_int(text):
+    if len(text.lstrip("-")) > 18:
+        raise RequestError(f"number {text[:20]}... has more than 18 digits")
+    return int(text)
+
+
+def _no_constant(name):
+    raise RequestError(f"{name} is not a number a request may carry")
+
+
+def _text_field(request, name) -> str:
+    value = request.get(name)
+    if not isinstance(value, str):
+        raise RequestError(f"'{name}' must be a text, got {_show(value)}")
+    return value
+
+
+def _bool_field(request, name, default) -> bool:
+    value = request.get(name, default)
+    if not isinstance(value, bool):
+        raise RequestError(f"'{name}' must be true or false, got {_show(value)}")
+    return value
+
+
+def _int_field(request, name, default, low, high, message) -> int:
+    value = request.get(name, default)
+    if type(value) is not int:
+        raise RequestError(f"'{name}' must be an integer, got {_show(value)}")
+    if value < low or (high is not None and value > high):
+        raise RequestError(message.format(_show(value)))
+    return value
+
+
+def _params(request) -> dict:
+    params = request.get("params", {})
+    if params is None:
+        return {}
+    if not isinstance(params, dict):
+        raise RequestError(f"'params' must be an object, got {_show(params)}")
+    for key, value in params.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise RequestError(f"parameter '{key}' must be a finite number")
+        if not isinstance(value, (bool, int, float, str)) or (isinstance(value, str) and len(value) > 64):
+            raise RequestError(f"parameter '{key}' must be a number, true/false or a short text, got "
+                               f"{_show(value)}")
+    return params
 
 
 def _svr(robot):
     source = getattr(robot, "svr_source", None)
     if source is None:
-        raise ValueError("the Ethernet Slave is not running (simulator started with --no-svr)")
+        raise RequestError("the Ethernet Slave is not running (simulator started with --no-svr)")
     return source
 
 
 def _mode(text):
     if text not in ("auto", "manual"):
-        raise ValueError(f"operation mode must be \"auto\" or \"manual\", got {text!r}")
+        raise RequestError(f"operation mode must be \"auto\" or \"manual\", got {_show(text)}")
     return text == "auto"
+
+
+def _show(value) -> str:
+    text = json.dumps(value) if isinstance(value, (dict, list, str)) else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _error(text) -> dict:
+    return {"ok": False, "error": text}
+
+
+def _encode(answer) -> bytes:
+    return (json.dumps(answer, allow_nan=False, ensure_ascii=False) + "\n").encode("utf-8")
 
 
 def request(port: int, payload: dict, host="127.0.0.1", timeout=5.0) -> dict:

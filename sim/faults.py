@@ -1,20 +1,74 @@
 """Fault injection on the outgoing side of one robot (what the server writes, and when).
 
-| fault                | parameters                        | effect                                               |
+| fault                | parameters (range)                | effect                                               |
 |----------------------|-----------------------------------|------------------------------------------------------|
-| reply_delay          | seconds=0.5, count=None           | every frame (or the next ``count``) leaves ``seconds`` later (virtual time) |
-| split_replies        | size=1                            | frames are written in ``size``-byte pieces, one piece per poll |
-| glue_replies         | count=2, max_wait=0.05            | frames are held until ``count`` are waiting (or ``max_wait`` s passed), then sent in one send |
+| reply_delay          | seconds=0.5 (0..3600), count=None (1..10^6) | every frame (or the next ``count``) leaves ``seconds`` later (virtual time) |
+| split_replies        | size=1 (1..65536)                 | frames are written in ``size``-byte pieces, one piece per poll |
+| glue_replies         | count=2 (2..1000), max_wait=0.05 (0..60) | frames are held until ``count`` are waiting (or ``max_wait`` s passed), then sent in one send |
 | corrupt_checksum     | count=1                           | the next ``count`` frames carry a wrong checksum     |
 | close_after          | frames=1                          | the connection is closed after ``frames`` more received frames (replies to them are sent first) |
 | close_mid_frame      | -                                 | the next frame is cut in half and the connection closed |
 | black_hole           | enabled=True                      | received bytes are discarded, nothing is answered    |
 | refuse_connections   | enabled=True                      | the listening socket is closed (connects are refused); existing clients stay |
 Session-level faults handled in server.Robot.inject: reply_error, leave_node, stop_project, disconnect.
+Parameters are checked by ``check_params`` (PARAMS below); a value outside its range is a ValueError.
+Clearing the faults (``adopt``) keeps what is held back: it still leaves, whole and in order.
 """
 from __future__ import annotations
 
+import math
 from collections import deque
+
+# fault -> parameter -> (kind, default, low, high); kind "choice": high holds the allowed values
+PARAMS = {
+    "reply_delay": {"seconds": ("number", 0.5, 0.0, 3600.0), "count": ("int", None, 1, 10 ** 6)},
+    "split_replies": {"size": ("int", 1, 1, 65536)},
+    "glue_replies": {"count": ("int", 2, 2, 1000), "max_wait": ("number", 0.05, 0.0, 60.0)},
+    "corrupt_checksum": {"count": ("int", 1, 1, 10 ** 6)},
+    "close_after": {"frames": ("int", 1, 0, 10 ** 6)},
+    "close_mid_frame": {},
+    "black_hole": {"enabled": ("bool", True, None, None)},
+    "refuse_connections": {"enabled": ("bool", True, None, None)},
+    "reply_error": {"count": ("int", 1, 1, 10 ** 6)},
+    "leave_node": {"path": ("choice", "Pass", None, ("Pass", "Fail"))},
+    "stop_project": {},
+    "disconnect": {},
+}
+
+
+def check_params(fault: str, params: dict) -> dict:
+    """The parameters of ``fault`` with defaults filled in; ValueError naming the first bad one."""
+    spec = PARAMS.get(fault)
+    if spec is None:
+        raise ValueError(f"unknown fault '{fault}'; known faults: {', '.join(KNOWN)}")
+    unknown = sorted(set(params) - set(spec))
+    if unknown:
+        raise ValueError(f"bad parameter for fault '{fault}': unknown parameter '{unknown[0]}' "
+                         f"(known: {', '.join(spec) or 'none'})")
+    checked = {}
+    for name, (kind, default, low, high) in spec.items():
+        value = params.get(name, default)
+        if value is None:
+            checked[name] = None
+            continue
+        if kind == "bool":
+            if not isinstance(value, bool):
+                raise ValueError(f"bad parameter for fault '{fault}': {name} must be true or false, got {value!r}")
+        elif kind == "choice":
+            if value not in high:
+                raise ValueError(f"bad parameter for fault '{fault}': {name} must be one of "
+                                 f"{', '.join(high)}, got {value!r}")
+        else:
+            integer = kind == "int"
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or (
+                    integer and isinstance(value, float) and not value.is_integer()):
+                raise ValueError(f"bad parameter for fault '{fault}': {name} must be "
+                                 f"{'an integer' if integer else 'a number'}, got {value!r}")
+            if not math.isfinite(value) or not low <= value <= high:
+                raise ValueError(f"bad parameter for fault '{fault}': {name} must be {low}..{high}, got {value!r}")
+            value = int(value) if integer else float(value)
+        checked[name] = value
+    return checked
 
 
 class FaultState:
@@ -33,31 +87,27 @@ class FaultState:
         self._partial: dict[int, bytes] = {}
 
     def arm(self, fault, **params):
-        try:
-            if fault == "reply_delay":
-                self.delay = float(params.get("seconds", 0.5))
-                self.delay_count = params.get("count")
-            elif fault == "split_replies":
-                self.split = max(1, int(params.get("size", 1)))
-            elif fault == "glue_replies":
-                self.glue = max(2, int(params.get("count", 2)))
-                self.glue_wait = float(params.get("max_wait", 0.05))
-            elif fault == "corrupt_checksum":
-                self.corrupt += int(params.get("count", 1))
-            elif fault == "close_after":
-                self.close_after = max(0, int(params.get("frames", 1)))
-            elif fault == "close_mid_frame":
-                self.close_mid = True
-            elif fault == "black_hole":
-                self.black_hole = bool(params.get("enabled", True))
-            elif fault == "refuse_connections":
-                self.refuse = bool(params.get("enabled", True))
-            else:
-                raise ValueError(f"unknown fault '{fault}'; known faults: {', '.join(KNOWN)}")
-        except (TypeError, ValueError) as exc:
-            if "unknown fault" in str(exc):
-                raise
-            raise ValueError(f"bad parameter for fault '{fault}': {exc}") from None
+        params = check_params(fault, params)
+        if fault == "reply_delay":
+            self.delay = params["seconds"]
+            self.delay_count = params["count"]
+        elif fault == "split_replies":
+            self.split = params["size"]
+        elif fault == "glue_replies":
+            self.glue = params["count"]
+            self.glue_wait = params["max_wait"]
+        elif fault == "corrupt_checksum":
+            self.corrupt = min(self.corrupt + params["count"], 10 ** 6)
+        elif fault == "close_after":
+            self.close_after = params["frames"]
+        elif fault == "close_mid_frame":
+            self.close_mid = True
+        elif fault == "black_hole":
+            self.black_hole = params["enabled"]
+        elif fault == "refuse_connections":
+            self.refuse = params["enabled"]
+        else:
+            raise ValueError(f"fault '{fault}' is not an output fault")
 
     @property
     def active(self) -> bool:
@@ -117,6 +167,11 @@ class FaultState:
             ready_bytes = [b"".join(item[2] for item in ready)]
         else:
             ready_bytes = [item[2] for item in ready]
+        held = self._partial.pop(conn, b"")
+        if held and not self.split:          # pieces of a split that was cleared: they go first, whole
+            return [held, *ready_bytes], False
+        if held:
+            self._partial[conn] = held
         if self.split:
             partial = self._partial.get(conn, b"") + b"".join(ready_bytes)
             piece, rest = partial[: self.split], partial[self.split:]
@@ -125,6 +180,4 @@ class FaultState:
         return ready_bytes, False
 
 
-KNOWN = ("reply_delay", "split_replies", "glue_replies", "corrupt_checksum", "close_after",
-         "close_mid_frame", "black_hole", "refuse_connections", "reply_error", "leave_node",
-         "stop_project", "disconnect")
+KNOWN = tuple(PARAMS)

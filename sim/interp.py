@@ -8,14 +8,24 @@
 It returns "exit" when ScriptExit() ran (the rest of the packet is ignored), else None.
 Immediate statements run when reached; motions, queue tags, base/TCP/load changes and DO/AO writes
 are appended to the robot FIFO.
+
+Values are bounded as on the robot (sim/limits.py; each bound is a run-time ``ERROR;line``):
+int arithmetic wraps at 32 bits and byte arithmetic at 8 bits [MAN 2.24 §2.2]; a float variable refuses
+a value beyond ±3.4028235E+38, infinity or NaN [MAN 2.24 §2.5]; arrays hold at most 2048 elements
+[MAN 2.24 §2.3]; strings at most STRING_MAX characters; a project at most VARIABLES_MAX variables using
+VARIABLE_BYTES_MAX bytes; one script at most STEPS_MAX steps of work. A script's intermediate values
+are freed when it ends; its variables live until the flow leaves the Listen node.
 """
 from __future__ import annotations
 
+import math
 import struct
 
 from . import script as ast
 from .checker import IO_WRITABLE
 from .codec import encode as encode_frame
+from .limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
+                     VARIABLES_MAX)
 from .motion import MotionRequest
 
 MOTIONS = ("PTP", "Line", "Circle", "PLine", "Move_PTP", "Move_Line", "Move_PLine")
@@ -33,6 +43,8 @@ class Context:
         self.robot = robot
         self.vars = variables
         self.types = types
+        self.steps = 0                          # work done by this script (STEPS_MAX)
+        self.var_bytes = sum(map(_size, variables.values()))
         self.listen_send = listen_send          # (ip_filter or None, sub, payload bytes) -> None
         self.stop_and_clear = stop_and_clear    # () -> None
         self.log_line = log_line                # (line) -> None
@@ -46,22 +58,28 @@ def run_script(lines, ctx: Context):
         ctx.log_line(line)
         try:
             stmt = line.stmt
+            _work(ctx, 1)
             if isinstance(stmt, ast.Decl):
                 type_name = stmt.type + ("[]" if stmt.is_array else "")
-                ctx.types[stmt.name] = type_name
+                if stmt.name not in ctx.vars and len(ctx.vars) >= VARIABLES_MAX:
+                    raise ScriptRuntimeError(f"the project holds at most {VARIABLES_MAX} variables")
                 if stmt.init is None:
-                    ctx.vars[stmt.name] = [] if stmt.is_array else _DEFAULTS[stmt.type]
+                    value = _Array() if stmt.is_array else _DEFAULTS[stmt.type]
                 else:
-                    ctx.vars[stmt.name] = _coerce(type_name, (yield from _eval(stmt.init, ctx, line)))
+                    _check_constant(type_name, stmt.init)
+                    value = _coerce(type_name, (yield from _eval(stmt.init, ctx, line)), ctx)
+                _set_variable(ctx, stmt.name, type_name, value)
             elif isinstance(stmt, ast.Assign):
                 value = yield from _eval(stmt.value, ctx, line)
                 if stmt.op != "=":
                     current = yield from _eval(stmt.target, ctx, line)
-                    value = _arith(stmt.op[0], current, value)
+                    value = _arith(stmt.op[0], current, value, ctx)
+                elif isinstance(stmt.target, ast.Name):
+                    _check_constant(ctx.types.get(stmt.target.id, "any"), stmt.value)
                 yield from _store(stmt.target, value, ctx, line)
             elif isinstance(stmt, ast.IncDec):
                 current = yield from _eval(stmt.target, ctx, line)
-                yield from _store(stmt.target, current + (1 if stmt.op == "++" else -1), ctx, line)
+                yield from _store(stmt.target, _arith("+" if stmt.op == "++" else "-", current, 1, ctx), ctx, line)
             elif isinstance(stmt.expr, ast.Call) and stmt.expr.name == "ScriptExit":
                 return "exit"
             else:
@@ -73,32 +91,123 @@ def run_script(lines, ctx: Context):
     return None
 
 
-def _coerce(type_name, value):
-    if type_name in ("int", "byte"):
+class _Array(list):
+    """An array value of a variable; ``nbytes`` is its share of VARIABLE_BYTES_MAX (kept up to date)."""
+    __slots__ = ("nbytes",)
+
+    def __init__(self, items=(), nbytes=None):
+        super().__init__(items)
+        self.nbytes = sum(map(_size, self)) if nbytes is None else nbytes
+
+
+def _size(value) -> int:
+    """Bytes a variable value counts against VARIABLE_BYTES_MAX: 8 a number, 1 a character."""
+    if type(value) is str:
+        return 8 + len(value)
+    if type(value) is _Array:
+        return 8 + value.nbytes
+    if isinstance(value, list):
+        return 8 + sum(map(_size, value))
+    return 8
+
+
+def _work(ctx, steps):
+    ctx.steps += steps
+    if ctx.steps > STEPS_MAX:
+        raise ScriptRuntimeError(f"the script needs more than {STEPS_MAX} steps of work; "
+                                 f"send it in smaller packets")
+
+
+def _set_variable(ctx, name, type_name, value):
+    """Store a whole variable, keeping the project within VARIABLE_BYTES_MAX."""
+    new = _size(value)
+    old = _size(ctx.vars[name]) if name in ctx.vars else 0
+    if ctx.var_bytes - old + new > VARIABLE_BYTES_MAX:
+        raise ScriptRuntimeError(f"variable memory full: the project's variables may use {VARIABLE_BYTES_MAX} bytes")
+    ctx.var_bytes += new - old
+    ctx.types[name] = type_name
+    ctx.vars[name] = value
+
+
+def _wrap_int(value: int) -> int:
+    """[MAN 2.24 §2.2] int keeps the low 32 bits of a result, as a signed value (2147483647 + 1 = -2147483648)."""
+    if INT_MIN <= value <= INT_MAX:
+        return value
+    return ((value - INT_MIN) & 0xFFFFFFFF) + INT_MIN
+
+
+def _check_constant(type_name, node):
+    """[MAN 2.24 §2.2] a constant outside the byte range assigned to a byte is an Error (byte b = -100)."""
+    if type_name == "byte" and isinstance(node, ast.Num) and not 0 <= node.value <= BYTE_MAX:
+        raise ScriptRuntimeError(f"constant {node.value} is outside the byte range 0..{BYTE_MAX}")
+
+
+def _to_int(value) -> int:
+    if isinstance(value, float):
+        if not math.isfinite(value) or not INT_MIN <= value < INT_MAX + 1:
+            raise ScriptRuntimeError(f"value {value:g} does not fit int ({INT_MIN}..{INT_MAX})")
         return int(value)
-    if type_name == "float":
-        return float(value)
-    if type_name.endswith("[]"):
-        return [_coerce(type_name[:-2], v) for v in value]
+    return _wrap_int(int(value))
+
+
+def _to_float(value) -> float:
+    value = float(value)
+    if not math.isfinite(value) or abs(value) > FLOAT_MAX:        # [MAN 2.24 §2.5]
+        raise ScriptRuntimeError(f"value {value:g} is outside the float range (±3.4028235E+38)")
     return value
 
 
-def _arith(op, a, b):
+def _coerce(type_name, value, ctx):
+    if type_name == "int":
+        return _to_int(value)
+    if type_name == "byte":
+        return _to_int(value) & BYTE_MAX          # [MAN 2.24 §2.2] byte keeps the low 8 bits (0 - 1 = 255)
+    if type_name == "float":
+        return _to_float(value)
+    if type_name.endswith("[]"):
+        if len(value) > ARRAY_MAX:
+            raise ScriptRuntimeError(f"an array holds at most {ARRAY_MAX} elements, got {len(value)}")
+        _work(ctx, len(value) // 8)
+        element = type_name[:-2]
+        if element == "int" and all(type(v) is int and INT_MIN <= v <= INT_MAX for v in value):
+            items = list(value)                   # fast path: a copy of valid values (array = array)
+        elif element == "float" and all(type(v) is float and -FLOAT_MAX <= v <= FLOAT_MAX for v in value):
+            items = list(value)
+        else:
+            items = [_coerce(element, v, ctx) for v in value]
+        return _Array(items, 8 * len(items) + sum(len(v) for v in items if type(v) is str))
+    if type(value) is str and len(value) > STRING_MAX:
+        raise ScriptRuntimeError(f"a string holds at most {STRING_MAX} characters")
+    return value
+
+
+def _arith(op, a, b, ctx):
+    if op == "+" and (isinstance(a, str) or isinstance(b, str)):
+        a, b = str(a), str(b)
+        if len(a) + len(b) > STRING_MAX:
+            raise ScriptRuntimeError(f"a string holds at most {STRING_MAX} characters")
+        _work(ctx, (len(a) + len(b)) // 256)
+        return a + b
+    if isinstance(a, (str, list)) or isinstance(b, (str, list)):
+        raise ScriptRuntimeError(f"operator {op} needs numbers")
+    integer = not (isinstance(a, float) or isinstance(b, float))
     if op == "+":
-        return (str(a) + str(b)) if isinstance(a, str) or isinstance(b, str) else a + b
-    if op == "-":
-        return a - b
-    if op == "*":
-        return a * b
-    if op == "/":
+        result = a + b
+    elif op == "-":
+        result = a - b
+    elif op == "*":
+        result = a * b
+    elif op == "/":
         if b == 0:
             raise ScriptRuntimeError("division by zero")
-        return a / b if isinstance(a, float) or isinstance(b, float) else int(a / b)
-    if op == "%":
+        result = int(a / b) if integer else a / b
+    elif op == "%":
         if b == 0:
             raise ScriptRuntimeError("division by zero")
-        return a % b
-    raise ScriptRuntimeError(f"unsupported operator {op}")
+        result = a % b
+    else:
+        raise ScriptRuntimeError(f"unsupported operator {op}")
+    return _wrap_int(result) if integer else result
 
 
 _COMPARE = {"==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
@@ -110,6 +219,8 @@ def _io_key(node, ctx, line):
     module = member.obj.index
     name = module.id if isinstance(module, ast.Name) else module.value
     index = yield from _eval(node.index, ctx, line)
+    if not 0 <= index <= IO_INDEX_MAX:
+        raise ScriptRuntimeError(f"IO index {index} is outside 0..{IO_INDEX_MAX}")
     return f"{name}.{member.name}[{index}]", member.name
 
 
@@ -121,7 +232,8 @@ def _is_io(node):
 
 def _store(target, value, ctx, line):
     if isinstance(target, ast.Name):
-        ctx.vars[target.id] = _coerce(ctx.types.get(target.id, "any"), value)
+        type_name = ctx.types.get(target.id, "any")
+        _set_variable(ctx, target.id, type_name, _coerce(type_name, value, ctx))
         return
     if _is_io(target):
         key, member = yield from _io_key(target, ctx, line)
@@ -138,13 +250,26 @@ def _store(target, value, ctx, line):
     if isinstance(target, ast.Member):          # Robot[0].CameraLight
         ctx.robot.io["CameraLight"] = int(value)
         return
-    array = ctx.vars[target.obj.id]
+    name = target.obj.id
+    array = ctx.vars[name]
     index = yield from _eval(target.index, ctx, line)
-    if index < 0:
-        raise ScriptRuntimeError(f"index {index} is negative")
-    while len(array) <= index:
-        array.append(_DEFAULTS.get(ctx.types[target.obj.id][:-2], 0))
-    array[index] = _coerce(ctx.types[target.obj.id][:-2], value)
+    if not 0 <= index < ARRAY_MAX:           # [MAN 2.24 §2.3] at most 2048 elements
+        raise ScriptRuntimeError(f"index {index} is outside 0..{ARRAY_MAX - 1} (an array holds at most "
+                                 f"{ARRAY_MAX} elements)")
+    element_type = ctx.types[name][:-2]
+    value = _coerce(element_type, value, ctx)
+    default = _DEFAULTS.get(element_type, 0)
+    grown = max(0, index + 1 - len(array))
+    old = _size(array[index]) if index < len(array) else 0
+    added = grown * _size(default) - (_size(default) if grown else 0) + _size(value) - old
+    if ctx.var_bytes + added > VARIABLE_BYTES_MAX:
+        raise ScriptRuntimeError(f"variable memory full: the project's variables may use {VARIABLE_BYTES_MAX} bytes")
+    _work(ctx, grown)
+    array.extend([default] * grown)
+    array[index] = value
+    ctx.var_bytes += added
+    if type(array) is _Array:
+        array.nbytes += added
 
 
 _LITERALS = frozenset({ast.Num, ast.Str, ast.Bool})
@@ -157,14 +282,22 @@ def _eval(node, ctx, line):
         return node.value
     if isinstance(node, ast.Name):
         return ctx.vars[node.id] if node.id in ctx.vars else node.id     # else: unquoted string constant
+    ctx.steps += 1
     if isinstance(node, ast.Array):
+        if len(node.items) > ARRAY_MAX:
+            raise ScriptRuntimeError(f"an array holds at most {ARRAY_MAX} elements, got {len(node.items)}")
         values = []
         for item in node.items:
-            values.append((yield from _eval(item, ctx, line)))
+            if type(item) in _LITERALS:             # no generator for a literal element
+                values.append(item.value)
+            else:
+                values.append((yield from _eval(item, ctx, line)))
         return values
     if isinstance(node, ast.Unary):
         value = yield from _eval(node.operand, ctx, line)
-        return (not value) if node.op == "!" else -value
+        if node.op == "!":
+            return not value
+        return -value if isinstance(value, float) else _wrap_int(-value)
     if isinstance(node, ast.Binary):
         left = yield from _eval(node.left, ctx, line)
         if node.op in ("&&", "||"):
@@ -174,7 +307,7 @@ def _eval(node, ctx, line):
         right = yield from _eval(node.right, ctx, line)
         if node.op in _COMPARE:
             return _COMPARE[node.op](left, right)
-        return _arith(node.op, left, right)
+        return _arith(node.op, left, right, ctx)
     if isinstance(node, ast.Call):
         args = []
         for arg in node.args:

@@ -11,11 +11,19 @@ One statement per line. Grammar (informal)::
     add       = mul {("+"|"-") mul} ; mul = unary {("*"|"/"|"%") unary} ; unary = ("-"|"!"|"+") unary | postfix
     postfix   = primary { "[" expr "]" | "." NAME }
     primary   = NUMBER | STRING | true | false | NAME ["(" [expr {"," expr}] ")"] | "{" [expr {"," expr}] "}" | "(" expr ")"
+
+Bounds (sim/limits.py), each a syntax error of its line (``ERROR;line``): at most TOKENS_MAX tokens per
+script (a line that is a call with constant arguments only - a motion line - counts as one), DEPTH_MAX
+levels of nesting per expression, STATEMENTS_MAX statements per script, string constants of at most
+STRING_MAX characters, hexadecimal constants of at most 32 bits. A decimal integer constant beyond the
+int range is a float constant ([MAN 2.24 §2.2]: constants take the smallest type that holds them).
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+
+from .limits import DEPTH_MAX, HEX_DIGITS_MAX, INT_MAX, STATEMENTS_MAX, STRING_MAX, TOKENS_MAX
 
 TYPES = frozenset({"int", "float", "double", "string", "bool", "byte"})
 
@@ -141,6 +149,30 @@ def _unescape(body: str) -> str:
     return re.sub(r"\\(.)", lambda m: _ESCAPES.get(m.group(1), m.group(1)), body)
 
 
+def number_value(text: str) -> tuple[int | float, bool]:
+    """(value, is_float) of a decimal or 0x constant; ScriptSyntaxError when it cannot be a TM number.
+
+    [MAN 2.24 §2.2] a constant takes the smallest type that holds it: a decimal integer beyond int
+    (32 bits; 2147483648 is kept so that -2147483648 works) is a float constant; a float constant
+    beyond the double range reads as infinity (a motion with it is a robot error, a variable refuses it).
+    A hexadecimal constant is 32 bits at most: 0x80000000..0xFFFFFFFF are the negative ints.
+    """
+    if text[:2] in ("0x", "0X"):
+        digits = text[2:].lstrip("0")
+        if len(digits) > HEX_DIGITS_MAX:
+            raise ScriptSyntaxError(f"hexadecimal constant {text[:12]}... is wider than 32 bits")
+        value = int(digits or "0", 16)
+        return (value - (1 << 32) if value > INT_MAX else value), False
+    if "." in text or "e" in text or "E" in text:
+        return float(text), True
+    if len(text) <= 10 and int(text) <= INT_MAX + 1:
+        return int(text), False
+    return float(text), True
+
+
+_TOO_LONG = f"script longer than {TOKENS_MAX} elements (names, numbers, operators); split it into packets"
+
+
 def tokenize(text: str) -> list[tuple[str, object]]:
     """Return (kind, value) tokens: num, str, name, op; raises ScriptSyntaxError."""
     tokens, pos, n = [], 0, len(text)
@@ -155,17 +187,16 @@ def tokenize(text: str) -> list[tuple[str, object]]:
         if kind in ("num", "hex"):
             if end < n and (text[end].isalnum() or text[end] == "_"):
                 raise ScriptSyntaxError(f"malformed number at column {pos + 1}")
-            if kind == "hex":
-                tokens.append(("num", (int(value, 16), False)))
-            elif "." in value or "e" in value or "E" in value:
-                tokens.append(("num", (float(value), True)))
-            else:
-                tokens.append(("num", (int(value), False)))
+            tokens.append(("num", number_value(value)))
         elif kind == "name" or kind == "op":
             tokens.append((kind, value))
         elif kind == "str":
+            if end - pos - 2 > STRING_MAX:
+                raise ScriptSyntaxError(f"string constant longer than {STRING_MAX} characters")
             tokens.append(("str", _unescape(value[1:-1])))
         pos = end
+        if len(tokens) > TOKENS_MAX:
+            raise ScriptSyntaxError(_TOO_LONG)
     tokens.append(("end", None))
     return tokens
 
@@ -314,6 +345,36 @@ def _check_target(expr):
         raise ScriptSyntaxError("the left side of an assignment must be a variable or an IO point")
 
 
+def _check_depth(stmt):
+    """ScriptSyntaxError when an expression of ``stmt`` nests deeper than DEPTH_MAX (e.g. a sum of more
+    than DEPTH_MAX terms: each '+' holds the terms before it)."""
+    stack = [(stmt, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > DEPTH_MAX:
+            raise ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
+        kind = type(node)
+        if kind is Binary:
+            stack += ((node.left, depth + 1), (node.right, depth + 1))
+        elif kind is Call or kind is Array:
+            stack += ((item, depth + 1) for item in (node.args if kind is Call else node.items))
+        elif kind is Unary:
+            stack.append((node.operand, depth + 1))
+        elif kind is Index:
+            stack += ((node.obj, depth + 1), (node.index, depth + 1))
+        elif kind is Member:
+            stack.append((node.obj, depth + 1))
+        elif kind is Decl:
+            if node.init is not None:
+                stack.append((node.init, depth))
+        elif kind is Assign:
+            stack += ((node.target, depth), (node.value, depth))
+        elif kind is IncDec:
+            stack.append((node.target, depth))
+        elif kind is ExprStmt:
+            stack.append((node.expr, depth))
+
+
 def _describe(tok):
     kind, value = tok
     if kind == "end":
@@ -327,6 +388,7 @@ def _describe(tok):
 
 _CACHE: dict[str, object] = {}
 _CACHE_SIZE = 4096
+_CACHE_LINE = 512          # longer lines are not kept: the cache stays below ~4 MB
 
 
 # A call whose arguments are all plain literals - the shape of nearly every streamed motion line,
@@ -356,46 +418,73 @@ def _simple_call(text: str):
                 args.append(Bool(first == "t"))
             else:
                 minus = first == "-"
-                digits = piece[1:].lstrip(" \t") if minus else piece
-                if "." in digits or "e" in digits or "E" in digits:
-                    args.append(Num(-float(digits) if minus else float(digits), True))
-                else:
-                    args.append(Num(-int(digits) if minus else int(digits), False))
+                value, is_float = number_value(piece[1:].lstrip(" \t") if minus else piece)
+                args.append(Num(-value if minus else value, is_float))
     return ExprStmt(Call(match.group(1), args))
 
 
-def parse_line(text: str) -> object:
-    """Parse one script line into a statement node; raises ScriptSyntaxError.
+def _parse(text: str) -> tuple[object, int]:
+    """(statement node or ScriptSyntaxError, tokens it counts against TOKENS_MAX).
 
-    Statement trees are never modified after parsing, so the results of recently seen lines are
+    Statement trees are never modified after parsing, so the results of recently seen short lines are
     cached (PLC clients send the same lines again and again).
     """
     cached = _CACHE.get(text)
     if cached is None:
+        cost = 1
         try:
-            cached = _simple_call(text) or _Parser(tokenize(text)).line()
+            stmt = _simple_call(text)
+            if stmt is None:
+                tokens = tokenize(text)
+                cost = len(tokens)
+                stmt = _Parser(tokens).line()
+                _check_depth(stmt)
         except ScriptSyntaxError as exc:
-            cached = exc
+            stmt = exc
         except RecursionError:
-            cached = ScriptSyntaxError("expression nested too deeply")
-        if len(_CACHE) >= _CACHE_SIZE:
-            _CACHE.clear()
-        _CACHE[text] = cached
-    if isinstance(cached, ScriptSyntaxError):
-        raise cached
+            stmt = ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
+        cached = (stmt, cost)
+        if len(text) <= _CACHE_LINE:
+            if len(_CACHE) >= _CACHE_SIZE:
+                _CACHE.clear()
+            _CACHE[text] = cached
     return cached
 
 
+def parse_line(text: str) -> object:
+    """Parse one script line into a statement node; raises ScriptSyntaxError."""
+    stmt = _parse(text)[0]
+    if isinstance(stmt, ScriptSyntaxError):
+        raise stmt
+    return stmt
+
+
 def split_lines(script: str) -> list[Line]:
-    """Split a script on CR LF (the protocol's line separator) and parse each line."""
-    lines = []
+    """Split a script on CR LF (the protocol's line separator) and parse each line. The line that goes
+    beyond STATEMENTS_MAX statements or TOKENS_MAX tokens is an error; the lines after it are not parsed."""
+    lines, statements, tokens, full = [], 0, 0, False
     for number, text in enumerate(script.split("\r\n"), start=1):
         line = Line(number, text)
-        try:
-            if "\r" in text or "\n" in text:
-                raise ScriptSyntaxError("lines must be separated by CR LF")
-            line.stmt = parse_line(text)
-        except ScriptSyntaxError as exc:
-            line.error = str(exc)
         lines.append(line)
+        if full:
+            line.stmt = Empty()
+            continue
+        if "\r" in text or "\n" in text:
+            line.error = "lines must be separated by CR LF"
+            continue
+        stmt, cost = _parse(text)
+        if isinstance(stmt, Empty):
+            line.stmt = stmt
+            continue
+        statements += 1
+        tokens += cost
+        if statements > STATEMENTS_MAX:
+            line.error = f"a script holds at most {STATEMENTS_MAX} statements; send the rest in another packet"
+        elif tokens > TOKENS_MAX:
+            line.error = _TOO_LONG
+        elif isinstance(stmt, ScriptSyntaxError):
+            line.error = str(stmt)
+        else:
+            line.stmt = stmt
+        full = statements > STATEMENTS_MAX or tokens > TOKENS_MAX
     return lines

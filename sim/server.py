@@ -12,8 +12,10 @@ Limits (per robot unless noted):
 """
 from __future__ import annotations
 
+import errno
 import gc
 import json
+import math
 import selectors
 import socket
 import threading
@@ -22,7 +24,8 @@ import time
 from . import codec
 from .control import ControlChannel
 from .ethernet_slave import EthernetSlave
-from .faults import KNOWN as KNOWN_FAULTS, FaultState
+from .faults import FaultState, check_params as check_fault_params
+from .limits import ACCEPT_BACKOFF_S, EVENT_BYTES_MAX
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
 
@@ -30,7 +33,9 @@ MAX_CLIENTS = 256
 MAX_PENDING = 1000
 MAX_OUTBOX = 1 << 20
 RECV_SIZE = 65536
-EVENT_BUDGET = 40_000       # events kept in memory (~0.5 KB each), shared by all robots (the JSONL file gets all)
+EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all) ...
+EVENT_OVERHEAD = 200        # ... and at most limits.EVENT_BYTES_MAX bytes: an event counts this + its texts
+_OUT_OF_DESCRIPTORS = (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM)
 POLL_BUDGET_S = 0.004       # after this long, one poll() stops serving sockets in between and ends
 GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
@@ -56,12 +61,16 @@ class Robot:
         self.index = index
         self.port = port
         self.events: list[dict] = []
+        self.events_dropped = 0                  # events removed from the front of ``events`` so far
+        self._event_sizes: list[int] = []
+        self.event_bytes = 0
         self._waiters: list[tuple] = []          # (predicate, threading.Event, [match]) of wait_event
         self.faults = FaultState()
         self.session = ListenSession(RobotModel(tag_history=tag_history, bases=frames[0], tools=frames[1]),
                                      send_message, self._log,
                                      auto_enter=auto_enter, data_timeout=timeouts[0], connection_timeout=timeouts[1])
         self.listener = None
+        self.accept_paused_until = None          # out of descriptors: the listener is not watched until then
         self.conns: dict[int, _Conn] = {}
         self.reading_paused = False
 
@@ -70,16 +79,38 @@ class Robot:
         session = self.__dict__.get("session")
         event = {"t": round(session.now, 6) if session is not None else 0.0, "robot": self.index, "kind": kind,
                  **fields}
+        if self._server.log_file is not None:
+            self._server.log_file.write(json.dumps(event, ensure_ascii=False) + "\n")
+        size = EVENT_OVERHEAD
+        for value in fields.values():
+            if type(value) is str:
+                size += len(value)
+        budget = self._server.event_bytes_limit
+        if size > budget // 4:                   # one huge event must not push out all others
+            event, size = _shortened(event, budget // 4), budget // 4
         self.events.append(event)
+        self._event_sizes.append(size)
+        self.event_bytes += size
         if self._waiters:
             for predicate, flag, found in list(self._waiters):
                 if not flag.is_set() and predicate(event):
                     found.append(event)
                     flag.set()
-        if len(self.events) > self._server.event_limit:
-            del self.events[: len(self.events) // 2]
-        if self._server.log_file is not None:
-            self._server.log_file.write(json.dumps(event, ensure_ascii=False) + "\n")
+        if len(self.events) > self._server.event_limit or self.event_bytes > budget:
+            self._drop_old_events()
+
+    def _drop_old_events(self):
+        """Drop the oldest events until at most half the count and half the bytes are kept."""
+        keep_bytes, count = self._server.event_bytes_limit // 2, len(self.events)
+        cut, excess = max(0, count - self._server.event_limit // 2), self.event_bytes - keep_bytes
+        dropped_bytes = sum(self._event_sizes[:cut])
+        while cut < count and dropped_bytes < excess:
+            dropped_bytes += self._event_sizes[cut]
+            cut += 1
+        del self.events[:cut]
+        del self._event_sizes[:cut]
+        self.event_bytes -= dropped_bytes
+        self.events_dropped += cut
 
     def wait_event(self, kind: str, timeout: float = 5.0, since: int = 0, **fields) -> dict | None:
         """First event of ``kind`` whose fields equal ``fields``, among events[since:] or logged later
@@ -119,18 +150,15 @@ class Robot:
                 self.session.fire("enter_node", source="control")
 
     def inject(self, fault: str, **params):
-        """Arm a fault (see docs/simulator.md, 'Fault injection'); raises ValueError when unknown."""
-        if fault not in KNOWN_FAULTS:
-            raise ValueError(f"unknown fault '{fault}'; known faults: {', '.join(KNOWN_FAULTS)}")
+        """Arm a fault (see docs/simulator.md, 'Fault injection'); raises ValueError when unknown or when a
+        parameter is out of its range (faults.PARAMS)."""
+        checked = check_fault_params(fault, params)
         with self._server.lock:
             if fault == "reply_error":
-                try:
-                    self.session.faults["reply_error"] += int(params.get("count", 1))
-                except (TypeError, ValueError):
-                    raise ValueError(f"bad parameter for fault 'reply_error': count must be an integer, "
-                                     f"got {params.get('count')!r}") from None
+                self.session.faults["reply_error"] = min(self.session.faults["reply_error"] + checked["count"],
+                                                         10 ** 6)
             elif fault == "leave_node":
-                self.session.fire("leave_node", path=params.get("path", "Pass"), source="fault")
+                self.session.fire("leave_node", path=checked["path"], source="fault")
             elif fault == "stop_project":
                 self.stop_project()
             elif fault == "refuse_connections":
@@ -155,7 +183,8 @@ class Robot:
     def state(self) -> dict:
         with self._server.lock:
             data = self.session.snapshot()
-            data.update(port=self.port, clients=len(self.conns), faults=self.faults.describe())
+            data.update(port=self.port, clients=len(self.conns), faults=self.faults.describe(),
+                        events_kept=len(self.events), event_bytes=self.event_bytes)
             return data
 
 
@@ -163,14 +192,15 @@ class SimServer:
     def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
                  send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
                  control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None,
-                 manage_gc=False, svr_port=None, svr_options=None):
+                 manage_gc=False, svr_port=None, svr_options=None, control_host="127.0.0.1"):
         if not 1 <= robots <= 512:
             raise ValueError(f"robots must be 1..512, got {robots}")
-        if speedup <= 0:
-            raise ValueError(f"speedup must be positive, got {speedup}")
+        if not (math.isfinite(speedup) and speedup > 0):
+            raise ValueError(f"speedup must be a positive number, got {speedup}")
         self.host, self.speedup, self.auto_enter = host, speedup, auto_enter
         self.lock = threading.RLock()
         self.event_limit = event_limit or EVENT_BUDGET // robots    # per robot: all robots together keep <= 40,000
+        self.event_bytes_limit = EVENT_BYTES_MAX // robots           # per robot: all together keep <= 20 MiB
         try:
             self.log_file = open(log_path, "a", encoding="utf-8", buffering=1) if log_path else None
         except OSError as exc:
@@ -192,6 +222,7 @@ class SimServer:
         self._control_port = control_port
         self.svr = None                       # Ethernet Slave (sim/ethernet_slave.py) when svr_port is not None
         self._svr = (svr_port, svr_options or {})
+        self._control_host = control_host
 
     @property
     def ports(self) -> list[int]:
@@ -204,7 +235,7 @@ class SimServer:
                 for robot in self.robots:
                     self._listen(robot)
                 if self._control_port is not None:
-                    self.control = ControlChannel(self, self.host, self._control_port)
+                    self.control = ControlChannel(self, self._control_host, self._control_port)
                 if self._svr[0] is not None:
                     self.svr = EthernetSlave(self, self._svr[0], **self._svr[1])
             except OSError:
@@ -231,11 +262,20 @@ class SimServer:
         self.selector.register(sock, selectors.EVENT_READ, ("listen", robot, None))
         robot._log("listening", host=self.host, port=robot.port)
 
+    def _close_listener(self, robot):
+        if robot.accept_paused_until is None:
+            self.selector.unregister(robot.listener)
+        robot.accept_paused_until = None
+        robot.listener.close()
+        robot.listener = None
+
+    def _log_server(self, kind, **fields):
+        """An event of the server as a whole (control channel): logged in robot 0's log."""
+        self.robots[0]._log(kind, **fields)
+
     def _apply_refuse(self, robot):
         if robot.faults.refuse and robot.listener is not None:
-            self.selector.unregister(robot.listener)
-            robot.listener.close()
-            robot.listener = None
+            self._close_listener(robot)
         elif not robot.faults.refuse and robot.listener is None and robot.session.state != STOPPED:
             self._listen(robot)
 
@@ -243,9 +283,7 @@ class SimServer:
         for conn in list(robot.conns.values()):
             self._drop(robot, conn, reason)
         if robot.listener is not None:
-            self.selector.unregister(robot.listener)
-            robot.listener.close()
-            robot.listener = None
+            self._close_listener(robot)
 
     def close(self):
         self.stop()
@@ -303,12 +341,17 @@ class SimServer:
             self._poll_end = self._slice_start + POLL_BUDGET_S
             for robot in self.robots:
                 session = robot.session
+                if robot.accept_paused_until is not None and self._now >= robot.accept_paused_until:
+                    robot.accept_paused_until = None
+                    self.selector.register(robot.listener, selectors.EVENT_READ, ("listen", robot, None))
                 self._advance(robot)
                 if any(client.outbox for client in session.clients.values()) and not robot.faults.active:
                     self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
                 self._breathe()
             if self.svr is not None:
                 self.svr.poll(self._now)
+            if self.control is not None:
+                self.control.tick(self._now)
             ready = self._serve(timeout)
             self._start_touched()
             for robot in self.robots:
@@ -397,7 +440,13 @@ class SimServer:
             except (BlockingIOError, InterruptedError):
                 return
             except OSError as exc:
-                robot._log("accept_error", reason=exc.strerror)
+                if exc.errno in _OUT_OF_DESCRIPTORS:
+                    # the listener stays readable: watching it now would spin; try again after a pause
+                    self.selector.unregister(robot.listener)
+                    robot.accept_paused_until = self._now + ACCEPT_BACKOFF_S
+                    robot._log("accept_paused", reason=exc.strerror, seconds=ACCEPT_BACKOFF_S)
+                else:
+                    robot._log("accept_error", reason=exc.strerror)
                 return
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -517,6 +566,13 @@ def _collect_garbage(idle: bool):
     young, middle, old = gc.get_count()
     if young >= (GC_IDLE if idle else GC_FORCE):
         gc.collect(2 if old >= 10 else 1 if middle >= 10 else 0)
+
+
+def _shortened(event, size):
+    """A copy of ``event`` whose long texts are cut so that it counts about ``size`` bytes."""
+    room = max(64, (size - EVENT_OVERHEAD) // max(1, sum(type(v) is str for v in event.values())))
+    return {key: (value[:room] + f"...[{len(value)} characters]" if type(value) is str and len(value) > room
+                  else value) for key, value in event.items()}
 
 
 def _send(sock, data) -> int:

@@ -3,15 +3,18 @@
     python sim/tmflow_listener.py [--host 127.0.0.1] [--port 5890] [--robots N]
                                   [--realtime | --speedup K] [--log FILE.jsonl]
                                   [--no-auto-enter] [--send-message Listen1]
-                                  [--control-port 5889 | --no-control] [--tag-history 4]
-                                  [--data-timeout S] [--connection-timeout S]
+                                  [--control-port 5889 | --no-control] [--control-host 127.0.0.1]
+                                  [--tag-history 4] [--data-timeout S] [--connection-timeout S]
                                   [--svr-port PORT | --no-svr] [--svr-period S]
                                   [--svr-format binary|string|json] [--svr-items A,B,...]
+
+Every number is range-checked before anything starts; a bad one is one line on stderr, exit code 2.
 """
 from __future__ import annotations
 
 import argparse
 import gc
+import math
 import os
 import signal
 import sys
@@ -46,12 +49,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--control-port", type=int, default=5889, metavar="PORT",
                         help="port of the local JSON control channel (default 5889, 0 = any free port)")
     parser.add_argument("--no-control", action="store_true", help="do not open the control channel")
+    parser.add_argument("--control-host", default="127.0.0.1", metavar="ADDRESS",
+                        help="address of the control channel (default 127.0.0.1, whatever --host says)")
     parser.add_argument("--data-timeout", type=float, default=0.0, metavar="S",
                         help="leave the node via Fail after S seconds without a packet (0 = none, default)")
     parser.add_argument("--connection-timeout", type=float, default=0.0, metavar="S",
                         help="leave the node via Fail when no client connected within S seconds (0 = none)")
     parser.add_argument("--tag-history", type=int, default=4, metavar="N",
-                        help="number of reached queue tags the robot remembers (default 4)")
+                        help="number of reached queue tags the robot remembers (1..1000, default 4)")
     svr = parser.add_argument_group("Ethernet Slave ($TMSVR, TMscript manual chapter 17)")
     svr.add_argument("--svr-port", type=int, default=None, metavar="PORT",
                      help="Ethernet Slave port of robot 1, further robots the next ports "
@@ -67,27 +72,40 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+MAX_SPEEDUP = 1000.0
+MAX_NODE_TIMEOUT_S = 86_400.0
+
+
+def check_args(args) -> tuple[list[str], int | None, list[str]]:
+    """(one line per argument outside its range, Ethernet Slave port or None, its data-table items)."""
     problems = []
     if not 1 <= args.robots <= 512:
         problems.append(f"--robots must be between 1 and 512 (got {args.robots})")
     if not 0 <= args.port <= 65535 or (args.port and args.port + args.robots - 1 > 65535):
         problems.append(f"--port {args.port} with {args.robots} robot(s) leaves the port range 1..65535")
-    if args.speedup <= 0:
-        problems.append(f"--speedup must be positive (got {args.speedup:g})")
+    if not (math.isfinite(args.speedup) and 0 < args.speedup <= MAX_SPEEDUP):
+        problems.append(f"--speedup must be positive and at most {MAX_SPEEDUP:g} (got {args.speedup:g})")
     if not 0 <= args.control_port <= 65535:
         problems.append(f"--control-port must be 0..65535 (got {args.control_port})")
-    if args.tag_history < 1:
-        problems.append(f"--tag-history must be at least 1 (got {args.tag_history})")
+    if not 1 <= args.tag_history <= 1000:
+        problems.append(f"--tag-history must be between 1 and 1000 (got {args.tag_history})")
+    for flag, value in (("--data-timeout", args.data_timeout), ("--connection-timeout", args.connection_timeout)):
+        if not (math.isfinite(value) and 0 <= value <= MAX_NODE_TIMEOUT_S):
+            problems.append(f"{flag} must be 0 (none) to {MAX_NODE_TIMEOUT_S:g} seconds (got {value:g})")
     svr_port = None if args.no_svr else args.port + args.robots if args.svr_port is None and args.port else \
         (args.svr_port or 0)
     if svr_port is not None and not (0 <= svr_port and (not svr_port or svr_port + args.robots - 1 <= 65535)):
         problems.append(f"--svr-port {svr_port} with {args.robots} robot(s) leaves the port range 1..65535")
-    if not 0 <= args.svr_period <= 3600:
+    if not (math.isfinite(args.svr_period) and 0 <= args.svr_period <= 3600):
         problems.append(f"--svr-period must be 0 (off) .. 3600 s (got {args.svr_period:g})")
     svr_items = [name.strip() for name in args.svr_items.split(",") if name.strip()]
+    return problems, svr_port, svr_items
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    problems, svr_port, svr_items = check_args(args)
     if problems:
         for problem in problems:
             print(f"tmflow_listener: error: {problem}", file=sys.stderr)
@@ -99,7 +117,7 @@ def main(argv=None) -> int:
                            control_port=None if args.no_control else args.control_port,
                            data_timeout=args.data_timeout if args.data_timeout > 0 else None,
                            connection_timeout=args.connection_timeout if args.connection_timeout > 0 else None,
-                           manage_gc=True, svr_port=svr_port,
+                           manage_gc=True, control_host=args.control_host, svr_port=svr_port,
                            svr_options=dict(period=args.svr_period, mode=SVR_FORMATS[args.svr_format],
                                             items=svr_items))
         server.start()
@@ -114,7 +132,7 @@ def main(argv=None) -> int:
         slave = f", Ethernet Slave on {args.host}:{robot.svr_port}" if server.svr is not None else ""
         print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node}){slave}", flush=True)
     if server.control is not None:
-        print(f"control channel: {args.host}:{server.control.port} (JSON lines)", flush=True)
+        print(f"control channel: {args.control_host}:{server.control.port} (JSON lines)", flush=True)
     if server.svr is not None:
         print(f"Ethernet Slave data table: every {args.svr_period:g} s, {args.svr_format}, "
               f"{len(server.robots[0].svr.stream_items)} items", flush=True)

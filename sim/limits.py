@@ -1,0 +1,44 @@
+"""Every bound of the simulated controller and of its servers, in one place.
+
+docs/simulator.md ("Limits") shows each of them with the error a client sees;
+tests/security/test_sim_limits_doc.py checks that the table and this file agree.
+Values marked [MAN 2.24 §x] follow Techman's *Programming Language TMscript* 2.24 manual;
+the others are the simulator's choice (a robot controller has such bounds, the manual does not
+give their values).
+"""
+from __future__ import annotations
+
+import sys
+
+# ---- script values ------------------------------------------------------------------------------
+INT_MIN, INT_MAX = -2 ** 31, 2 ** 31 - 1    # [MAN 2.24 §2.1] int: 32-bit signed; results wrap (§2.2)
+BYTE_MAX = 255                              # [MAN 2.24 §2.1] byte: 8-bit unsigned; results wrap (§2.2)
+FLOAT_MAX = 3.4028235e38                    # [MAN 2.24 §2.1] float: 32-bit; beyond it an Error (§2.5)
+DOUBLE_MAX = sys.float_info.max             # [MAN 2.24 §2.1] double: 64-bit
+ARRAY_MAX = 2048                            # [MAN 2.24 §2.3] "The maximum element number is 2048"
+STRING_MAX = 65_536                         # characters in one string value (a frame's data is 64 KiB)
+HEX_DIGITS_MAX = 8                          # a hexadecimal constant is at most 32 bits wide
+IO_INDEX_MAX = 255                          # IO["module"].DO[n] and the like: n in 0..255
+
+# ---- one script (TMSCT packet) -----------------------------------------------------------------
+STATEMENTS_MAX = 5_000                      # non-empty lines of one packet
+TOKENS_MAX = 10_000                         # tokens of one script (an array of 2048 numbers takes 4,097; a
+                                            # call with constant arguments only, e.g. a motion, counts 1)
+DEPTH_MAX = 100                             # nesting of one expression (operands of operands ...)
+STEPS_MAX = 20_000                          # work of one script: statements + expression nodes + array
+                                            # elements copied / 8 + string characters built / 256
+
+# ---- one project (the flow's variables while it stays in the Listen node) ----------------------
+VARIABLES_MAX = 1_000                       # declared variables
+VARIABLE_BYTES_MAX = 8 << 20                # their memory: 8 bytes a number, 1 a character (as text)
+
+# ---- control channel -----------------------------------------------------------------------------
+CONTROL_LINE_MAX = 65_536                   # bytes of one request line
+CONTROL_DEPTH_MAX = 8                       # JSON nesting of one request
+CONTROL_OUTBOX_MAX = 4 << 20                # unsent answer bytes per client; beyond: the client is closed
+CONTROL_EVENTS_MAX = 1_000                  # events in one "events" answer (page on with "next")
+CONTROL_CLIENTS_MAX = 16
+
+# ---- robot servers (per robot unless noted) -----------------------------------------------------
+EVENT_BYTES_MAX = 20 << 20                  # event log kept in memory, all robots together
+ACCEPT_BACKOFF_S = 0.1                      # out of descriptors: stop accepting for this long

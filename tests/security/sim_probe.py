@@ -1,0 +1,37 @@
+"""Helpers of the simulator security tests: the tests/sim harness (virtual clock, loopback) and a raw
+JSON-lines client of the control channel."""
+import json
+import pathlib
+import socket
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "sim"))
+
+from sim_harness import Harness, Peer, sct, sta  # noqa: E402,F401
+
+
+class ControlClient:
+    """One control-channel connection kept open across requests (the probes send raw lines)."""
+
+    def __init__(self, port, timeout=5.0):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+        self.buf = b""
+
+    def send_line(self, line: bytes):
+        self.sock.sendall(line + b"\n")
+
+    def answer(self) -> dict:
+        while b"\n" not in self.buf:
+            chunk = self.sock.recv(65536)
+            if not chunk:
+                raise ConnectionError("the simulator closed the control connection")
+            self.buf += chunk
+        line, _, self.buf = self.buf.partition(b"\n")
+        return json.loads(line)
+
+    def ask(self, payload) -> dict:
+        self.send_line(payload if isinstance(payload, bytes) else json.dumps(payload).encode())
+        return self.answer()
+
+    def close(self):
+        self.sock.close()

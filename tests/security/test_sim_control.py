@@ -1,0 +1,108 @@
+"""Control channel under hostile requests (issue 12, "One request kills the simulator", "A control-channel
+client that never reads its answers hangs the whole simulator", "binds whatever --host says").
+Each probe is answered with {"ok": false, "error": ...} and the simulator keeps serving."""
+import socket
+
+import pytest
+
+from sim.limits import CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX
+from sim.server import SimServer
+
+from sim_probe import ControlClient
+
+
+@pytest.fixture
+def channel():
+    srv = SimServer(port=0, control_port=0).start_background()
+    client = ControlClient(srv.control.port)
+    yield srv, client
+    client.close()
+    srv.close()
+
+
+@pytest.mark.parametrize("line, reason", [
+    (b'{"cmd":"state","robot":1e400}', "'robot' must be an integer"),
+    (b'{"cmd":"events","since":1e400}', "'since' must be an integer"),
+    (b'{"cmd":"events","since":-5}', "since must be 0 or more"),
+    (b'{"cmd":"state","robot":"0"}', "'robot' must be an integer"),
+    (b'{"cmd":"state","robot":true}', "'robot' must be an integer"),
+    (b'{"cmd":"state","robot":1.0}', "'robot' must be an integer"),
+    (b'{"cmd":"state","robot":-1}', "robot -1 does not exist"),
+    (b'{"cmd":"state","robot":' + b"9" * 5000 + b"}", "more than 18 digits"),
+    (b"[" * 30_000 + b"]" * 30_000, "nested deeper than"),
+    (b'{"cmd":"ping","x":' + b"[" * 50 + b"]" * 50 + b"}", "nested deeper than"),
+    (b'{"cmd":["ping"]}', "'cmd' must be a text"),
+    (b'{"cmd":"ping","robt":0}', "unknown field 'robt'"),
+    (b'{"cmd":"inject","fault":"reply_delay","params":{"seconds":NaN}}', "NaN is not a number"),
+    (b'{"cmd":"inject","fault":"reply_delay","params":{"seconds":1e400}}', "finite"),
+    (b'{"cmd":"inject","fault":"reply_delay","params":{"seconds":-1}}', "seconds must be 0.0..3600.0"),
+    (b'{"cmd":"inject","fault":"split_replies","params":{"size":0}}', "size must be 1..65536"),
+    (b'{"cmd":"inject","fault":"split_replies","params":{"size":2.5}}', "size must be an integer"),
+    (b'{"cmd":"inject","fault":"reply_delay","params":{"secs":1}}', "unknown parameter 'secs'"),
+    (b'{"cmd":"inject","fault":"reply_delay","params":[1]}', "'params' must be an object"),
+    (b'{"cmd":"inject","fault":"leave_node","params":{"path":"Elsewhere"}}', "path must be one of Pass, Fail"),
+    (b'{"cmd":"inject","fault":7}', "'fault' must be a text"),
+    (b'\xff\xfe{"cmd":"ping"}', "one JSON object on one line"),
+    (b'"ping"', "must be a JSON object"),
+])
+def test_bad_request_is_a_json_error_and_the_simulator_keeps_answering(channel, line, reason):
+    srv, client = channel
+    answer = client.ask(line)
+    assert answer["ok"] is False and reason in answer["error"], answer
+    assert client.ask({"cmd": "ping"}) == {"ok": True, "result": "pong"}       # same connection still usable
+    assert srv.robots[0].state()["faults"]["reply_delay"] == 0                # nothing was armed
+
+
+@pytest.mark.parametrize("line", [b'{"cmd":"ping","x":"' + b"a" * (CONTROL_LINE_MAX + 10),
+                                  b"[" * 60_000 + b"]" * 60_000 + b"\n"])
+def test_overlong_request_line_is_answered_then_the_connection_closed(channel, line):
+    srv, client = channel
+    client.sock.sendall(line)
+    answer = client.answer()
+    assert answer["ok"] is False and "longer than 65536 bytes" in answer["error"]
+    with pytest.raises(ConnectionError):
+        client.answer()
+    other = ControlClient(srv.control.port)
+    assert other.ask({"cmd": "ping"})["ok"]
+    other.close()
+
+
+def test_a_client_that_never_reads_its_answers_is_closed_and_never_stalls_the_others(channel):
+    srv, _client = channel
+    lazy = socket.create_connection(("127.0.0.1", srv.control.port), timeout=5)
+    lazy.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    request = b'{"cmd":"state"}\n'
+    answer_size = len(ControlClient(srv.control.port).ask({"cmd": "state"}).__repr__())
+    lazy.sendall(request * (3 * CONTROL_OUTBOX_MAX // answer_size))     # answers it never reads
+    other = ControlClient(srv.control.port, timeout=5)
+    assert other.ask({"cmd": "ping"})["ok"]                              # the old code blocked here
+    closed = srv.robots[0].wait_event("control_closed", timeout=10)
+    assert closed is not None and "does not read its answers" in closed["reason"]
+    assert other.ask({"cmd": "ping"})["ok"]
+    other.close()
+    lazy.close()
+
+
+def test_control_channel_binds_loopback_even_when_the_robots_listen_elsewhere():
+    srv = SimServer(host="127.0.0.2", port=0, control_port=0).start()
+    try:
+        assert srv.robots[0].listener.getsockname()[0] == "127.0.0.2"
+        assert srv.control.sock.getsockname()[0] == "127.0.0.1"
+    finally:
+        srv.close()
+
+
+def test_events_are_paged_by_absolute_index_across_the_log_trimming():
+    srv = SimServer(port=0, control_port=0, event_limit=100).start_background()
+    client = ControlClient(srv.control.port)
+    try:
+        for n in range(250):
+            srv.robots[0]._log("io", point="x", value=n)
+        first = client.ask({"cmd": "events", "since": 0})["result"]
+        assert first["first"] > 0 and first["events"][0] is not None
+        nxt = client.ask({"cmd": "events", "since": first["next"]})["result"]
+        assert nxt["events"] == [] and nxt["next"] == first["next"]
+        assert first["events"][-1]["value"] == 249
+    finally:
+        client.close()
+        srv.close()
