@@ -207,6 +207,7 @@ class _Parser:
         self.toks = tokens
         self.pos = 0
         self.last = len(tokens) - 1
+        self.nesting = 0                # expressions open right now (parentheses, arguments, unary chains)
 
     def peek(self, offset=0):
         index = self.pos + offset
@@ -266,7 +267,12 @@ class _Parser:
         return Decl("float" if type_name == "double" else type_name, is_array, name, init)
 
     def expr(self):
-        return self.binary(1)
+        self.nesting += 1
+        if self.nesting > DEPTH_MAX:
+            raise ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
+        node = self.binary(1)
+        self.nesting -= 1
+        return node
 
     _PRECEDENCE = {"||": 1, "&&": 2, "==": 3, "!=": 3, "<": 3, ">": 3, "<=": 3, ">=": 3,
                    "+": 4, "-": 4, "*": 5, "/": 5, "%": 5}
@@ -287,7 +293,11 @@ class _Parser:
     def unary(self):
         if self.peek()[0] == "op" and self.peek()[1] in ("-", "!", "+"):
             op = self.next()[1]
+            self.nesting += 1
+            if self.nesting > DEPTH_MAX:
+                raise ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
             operand = self.unary()
+            self.nesting -= 1
             if op == "-" and isinstance(operand, Num):
                 return Num(-operand.value, operand.is_float)
             return operand if op == "+" else Unary(op, operand)
