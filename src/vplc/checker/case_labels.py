@@ -38,7 +38,7 @@ def check(ck, stmt: A.Case, sel_type: T.Type) -> None:
     if not ok_sel:
         ctx.diags.error("ST1401", f"the CASE selector must be an integer or enumeration, not {sel_type.name}",
                         stmt.selector.span)
-    seen: list[tuple[int, int, A.Node]] = []
+    ranges: list[tuple[int, int, int, A.Node]] = []      # lo, hi, position in the source, label
     for branch in stmt.branches:
         for label in branch.labels:
             parts = [label.lo, label.hi] if isinstance(label, A.CaseRange) else [label]
@@ -54,13 +54,20 @@ def check(ck, stmt: A.Case, sel_type: T.Type) -> None:
                 if v is None and not T.is_error(lt):
                     ctx.diags.error("ST1401", "CASE labels must be constants", p.span)
                 values.append(v)
-            if any(v is None for v in values):
-                continue
-            lo, hi = values[0], values[-1]
-            for slo, shi, node in seen:
-                if lo <= shi and slo <= hi:
-                    line, col = node.span.file.line_col(node.span.start)
-                    ctx.diags.error("ST1402", f"CASE label `{ck.text(label)}` repeats a value already handled at "
-                                    f"line {line}", label.span)
-                    break
-            seen.append((lo, hi, label))
+            if all(v is not None for v in values):
+                ranges.append((values[0], values[-1], len(ranges), label))
+    _report_overlaps(ck, ranges)
+
+
+def _report_overlaps(ck, ranges) -> None:
+    """ST1402 once per label that overlaps an earlier one: sorted by value, so n log n even for 100,000 labels."""
+    ranges.sort(key=lambda r: (r[0], r[2]))
+    reach = None                                  # the range reaching furthest up among those sorted so far
+    for current in ranges:
+        if reach is not None and current[0] <= reach[1]:
+            later, earlier = (current, reach) if current[2] > reach[2] else (reach, current)
+            line, _ = earlier[3].span.file.line_col(earlier[3].span.start)
+            ck.ctx.diags.error("ST1402", f"CASE label `{ck.text(later[3])}` repeats a value already handled at "
+                               f"line {line}", later[3].span)
+        if reach is None or current[1] > reach[1]:
+            reach = current

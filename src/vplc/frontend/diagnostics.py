@@ -5,6 +5,7 @@ The full table of codes (with a failing and a fixed example each) is docs/toolch
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field
 
 from .source import Span
@@ -62,6 +63,14 @@ class Diagnostic:
         }
 
 
+_QUOTED = re.compile(r"`([^`]{61,})`")
+
+
+def _elide_quotes(message: str) -> str:
+    """A quoted piece of source longer than 60 characters is shown by its ends (a 5,000-digit literal)."""
+    return _QUOTED.sub(lambda m: f"`{m.group(1)[:28]}…{m.group(1)[-28:]}`", message)
+
+
 class DiagnosticBag:
     """Collects diagnostics of one stage; deduplicates identical reports at the same place."""
 
@@ -70,6 +79,7 @@ class DiagnosticBag:
         self._seen: set[tuple] = set()
 
     def add(self, code: str, severity: str, message: str, span: Span, notes: list[str] | None = None) -> Diagnostic:
+        message = _elide_quotes(message)
         if len(message) > 400:  # e.g. a 1,000,000-character identifier: keep the message readable
             message = message[:397] + "..."
         key = (code, span.file.path, span.start, message)

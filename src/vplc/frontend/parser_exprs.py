@@ -5,6 +5,7 @@ Precedence, lowest first: OR; XOR; AND &; = <>; < > <= >=; + -; * / MOD; unary -
 from __future__ import annotations
 
 import calendar
+import math
 import re
 
 from . import ast as A
@@ -16,6 +17,7 @@ BINARY_PREC = {"OR": 1, "XOR": 2, "AND": 3, "&": 3, "=": 4, "<>": 4, "<": 5, ">"
 
 INT_PREFIXES = {"SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "BYTE", "WORD", "DWORD", "LWORD"}
 REAL_PREFIXES = {"REAL", "LREAL"}
+MAX_INT_DIGITS = 1000          # far beyond any 64-bit value, far below Python's 4,300-digit int() limit
 _UNIT_NS = {"D": 86_400_000_000_000, "H": 3_600_000_000_000, "M": 60_000_000_000, "S": 1_000_000_000,
             "MS": 1_000_000, "US": 1_000, "NS": 1}
 _DUR_PART = re.compile(r"([0-9][0-9_]*(?:\.[0-9_]+)?)(ms|us|ns|d|h|m|s)_?", re.I)
@@ -36,19 +38,23 @@ def parse_duration(body: str) -> int | None:
             return None
         num = m.group(1).replace("_", "")
         unit = _UNIT_NS[m.group(2).upper()]
-        if "." in num:
+        if len(num) > MAX_INT_DIGITS:
+            exact += 10 ** MAX_INT_DIGITS * unit          # beyond any TIME: the checker's range rule reports it
+        elif "." in num:
             total += float(num) * unit
         else:
             exact += int(num) * unit
         pos = m.end()
     if pos != len(body) or pos == 0:
         return None
+    if not math.isfinite(total):
+        total, exact = 0.0, exact + 10 ** MAX_INT_DIGITS
     return sign * (exact + round(total))
 
 
 def parse_clock(text: str) -> int | None:
     m = _CLOCK_RE.match(text)
-    if not m:
+    if not m or len(text) > MAX_INT_DIGITS:
         return None
     h, mi, s = int(m.group(1)), int(m.group(2)), int(m.group(3) or 0)
     frac = m.group(4) or ""
@@ -130,7 +136,7 @@ class ExpressionsMixin:
                 t = self.tok
                 if t.kind == "INT":
                     self.advance()
-                    node = A.BitAccess(node, int(t.text.replace("_", "")), span=self.span_from(start))
+                    node = A.BitAccess(node, self.decimal_value(t), span=self.span_from(start))
                     continue
                 name = self.ident("a member name after `.`")
                 node = A.Member(node, name.text, span=self.span_from(start))
@@ -212,7 +218,7 @@ class ExpressionsMixin:
         start = t.start
         if kind == "INT":
             self.advance()
-            return A.Literal("int", int(t.text.replace("_", "")), None, t.text, span=self.tok_span(t))
+            return A.Literal("int", self.decimal_value(t), None, t.text, span=self.tok_span(t))
         if kind == "BASED":
             self.advance()
             return A.Literal("int", self.based_value(t), None, t.text, span=self.tok_span(t))
@@ -255,6 +261,16 @@ class ExpressionsMixin:
             self.fail("direct addresses (`%IX0.0`) are only allowed after AT in a declaration")
         self.fail_expected("an expression")
 
+    def decimal_value(self, t) -> int:
+        """A decimal integer literal; one far beyond 64 bits is reported here, before Python's int() refuses
+        it (more than 4,300 digits), and the checker's range rule does the rest."""
+        digits = t.text.replace("_", "")
+        if len(digits) > MAX_INT_DIGITS:
+            self.diags.error("ST0106", f"integer literal of {len(digits):,} digits: the largest integer types "
+                             f"(LINT, ULINT, LWORD) hold at most 20 digits", self.tok_span(t))
+            return 0
+        return int(digits)
+
     def based_value(self, t) -> int:
         base_text, digits = t.text.split("#", 1)
         base = int(base_text)
@@ -285,7 +301,7 @@ class ExpressionsMixin:
                     self.fail(f"`{text}`: a {prefix} literal cannot have a fraction", "ST0106", t)
                 value = float(t.text.replace("_", ""))
             else:
-                value = self.based_value(t) if t.kind == "BASED" else int(t.text.replace("_", ""))
+                value = self.based_value(t) if t.kind == "BASED" else self.decimal_value(t)
             if sign == "-":
                 value = -value
             if prefix in REAL_PREFIXES:
