@@ -7,6 +7,7 @@ Exit 0 on a clean stop, 1 on a major fault, 2 on usage or load errors.
 """
 from __future__ import annotations
 
+import os
 import sys
 import threading
 import time
@@ -49,6 +50,10 @@ def run_cmd(args) -> int:
         return _err("--trace and --trace-out go together")
     if args.trace_out and not args.trace_out.lower().endswith((".vcd", ".svg")):
         return _err(f"--trace-out {args.trace_out!r} must end in .vcd or .svg")
+    if args.trace_out:
+        folder = os.path.dirname(os.path.abspath(args.trace_out))
+        if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+            return _err(f"--trace-out {args.trace_out!r}: the folder {folder} does not exist or is not writable")
     if args.cycles is not None and args.cycles < 0:
         return _err("--cycles must be 0 or more")
     duration = parse_duration(args.duration) if args.duration else None
@@ -91,7 +96,11 @@ def run_cmd(args) -> int:
     if stats is not None:
         print(stats.summary())
     if rec is not None:
-        write_trace(rec, args.trace_out)
+        try:
+            write_trace(rec, args.trace_out)
+        except OSError as exc:
+            print(f"vplc run: cannot write the trace to {args.trace_out}: {exc.strerror}", file=sys.stderr)
+            return 1
         print(f"trace written to {args.trace_out}")
     return status
 

@@ -13,6 +13,8 @@ from ..frontend import types as T
 from .codegen_expr import ExprGen, attr, is_scalar
 from ..runtime.program import GEN_FILE, PouClass, Program
 
+CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)
+
 
 class CodeGen(ExprGen):
     def __init__(self, proj, count_statements: bool = False) -> None:
@@ -292,8 +294,38 @@ class CodeGen(ExprGen):
     def st_Case(self, st: A.Case) -> None:
         sel = self.tmp("_c")
         self.emit(f"{sel} = {self.expr(st.selector)}")
-        first = True
-        for br in st.branches:
+        if len(st.branches) <= CASE_CHAIN:
+            self.case_chain(st.branches, sel, st.span)
+            if st.else_body:
+                self.emit("else:" if st.branches else "if True:")
+                self.ind += 1
+                self.block(st.else_body)
+                self.ind -= 1
+            return
+        # Python nests each elif one level deeper when it compiles, so thousands of labels in one chain exceed
+        # its recursion limit: a long CASE becomes consecutive chains of CASE_CHAIN branches, the next one
+        # tried only while no branch has matched (same order, same first-match semantics).
+        pending = self.tmp("_p")
+        self.emit(f"{pending} = False")
+        for start in range(0, len(st.branches), CASE_CHAIN):
+            if start:
+                self.emit(f"if {pending}:")
+                self.ind += 1
+                self.emit(f"{pending} = False")
+            self.case_chain(st.branches[start:start + CASE_CHAIN], sel, st.span)
+            self.emit("else:")
+            self.emit(f"    {pending} = True")
+            if start:
+                self.ind -= 1
+        if st.else_body:
+            self.emit(f"if {pending}:")
+            self.ind += 1
+            self.block(st.else_body)
+            self.ind -= 1
+
+    def case_chain(self, branches, sel: str, span) -> None:
+        """One if/elif chain over the CASE branches given (no else part)."""
+        for index, br in enumerate(branches):
             tests = []
             singles = []
             for lab in br.labels:
@@ -305,19 +337,10 @@ class CodeGen(ExprGen):
                 tests.insert(0, f"{sel} == {singles[0]}")
             elif singles:
                 tests.insert(0, f"{sel} in ({', '.join(singles)})")
-            self.at(br.span or st.span)
-            self.emit(f"{'if' if first else 'elif'} {' or '.join(tests) or 'False'}:")
-            first = False
+            self.at(br.span or span)
+            self.emit(f"{'elif' if index else 'if'} {' or '.join(tests) or 'False'}:")
             self.ind += 1
             self.block(br.body)
-            self.ind -= 1
-        if st.else_body:
-            if first:
-                self.emit("if True:")
-            else:
-                self.emit("else:")
-            self.ind += 1
-            self.block(st.else_body)
             self.ind -= 1
 
     def loop_guard(self) -> None:
