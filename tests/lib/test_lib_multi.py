@@ -21,7 +21,10 @@ def test_thirty_two_robots_move_independently():
             plc.write(f"Main.MoveExec[{i}]", True)
         assert plc.run_until(lambda: all(plc.read(f"Main.movers[{i}].Done") or plc.read(f"Main.movers[{i}].Error")
                                          for i in range(1, 33)), 5 * SEC, on_scan=pump)
-        assert plc.read("Main.movers[8].Error") and not plc.read("Main.conns[8].Connected")
+        assert plc.read("Main.movers[8].Error")
+        # robot 8 alone lost its link, and got it back by itself (Execute held)
+        assert plc.read("Main.conns[8].Reconnecting") or plc.read("Main.conns[8].RetryCount") >= 1
+        assert all(not plc.read(f"Main.conns[{i}].Reconnecting") for i in range(1, 33) if i != 8)
         for i in range(1, 33):
             if i != 8:
                 assert plc.read(f"Main.movers[{i}].Done")

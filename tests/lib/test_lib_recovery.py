@@ -1,0 +1,127 @@
+"""Recovery without a PLC restart (issue 14): with CBT_Connect's Execute held TRUE, every kind of loss is shown as
+Error with its own ErrorID for at least one scan and then repaired by automatic reconnect attempts with the
+documented back-off (100 ms, 1 s, 2 s, then every 5 s); a command sent but not confirmed before the loss ends
+with 16#200B (outcome unknown), never as "failed". The simulator's event log is the witness."""
+from rig import SEC, Rig, move_abs
+
+import pytest
+
+
+def go(rig, k, rz, speed=50):
+    rig.set_struct(f"MParam[{k}]", move_abs(Speed=speed, TargetPosition=dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=rz)))
+    rig.write(f"MExec[{k}]", True)
+
+
+def connects(rig):
+    return [e for e in rig.events("connect")]
+
+
+def watch_error_scans(rig):
+    """on_scan hook counting the scans in which CBT_Connect showed Error, and the ErrorIDs it showed."""
+    seen = {"scans": 0, "ids": []}
+
+    def hook(_now):
+        if rig.read("conn.Error"):
+            seen["scans"] += 1
+            if rig.read("conn.ErrorID") not in seen["ids"]:
+                seen["ids"].append(rig.read("conn.ErrorID"))
+    return seen, hook
+
+
+@pytest.mark.parametrize("fault,error_id", [("disconnect", 0x2008), ("stop_project", 0x2008),
+                                            ("close_mid_frame", 0x2008)])
+def test_robot_closing_the_connection_is_shown_then_repaired_by_itself(rig, fault, error_id):
+    seen, hook = watch_error_scans(rig)
+    rig.robot.inject(fault)
+    if fault == "close_mid_frame":
+        go(rig, 1, rz=15)
+    assert rig.until(lambda: rig.read("conn.Reconnecting"), 2, on_scan=hook)
+    if fault == "stop_project":
+        rig.robot.start_project()
+    assert rig.until(lambda: rig.read("conn.Connected"), 3, on_scan=hook), rig.read("conn.ErrorDescrip")
+    assert seen["ids"] == [error_id] and seen["scans"] >= 1
+    assert rig.read("conn.RetryCount") >= 1 and not rig.read("conn.Reconnecting") and not rig.read("conn.Error")
+    assert rig.read("conn.LastLostTime") >= rig.read("conn.LastConnTime") or rig.read("conn.Connected")
+    # the machine carries on: a new motion runs on the new connection
+    rig.write("MExec[2]", False)
+    go(rig, 2, rz=30)
+    assert rig.until(lambda: rig.read("movers[2].Done"), 5), rig.read("movers[2].ErrorDescrip")
+
+
+def test_black_hole_then_restore_reconnects_with_the_documented_back_off(rig):
+    """The first attempt follows the loss after 100 ms, the next ones 1 s, 2 s and 5 s apart (bounded)."""
+    rig.robot.inject("black_hole")
+    assert rig.until(lambda: rig.read("conn.Error"), 2)
+    assert rig.read("conn.ErrorID") == 0x2006
+    lost_at = rig.plc.now_ns
+    attempts_before = len(connects(rig))
+    assert rig.until(lambda: rig.read("conn.RetryCount") >= 1, 1)
+    assert rig.plc.now_ns - lost_at <= 150_000_000                 # first retry fast (100 ms)
+    assert rig.read("conn.Reconnecting") and rig.read("conn.Busy") and not rig.read("conn.Error")
+    rig.robot.clear_faults()                                        # network repaired
+    assert rig.until(lambda: rig.read("conn.Connected"), 15), rig.read("conn.ErrorDescrip")
+    assert len(connects(rig)) > attempts_before
+    assert not rig.read("conn.Reconnecting") and rig.read("Cobot.InListenNode")
+
+
+def test_back_off_between_refused_attempts_is_100ms_1s_2s_then_5s():
+    r = Rig()
+    try:
+        r.robot.inject("refuse_connections")
+        r.robot.inject("disconnect")
+        lost = r.plc.now_ns
+        times = []
+
+        def hook(now):
+            if r.read("conn.RetryCount") > len(times):
+                times.append((now - lost) / SEC)
+        assert r.until(lambda: len(times) >= 5, 20, on_scan=hook)
+        gaps = [round(b - a, 1) for a, b in zip(times, times[1:])]
+        assert round(times[0], 1) == 0.1 and gaps == [1.0, 2.0, 5.0, 5.0], (times, gaps)
+        assert r.read("conn.Error") or r.read("conn.Busy")
+        assert r.read("conn.ErrorID") in (0, 0x2004)
+        r.robot.clear_faults()
+        assert r.until(lambda: r.read("conn.Connected"), 6)
+        assert r.read("conn.RetryCount") >= 5                       # kept once connected, for the HMI
+    finally:
+        r.close()
+
+
+def test_execute_falling_while_reconnecting_ends_quietly_and_a_manual_trigger_connects(rig):
+    rig.robot.inject("refuse_connections")
+    rig.robot.inject("disconnect")
+    assert rig.until(lambda: rig.read("conn.RetryCount") >= 1, 2)
+    rig.write("ConnExec", False)
+    rig.scans(2)
+    assert not (rig.read("conn.Error") or rig.read("conn.Busy") or rig.read("conn.Reconnecting"))
+    assert rig.read("conn.ErrorID") == 0
+    rig.robot.clear_faults()
+    rig.write("ConnExec", True)
+    assert rig.until(lambda: rig.read("conn.Connected"), 3)
+    assert rig.read("conn.RetryCount") == 0
+
+
+def test_robot_stalled_after_a_motion_frame_reports_outcome_unknown_and_the_motion_ran_once(rig):
+    go(rig, 1, rz=40, speed=20)
+    assert rig.until(lambda: any(e.get("header") == "TMSCT" for e in rig.events("frame_in")), 1)
+    rig.robot.inject("black_hole")                                  # the robot goes silent after the frame
+    assert rig.until(lambda: rig.read("movers[1].Error"), 2)
+    assert rig.read("movers[1].ErrorID") == 0x200B
+    assert rig.read("movers[1].ErrorDescrip") == "Outcome unknown: may have executed; check position before repeating"
+    assert rig.read("conn.ErrorID") == 0x2006
+    rig.robot.clear_faults()
+    assert rig.until(lambda: rig.read("conn.Connected"), 3)
+    # the witness: the robot did start the motion, exactly once
+    assert len(rig.events("motion_start")) == 1
+
+
+def test_commands_waiting_at_a_loss_end_with_outcome_unknown(rig):
+    """Sent and not yet confirmed: each waiting FB ends with an Error (PLCopen) saying it may have run."""
+    for k in (1, 2, 3):
+        go(rig, k, rz=10.0 * k, speed=10)
+    assert rig.until(lambda: all(rig.read(f"movers[{k}].Busy") for k in (1, 2, 3)), 1)
+    rig.scans(3)
+    rig.robot.inject("disconnect")
+    assert rig.until(lambda: not any(rig.read(f"movers[{k}].Busy") for k in (1, 2, 3)), 2)
+    assert [rig.read(f"movers[{k}].ErrorID") for k in (1, 2, 3)] == [0x200B] * 3
+    assert rig.read("Cobot.LastErrorID") == 0x2008
