@@ -24,6 +24,8 @@ class Rig:
         self.robot = self.srv.robots[0]
         self.plc = load_plc([str(LIB), str(ST / program)], task="Main@1ms", **(load_args or {}))
         self.plc.write("Main.Port", self.srv.ports[0])
+        if sim_args.get("svr_port") is not None:
+            self.plc.write("Main.SvrPort", self.robot.svr_port)
         if connect:
             self.write("ConnExec", True)
             assert self.until(lambda: self.read("conn.Connected"), 5), self.read("conn.ErrorDescrip")
