@@ -28,6 +28,8 @@ STEPS = {
     "CBT_Stop": [("StopButton", "fbStop.Done")],
     "CBT_SetOutput": [("CloseGripper", "fbGripper.Done")],
     "CBT_ReadActualPosition": [(None, "fbReadPos.Valid")],
+    "CBT_RobotStatus": [(None, "fbStatus.Valid")],
+    "CBT_ProjectControl": [("PlayButton", "fbPlay.Done")],
 }
 
 
@@ -47,12 +49,13 @@ def test_every_fb_page_has_a_runnable_example():
 def test_page_example_runs_against_the_simulator(page, tmp_path):
     code, promised = example_of(page)
     program = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
-    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True)
+    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0)
     srv.start()
     try:
         source = tmp_path / f"{page}_example.st"
         source.write_text(code.replace("'192.168.1.10'", "'127.0.0.1'")
-                          .replace("IPPort := 5890", f"IPPort := {srv.ports[0]}"), encoding="utf-8")
+                          .replace("IPPort := 5890", f"IPPort := {srv.ports[0]}")
+                          .replace("SvrPort := 5891", f"SvrPort := {srv.robots[0].svr_port}"), encoding="utf-8")
         plc = load_plc([str(LIB), str(source)], task="Main@1ms")
         read = lambda name: plc.read(f"{program}.{name}")  # noqa: E731
         pump = lambda now_ns: srv.poll(now_ns / 1e9)  # noqa: E731
