@@ -294,8 +294,14 @@ def test_connection_loss_shows_on_the_connect_page(connected):
     browser.wait_status("Connect_Connected", "true")
     lost_before = browser.status("Connect_LastLostTime")
     with connected.sim.lock:
+        connected.robot.inject("refuse_connections")           # the robot stays away: the loss stays visible
         connected.robot.inject("disconnect")
     browser.wait_status("Connect_Connected", "false")
+    browser.wait_status("Connect_Reconnecting", "true")
     browser.wait_for(lambda d: browser.status("Connect_LastLostTime") != lost_before, "LastLostTime to change")
     browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot not connected", "the pill")
     browser.screenshot("e2e_connect_lost")
+    with connected.sim.lock:
+        connected.robot.clear_faults()                          # back: CBT_Connect reconnects by itself
+    browser.wait_status("Connect_Connected", "true")
+    browser.wait_status("Connect_Reconnecting", "false")
