@@ -56,7 +56,8 @@ def test_read_position_without_ethernet_slave_is_rate_limited_by_period(rig):
     start, first = rig.plc.now_ns, len(listen_scripts(rig))
     rig.until(lambda: False, 5)
     rate = (len(listen_scripts(rig)) - first) / ((rig.plc.now_ns - start) / 1e9)
-    assert 3.0 <= rate <= 4.0 + 1e-9, rate                       # at most one script per 250 ms
+    # at most one script per 250 ms (fewer when replies are slow: loopback delivery is real time)
+    assert 1.0 <= rate <= 4.0 + 1e-9, rate
     assert rig.read("rd.Valid")
 
 
