@@ -247,7 +247,10 @@ class RobotModel:
                 "load": self.load, "io": dict(self.io), "queue_length": self.queue_length,
                 "moving": self.active is not None, "paused": self.paused,
                 "tags": {str(k): v for k, v in self.tags.items()}, "fault": self.fault,
-                "pvt": {None: None, 0: "joint", 1: "cartesian"}[self.pvt_mode]}
+                "pvt": {None: None, 0: "joint", 1: "cartesian"}[self.pvt_mode],
+                "robot_error": {"active": self.error_active, "code": self.error_code, "text": self.error_text},
+                "estop": self.estop, "operation_mode": "auto" if self.auto_mode else "manual",
+                "project_speed": self.project_speed}
 
 
 def _round(values):

@@ -24,7 +24,8 @@ if __package__ in (None, ""):
     sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from sim.server import SimServer  # noqa: E402
-from sim.svr_session import DEFAULT_STREAM, SvrConfigError  # noqa: E402
+from sim.svr_session import DEFAULT_STREAM  # noqa: E402
+from sim.svr_table import ITEMS  # noqa: E402
 
 SVR_FORMATS = {"binary": 1, "string": 2, "json": 3}
 
@@ -99,6 +100,9 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
     if not (math.isfinite(args.svr_period) and 0 <= args.svr_period <= 3600):
         problems.append(f"--svr-period must be 0 (off) .. 3600 s (got {args.svr_period:g})")
     svr_items = [name.strip() for name in args.svr_items.split(",") if name.strip()]
+    unknown = [name for name in svr_items if name not in ITEMS]
+    if unknown:
+        problems.append(f"--svr-items: unknown data table item(s): {', '.join(unknown)} (see docs/simulator.md)")
     return problems, svr_port, svr_items
 
 
@@ -121,9 +125,6 @@ def main(argv=None) -> int:
                            svr_options=dict(period=args.svr_period, mode=SVR_FORMATS[args.svr_format],
                                             items=svr_items))
         server.start()
-    except SvrConfigError as exc:
-        print(f"tmflow_listener: error: {exc}", file=sys.stderr)
-        return 2
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)
         return 1

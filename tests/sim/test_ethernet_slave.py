@@ -290,3 +290,70 @@ def test_control_channel_presses_the_estop_switches_mode_and_configures_the_stre
         assert "not running" in request(plain.control.port, {"cmd": "estop"})["error"]
     finally:
         plain.close()
+
+
+def test_each_robot_has_its_own_ethernet_slave_with_its_own_data():
+    h = Harness(robots=3, svr_port=0, svr_options={"period": 0})
+    try:
+        ports = [r.svr_port for r in h.srv.robots]
+        assert len(set(ports)) == 3 and not set(ports) & set(h.srv.ports)
+        node, peers = h.connect(robot=1), [h.connect_svr(robot=i) for i in range(3)]
+        h.request(node, sct("1", 'Line("CPP",2000,0,0,180,0,0,10,200,0,true)'))
+        assert h.until(lambda: node.closed)
+        assert [values(h, p, ["Robot_Error"])["Robot_Error"] for p in peers] == [False, True, False]
+        assert h.srv.robots[1].state()["robot_error"]["code"] == 0x00010001
+    finally:
+        h.close()
+
+
+def test_random_damaged_frames_never_stop_either_port():
+    import random
+    rng = random.Random(14)
+    good = [svr("A1,2,Ctrl_DO0=1"), svr("A2,12,Joint_Angle"), svr('A3,13,[{"Item":"Error_Code"}]'),
+            svr(b"A4,1," + table.encode_binary([(ITEMS["Ctrl_AO0"], 1.0)])), svr("A5,2,Stick_Plus=1")]
+    h = Harness(svr_port=0, svr_options={"period": 0.05})
+    try:
+        node, peer = h.connect(), h.connect_svr()
+        for _ in range(300):
+            frame = bytearray(rng.choice(good))
+            for _ in range(rng.randint(1, 4)):
+                action, pos = rng.randrange(3), rng.randrange(len(frame))
+                if action == 0:
+                    frame[pos] = rng.randrange(256)
+                elif action == 1:
+                    del frame[pos]
+                else:
+                    frame.insert(pos, rng.choice(b"$,*\r\n=0{}\x00\xff"))
+            peer.send(bytes(frame))
+            h.step(0.002)
+        peer.send(b",*00\r\n" * 3)                       # close a frame a damaged length left open
+        h.run(0.1)
+        assert not peer.closed and not any(e["kind"] == "internal_error" for e in h.robot.events)
+        assert ask(h, peer, "Z9,12,Project_Run") == ("TMSVR", b"Z9,12,Project_Run=true")
+        assert h.request(node, sta("00")) == [("TMSTA", "00,true,Listen1")]
+    finally:
+        h.close()
+
+
+def test_cli_opens_the_ethernet_slave_next_to_the_listen_node_and_no_svr_disables_it():
+    import pathlib
+    import subprocess
+    import sys
+    script = pathlib.Path(__file__).resolve().parents[2] / "sim" / "tmflow_listener.py"
+    for extra, expect in (([], True), (["--no-svr"], False)):
+        proc = subprocess.Popen([sys.executable, str(script), "--port", "0", "--no-control", *extra],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            line = proc.stdout.readline()
+            assert line.startswith("robot 1: TM5-700 listening on 127.0.0.1:")
+            assert ("Ethernet Slave on 127.0.0.1:" in line) == expect
+            if expect:
+                assert proc.stdout.readline().startswith("Ethernet Slave data table: every 0.1 s, binary")
+        finally:
+            proc.terminate()
+            _out, err = proc.communicate(timeout=10)
+        assert "Traceback" not in err
+    bad = subprocess.run([sys.executable, str(script), "--port", "0", "--no-control", "--svr-items",
+                          "Joint_Angel"],
+                         capture_output=True, text=True, timeout=20)
+    assert bad.returncode == 2 and "unknown data table item(s): Joint_Angel" in bad.stderr
