@@ -13,8 +13,8 @@ from __future__ import annotations
 import datetime
 
 from . import kinematics as kin
+from .svr_table import ITEMS
 
-_IDENTITY = kin.pose_to_matrix((0.0,) * 6)
 _SPEED_STEP_S = 0.01          # Joint_Speed / TCP_Speed: difference quotient over this much motion time
 
 _IO = {"Ctrl_": "ControlBox", "End_": "EndModule"}
@@ -22,6 +22,16 @@ _IO = {"Ctrl_": "ControlBox", "End_": "EndModule"}
 # Robot_Light (Appendix D) shown by the simulator: our choice of the documented colours
 LIGHT_ESTOP, LIGHT_ERROR = 1, 2                                        # solid red, flashing red
 LIGHT = {(True, True): 4, (True, False): 3, (False, True): 6, (False, False): 5}   # (auto, running)
+
+
+# items whose value the simulator does not model (no force sensor, no teach pendant, no safeguard inputs)
+_CONSTANT = {
+    "Robot_Link": 1, "Get_UI_Control": 0, "Warning_Code": 0, "Warning_Time": "", "Project_Edit": 0,
+    "Stick_MA": 0, "Stick_Play": 0, "Stick_Stop": 0, "Stick_Plus": 0, "Stick_Minus": 0, "Stick_Pause": 0,
+    "Stick_PlayPause": 0, "Ext_Safeguard": 0, "Safeguard_A": 0, "Robot_Model": "TM5-700",
+    "ControlBox_SN": "SIM00000001", "TMflow_Version": "2.24.0000", "TCP_Force": [0.0] * 3, "TCP_Force3D": 0.0,
+    "Joint_Torque": [0.0] * 6,
+}
 
 
 def io_key(name: str) -> str | None:
@@ -42,6 +52,7 @@ class RobotDataSource:
         self.origin = origin or datetime.datetime.now().replace(microsecond=0)   # virtual time 0 on the clock
         self.project_name = "CBT_Demo"
         self.run_since = None
+        self._getters = self._build_getters()
 
     @property
     def model(self):
@@ -53,104 +64,56 @@ class RobotDataSource:
 
     # ---- reading ------------------------------------------------------------------------------
     def values(self, names) -> dict:
+        """{name: value} of one consistent moment (joints and poses computed once)."""
         session, model = self.robot.session, self.model
         running = session.state != "project_stopped"
         if running and self.run_since is None:
             self.run_since = session.now
         elif not running:
             self.run_since = None
-        joints = model.current_joints()
-        cache = {}
+        now = _Moment(model, session, running)
+        getters = self._getters
+        return {name: getters[name](now) for name in names}
 
-        def pose(kind):
-            if kind not in cache:
-                tool = model._matrix(model.tool_pose) if kind.endswith("Tool") else _IDENTITY
-                m = kin.forward(joints, tool)
-                if kind.startswith("Coord_Base"):
-                    m = kin.matmul(kin.inverse(model._matrix(model.base_pose)), m)
-                cache[kind] = kin.matrix_to_pose(m)
-            return cache[kind]
-
-        out = {}
-        for name in names:
-            out[name] = self._value(name, model, session, running, joints, pose)
-        return out
-
-    def _value(self, name, model, session, running, joints, pose):
-        if name.startswith("Coord_"):
-            return pose(name)
-        key = io_key(name)
-        if key is not None:
-            return model.io.get(key, 0)
-        simple = {
-            "Robot_Link": 1, "Get_UI_Control": 0, "Warning_Code": 0, "Warning_Time": "", "Project_Edit": 0,
-            "Stick_MA": 0, "Stick_Play": 0, "Stick_Stop": 0, "Stick_Plus": 0, "Stick_Minus": 0,
-            "Stick_Pause": 0, "Stick_PlayPause": 0, "Ext_Safeguard": 0, "Safeguard_A": 0,
-            "Robot_Model": "TM5-700", "ControlBox_SN": "SIM00000001", "TMflow_Version": "2.24.0000",
-            "TCP_Force": [0.0] * 3, "TCP_Force3D": 0.0, "Joint_Torque": [0.0] * 6,
-        }
-        if name in simple:
-            return simple[name]
-        if name == "Joint_Angle":
-            return joints
-        if name in ("Joint_Speed", "TCP_Speed", "TCP_Speed3D"):
-            return self._speeds(model, joints, pose)[name]
-        if name == "Robot_Error":
-            return model.error_active
-        if name == "Error_Code":
-            return model.error_code
-        if name == "Error_Content":
-            return model.error_text
-        if name == "Error_Time":
-            return self._clock(model.error_time) if model.error_time is not None else ""
-        if name == "Camera_Light":
-            return int(model.io.get("CameraLight", 0))
-        if name == "Project_Speed":
-            return model.project_speed
-        if name == "Project_Name":
-            return self.project_name
-        if name == "Project_Run_Time":
-            return _duration(session.now - self.run_since if self.run_since is not None else 0.0)
-        if name == "Project_Run":
-            return running
-        if name == "Project_Pause":
-            return running and model.paused
-        if name in ("ESTOP", "Stick_ESTOP"):
-            return model.estop
-        if name == "Robot_State":          # 0 normal, 3 error, 4 STO (including ESTOP)
-            return 4 if model.estop else 3 if model.error_active else 0
-        if name == "Robot_Light":
-            return LIGHT_ESTOP if model.estop else LIGHT_ERROR if model.error_active else \
-                LIGHT[(model.auto_mode, running)]
-        if name == "Operation_Mode":       # Appendix D: 0 manual, 1 auto
-            return 1 if model.auto_mode else 0
-        if name == "MA_Mode":              # older tables (EtherNet/IP ManualAuto): 1 manual, 2 auto
-            return 2 if model.auto_mode else 1
-        if name == "TCP_Name":
-            return model.tool_name
-        if name == "TCP_Value":
-            return list(model.tool_pose)
-        if name == "TCP_Mass":
-            return model.tool_mass
-        if name == "Base_Name":
-            return model.base_name
-        if name == "Base_Value":
-            return list(model.base_pose)
-        raise KeyError(name)
-
-    def _speeds(self, model, joints, pose):
-        """Joint and TCP speed from the motion under way (difference quotient), zero when it stands."""
-        plan = model.active
-        if plan is None or model.paused:
-            return {"Joint_Speed": [0.0] * 6, "TCP_Speed": [0.0] * 6, "TCP_Speed3D": 0.0}
-        h = _SPEED_STEP_S
-        later = plan.joints_at(min(plan.total, model.active_t + h), joints)
-        scale = model.project_speed / 100.0 / h
-        joint_speed = [(b - a) * scale for a, b in zip(joints, later)]
-        now_pose = pose("Coord_Robot_Tool")
-        then = kin.matrix_to_pose(kin.forward(later, model._matrix(model.tool_pose)))
-        tcp = [(b - a) * scale for a, b in zip(now_pose, then)]
-        return {"Joint_Speed": joint_speed, "TCP_Speed": tcp, "TCP_Speed3D": sum(v * v for v in tcp[:3]) ** 0.5}
+    def _build_getters(self):
+        """One function per item (the per-frame cost is one call per item)."""
+        getters = {name: (lambda m, v=value: v) for name, value in _CONSTANT.items()}
+        for name in ITEMS:
+            key = io_key(name)
+            if key is not None:
+                getters[name] = lambda m, key=key: m.model.io.get(key, 0)
+            elif name.startswith("Coord_"):
+                getters[name] = lambda m, kind=name: m.pose(kind)
+        getters.update({
+            "Joint_Angle": lambda m: m.joints,
+            "Joint_Speed": lambda m: m.speeds()["Joint_Speed"],
+            "TCP_Speed": lambda m: m.speeds()["TCP_Speed"],
+            "TCP_Speed3D": lambda m: m.speeds()["TCP_Speed3D"],
+            "Robot_Error": lambda m: m.model.error_active,
+            "Error_Code": lambda m: m.model.error_code,
+            "Error_Content": lambda m: m.model.error_text,
+            "Error_Time": lambda m: self._clock(m.model.error_time) if m.model.error_time is not None else "",
+            "Camera_Light": lambda m: int(m.model.io.get("CameraLight", 0)),
+            "Project_Speed": lambda m: m.model.project_speed,
+            "Project_Name": lambda m: self.project_name,
+            "Project_Run_Time": lambda m: _duration(m.session.now - self.run_since
+                                                    if self.run_since is not None else 0.0),
+            "Project_Run": lambda m: m.running,
+            "Project_Pause": lambda m: m.running and m.model.paused,
+            "ESTOP": lambda m: m.model.estop,
+            "Stick_ESTOP": lambda m: m.model.estop,
+            "Robot_State": lambda m: 4 if m.model.estop else 3 if m.model.error_active else 0,   # 4 STO, 3 error
+            "Robot_Light": lambda m: LIGHT_ESTOP if m.model.estop else LIGHT_ERROR if m.model.error_active
+            else LIGHT[(m.model.auto_mode, m.running)],
+            "Operation_Mode": lambda m: 1 if m.model.auto_mode else 0,       # Appendix D: 0 manual, 1 auto
+            "MA_Mode": lambda m: 2 if m.model.auto_mode else 1,              # older tables: 1 manual, 2 auto
+            "TCP_Name": lambda m: m.model.tool_name,
+            "TCP_Value": lambda m: list(m.model.tool_pose),
+            "TCP_Mass": lambda m: m.model.tool_mass,
+            "Base_Name": lambda m: m.model.base_name,
+            "Base_Value": lambda m: list(m.model.base_pose),
+        })
+        return getters
 
     def _clock(self, seconds) -> str:
         """[YYYY]-[MM]-[DD]T[hh]:[mm]:[ss.sss] (Appendix D) of a virtual time."""
@@ -216,6 +179,43 @@ class RobotDataSource:
     def set_auto_mode(self, auto: bool):
         self.model.auto_mode = bool(auto)
         self.log("operation_mode", mode="auto" if auto else "manual")
+
+
+class _Moment:
+    """What one read of the data table sees: joints, poses and speeds computed once, on first use."""
+
+    def __init__(self, model, session, running):
+        self.model, self.session, self.running = model, session, running
+        self.joints = model.current_joints()
+        self._poses, self._speeds, self._flange = {}, None, None
+
+    def pose(self, kind):
+        """Coord_{Base|Robot}_{Flange|Tool}: the flange matrix once, then tool and base applied."""
+        pose = self._poses.get(kind)
+        if pose is None:
+            model = self.model
+            if self._flange is None:
+                self._flange = kin.forward(self.joints)
+            m = kin.matmul(self._flange, model._matrix(model.tool_pose)) if kind.endswith("Tool") else self._flange
+            if kind.startswith("Coord_Base"):
+                m = kin.matmul(kin.inverse(model._matrix(model.base_pose)), m)
+            pose = self._poses[kind] = kin.matrix_to_pose(m)
+        return pose
+
+    def speeds(self):
+        """Joint and TCP speed of the motion under way (difference quotient), zero while it stands."""
+        if self._speeds is None:
+            model, plan = self.model, self.model.active
+            if plan is None or model.paused:
+                self._speeds = {"Joint_Speed": [0.0] * 6, "TCP_Speed": [0.0] * 6, "TCP_Speed3D": 0.0}
+            else:
+                later = plan.joints_at(min(plan.total, model.active_t + _SPEED_STEP_S), self.joints)
+                scale = model.project_speed / 100.0 / _SPEED_STEP_S
+                then = kin.matrix_to_pose(kin.forward(later, model._matrix(model.tool_pose)))
+                tcp = [(b - a) * scale for a, b in zip(self.pose("Coord_Robot_Tool"), then)]
+                self._speeds = {"Joint_Speed": [(b - a) * scale for a, b in zip(self.joints, later)],
+                                "TCP_Speed": tcp, "TCP_Speed3D": sum(v * v for v in tcp[:3]) ** 0.5}
+        return self._speeds
 
 
 def _duration(seconds: float) -> str:

@@ -89,6 +89,12 @@ def _items():
 
 ITEMS: dict[str, Item] = _items()
 
+_U16 = struct.Struct("<H")
+# item name -> (length-prefixed name, packer of its value) for the binary format
+_PACKERS = {item.name: (_U16.pack(len(item.name.encode())) + item.name.encode(),
+                        None if item.type == "string" else struct.Struct("<%d%s" % (item.size, _PACK[item.type])))
+            for item in ITEMS.values()}
+
 
 # ---- checking a value against its item ------------------------------------------------------------
 def check_value(item: Item, value):
@@ -133,20 +139,21 @@ def _scalar(item, value):
 def binary_value(item: Item, value) -> bytes:
     if item.type == "string":
         return value.encode("utf-8")
-    values = value if item.size > 1 else [value]
-    fmt = "<%d%s" % (len(values), _PACK[item.type])
-    if item.type == "float":
-        return struct.pack(fmt, *(float(v) for v in values))
-    return struct.pack(fmt, *(int(v) for v in values))
+    packer = _PACKERS[item.name][1]
+    if item.size > 1:
+        return packer.pack(*value)
+    return packer.pack(value)
 
 
 def encode_binary(pairs) -> bytes:
-    """``pairs``: (Item, value) in table order -> mode 1 content."""
-    out = bytearray()
+    """``pairs``: (Item, value) -> mode 1 content: u16 name length, name, u16 value length, value."""
+    out = []
     for item, value in pairs:
-        name, data = item.name.encode("utf-8"), binary_value(item, value)
-        out += struct.pack("<H", len(name)) + name + struct.pack("<H", len(data)) + data
-    return bytes(out)
+        data = binary_value(item, value)
+        out.append(_PACKERS[item.name][0])
+        out.append(_U16.pack(len(data)))
+        out.append(data)
+    return b"".join(out)
 
 
 def split_binary(content: bytes, with_values: bool) -> list[tuple[str, bytes | None]]:

@@ -357,3 +357,18 @@ def test_cli_opens_the_ethernet_slave_next_to_the_listen_node_and_no_svr_disable
                           "Joint_Angel"],
                          capture_output=True, text=True, timeout=20)
     assert bad.returncode == 2 and "unknown data table item(s): Joint_Angel" in bad.stderr
+
+
+def test_poses_follow_the_base_and_tool_in_use(h):
+    node, peer = h.connect(), h.connect_svr()
+    h.request(node, sct("1", "ChangeBase(100,50,20,0,0,30)\r\nChangeTCP(0,0,150,0,0,0)\r\n"
+                             'PTP("JPP",20,10,80,0,90,0,100,200,0,false)\r\nQueueTag(1,1)'), count=2)
+    state = h.robot.state()
+    got = values(h, peer, ["Coord_Base_Tool", "Coord_Robot_Tool", "Coord_Robot_Flange", "Coord_Base_Flange",
+                           "Joint_Angle", "Base_Value", "TCP_Value"])
+    assert got["Joint_Angle"] == pytest.approx(state["joints"], abs=1e-4)
+    assert got["Coord_Base_Tool"] == pytest.approx(state["tcp"], abs=1e-3)
+    assert got["Coord_Robot_Tool"] == pytest.approx(state["tcp_robot"], abs=1e-3)
+    assert got["Coord_Robot_Flange"][2] == pytest.approx(state["tcp_robot"][2] + 150, abs=1e-3)   # tool points down
+    assert got["Base_Value"] == [100, 50, 20, 0, 0, 30] and got["TCP_Value"] == [0, 0, 150, 0, 0, 0]
+    assert got["Coord_Base_Flange"] != got["Coord_Robot_Flange"]
