@@ -303,7 +303,7 @@ def split_json(content: str, with_values: bool) -> list[tuple[str, object]]:
     """Mode 3 content -> [(name, value)]; mode 13 -> [(name, None)] (a single object is one item)."""
     try:
         data = json.loads(content)
-    except ValueError:
+    except (ValueError, RecursionError):         # RecursionError: nested deeper than the parser goes
         raise SvrContentError("the content is not JSON") from None
     if isinstance(data, dict):
         data = [data]

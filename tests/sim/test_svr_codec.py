@@ -123,7 +123,7 @@ def test_binary_value_of_the_wrong_size_is_a_value_error():
 
 @pytest.mark.parametrize("kind, content", [
     ("binary", b"\x05\x00Ab"), ("binary", b"\x01"), ("binary", b""), ("string", "Ctrl_DO0"), ("string", "=1"),
-    ("json", "Ctrl_DO0=1"), ("json", '[{"Value": 1}]'), ("json", '[{"Item": "Ctrl_DO0"}]'), ("json", "[]"),
+    ("json", "Ctrl_DO0=1"), ("json", '[{"Value": 1}]'), ("json", "[" * 60000 + "]" * 60000), ("json", '[{"Item": "Ctrl_DO0"}]'), ("json", "[]"),
 ])
 def test_content_that_does_not_match_its_mode_is_invalid_data(kind, content):
     split = {"binary": table.split_binary, "string": table.split_string, "json": table.split_json}[kind]
