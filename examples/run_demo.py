@@ -1,6 +1,6 @@
 """`make demo`: robot simulator + virtual PLC running the examples in real time + web HMI, stopped by Ctrl-C.
 
-    python examples/run_demo.py [--host 127.0.0.1] [--robot-port 5890] [--hmi-port 8080]
+    python examples/run_demo.py [--host 127.0.0.1] [--robot-port 5890] [--svr-port 5891] [--hmi-port 8080]
 """
 from __future__ import annotations
 
@@ -54,22 +54,24 @@ def parse_args(argv):
     parser = argparse.ArgumentParser(prog="make demo", description=__doc__.splitlines()[0])
     parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     parser.add_argument("--robot-port", type=tcp_port, default=5890, help="robot Listen Node port (default 5890)")
+    parser.add_argument("--svr-port", type=tcp_port, default=None,
+                        help="robot Ethernet Slave port (default: the robot port + 1, i.e. 5891)")
     parser.add_argument("--hmi-port", type=tcp_port, default=8080, help="web HMI port (default 8080)")
     return parser.parse_args(argv)
 
 
 class Demo:
-    def __init__(self, host: str, robot_port: int, hmi_port: int):
+    def __init__(self, host: str, robot_port: int, hmi_port: int, svr_port: int | None = None):
         self.host, self.robot_port, self.hmi_port = host, robot_port, hmi_port
+        self.svr_port = svr_port or (robot_port + 1 if robot_port < 65535 else robot_port - 1)
         self.stop_event = threading.Event()
         self.sim = self.plc = self.hmi = self.plc_thread = None
         self.fault: str | None = None
 
     def start(self) -> None:
         check_port_free(self.host, self.robot_port, "robot simulator", "--robot-port")
-        if self.robot_port < 65535:
-            check_port_free(self.host, self.robot_port + 1, "robot Ethernet Slave", "--robot-port")
         check_port_free(self.host, self.hmi_port, "web HMI", "--hmi-port")
+        check_port_free(self.host, self.svr_port, "robot Ethernet Slave", "--svr-port")
         try:
             mapping = Mapping.load()
         except MappingError as exc:
@@ -90,7 +92,7 @@ class Demo:
             self.plc.write("Connect_AddressIP", self.host)
             self.plc.write("Connect_Dest_PortIP", self.robot_port)
         self.sim = SimServer(host=self.host, port=self.robot_port, robots=1,
-                             svr_port=self.robot_port + 1 if self.robot_port < 65535 else 0)
+                             svr_port=self.svr_port)
         try:
             self.sim.start_background()
         except OSError as exc:
@@ -142,7 +144,7 @@ class Demo:
 
 def main(argv=None) -> int:
     args = parse_args(argv)
-    demo = Demo(args.host, args.robot_port, args.hmi_port)
+    demo = Demo(args.host, args.robot_port, args.hmi_port, args.svr_port)
     signal.signal(signal.SIGTERM, lambda *_: demo.stop_event.set())
     try:
         demo.start()

@@ -64,7 +64,7 @@ def test_demo_runs_everything_and_stops_cleanly_on_ctrl_c():
     import urllib.request
     robot_port, hmi_port = free_port(), free_port()
     demo = subprocess.Popen([sys.executable, str(DEMO), "--robot-port", str(robot_port), "--hmi-port",
-                             str(hmi_port)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+                             str(hmi_port), "--svr-port", str(free_port())], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
     lines: queue.Queue = queue.Queue()
     reader = threading.Thread(target=lambda: [lines.put(line) for line in demo.stdout], daemon=True)
     reader.start()
