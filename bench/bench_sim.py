@@ -12,6 +12,7 @@ What is measured, and why this way:
   parsed from the parser's cache; the clients are in lock-step (they all start in the same
   millisecond and their motions last equally long), the worst case for a single-threaded server.
 Targets (issue 5): >= 5,000 round trips/s; worst reply latency <= 5 ms; <= 60 MB RSS with 32 robots.
+Target (issue 12): a well-behaved client is answered within 10 ms (p99) while other clients flood the robot.
 """
 from __future__ import annotations
 
@@ -148,6 +149,58 @@ def bench_streaming(ports, seconds=5.0, look_ahead=3, saturate=False, warm_up=1.
     return latencies
 
 
+def bench_flood(port, flooders=1, seconds=3.0, warm_up=0.3):
+    """Fairness under a flood (issue 12): ``flooders`` clients write ``$`` bytes as fast as the simulator
+    takes them (and read whatever comes back) while one well-behaved client on the same robot does TMSTA 00
+    round trips. Returns (sorted latencies of the well-behaved client, bytes the flooders wrote, CPERR bytes
+    they received). Everything runs in this thread (one selectors loop)."""
+    sel = selectors.DefaultSelector()
+    chunk = b"$" * 65536
+    flood = {"in": 0, "out": 0}
+    for _ in range(flooders):
+        sock = socket.create_connection(("127.0.0.1", port))
+        sock.setblocking(False)
+        sel.register(sock, selectors.EVENT_READ | selectors.EVENT_WRITE, "flood")
+    good = socket.create_connection(("127.0.0.1", port))
+    good.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    good.setblocking(False)
+    sel.register(good, selectors.EVENT_READ, "good")
+    request, expected = codec.encode("TMSTA", "00"), codec.encode("TMSTA", "00,true,Listen1")
+    latencies, reply, sent_at = [], b"", time.perf_counter()
+    good.sendall(request)
+    counted_from = time.perf_counter() + warm_up
+    end = counted_from + seconds
+    while time.perf_counter() < end:
+        for key, mask in sel.select(0.05):
+            if key.data == "good":
+                reply += good.recv(4096)
+                if len(reply) >= len(expected):
+                    if reply != expected:
+                        raise AssertionError(f"unexpected reply {reply!r}")
+                    if sent_at >= counted_from:
+                        latencies.append(time.perf_counter() - sent_at)
+                    reply, sent_at = b"", time.perf_counter()
+                    good.sendall(request)
+                continue
+            try:
+                if mask & selectors.EVENT_READ:
+                    data = key.fileobj.recv(1 << 20)
+                    if not data:
+                        sel.unregister(key.fileobj)
+                        continue
+                    flood["out"] += len(data)
+                if mask & selectors.EVENT_WRITE:
+                    flood["in"] += key.fileobj.send(chunk)
+            except (BlockingIOError, InterruptedError):
+                pass
+            except OSError:
+                sel.unregister(key.fileobj)
+    for key in list(sel.get_map().values()):
+        key.fileobj.close()
+    latencies.sort()
+    return latencies, flood["in"], flood["out"]
+
+
 def bench_poll_cost(robots=32, iterations=2000):
     srv = SimServer(port=0, robots=robots).start()
     try:
@@ -197,6 +250,16 @@ def main():
           f"{ms(saturated)}   (no target; once a robot's FIFO holds 1,000 items a script waits for room)")
     print(f"RSS of the simulator with 32 robots: {peak_rss:.1f} MB after flooding   (target <= 60 MB; "
           f"{idle_rss:.1f} MB idle, {busy_rss:.1f} MB after streaming)")
+    for flooders in (1, 50):
+        proc, ports = start_cli(1)
+        try:
+            latencies, flood_in, flood_out = bench_flood(ports[0], flooders=flooders)
+        finally:
+            proc.terminate()
+            proc.communicate(timeout=10)
+        print(f"{flooders} client(s) flooding '$' bytes, one client doing TMSTA 00 round trips on the same robot: "
+              f"latency median / p99 / worst {ms(latencies)}   (target p99 <= 10 ms; {len(latencies):,d} round "
+              f"trips in 3 s); flood {flood_in / 1e6:.1f} MB in, {flood_out / 1e6:.2f} MB of CPERR out")
     cost = bench_poll_cost()
     print(f"poll() with 32 idle robots (in-process, virtual clock): {cost * 1e6:.1f} us per call   (no target)")
     return 0

@@ -42,3 +42,8 @@ CONTROL_CLIENTS_MAX = 16
 # ---- robot servers (per robot unless noted) -----------------------------------------------------
 EVENT_BYTES_MAX = 20 << 20                  # event log kept in memory, all robots together
 ACCEPT_BACKOFF_S = 0.1                      # out of descriptors: stop accepting for this long
+SERVE_ITEMS = 8                             # items of one client's input processed in one turn ...
+SERVE_SCAN = 256                            # ... and decoded (bad packets not answered count here only)
+CPERR_BURST = 16                            # CPERR answers to bad packets a client gets at once ...
+CPERR_PER_S = 100                           # ... then at most this many per second (robot clock)
+OUTBOX_TOTAL_MAX = 16 << 20                 # unsent bytes of all clients of one robot

@@ -8,7 +8,12 @@ Limits (per robot unless noted):
 * MAX_CLIENTS simultaneous connections; more are accepted and closed at once
 * MAX_PENDING buffered scripts; beyond that the server stops reading from that robot's clients
   (TCP back-pressure) until the queue shrinks
-* MAX_OUTBOX bytes waiting to be sent to one client; a client that does not read is dropped
+* MAX_OUTBOX bytes waiting to be sent to one client, OUTBOX_TOTAL_MAX to all clients of a robot; a client
+  that does not read (the one with most waiting, for the total) is dropped
+* fairness: one turn processes at most SERVE_ITEMS items of one client's input (and decodes at most
+  SERVE_SCAN); the rest waits in its receive buffer, which is not read further meanwhile, while the other
+  clients get their turn. Bad packets are answered with CPERR at most CPERR_BURST at once, then
+  CPERR_PER_S per second (robot clock) per client; the others are counted (event ``cperr_suppressed``)
 """
 from __future__ import annotations
 
@@ -25,7 +30,8 @@ from . import codec
 from .control import ControlChannel
 from .ethernet_slave import EthernetSlave
 from .faults import FaultState, check_params as check_fault_params
-from .limits import ACCEPT_BACKOFF_S, EVENT_BYTES_MAX
+from .limits import (ACCEPT_BACKOFF_S, CPERR_BURST, CPERR_PER_S, EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX,
+                     SERVE_ITEMS, SERVE_SCAN)
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
 
@@ -33,6 +39,7 @@ MAX_CLIENTS = 256
 MAX_PENDING = 1000
 MAX_OUTBOX = 1 << 20
 RECV_SIZE = 65536
+RBUF_READ_BELOW = codec.MAX_DATA + 64     # a receive buffer this full holds a complete item: process it first
 EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all) ...
 EVENT_OVERHEAD = 200        # ... and at most limits.EVENT_BYTES_MAX bytes: an event counts this + its texts
 _OUT_OF_DESCRIPTORS = (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM)
@@ -43,14 +50,18 @@ IO_SLICE_S = 0.0003          # at most this much work (planning, advancing) betw
 
 
 class _Conn:
-    __slots__ = ("sock", "id", "rbuf", "wbuf", "eof", "frames_in", "peer")
+    __slots__ = ("sock", "id", "rbuf", "wbuf", "eof", "frames_in", "peer", "cperr_tokens", "cperr_at",
+                 "suppressed", "greedy")
 
-    def __init__(self, sock, conn_id, peer):
+    def __init__(self, sock, conn_id, peer, now):
         self.sock, self.id, self.peer = sock, conn_id, peer
         self.rbuf = bytearray()
         self.wbuf = bytearray()
         self.eof = False
         self.frames_in = 0
+        self.cperr_tokens, self.cperr_at = float(CPERR_BURST), now     # CPERR answers to bad bytes (a bucket)
+        self.suppressed = 0                                              # bad packets not answered since
+        self.greedy = False                     # its last read filled RECV_SIZE, or input is left over
 
 
 class Robot:
@@ -214,6 +225,7 @@ class SimServer:
         self._now = 0.0
         self._dispatch = {"listen": self._accept, "conn": self._read}
         self._touched: list[Robot] = []       # robots that received data and still have to advance
+        self._backlog: dict[tuple, tuple] = {}    # (robot index, conn id) -> (robot, conn) with input left over
         self._starting = False
         self._slice_start = self._poll_end = 0.0
         self.started = False
@@ -352,7 +364,8 @@ class SimServer:
                 self.svr.poll(self._now)
             if self.control is not None:
                 self.control.tick(self._now)
-            ready = self._serve(timeout)
+            ready = self._serve(0.0 if self._backlog else timeout)
+            self._serve_backlog()
             self._start_touched()
             for robot in self.robots:
                 self._flush(robot)
@@ -380,6 +393,8 @@ class SimServer:
         robot.reading_paused = not reading
         robot._log("reading_resumed" if reading else "reading_paused", buffered=len(robot.session.pending))
         for conn in robot.conns.values():
+            if reading and conn.rbuf:
+                self._backlog[(robot.index, conn.id)] = (robot, conn)    # input read before the pause
             if conn.eof:
                 continue
             try:
@@ -390,12 +405,25 @@ class SimServer:
             except (KeyError, ValueError):
                 pass
 
-    def _serve(self, timeout):
+    def _serve(self, timeout, quick_only=False):
         """Accept and read every ready socket; the replies are written at once. Robots that received
-        something are remembered in ``_touched`` for ``_start_touched``."""
+        something are remembered in ``_touched`` for ``_start_touched``.
+
+        Fairness: clients whose last read filled the receive size or who have input left over ("greedy",
+        i.e. flooding) are served after the others, and every IO_SLICE_S in between them the sockets are
+        polled again for the others' new requests (``quick_only``: serve only those)."""
         ready = self.selector.select(timeout)
+        ready.sort(key=_is_greedy)
+        checked = time.perf_counter()
         for key, _mask in ready:
             kind, robot, conn = key.data
+            greedy = _is_greedy((key, _mask))
+            if greedy:
+                if quick_only:
+                    continue
+                if time.perf_counter() - checked > IO_SLICE_S:
+                    self._serve(0.0, quick_only=True)
+                    checked = time.perf_counter()
             try:
                 self._dispatch[kind](robot, conn)
             except Exception as exc:          # safety net: one bad client never stops the others
@@ -407,7 +435,7 @@ class SimServer:
                 if robot not in self._touched:
                     self._touched.append(robot)
                 if not robot.faults.active:
-                    self._flush(robot)
+                    self._flush(robot, conn)
         return len(ready)
 
     def _advance(self, robot):
@@ -454,7 +482,7 @@ class SimServer:
                 robot._log("rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")
                 sock.close()
                 continue
-            conn = _Conn(sock, self._next_conn, addr[0])
+            conn = _Conn(sock, self._next_conn, addr[0], self._now)
             self._next_conn += 1
             robot.conns[conn.id] = conn
             robot.session.connect(conn.id, addr[0])
@@ -466,24 +494,51 @@ class SimServer:
         if len(robot.session.pending) >= MAX_PENDING:
             self._set_reading(robot, False)
             return
-        try:
-            data = conn.sock.recv(RECV_SIZE)
-        except (BlockingIOError, InterruptedError):
-            return
-        except OSError as exc:
-            self._drop(robot, conn, f"receive failed: {exc.strerror}")
-            return
-        if not data:
-            conn.eof = True
-            self.selector.unregister(conn.sock)
-            robot._log("peer_closed", conn=conn.id)
-            return
-        if robot.faults.black_hole:
-            robot._log("black_hole", conn=conn.id, bytes=len(data))
-            return
-        conn.rbuf += data
-        for item in codec.decode_all(conn.rbuf):
-            if isinstance(item, codec.Frame):
+        if len(conn.rbuf) < RBUF_READ_BELOW:     # else: what is buffered is processed first (fairness)
+            try:
+                data = conn.sock.recv(RECV_SIZE)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                self._drop(robot, conn, f"receive failed: {exc.strerror}")
+                return
+            if not data:
+                conn.eof = True
+                self.selector.unregister(conn.sock)
+                robot._log("peer_closed", conn=conn.id)
+                return
+            conn.greedy = len(data) == RECV_SIZE
+            if robot.faults.black_hole:
+                robot._log("black_hole", conn=conn.id, bytes=len(data))
+                return
+            conn.rbuf += data
+        if (robot.index, conn.id) not in self._backlog:     # else it waits for its turn in _serve_backlog
+            self._process(robot, conn)
+
+    def _process(self, robot, conn):
+        """One turn of ``conn``'s input: at most SERVE_ITEMS items handled, SERVE_SCAN decoded. What is left
+        waits for the next turn (``_backlog``), after the other clients' turns."""
+        handled, key = 0, (robot.index, conn.id)
+        for _ in range(SERVE_SCAN):
+            if conn.rbuf[:2] == b"$$" and self._cperr_tokens(conn) < 1.0:
+                # a '$' followed by another '$' is always a bad packet (header missing, CPERR 01): a run of
+                # them that gets no answer anyway is skipped at once
+                run = len(conn.rbuf) - len(conn.rbuf.lstrip(b"$")) - 1
+                del conn.rbuf[:run]
+                conn.suppressed += run
+                continue
+            item, used = codec.decode(conn.rbuf)
+            if not used:
+                self._backlog.pop(key, None)
+                break
+            del conn.rbuf[:used]
+            if type(item) is codec.BadFrame and not self._may_answer_bad(conn):
+                conn.suppressed += 1
+                continue
+            if conn.suppressed:
+                robot._log("cperr_suppressed", conn=conn.id, count=conn.suppressed)
+                conn.suppressed = 0
+            if type(item) is codec.Frame:
                 conn.frames_in += 1
                 robot._log("frame_in", conn=conn.id, raw=_text(item.raw), header=item.header,
                            data=_text(item.data))
@@ -493,13 +548,68 @@ class SimServer:
                 self._flush(robot)
                 self._drop(robot, conn, "fault: close_after")
                 return
+            handled += 1
+            if handled >= SERVE_ITEMS or len(robot.session.pending) >= MAX_PENDING:
+                self._backlog[key] = (robot, conn)
+                conn.greedy = True
+                break
+        else:
+            self._backlog[key] = (robot, conn)
+            conn.greedy = True
 
-    def _flush(self, robot):
+    def _cperr_tokens(self, conn) -> float:
+        """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""
+        conn.cperr_tokens = min(CPERR_BURST, conn.cperr_tokens + (self._now - conn.cperr_at) * CPERR_PER_S)
+        conn.cperr_at = self._now
+        return conn.cperr_tokens
+
+    def _may_answer_bad(self, conn) -> bool:
+        if self._cperr_tokens(conn) < 1.0:
+            return False
+        conn.cperr_tokens -= 1.0
+        return True
+
+    def _serve_backlog(self):
+        """Turns for the clients with input left over, round robin, until none is left or POLL_BUDGET_S has
+        passed; every IO_SLICE_S the sockets are polled, so fresh requests of other clients go first."""
+        served = start = time.perf_counter()
+        while self._backlog and time.perf_counter() - start < POLL_BUDGET_S:
+            served = self._backlog_round(served)
+
+    def _backlog_round(self, served):
+        for key, (robot, conn) in list(self._backlog.items()):
+            if time.perf_counter() - served > IO_SLICE_S:
+                self._serve(0.0, quick_only=True)
+                served = time.perf_counter()
+            if conn.id not in robot.conns:
+                self._backlog.pop(key, None)
+                continue
+            if len(robot.session.pending) >= MAX_PENDING:
+                self._backlog.pop(key, None)      # the script buffer is full: _set_reading resumes it
+                if not robot.reading_paused:
+                    self._set_reading(robot, False)
+                continue
+            self._process(robot, conn)
+            if robot not in self._touched:
+                self._touched.append(robot)
+            if not robot.faults.active:
+                self._flush(robot, conn)
+        return served
+
+    def _flush(self, robot, only=None):
+        """Write what the robot's session produced; ``only``: just that client's output (cheap, right after
+        its request), else every client's plus the per-robot checks (once a poll at least)."""
         if not robot.conns:                       # (the session has no client without a connection)
             return
         now = self._now
         faulty = robot.faults.active
-        for conn_id, client in list(robot.session.clients.items()):
+        waiting = 0
+        clients = robot.session.clients
+        if only is None:
+            items = list(clients.items())
+        else:
+            items = [(only.id, clients[only.id])] if only.id in clients else []
+        for conn_id, client in items:
             conn = robot.conns.get(conn_id)
             if conn is None:
                 continue
@@ -533,13 +643,21 @@ class SimServer:
             if len(conn.wbuf) > MAX_OUTBOX:
                 self._drop(robot, conn, f"client does not read (more than {MAX_OUTBOX} bytes waiting)")
                 continue
+            waiting += len(conn.wbuf)
             if close:
                 self._drop(robot, conn, "fault: close_mid_frame")
             elif conn.eof and not conn.wbuf and not robot.faults.holding(conn_id) and \
                     not _has_work_for(robot.session, conn_id):
                 self._drop(robot, conn, "peer closed its side")
+        if only is not None:
+            return
         for conn in [c for c in robot.conns.values() if c.id not in robot.session.clients]:
             self._drop(robot, conn, "session ended")
+        while waiting > OUTBOX_TOTAL_MAX:             # e.g. a large ListenSend to many clients that do not read
+            laziest = max(robot.conns.values(), key=lambda c: len(c.wbuf))
+            waiting -= len(laziest.wbuf)
+            self._drop(robot, laziest, f"client does not read (its robot's clients have more than "
+                                       f"{OUTBOX_TOTAL_MAX} bytes waiting)")
 
     def _drop(self, robot, conn, reason):
         if robot.conns.pop(conn.id, None) is None:
@@ -554,6 +672,9 @@ class SimServer:
         except OSError:
             pass
         robot.faults.forget(conn.id)
+        self._backlog.pop((robot.index, conn.id), None)
+        if conn.suppressed:
+            robot._log("cperr_suppressed", conn=conn.id, count=conn.suppressed)
         robot.session.disconnect(conn.id)
         robot._log("closed", conn=conn.id, reason=reason)
 
@@ -573,6 +694,11 @@ def _shortened(event, size):
     room = max(64, (size - EVENT_OVERHEAD) // max(1, sum(type(v) is str for v in event.values())))
     return {key: (value[:room] + f"...[{len(value)} characters]" if type(value) is str and len(value) > room
                   else value) for key, value in event.items()}
+
+
+def _is_greedy(ready_item) -> bool:
+    conn = ready_item[0].data[2]
+    return type(conn) is _Conn and conn.greedy
 
 
 def _send(sock, data) -> int:

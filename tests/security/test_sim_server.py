@@ -4,7 +4,7 @@ import os
 import resource
 import socket
 
-from sim.limits import ACCEPT_BACKOFF_S, EVENT_BYTES_MAX
+from sim.limits import ACCEPT_BACKOFF_S, CPERR_BURST, CPERR_PER_S, EVENT_BYTES_MAX
 
 from sim_probe import Harness, sct, sta
 
@@ -98,4 +98,110 @@ def test_out_of_descriptors_pauses_accepting_logs_once_and_resumes():
         for fd in held:
             os.close(fd)
         resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+        h.close()
+
+
+def _flood(h, sock, data, chunk=65536, max_steps=20_000):
+    """Write ``data`` without blocking the thread that polls the simulator; step until all is written."""
+    sock.setblocking(False)
+    sent, steps = 0, 0
+    while sent < len(data) and steps < max_steps:
+        try:
+            sent += sock.send(data[sent:sent + chunk])
+        except BlockingIOError:
+            pass
+        h.step()
+        steps += 1
+    return sent
+
+
+def test_a_megabyte_of_dollar_signs_gets_a_few_cperr_not_seventeen_megabytes():
+    """Probe: 1 MB of '$' (old: 17.8 MB of CPERR 01 back, x17). CPERR answers to bad packets are limited
+    per client: CPERR_BURST at once, CPERR_PER_S per second of robot clock; the rest is counted in an event."""
+    h = Harness()
+    try:
+        flooder = h.connect()
+        start = h.t
+        assert _flood(h, flooder.sock, b"$" * (1 << 20)) == 1 << 20
+        conn = h.robot.conns[max(h.robot.conns)]
+
+        def accounted():                       # answered + counted (an event, or still on the connection)
+            flooder.pump()
+            return (len([f for f in flooder.frames if f.header == "CPERR"]) + conn.suppressed +
+                    sum(e["count"] for e in h.robot.events if e["kind"] == "cperr_suppressed"))
+        assert h.until(lambda: accounted() >= (1 << 20) - 1, timeout=5)   # every '$' but the last (it waits)
+        answered = len([f for f in flooder.frames if f.header == "CPERR"])
+        assert answered <= CPERR_BURST + CPERR_PER_S * (h.t - start) + 1
+        assert sum(map(len, flooder.raw_reads)) < 20 * (answered + 1) < 64 * 1024
+        assert not flooder.closed and h.request(h.connect(), sta("00")) == [("TMSTA", "00,true,Listen1")]
+    finally:
+        h.close()
+
+
+def test_a_well_behaved_client_is_served_before_a_flooding_one():
+    """Probe: one client floods while another asks TMSTA 00 (old: the other waited up to 1.5 s). A client
+    whose reads fill the receive size or who has input left over is served after the others, one bounded
+    turn at a time (the latency figure is in bench/bench_sim.py)."""
+    h = Harness()
+    try:
+        flooder, polite = h.connect(), h.connect()
+        flooder.sock.setblocking(False)
+        flood = sta("00") * 8000                               # 120 KB of status queries, 8,000 replies due
+        sent = flooder.sock.send(flood)
+        h.step()                                              # the flooder is now 'greedy'
+        polite.send(sta("00"))
+        events_before = len(h.robot.events)
+        h.step()
+        assert polite.texts() == [("TMSTA", "00,true,Listen1")]
+        this_poll = h.robot.events[events_before:]
+        first_polite = next(i for i, e in enumerate(this_poll) if e.get("conn") == polite_conn(h, polite))
+        assert first_polite <= 4, this_poll[:first_polite]    # nothing of the flooder's went first
+        while sent < len(flood):
+            try:
+                sent += flooder.sock.send(flood[sent:])
+            except BlockingIOError:
+                pass
+            h.step()
+        assert h.until(lambda: len(flooder.frames) == 8000, timeout=30)
+        assert {t for _, t in flooder.texts()} == {"00,true,Listen1"}     # nothing lost, each once
+    finally:
+        h.close()
+
+
+def polite_conn(h, peer):
+    port = peer.sock.getsockname()[1]
+    return next(e["conn"] for e in h.robot.events if e["kind"] == "connect" and e.get("peer") and
+                h.robot.conns.get(e["conn"]) and h.robot.conns[e["conn"]].sock.getpeername()[1] == port)
+
+
+def test_listen_send_fan_out_to_lazy_clients_is_bounded_in_memory(monkeypatch):
+    """Probe: a 60 KB ListenSend to many clients that never read (old: 3.6 GB). Unsent output is bounded per
+    client (MAX_OUTBOX) and per robot (OUTBOX_TOTAL_MAX: the laziest client is dropped); the event log by bytes."""
+    from sim import server
+    monkeypatch.setattr(server, "OUTBOX_TOTAL_MAX", 1 << 20)    # the kernel buffers must fill first: keep it short
+    h = Harness()
+    try:
+        sender = h.connect()
+        lazy = []
+        for _ in range(6):
+            sock = socket.create_connection(("127.0.0.1", h.srv.ports[0]))
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+            lazy.append(sock)
+        h.step()
+        h.request(sender, sct("0", 'string s = "' + "z" * 60_000 + '"'))
+        dropped = []
+        for n in range(1, 400):
+            sender.rbuf.clear()
+            sender.frames.clear()
+            h.request(sender, sct(str(n), "ListenSend(90, s)"), count=2)
+            dropped = [e for e in h.robot.events if e["kind"] == "closed" and "its robot's clients" in e["reason"]]
+            waiting = sum(len(c.wbuf) for c in h.robot.conns.values())
+            assert waiting <= (1 << 20) + 70_000
+            if dropped:
+                break
+        assert dropped, "no lazy client was dropped"
+        assert h.robot.event_bytes <= EVENT_BYTES_MAX
+        for sock in lazy:
+            sock.close()
+    finally:
         h.close()

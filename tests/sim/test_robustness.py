@@ -6,6 +6,7 @@ import time
 from sim import codec
 from sim.script import split_lines
 from sim.checker import check_script
+from sim.server import MAX_PENDING
 from sim_harness import Harness, sct, sta
 
 
@@ -147,7 +148,7 @@ def test_full_script_buffer_pauses_reading_and_resumes_when_it_drains(harness):
     h.run(0.1)
     peer.send(b"".join(sct(f"C{i}", "ChangeLoad(2)") for i in range(100)))
     h.run(0.4)
-    assert h.robot.reading_paused and len(h.robot.session.pending) == 1100
+    assert h.robot.reading_paused and len(h.robot.session.pending) == MAX_PENDING    # exactly, not one read more
     assert h.until(lambda: len(peer.frames) >= 1202, timeout=30, dt=0.01)
     assert not h.robot.reading_paused
     assert peer.texts()[-1] == ("TMSCT", "C99,OK")
