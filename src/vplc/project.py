@@ -14,6 +14,7 @@ from .checker.scope import Ambiguous, Tables
 from .frontend.diagnostics import DiagnosticBag, Diagnostic, render_all, sort_key
 from .frontend.parser import parse
 from .frontend.source import SourceFile, Span
+from .ladder.load import attach_ladders, check_operands, is_xml, read_xml
 
 PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
 VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st")
@@ -98,9 +99,9 @@ def collect_files(paths, diags: DiagnosticBag) -> list[str]:
             found = []
             for root, dirs, names in os.walk(p):
                 dirs.sort()
-                found += [os.path.join(root, n) for n in sorted(names) if n.lower().endswith(".st")]
+                found += [os.path.join(root, n) for n in sorted(names) if n.lower().endswith(".st") or is_xml(n)]
             if not found:
-                diags.warning("ST0004", f"folder `{p}` contains no .st files", Span(SourceFile(p, ""), 0, 0))
+                diags.warning("ST0004", f"folder `{p}` contains no .st or .xml files", Span(SourceFile(p, ""), 0, 0))
             files += found
         elif os.path.exists(p):
             files.append(p)
@@ -143,7 +144,8 @@ def read_source(path: str, diags: DiagnosticBag) -> SourceFile | None:
 # ---- loading -------------------------------------------------------------------------------------
 
 def load_project(paths, *, dialect: str = "sysmac", include_prelude: bool = True, portable: bool = False) -> Project:
-    """Read, parse and check ``paths`` (files or folders, recursively ``*.st``) plus the prelude."""
+    """Read, parse and check ``paths`` (files or folders, recursively ``*.st`` and ``*.xml``: PLCopen XML and
+    IEC 61131-10 projects, see :mod:`vplc.ladder`) plus the prelude."""
     # The front end allocates many small long-lived objects and frees almost nothing: the cyclic garbage
     # collector would only re-scan them (making large files quadratic-ish), so it is paused while loading.
     was_enabled = gc.isenabled()
@@ -167,6 +169,13 @@ def _load(paths, dialect: str, include_prelude: bool, portable: bool) -> Project
     prelude_abs = {os.path.abspath(f) for f in prelude_files}
     user_files = [f for f in user_files if os.path.abspath(f) not in prelude_abs]
     for path in prelude_files + user_files:
+        if is_xml(path):
+            for src, namespace in read_xml(path, diags):
+                unit = parse(src, diags)
+                unit.namespace = namespace or namespace_of(path)
+                attach_ladders(unit)
+                proj.units.append(unit)
+            continue
         src = read_source(path, diags)
         if src is None:
             continue
@@ -176,6 +185,7 @@ def _load(paths, dialect: str, include_prelude: bool, portable: bool) -> Project
         unit.vendor = unit.in_prelude and os.path.basename(path) in VENDOR_PRELUDE
         proj.units.append(unit)
     check_units(ctx, proj)
+    check_operands(ctx, proj.units)
     if portable:
         for unit in proj.units:
             portable_rule.check_unit(ctx, unit)

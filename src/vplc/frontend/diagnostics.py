@@ -28,6 +28,9 @@ class Diagnostic:
         return self.severity == ERROR
 
     def location(self) -> str:
+        where = getattr(self.span.file, "where", None)      # ST generated from a ladder: file:POU:rung N:element
+        if where is not None:
+            return f"{self.span.file.path}:{where(self.span.start)}"
         line, col = self.span.file.line_col(self.span.start)
         return f"{self.span.file.path}:{line}:{col}"
 
@@ -46,7 +49,7 @@ class Diagnostic:
             end_line, end_col = self.span.file.line_col(max(self.span.start, self.span.end - 1))
             width = end_col - col + 1 if end_line == line else len(text) - col + 1
             width = max(1, min(width, len(text) - col + 2, 200))
-            gutter = f"{line:>5} | "
+            gutter = "   ST | " if hasattr(self.span.file, "where") else f"{line:>5} | "
             lines.append(gutter + text)
             lines.append(" " * (len(gutter) + col - 1) + "^" * width)
         for note in self.notes:
@@ -56,8 +59,12 @@ class Diagnostic:
     def to_dict(self) -> dict:
         line, col = self.span.file.line_col(self.span.start)
         end_line, end_col = self.span.file.line_col(self.span.end)
+        where = getattr(self.span.file, "where", None)
+        if where is not None:                                # no line in the XML file: the element instead
+            line = col = end_line = end_col = 0
         return {
             "path": self.span.file.path, "line": line, "column": col,
+            **({"element": where(self.span.start)} if where is not None else {}),
             "end_line": end_line, "end_column": end_col,
             "severity": self.severity, "code": self.code, "message": self.message, "notes": list(self.notes),
         }

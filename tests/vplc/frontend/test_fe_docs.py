@@ -8,7 +8,7 @@ from fe_helpers import ROOT
 
 def test_every_emitted_code_is_documented_with_examples():
     src = ROOT / "src" / "vplc"
-    files = [p for p in src.glob("*.py")] + list((src / "checker").glob("*.py"))
+    files = [p for p in src.glob("*.py")] + list((src / "checker").glob("*.py")) + list((src / "ladder").glob("*.py"))
     emitted = set()
     for p in files:
         emitted |= set(re.findall(r'"(ST[0-9]{4})"', p.read_text(encoding="utf-8")))

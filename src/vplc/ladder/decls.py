@@ -1,0 +1,67 @@
+"""What an XML project file declares, as Structured Text pieces both readers fill in and
+:mod:`vplc.ladder.translate` turns into one ST text the front end parses.
+
+Readers convert each XML type reference and initial value to its ST spelling (``STRING[80]``,
+``ARRAY[0..9] OF INT``, ``(X := 1.0)``), so the checker sees exactly what a ``.st`` file would declare.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .model import LadderBody
+
+
+@dataclass
+class VarText:
+    name: str
+    type: str
+    init: str | None = None
+    comment: str = ""
+    at: str | None = None
+
+
+@dataclass
+class SectionText:
+    kind: str                       # VAR, VAR_INPUT, ... as in ST
+    vars: list[VarText] = field(default_factory=list)
+    constant: bool = False
+    retain: bool = False
+
+
+@dataclass
+class TypeText:
+    name: str
+    spec: str                       # ST text after ``Name :``
+    init: str | None = None
+    comment: str = ""
+
+
+@dataclass
+class PouText:
+    kind: str                       # PROGRAM | FUNCTION_BLOCK | FUNCTION
+    name: str
+    return_type: str | None = None
+    sections: list[SectionText] = field(default_factory=list)
+    st_body: str | None = None
+    ladder: LadderBody | None = None
+    comment: str = ""
+
+
+@dataclass
+class XmlUnit:
+    """The declarations of one namespace of an XML file (None: the global namespace)."""
+    namespace: str | None
+    types: list[TypeText] = field(default_factory=list)
+    pous: list[PouText] = field(default_factory=list)
+    globals: list[SectionText] = field(default_factory=list)
+
+
+class FormatError(Exception):
+    """The XML is well formed but describes something we cannot run; ``where`` names the place, ``code`` is
+    the diagnostic code (docs/toolchain/diagnostics.md, ST21xx)."""
+
+    def __init__(self, where: str, message: str, code: str = "ST2102") -> None:
+        super().__init__(f"{where}: {message}" if where else message)
+        self.where = where
+        self.message = message
+        self.code = code

@@ -1,0 +1,95 @@
+"""Front-end entry for XML project files: ``read_xml(path, diags)`` gives the generated ST sources (one per
+namespace of the file) that :mod:`vplc.project` parses and checks with the ``.st`` files, and
+``check_operands`` adds the ladder-only type rule after the checker ran.
+
+Diagnostic codes ST2101-ST2107 (docs/toolchain/diagnostics.md).
+"""
+from __future__ import annotations
+
+from ..frontend import ast as A
+from ..frontend.source import SourceFile, Span
+from . import iec10_read, plcopen_read
+from .decls import FormatError
+from .translate import LadderSource, unit_source
+from .xmlsafe import XmlError, read as read_safely
+
+XML_SUFFIXES = (".xml",)
+PLCOPEN_NS = "http://www.plcopen.org/xml/tc6"
+
+
+def is_xml(path: str) -> bool:
+    return path.lower().endswith(XML_SUFFIXES)
+
+
+def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
+    """(generated source, namespace or None) per namespace of the file; [] after reporting an error."""
+    try:
+        text, root = read_safely(path)
+    except XmlError as exc:
+        src = SourceFile(path, _raw_text(path))
+        diags.error("ST2101", f"`{path}` cannot be loaded: {exc}", Span(src, exc.offset, exc.offset + 1))
+        return []
+    if root.tag == "project":
+        reader = plcopen_read.read
+    elif root.tag == "Project":
+        reader = iec10_read.read
+    else:
+        diags.error("ST2101", f"`{path}` is not a PLCopen XML (TC6) or IEC 61131-10 project: its root element is "
+                    f"<{root.tag}>", Span(SourceFile(path, text), 0, 1))
+        return []
+    try:
+        out = []
+        for unit in reader(root):
+            out.append((unit_source(path, unit), unit.namespace))
+        return out
+    except FormatError as exc:
+        place = LadderSource(path, "", [(0, 1, exc.where or "project")])
+        diags.error(exc.code, exc.message, Span(place, 0, 1))
+        return []
+    except (ValueError, TypeError, AttributeError) as exc:      # numbers or attributes malformed in the file
+        place = LadderSource(path, "", [(0, 1, "project")])
+        diags.error("ST2102", f"the XML does not follow the format: {exc}", Span(place, 0, 1))
+        return []
+
+
+def attach_ladders(unit: A.CompilationUnit) -> None:
+    """Give every POU generated from a ladder its model (``pou.ladder``): the drawing, the HMI and the
+    export read it."""
+    src = unit.span.file if unit.span is not None else None
+    ladders = {lad.pou.upper(): lad for lad in getattr(src, "ladders", ())}
+    for item in unit.items:
+        if isinstance(item, A.Pou) and item.name.upper() in ladders:
+            item.ladder = ladders[item.name.upper()]
+
+
+def _raw_text(path: str) -> str:
+    try:
+        with open(path, "rb") as fh:
+            return fh.read(1 << 20).decode("utf-8", "replace")
+    except OSError:
+        return ""
+
+
+def check_operands(ctx, units) -> None:
+    """ST2105: a contact's operand must be BOOL. Other errors the checker reported inside the same
+    generated statement are dropped: they are consequences of the wrong operand."""
+    bad_statements = []
+    for unit in units:
+        src = unit.span.file if unit.span is not None else None
+        if not isinstance(src, LadderSource) or not src.checks:
+            continue
+        wanted = {(s, e): (where, operand) for s, e, where, operand in src.checks}
+        for node in A.walk(unit):
+            if isinstance(node, A.Expr) and node.span is not None and (node.span.start, node.span.end) in wanted:
+                ty = node.ty
+                if ty is None or getattr(ty, "name", "?") == "BOOL" or getattr(ty, "name", "?").startswith(("?", "<")):
+                    continue
+                where, operand = wanted.pop((node.span.start, node.span.end))
+                stmt = next(((s, e) for s, e in src.statements if s <= node.span.start < e), None)
+                if stmt is not None:
+                    bad_statements.append((src, stmt))
+                ctx.diags.error("ST2105", f"the {operand}'s operand `{node.span.file.text[node.span.start:node.span.end]}`"
+                                f" is {ty.name}; a {operand} needs a BOOL variable", node.span)
+    if bad_statements:
+        ctx.diags.items = [d for d in ctx.diags.items if d.code == "ST2105" or not any(
+            d.span.file is src and s <= d.span.start < e for src, (s, e) in bad_statements)]

@@ -1,0 +1,97 @@
+"""The ladder model both XML readers produce and every back end of a ladder reads (translation to ST,
+drawing, live monitoring, export).
+
+A POU body is a list of rungs; a rung is a graph of elements joined by connections. A connection goes
+from an output point (an element and, for a block, the name of its output or in-out pin) to an input
+point; several connections arriving at one input are a wired OR. Element kinds:
+
+=============  =========================================================================================
+left_rail      power source of a rung (always energised)
+right_rail     power sink (connections into it only close the drawing)
+contact        ``var``: normal, ``negated`` (NC), ``edge`` rising / falling (P / N contact)
+coil           ``var``: normal, ``negated``, ``storage`` set / reset (S / R coil), ``edge`` rising / falling
+block          function block instance (``instance`` set) or function call; pins in ``inputs``,
+               ``inouts``, ``outputs``; an ``EN`` input makes the call conditional, ``ENO`` is its power out
+in_var         ``var`` is an expression read by the rung (a variable or a literal)
+out_var        ``var`` is a variable the rung writes
+inout_var      ``var`` is read and written
+jump           ``var`` is the label jumped to when the jump has power
+label          ``var`` is the label name (marks the rung it stands in)
+return         leaves the POU when it has power
+=============  =========================================================================================
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+KINDS = ("left_rail", "right_rail", "contact", "coil", "block", "in_var", "out_var", "inout_var",
+         "jump", "label", "return")
+EDGES = ("none", "rising", "falling")
+STORAGES = ("none", "set", "reset")
+
+
+@dataclass
+class Conn:
+    """One wire arriving at an input point: from element ``ref`` (its output pin ``pin`` for a block)."""
+    ref: str
+    pin: str | None = None
+
+
+@dataclass
+class Pin:
+    """A block pin, or the single input point of a simple element (``name`` "")."""
+    name: str
+    conns: list[Conn] = field(default_factory=list)
+    negated: bool = False
+    edge: str = "none"
+
+
+@dataclass
+class Element:
+    id: str
+    kind: str
+    var: str = ""                   # operand, expression, label name
+    negated: bool = False
+    edge: str = "none"
+    storage: str = "none"
+    type_name: str = ""             # blocks
+    instance: str = ""              # blocks: the FB instance; "" for a function
+    inputs: list[Pin] = field(default_factory=list)
+    inouts: list[Pin] = field(default_factory=list)
+    outputs: list[Pin] = field(default_factory=list)
+    pos: tuple[float, float] | None = None      # (x, y) as drawn by the IDE, when the file has it
+
+    @property
+    def power_in(self) -> Pin | None:
+        """The input point of a simple element (contact, coil, variable, jump, return)."""
+        return self.inputs[0] if self.inputs and self.kind != "block" else None
+
+    def describe(self) -> str:
+        """How diagnostics and the drawing name the element: ``contact Start``, ``block CBT_MoveAbsolute``."""
+        if self.kind == "block":
+            return f"block {self.type_name.split(chr(92))[-1]}"
+        noun = {"left_rail": "left power rail", "right_rail": "right power rail", "in_var": "variable",
+                "out_var": "variable", "inout_var": "variable"}.get(self.kind, self.kind)
+        return f"{noun} {self.var}".strip()
+
+
+@dataclass
+class Rung:
+    elements: list[Element]
+    comment: str = ""
+    label: str = ""                 # a label standing in this rung (jump target)
+
+    def element(self, ref: str) -> Element | None:
+        for el in self.elements:
+            if el.id == ref:
+                return el
+        return None
+
+
+@dataclass
+class LadderBody:
+    """The ladder body of one POU."""
+    pou: str
+    rungs: list[Rung]
+    path: str = ""                  # the XML file it was read from
+    helpers: list[str] = field(default_factory=list)   # hidden BOOLs the translation declared (never exported)

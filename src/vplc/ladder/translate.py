@@ -1,0 +1,497 @@
+"""Turn what an XML file declares into Structured Text the front end parses, checks and compiles like any
+``.st`` file; ladder bodies become ST statements in the documented LD evaluation order
+(docs/toolchain/ladder.md):
+
+* rungs run top to bottom; in a rung, elements run in power-flow order (an element after everything
+  wired into it), elements that do not depend on each other top to bottom, left to right;
+* a contact passes power ``in AND var`` (NC: ``AND NOT var``; P / N contacts: on the change of ``var``
+  since the rung's previous evaluation); wires meeting at one input are an OR;
+* a coil writes its power to ``var`` (negated, set, reset, P / N coils as IEC 61131-3 Table 60) and
+  passes it on unchanged;
+* a block is called once; with an ``EN`` input only while EN has power (its outputs then keep their
+  values); ``ENO`` carries EN's power;
+* a jump with power skips the rungs down to its label; RETURN with power leaves the POU.
+
+Hidden helper variables (edge memories, shared power of a branch point, jump flags) are BOOLs named
+``_ld…`` in an extra VAR section. The text carries regions: every diagnostic inside a region is reported
+as ``file:POU:rung N:element`` instead of a line of the generated text.
+"""
+from __future__ import annotations
+
+import heapq
+
+from ..frontend.source import SourceFile
+from .decls import FormatError, PouText, SectionText, XmlUnit
+from .model import Conn, Element, LadderBody, Pin, Rung
+
+TRUE = "TRUE"
+COMPARE = {"GT": ">", "GE": ">=", "EQ": "=", "LT": "<", "LE": "<=", "NE": "<>"}   # IEC comparison blocks
+
+
+class LadderSource(SourceFile):
+    """The ST text generated from an XML file; ``where(offset)`` names the XML element behind it."""
+
+    __slots__ = ("regions", "statements", "checks", "ladders")
+
+    def __init__(self, path: str, text: str, regions=(), statements=(), checks=(), ladders=()) -> None:
+        super().__init__(path, text)
+        self.regions = regions          # (start, end, label), any order
+        self.statements = statements    # (start, end) of each generated statement
+        self.checks = checks            # (start, end, label, operand): contact operands that must be BOOL
+        self.ladders = ladders          # LadderBody of every LD POU of the text
+
+    def where(self, offset: int) -> str:
+        best = None
+        for start, end, label in self.regions:
+            if start <= offset < end and (best is None or end - start < best[1] - best[0]):
+                best = (start, end, label)
+        return best[2] if best else "declarations"
+
+
+class Txt:
+    """Generated text with marked sub-ranges ``(start, end, label)``; ``prec`` is 3 atom, 2 AND, 1 OR."""
+
+    __slots__ = ("text", "marks", "prec")
+
+    def __init__(self, text: str, marks=(), prec: int = 3) -> None:
+        self.text = text
+        self.marks = list(marks)
+        self.prec = prec
+
+    def __add__(self, other: "Txt | str") -> "Txt":
+        if isinstance(other, str):
+            return Txt(self.text + other, self.marks, min(self.prec, 3))
+        n = len(self.text)
+        return Txt(self.text + other.text, self.marks + [(s + n, e + n, lab) for s, e, lab in other.marks])
+
+    def __radd__(self, other: str) -> "Txt":
+        n = len(other)
+        return Txt(other + self.text, [(s + n, e + n, lab) for s, e, lab in self.marks])
+
+    def marked(self, label: str) -> "Txt":
+        return Txt(self.text, self.marks + [(0, len(self.text), label)], self.prec)
+
+    def at_least(self, prec: int) -> "Txt":
+        return self if self.prec >= prec else ("(" + self + ")").with_prec(3)
+
+    def with_prec(self, prec: int) -> "Txt":
+        self.prec = prec
+        return self
+
+
+class Writer:
+    """Accumulates the ST text of one XML unit with its regions."""
+
+    def __init__(self) -> None:
+        self.parts: list[str] = []
+        self.size = 0
+        self.regions: list[tuple[int, int, str]] = []
+        self.statements: list[tuple[int, int]] = []
+        self.checks: list[tuple[int, int, str, str]] = []
+
+    def put(self, text: "Txt | str", label: str | None = None, statement: bool = False) -> None:
+        t = text if isinstance(text, Txt) else Txt(text)
+        base = self.size
+        for s, e, lab in t.marks:
+            if lab.startswith("check:"):
+                _, operand, where = lab.split(":", 2)
+                self.checks.append((base + s, base + e, where, operand))
+            else:
+                self.regions.append((base + s, base + e, lab))
+        if label is not None:
+            self.regions.append((base, base + len(t.text), label))
+        if statement:
+            self.statements.append((base, base + len(t.text)))
+        self.parts.append(t.text)
+        self.size += len(t.text)
+
+    def text(self) -> str:
+        return "".join(self.parts)
+
+
+def unit_source(path: str, unit: XmlUnit) -> LadderSource:
+    w = Writer()
+    ladders = []
+    w.put(f"(* generated from {path.replace('*)', '* )')} *)\n")
+    for t in unit.types:
+        init = f" := {t.init}" if t.init is not None else ""
+        w.put(f"TYPE\n{_comment(t.comment)}{t.name} : {t.spec}{init};\nEND_TYPE\n\n", f"data type {t.name}")
+    if unit.globals:
+        for section in unit.globals:
+            _section(w, section, "global variables")
+        w.put("\n")
+    for pou in unit.pous:
+        _pou(w, pou)
+        if pou.ladder is not None:
+            pou.ladder.path = path
+            ladders.append(pou.ladder)
+    return LadderSource(path, w.text(), w.regions, w.statements, w.checks, ladders)
+
+
+def _comment(text: str) -> str:
+    return f"(* {text.replace('(*', '( *').replace('*)', '* )')} *)\n" if text else ""
+
+
+def _section(w: Writer, s: SectionText, owner: str) -> None:
+    quals = (" CONSTANT" if s.constant else "") + (" RETAIN" if s.retain else "")
+    w.put(f"{s.kind}{quals}\n")
+    for v in s.vars:
+        at = f" AT {v.at}" if v.at else ""
+        init = f" := {v.init}" if v.init is not None else ""
+        w.put(f"    {v.name}{at} : {v.type}{init};", f"{owner}:variable {v.name}")
+        w.put(f" {_comment(v.comment)}" if v.comment else "\n")
+    w.put("END_VAR\n")
+
+
+def _pou(w: Writer, pou: PouText) -> None:
+    w.put(_comment(pou.comment))
+    head = f"{pou.kind} {pou.name}" + (f" : {pou.return_type}" if pou.return_type else "")
+    w.put(head + "\n", f"{pou.name}")
+    for s in pou.sections:
+        _section(w, s, pou.name)
+    if pou.ladder is not None:
+        names = {v.name.upper() for s in pou.sections for v in s.vars}
+        RungCompiler(w, pou, names).body(pou.ladder)
+    else:
+        w.put((pou.st_body or "") + "\n", f"{pou.name}:ST body")
+    w.put(f"END_{pou.kind}\n\n")
+
+
+def _error(where: str, message: str, code: str) -> FormatError:
+    return FormatError(where, message, code)
+
+
+class RungCompiler:
+    """Compiles the rungs of one POU; collects the hidden variables it needs."""
+
+    def __init__(self, w: Writer, pou: PouText, names: set[str]) -> None:
+        self.w = w
+        self.pou = pou.name
+        prefix = "_ld"
+        while any(n.startswith(prefix.upper()) for n in names):
+            prefix += "x"
+        self.prefix = prefix
+        self.hidden: list[str] = []
+        self.lines: list[tuple] = []          # (Txt | str, label | None, statement)
+
+    def new(self, kind: str) -> str:
+        name = f"{self.prefix}{kind}{len(self.hidden) + 1}"
+        self.hidden.append(name)
+        return name
+
+    def emit(self, text, label: str | None = None, indent: str = "") -> None:
+        self.lines.append((indent + text if isinstance(text, Txt) else indent + text, label))
+
+    # ---- the body ---------------------------------------------------------------------------
+    def body(self, ladder: LadderBody) -> None:
+        labels = {}
+        for n, rung in enumerate(ladder.rungs):
+            if rung.label:
+                if rung.label.upper() in labels:
+                    raise _error(f"{self.pou}:rung {n + 1}", f"label `{rung.label}` is defined twice", "ST2106")
+                labels[rung.label.upper()] = n
+        for n, rung in enumerate(ladder.rungs):
+            for el in rung.elements:
+                if el.kind == "jump":
+                    target = labels.get(el.var.upper())
+                    where = f"{self.pou}:rung {n + 1}:jump {el.var}"
+                    if target is None:
+                        raise _error(where, f"jump to label `{el.var}`, which no rung of {self.pou} has", "ST2106")
+                    if target <= n:
+                        raise _error(where, f"jump back to label `{el.var}` (rung {target + 1}); a jump may only "
+                                            "skip rungs below it, so a scan always ends", "ST2106")
+        self.jump_flags: dict[int, str] = {}
+        for n, rung in enumerate(ladder.rungs):
+            for el in rung.elements:
+                if el.kind == "jump":
+                    self.jump_flags[id(el)] = self.new("J")
+        for flag in self.jump_flags.values():
+            self.emit(f"{flag} := FALSE;\n")
+        flags_by_rung = {}
+        for n, rung in enumerate(ladder.rungs):
+            for el in rung.elements:
+                if el.kind == "jump":
+                    flag = self.jump_flags[id(el)]
+                    target = labels[el.var.upper()]
+                    for skipped in range(n + 1, target):
+                        flags_by_rung.setdefault(skipped, []).append(flag)
+        for n, rung in enumerate(ladder.rungs):
+            guard = flags_by_rung.get(n)
+            if rung.comment:
+                self.emit(f"(* rung {n + 1}: {rung.comment.replace('(*', '( *').replace('*)', '* )')} *)\n")
+            if guard:
+                self.emit(f"IF NOT ({' OR '.join(guard)}) THEN\n")
+            self.rung(rung, n + 1, "    " if guard else "")
+            if guard:
+                self.emit("END_IF;\n")
+        w = self.w
+        ladder.helpers = list(self.hidden)
+        if self.hidden:
+            w.put("VAR (* ladder helper variables *)\n")
+            for name in self.hidden:
+                w.put(f"    {name} : BOOL;\n", f"{self.pou}:ladder helper variables")
+            w.put("END_VAR\n")
+        for text, label in self.lines:
+            w.put(text, label, statement=label is not None)
+
+    # ---- one rung ---------------------------------------------------------------------------
+    def rung(self, rung: Rung, number: int, indent: str) -> None:
+        self.where = f"{self.pou}:rung {number}"
+        self.indent = indent
+        self.by_id = {e.id: e for e in rung.elements}
+        self.out: dict[tuple[str, str | None], Txt] = {}
+        self.guard: dict[str, Txt] = {}
+        consumers: dict[tuple[str, str | None], int] = {}
+        deps: dict[str, set[str]] = {e.id: set() for e in rung.elements}
+        users: dict[str, list[str]] = {e.id: [] for e in rung.elements}
+        for e in rung.elements:
+            if e.kind in ("left_rail", "right_rail"):
+                continue
+            for pin in [*e.inputs, *e.inouts]:
+                for c in pin.conns:
+                    src = self.by_id.get(c.ref)
+                    if src is None:
+                        raise _error(f"{self.where}:{e.describe()}",
+                                     f"input `{pin.name or 'power'}` is connected to element {c.ref.lstrip('?')}, "
+                                     "which is not in this rung", "ST2103")
+                    if src.kind == "right_rail":
+                        raise _error(f"{self.where}:{e.describe()}", "a wire starts at the right power rail", "ST2103")
+                    key = (src.id, self._pin_name(src, c, e))
+                    consumers[key] = consumers.get(key, 0) + 1
+                    if src.kind != "left_rail":
+                        deps[e.id].add(src.id)
+                        users[src.id].append(e.id)
+        self.consumers = consumers
+        index = {e.id: i for i, e in enumerate(rung.elements)}
+        rank = {e.id: ((e.pos[1], e.pos[0]) if e.pos else (0.0, 0.0), index[e.id]) for e in rung.elements}
+        waiting = {k: len(v) for k, v in deps.items()}
+        ready = [(rank[k], k) for k, n in waiting.items() if n == 0]
+        heapq.heapify(ready)
+        done = 0
+        while ready:
+            _, eid = heapq.heappop(ready)
+            done += 1
+            self.element(self.by_id[eid])
+            for u in users[eid]:
+                waiting[u] -= 1
+                if waiting[u] == 0:
+                    heapq.heappush(ready, (rank[u], u))
+        if done < len(rung.elements):
+            stuck = [self.by_id[k].describe() for k, n in waiting.items() if n > 0]
+            raise _error(self.where, "the rung is wired in a loop (" + ", ".join(stuck[:6])
+                         + "); power must flow from the left rail to the right without coming back", "ST2104")
+
+    def _pin_name(self, src: Element, c: Conn, user: Element) -> str | None:
+        if src.kind != "block":
+            return None
+        names = [p.name for p in src.outputs] + [p.name for p in src.inouts]
+        if c.pin is None:
+            first = next((p.name for p in src.outputs if p.name.upper() != "ENO"), None)
+            if first is None:
+                raise _error(f"{self.where}:{user.describe()}", f"is wired to {src.describe()}, which has no output", "ST2103")
+            return first
+        if c.pin.upper() not in (n.upper() for n in names):
+            raise _error(f"{self.where}:{user.describe()}",
+                         f"is wired to output `{c.pin}` of {src.describe()}, which has no such pin", "ST2103")
+        return next(n for n in names if n.upper() == c.pin.upper())
+
+    def label(self, e: Element) -> str:
+        return f"{self.where}:{e.describe()}"
+
+    def source(self, e: Element, c: Conn) -> Txt:
+        src = self.by_id[c.ref]
+        if src.kind == "left_rail":
+            return Txt(TRUE)
+        pin = self._pin_name(src, c, e)
+        if src.id in self.guard and (pin or "").upper() != "ENO" and e.kind not in ("out_var", "inout_var"):
+            raise _error(self.label(e), f"reads the result of {src.describe()}, a function with EN; wire the "
+                                        "result to a variable and read the variable", "ST2107")
+        return self.out[(src.id, pin)]
+
+    def power(self, e: Element, pin: Pin) -> Txt:
+        if not pin.conns:
+            raise _error(self.label(e), "nothing is connected to its input" if pin.name == "" else
+                         f"input `{pin.name}` is not connected", "ST2103")
+        terms = [self.source(e, c) for c in pin.conns]
+        if any(t.text == TRUE for t in terms):
+            return Txt(TRUE)
+        if len(terms) == 1:
+            return terms[0]
+        out = terms[0].at_least(2)
+        for t in terms[1:]:
+            out = out + " OR " + t.at_least(2)
+        return out.with_prec(1)
+
+    def materialize(self, value: Txt, kind: str = "P") -> Txt:
+        if value.text == TRUE or (value.prec == 3 and value.text.startswith(self.prefix)):
+            return value
+        name = self.new(kind)
+        self.stmt(name + " := " + value + ";")
+        return Txt(name)
+
+    def stmt(self, text: "Txt | str", label: str | None = None) -> None:
+        self.emit((text if isinstance(text, Txt) else Txt(text)) + "\n", label or self.where, self.indent)
+
+    def shared(self, e: Element, value: Txt, pin: str | None = None) -> Txt:
+        """An output read by several elements is evaluated once."""
+        return self.materialize(value) if self.consumers.get((e.id, pin), 0) > 1 else value
+
+    # ---- elements ---------------------------------------------------------------------------
+    def element(self, e: Element) -> None:
+        getattr(self, "el_" + e.kind)(e)
+
+    def el_left_rail(self, e: Element) -> None:
+        pass
+
+    def el_right_rail(self, e: Element) -> None:
+        pass
+
+    def el_contact(self, e: Element) -> None:
+        inp = self.power(e, e.power_in)
+        lab = self.label(e)
+        var = Txt(e.var, [(0, len(e.var), f"check:contact:{lab}")]).marked(lab)
+        if e.edge != "none":
+            mem = self.new("M")
+            test = (var + " AND NOT " + mem) if e.edge == "rising" else ("NOT " + var + " AND " + mem)
+            value = test if inp.text == TRUE else inp.at_least(2) + " AND " + test
+            out = self.new("P")
+            self.stmt(out + " := " + value + ";", lab)
+            self.stmt(mem + " := " + var + ";", lab)
+            self.out[(e.id, None)] = Txt(out)
+            return
+        op = ("NOT " + var).with_prec(3) if e.negated else var
+        value = op if inp.text == TRUE else (inp.at_least(2) + " AND " + op).with_prec(2)
+        self.out[(e.id, None)] = self.shared(e, value.marked(lab))
+
+    def el_coil(self, e: Element) -> None:
+        lab = self.label(e)
+        inp = self.power(e, e.power_in)
+        if self.consumers.get((e.id, None), 0) or e.edge != "none":
+            inp = self.materialize(inp)
+        var = Txt(e.var).marked(lab)
+        if e.edge != "none":
+            mem = self.new("M")
+            test = (inp + " AND NOT " + mem) if e.edge == "rising" else ("NOT " + inp + " AND " + mem)
+            self.stmt(var + " := " + test + ";", lab)
+            self.stmt(mem + " := " + inp + ";", lab)
+        elif e.storage != "none":
+            value = "TRUE" if e.storage == "set" else "FALSE"
+            if inp.text == TRUE:
+                self.stmt(var + f" := {value};", lab)
+            else:
+                self.stmt("IF " + inp + " THEN " + var + f" := {value}; END_IF;", lab)
+        elif e.negated:
+            self.stmt(var + " := NOT " + inp.at_least(3) + ";", lab)
+        else:
+            self.stmt(var + " := " + inp + ";", lab)
+        self.out[(e.id, None)] = inp
+
+    def el_in_var(self, e: Element) -> None:
+        lab = self.label(e)
+        value = Txt(e.var).marked(lab)
+        self.out[(e.id, None)] = ("NOT " + value.at_least(3)).marked(lab) if e.negated else value
+
+    def el_out_var(self, e: Element) -> None:
+        lab = self.label(e)
+        value = self.power(e, e.power_in)
+        var = Txt(e.var).marked(lab)
+        line = var + " := " + (("NOT " + value.at_least(3)) if e.negated else value) + ";"
+        guards = {self.guard[c.ref].text: self.guard[c.ref] for c in e.power_in.conns if c.ref in self.guard}
+        if guards:
+            line = "IF " + " OR ".join(guards) + " THEN " + line + " END_IF;"
+        self.stmt(line, lab)
+        if e.kind == "inout_var":
+            self.out[(e.id, None)] = var
+
+    def el_inout_var(self, e: Element) -> None:
+        if e.power_in is not None and e.power_in.conns:
+            self.el_out_var(e)
+        else:
+            self.el_in_var(e)
+
+    def el_jump(self, e: Element) -> None:
+        lab = self.label(e)
+        self.stmt(self.jump_flags[id(e)] + " := " + self.power(e, e.power_in) + ";", lab)
+
+    def el_return(self, e: Element) -> None:
+        lab = self.label(e)
+        inp = self.power(e, e.power_in)
+        self.stmt("RETURN;" if inp.text == TRUE else "IF " + inp + " THEN RETURN; END_IF;", lab)
+
+    def comparison(self, e: Element, values: list[Txt], lab: str) -> Txt:
+        """GT, GE, EQ, LT, LE, NE blocks are ST operators: ``IN1 > IN2 AND IN2 > IN3 ...``."""
+        if len(values) < 2:
+            raise _error(lab, f"a {e.type_name.upper()} block needs at least two connected inputs", "ST2103")
+        op = COMPARE[e.type_name.upper()]
+        terms = [("(" + a + f" {op} " + b + ")") for a, b in zip(values, values[1:])]
+        out = terms[0]
+        for t in terms[1:]:
+            out = out + " AND " + t
+        return out.with_prec(3 if len(terms) == 1 else 2).marked(lab)
+
+    def el_block(self, e: Element) -> None:
+        lab = self.label(e)
+        en = None
+        args: list[Txt] = []
+        values: list[Txt] = []
+        for pin in e.inputs:
+            if pin.name.upper() == "EN":
+                en = self.power(e, pin) if pin.conns else None
+                continue
+            if not pin.conns:
+                continue
+            value = self.power(e, pin)
+            if pin.negated:
+                value = "NOT " + value.at_least(3)
+            if pin.edge != "none":
+                mem = self.new("M")
+                value = self.materialize(value)
+                edge = (value + " AND NOT " + mem) if pin.edge == "rising" else ("NOT " + value + " AND " + mem)
+                out = self.new("P")
+                self.stmt(out + " := " + edge + ";", lab)
+                self.stmt(mem + " := " + value + ";", lab)
+                value = Txt(out)
+            args.append(pin.name + " := " + value)
+            values.append(value)
+        inouts = {}
+        for pin in e.inouts:
+            if pin.conns:
+                value = self.power(e, pin)
+                inouts[pin.name] = value
+                args.insert(len(inouts) - 1, pin.name + " := " + value)
+        if en is not None and en.text != TRUE and self.consumers.get((e.id, "ENO"), 0):
+            en = self.materialize(en)
+        call_args = Txt("")
+        for i, a in enumerate(args):
+            call_args = call_args + (", " if i else "") + a
+        for pin in e.outputs:
+            if pin.name.upper() == "ENO":
+                self.out[(e.id, pin.name)] = en if en is not None else Txt(TRUE)
+        for name, value in inouts.items():
+            self.out[(e.id, name)] = value
+        if not e.instance:
+            result = next((p for p in e.outputs if p.name.upper() != "ENO"), None)
+            others = [p for p in e.outputs if p is not result and p.name.upper() != "ENO"
+                      and self.consumers.get((e.id, p.name), 0)]
+            if others:
+                raise _error(lab, f"output `{others[0].name}` of a function is wired; only the result of a "
+                                  "function can be wired in a ladder", "ST2107")
+            if result is not None:
+                if self.consumers.get((e.id, result.name), 0) > 1:
+                    raise _error(lab, "the result of a function feeds several elements; write it to a variable "
+                                      "and read that variable where it is needed", "ST2107")
+                call = (self.comparison(e, values, lab) if e.type_name.upper() in COMPARE
+                        else (e.type_name + "(" + call_args + ")").marked(lab))
+                self.out[(e.id, result.name)] = ("NOT " + call) if result.negated else call
+                if en is not None and en.text != TRUE:
+                    self.guard[e.id] = en
+            return
+        call = (e.instance + "(" + call_args + ");").marked(lab)
+        if en is None or en.text == TRUE:
+            self.stmt(call, lab)
+        else:
+            self.stmt("IF " + en + " THEN " + call + " END_IF;", lab)
+        for pin in e.outputs:
+            if pin.name.upper() != "ENO":
+                value = Txt(f"{e.instance}.{pin.name}")      # the wire belongs to the element reading it
+                self.out[(e.id, pin.name)] = ("NOT " + value).with_prec(3) if pin.negated else value

@@ -1,0 +1,160 @@
+"""Bad ladder files get one clear diagnostic naming file, POU, rung and element (never a traceback), and the
+ST checker's rules hold for ladder POUs (docs/toolchain/diagnostics.md, ST21xx)."""
+from __future__ import annotations
+
+import pytest
+
+from ld_xml import HEAD, block, coil, contact, invar, jump, label, outvar, program, rail, right
+from vplc.ladder import xmlsafe
+from vplc.project import load_project
+
+
+def diags(*paths):
+    proj = load_project([str(p) for p in paths])
+    return [d for d in proj.diagnostics if d.severity == "error"]
+
+
+def one(*paths):
+    errors = diags(*paths)
+    assert len(errors) == 1, [d.render() for d in errors]
+    return errors[0]
+
+
+V = {"A": "BOOL", "B": "BOOL", "Q": "BOOL", "N": "INT", "T": "TON"}
+
+
+def test_missing_connection_names_the_element_and_the_missing_id(tmp_path):
+    d = one(program(tmp_path, V, [rail(1), contact(2, "A", 77), coil(3, "Q", 2)]))
+    assert d.code == "ST2103"
+    assert d.render().startswith(f"{tmp_path / 'main.xml'}:Main:rung 1:contact A: error[ST2103]: input `power` is "
+                                 "connected to element 77, which is not in this rung")
+
+
+def test_unconnected_coil_is_reported(tmp_path):
+    d = one(program(tmp_path, V, [rail(1), contact(2, "A", 1), coil(3, "Q")]))
+    assert (d.code, d.location().split(":", 1)[1]) == ("ST2103", "Main:rung 2:coil Q")
+    assert "nothing is connected to its input" in d.message
+
+
+def test_cycle_in_a_network_is_reported_with_its_elements(tmp_path):
+    d = one(program(tmp_path, V, [rail(1), contact(2, "A", 1, 3), contact(3, "B", 2), coil(4, "Q", 3)]))
+    assert d.code == "ST2104"
+    assert "wired in a loop (contact A, contact B" in d.message
+    assert d.location().endswith("main.xml:Main:rung 1")
+
+
+def test_unknown_element_is_refused_with_the_list_of_ladder_elements(tmp_path):
+    body = [rail(1), '<step localId="5" name="S1"><position x="0" y="0"/></step>']
+    d = one(program(tmp_path, V, body))
+    assert d.code == "ST2102" and d.location().endswith("main.xml:Main:element 5")
+    assert "unknown element <step> in a ladder body" in d.message and "contact" in d.message
+
+
+def test_wrong_pin_type_contact_on_an_integer(tmp_path):
+    d = one(program(tmp_path, V, [rail(1), contact(2, "N", 1), coil(3, "Q", 2)]))
+    assert d.code == "ST2105"
+    assert d.render().splitlines()[0].endswith(
+        "main.xml:Main:rung 1:contact N: error[ST2105]: the contact's operand `N` is INT; a contact needs a BOOL variable")
+
+
+def test_wrong_pin_type_integer_output_into_a_coil_is_a_type_mismatch(tmp_path):
+    body = [rail(1), contact(2, "A", 1), block(3, "TON", {"IN": 2, "PT": 4}, ["Q", "ET"], instance="T"),
+            invar(4, "T#1s", y=20), coil(5, "Q", (3, "ET"))]
+    d = one(program(tmp_path, V, body))
+    assert d.code == "ST1101" and ":Main:rung 1:coil Q:" in d.render()
+
+
+def test_wire_to_a_block_output_that_does_not_exist(tmp_path):
+    body = [rail(1), contact(2, "A", 1), block(3, "TON", {"IN": 2}, ["Q"], instance="T"), coil(5, "Q", (3, "Done"))]
+    d = one(program(tmp_path, V, body))
+    assert d.code == "ST2103" and "output `Done` of block TON, which has no such pin" in d.message
+
+
+def test_undeclared_variable_in_a_contact_is_the_st_rule(tmp_path):
+    d = one(program(tmp_path, V, [rail(1), contact(2, "Strat", 1), coil(3, "Q", 2)]))
+    assert d.code == "ST1001" and d.location().endswith("main.xml:Main:rung 1:contact Strat")
+
+
+def test_fb_direction_rule_an_output_wired_as_an_input(tmp_path):
+    body = [rail(1), contact(2, "A", 1), block(3, "TON", {"IN": 2, "Q": 2}, ["ET"], instance="T")]
+    d = one(program(tmp_path, V, body))
+    assert d.code == "ST1203" and d.location().endswith(":Main:rung 1:block TON")
+
+
+def test_jump_to_a_missing_label_and_backwards(tmp_path):
+    d = one(program(tmp_path, V, [rail(1), contact(2, "A", 1), jump(3, "Nowhere", 2)]))
+    assert d.code == "ST2106" and "which no rung of Main has" in d.message
+    d = one(program(tmp_path, V, [label(9, "Top", y=-10), rail(1), contact(2, "A", 1), coil(4, "Q", 2),
+                                  contact(5, "B", 1, y=50), jump(3, "Top", 5, y=50)]))
+    assert d.code == "ST2106" and "jump back to label `Top` (rung 1)" in d.message
+
+
+def write(tmp_path, text, name="x.xml"):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_xml_bomb_is_refused_before_parsing(tmp_path):
+    bomb = ('<?xml version="1.0"?>\n<!DOCTYPE lolz [<!ENTITY lol "lol"><!ENTITY lol2 "&lol;&lol;&lol;&lol;">]>\n'
+            '<project>&lol2;</project>')
+    d = one(write(tmp_path, bomb))
+    assert d.code == "ST2101" and "<!DOCTYPE declaration" in d.message
+    assert d.location().endswith("x.xml:2:1")
+
+
+def test_external_entity_is_refused(tmp_path):
+    xxe = '<?xml version="1.0"?><!DOCTYPE p [<!ENTITY x SYSTEM "file:///etc/passwd">]><project>&x;</project>'
+    d = one(write(tmp_path, xxe))
+    assert d.code == "ST2101" and "entities are refused" in d.message
+
+
+def test_huge_document_is_refused_without_reading_it(tmp_path, monkeypatch):
+    monkeypatch.setattr(xmlsafe, "MAX_BYTES", 1000)
+    d = one(write(tmp_path, HEAD + " " * 2000 + "<types/></project>"))
+    assert d.code == "ST2101" and "limited to" in d.message
+
+
+def test_not_well_formed_xml_points_at_the_line(tmp_path):
+    d = one(write(tmp_path, HEAD + "<types>\n<pous>\n</types></project>"))
+    assert d.code == "ST2101" and "not well-formed XML: mismatched tag" in d.message
+    assert d.location().split(":")[-2] == "7"
+
+
+def test_a_file_that_is_not_a_project(tmp_path):
+    d = one(write(tmp_path, "<svg/>"))
+    assert d.code == "ST2101" and "root element is <svg>" in d.message
+
+
+def test_fbd_body_is_refused(tmp_path):
+    text = (HEAD + '<types><dataTypes/><pous><pou name="F" pouType="program"><body><FBD/></body></pou></pous></types>'
+            '<instances><configurations/></instances></project>')
+    d = one(write(tmp_path, text))
+    assert d.code == "ST2102" and "FBD bodies are not supported" in d.message
+
+
+def test_ladder_and_st_files_mix_in_one_project(tmp_path):
+    (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    Start : BOOL;\n    Lamp : BOOL;\nEND_VAR\n", encoding="utf-8")
+    (tmp_path / "Helper.st").write_text("FUNCTION Both : BOOL\nVAR_INPUT a, b : BOOL; END_VAR\nBoth := a AND b;\n"
+                                        "END_FUNCTION\n", encoding="utf-8")
+    body = [rail(1), invar(2, "Start"), invar(3, "TRUE", y=10), block(4, "Both", {"a": 2, "b": 3}, ["Both"]),
+            outvar(5, "Lamp", (4, "Both"))]
+    program(tmp_path, {}, body)
+    from vplc.api import load_plc
+    plc = load_plc([str(tmp_path)], task="Main@1ms")
+    plc.write("Start", True)
+    plc.scan(0)
+    assert plc.read("Lamp") is True
+
+
+@pytest.mark.parametrize("name", ["vplc check", "json"])
+def test_cli_check_prints_the_element_location(tmp_path, capsys, name):
+    from vplc.cli.main import main
+    path = program(tmp_path, V, [rail(1), contact(2, "Strat", 1), coil(3, "Q", 2)])
+    args = ["check", str(path)] + (["--format", "json"] if name == "json" else [])
+    assert main(args) == 1
+    out = capsys.readouterr().out
+    if name == "json":
+        assert '"element": "Main:rung 1:contact Strat"' in out
+    else:
+        assert "main.xml:Main:rung 1:contact Strat: error[ST1001]" in out
