@@ -13,7 +13,7 @@ import sys
 
 from ..frontend.diagnostics import ERROR, NOTE, WARNING, to_json
 
-EXTENSION_MODULES = ("vplc.cli.run", "vplc.cli.test", "vplc.export")
+EXTENSION_MODULES = ("vplc.cli.run", "vplc.cli.test", "vplc.export", "vplc.cli.draw")
 
 
 class _Parser(argparse.ArgumentParser):

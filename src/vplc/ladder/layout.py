@@ -1,0 +1,139 @@
+"""Place the elements of each rung on a grid, the way Sysmac Studio lays out a rung: power flows left to
+right, coils line up at the right rail, a block's pins are one row apart, and variables wired to a block
+pin are written next to the pin instead of taking a cell. The drawing (:mod:`vplc.ladder.svg`), the HMI's
+Program page and the PLCopen writer (positions) all use this one layout.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .model import Element, LadderBody, Rung
+
+CELL_W = {"contact": 96, "coil": 86, "block": 200, "in_var": 130, "out_var": 130, "inout_var": 130,
+          "jump": 110, "return": 100}
+ROW_H = 44
+PIN_LABEL_W = 136          # room for a variable name left of a block input / right of a block output
+
+
+@dataclass
+class Placed:
+    element: Element
+    col: int
+    row: int
+    rows: int = 1
+    x: float = 0.0
+    y: float = 0.0          # top of the element's first row, relative to the rung
+    w: float = 0.0
+
+
+@dataclass
+class RungLayout:
+    rung: Rung
+    number: int
+    placed: dict[str, Placed] = field(default_factory=dict)
+    pin_labels: dict[tuple[str, str], str] = field(default_factory=dict)     # (block id, pin) -> variable text
+    attached: set[str] = field(default_factory=set)                          # variables drawn as pin labels
+    height: float = ROW_H
+    width: float = 0.0
+
+
+def pin_rows(e: Element) -> tuple[list[str], list[str]]:
+    """Input and output pin names of a block, top to bottom (in-outs on both sides, first)."""
+    ins = [p.name for p in e.inouts] + [p.name for p in e.inputs]
+    outs = [p.name for p in e.inouts] + [p.name for p in e.outputs]
+    return ins, outs
+
+
+def layout_rung(rung: Rung, number: int) -> RungLayout:
+    lay = RungLayout(rung, number)
+    by_id = {e.id: e for e in rung.elements}
+    blocks = {e.id: e for e in rung.elements if e.kind == "block"}
+    readers: dict[str, int] = {}
+    for e in rung.elements:
+        for pin in [*e.inputs, *e.inouts]:
+            for c in pin.conns:
+                readers[c.ref] = readers.get(c.ref, 0) + 1
+    for b in blocks.values():                          # variables written next to the pins
+        for pin in [*b.inputs, *b.inouts]:
+            if len(pin.conns) == 1:
+                src = by_id.get(pin.conns[0].ref)
+                if src is not None and src.kind == "in_var" and readers.get(src.id, 0) == 1:
+                    lay.pin_labels[(b.id, pin.name)] = src.var
+                    lay.attached.add(src.id)
+    for e in rung.elements:
+        if e.kind == "out_var" and len(e.inputs[0].conns) == 1:
+            c = e.inputs[0].conns[0]
+            if c.ref in blocks and c.pin:
+                lay.pin_labels[(c.ref, "out:" + c.pin)] = e.var
+                lay.attached.add(e.id)
+    body = [e for e in rung.elements if e.kind not in ("left_rail", "right_rail") and e.id not in lay.attached]
+    col: dict[str, int] = {}
+    ids = {e.id for e in body}
+
+    def column(e: Element, depth: int = 0) -> int:
+        if e.id in col:
+            return col[e.id]
+        col[e.id] = 0                                  # guards against loops (reported by the translation)
+        srcs = [c.ref for pin in [*e.inputs, *e.inouts] for c in pin.conns if c.ref in ids]
+        col[e.id] = 1 + max((column(by_id[s], depth + 1) for s in srcs), default=-1)
+        return col[e.id]
+
+    for e in body:
+        column(e)
+    last = max((col[e.id] for e in body if e.kind != "coil"), default=-1) + 1
+    for e in body:
+        if e.kind in ("coil", "jump", "return") and not readers.get(e.id):
+            col[e.id] = max(last, col[e.id])
+    desired: dict[str, int] = {}                       # a chain feeding block pin k starts on the pin's row
+    for e in sorted(body, key=lambda e: -col[e.id]):
+        if e.kind == "block":
+            names = pin_rows(e)[0]
+            for pin in [*e.inouts, *e.inputs]:
+                for c in pin.conns:
+                    if c.ref in ids and pin.name in names:
+                        desired[c.ref] = max(desired.get(c.ref, 0), desired.get(e.id, 0) + names.index(pin.name))
+        elif e.id in desired:
+            for pin in e.inputs:
+                for c in pin.conns:
+                    if c.ref in ids:
+                        desired[c.ref] = max(desired.get(c.ref, 0), desired[e.id])
+    taken: set[tuple[int, int]] = set()
+    for e in sorted(body, key=lambda e: col[e.id]):
+        rows = max(len(pin_rows(e)[0]), len(pin_rows(e)[1]), 1) if e.kind == "block" else 1
+        want = 0
+        names = pin_rows(e)[0] if e.kind == "block" else []
+        first = next(((pin, c) for pin in [*e.inouts, *e.inputs] for c in pin.conns if c.ref in lay.placed), None)
+        if first is not None:                          # line up with the wire that feeds the first connected pin
+            pin, c = first
+            src = lay.placed[c.ref]
+            outs = pin_rows(src.element)[1] if src.element.kind == "block" else []
+            offset = outs.index(c.pin) if c.pin in outs else 0
+            want = max(0, src.row + offset - (names.index(pin.name) if pin.name in names else 0))
+        row = max(want, desired.get(e.id, 0))
+        while any((col[e.id], r) in taken for r in range(row, row + rows)):
+            row += 1
+        for r in range(row, row + rows):
+            taken.add((col[e.id], r))
+        lay.placed[e.id] = Placed(e, col[e.id], row, rows)
+    ncols = max((p.col for p in lay.placed.values()), default=-1) + 1
+    widths = [0.0] * ncols
+    for p in lay.placed.values():
+        w = CELL_W.get(p.element.kind, 100)
+        if p.element.kind == "block":
+            w += PIN_LABEL_W * 2
+        widths[p.col] = max(widths[p.col], w)
+    xs = [30.0]
+    for w in widths:
+        xs.append(xs[-1] + w)
+    for p in lay.placed.values():
+        w = CELL_W.get(p.element.kind, 100)
+        p.w = w
+        p.x = xs[p.col] + (PIN_LABEL_W if p.element.kind == "block" else 0)
+        p.y = p.row * ROW_H
+    lay.width = xs[-1] + 10
+    lay.height = (max((p.row + p.rows for p in lay.placed.values()), default=1)) * ROW_H
+    return lay
+
+
+def layout(body: LadderBody) -> list[RungLayout]:
+    return [layout_rung(r, n) for n, r in enumerate(body.rungs, start=1)]
