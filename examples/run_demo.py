@@ -119,7 +119,7 @@ class Demo:
             "CBT_Commands_Lib demo is running:",
             f"  robot simulator   TM Listen Node, 1 robot on {self.host}:{self.robot_port}, "
             f"Ethernet Slave on {self.host}:{self.sim.robots[0].svr_port}",
-            f"  virtual PLC       PnP_Example + Commands_Example in a {period_ms:g} ms task (real time)",
+            f"  virtual PLC       PnP_Example + Commands_Example (ladder) in a {period_ms:g} ms task (real time)",
             f"  web HMI           {self.hmi.url} (without a key: monitor only)",
             "",
             "Open the operator address in a browser, press Connect, then try the Motion pages:",
@@ -127,6 +127,7 @@ class Demo:
             f"  engineer          {self.hmi.page_url('index', 'engineer')}"
             "   (also robot address, base, tool, outputs)",
             "The keys are new at every start; keep them to the people who may move the robot.",
+            "The Program (Ladder) page shows Commands_Example's rungs live.",
             "Press Ctrl-C to stop.",
         ])
 

@@ -200,7 +200,10 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
             raise FormatError(f"{pou}:rung {number}:element {index}",
                               f"unknown element <{obj.tag} xsi:type=\"{kind}\"> in a rung; a rung has {KNOWN}")
         eid = obj.get("globalId") or f"r{number}e{index}"
-        objects.append((obj, Element(eid, table[kind])))
+        ekind = table[kind]
+        if ekind == "out_var" and obj.find("ConnectionPointOut") is not None:
+            ekind = "inout_var"                          # a DataSink that is also read further on
+        objects.append((obj, Element(eid, ekind)))
         for pt in obj.iterfind("ConnectionPointOut"):
             outs[pt.get("connectionPointOutId", "")] = Conn(eid)
         for group in ("OutputVariables/OutputVariable", "InOutVariables/InOutVariable"):
@@ -214,7 +217,7 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
             e.negated = obj.get("negated", "false") in ("true", "negated")
             e.edge = _choice(obj, "edge", EDGES, where)
             e.storage = _choice(obj, "storage", STORAGES, where)
-        elif e.kind in ("in_var", "out_var"):
+        elif e.kind in ("in_var", "out_var", "inout_var"):
             e.var = obj.get("identifier", "")
             e.negated = obj.get("negated", "false") == "true"
         elif e.kind in ("jump", "label"):
