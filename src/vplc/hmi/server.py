@@ -10,6 +10,7 @@ API (all answers are JSON objects with "ok"):
   GET  /api/mapping                         the variable table (types, ranges, enumerations, roles)
   GET  /api/session                         {"ok", "role"}: the role the request's X-HMI-Key grants
   GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "values": {name: value}}
+  GET  /api/program[/state?pou=NAME]        ladder drawings and their live power flow (vplc.hmi.program)
   POST /api/write   {"values": {path: v}}   validate all, then write all in one scan gap
   POST /api/execute {"execute": "X_Execute", "values": {path: v}}
                                             validate, write the values and Execute := FALSE, wait for one
@@ -311,6 +312,7 @@ class HmiServer:
         self._thread: threading.Thread | None = None
         self.requests = 0
         self._execute_lock = threading.Lock()
+        self.program = None            # ProgramMonitor, built at the Program page's first request
 
     @property
     def port(self) -> int:
@@ -505,6 +507,8 @@ class _Handler(BaseHTTPRequestHandler):
                 query = parse_qs(url.query, max_num_fields=MAX_NAMES)
                 names = [n for part in query.get("names", []) for n in part.split(",") if n]
                 self._json(HTTPStatus.OK, self.hmi.read(names))
+            elif url.path in ("/api/program", "/api/program/state"):
+                self._program(url)
             elif url.path.startswith("/api/"):
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
             else:
@@ -515,6 +519,19 @@ class _Handler(BaseHTTPRequestHandler):
             self._fail(RequestError(f"malformed address: {exc}"))
 
     do_HEAD = do_GET
+
+    def _program(self, url) -> None:
+        """The Program page's ladder drawings and their live state (vplc.hmi.program)."""
+        from .program import ProgramError, ProgramMonitor
+        if self.hmi.program is None:
+            self.hmi.program = ProgramMonitor(self.hmi.plc)
+        try:
+            if url.path == "/api/program":
+                self._json(HTTPStatus.OK, self.hmi.program.page())
+            else:
+                self._json(HTTPStatus.OK, self.hmi.program.state(parse_qs(url.query).get("pou", [""])[0]))
+        except ProgramError as exc:
+            raise RequestError(str(exc), exc.status) from None
 
     def do_POST(self):  # noqa: N802 - http.server naming
         self.hmi.requests += 1

@@ -1,0 +1,158 @@
+"""Live ladder monitoring for the HMI's Program page, as Sysmac Studio's online monitoring shows it.
+
+    GET /api/program                  {"ok", "programs": [{"pou", "instance", "svg"}]}  the drawings (once)
+    GET /api/program/state?pou=NAME   {"ok", "on": [ids], "values": {variable text: value text}}
+
+``on`` lists the drawn elements and wires that carry power in the current scan state: power is worked
+out from the variable values the same way the translation does (contacts ``in AND var``, NC ``AND NOT``,
+coils pass power on, a block's outputs are the instance's outputs, ENO follows EN). Edge contacts show
+their variable, as Sysmac's monitor does. Only variables drawn in the ladder are read.
+"""
+from __future__ import annotations
+
+from http import HTTPStatus
+
+from ..ladder.svg import svg_document
+from .server import format_dt
+from ..runtime.values import PathError
+
+
+class ProgramError(Exception):
+    def __init__(self, message: str, status: HTTPStatus = HTTPStatus.BAD_REQUEST):
+        super().__init__(message)
+        self.status = status
+
+
+class LadderView:
+    """One ladder POU running in the PLC: its drawing and how to read its variables."""
+
+    def __init__(self, plc, pou, instance: str) -> None:
+        self.plc = plc
+        self.pou = pou
+        self.ladder = pou.ladder
+        self.instance = instance
+        self.locals = {d.name.upper() for s in pou.sections for d in s.vars}
+        self.svg = svg_document(self.ladder)
+        names = set()
+        for rung in self.ladder.rungs:
+            for e in rung.elements:
+                if e.kind in ("contact", "coil", "in_var", "out_var", "inout_var") and e.var:
+                    names.add(e.var)
+        self.names = sorted(names)
+        self.types = {}
+        for n in self.names:
+            try:
+                self.types[n] = plc.var_type(self.path(n))
+            except (PathError, KeyError, ValueError, TypeError):
+                pass
+
+    def path(self, text: str) -> str:
+        head = text.split(".", 1)[0].split("[", 1)[0].strip().upper()
+        return f"{self.instance}.{text}" if head in self.locals else text
+
+    def read(self, text: str):
+        try:
+            return self.plc.read(self.path(text))
+        except (PathError, KeyError, ValueError, TypeError):
+            return None
+
+    def state(self) -> dict:
+        with self.plc.lock:
+            raw = {n: self.read(n) for n in self.names}
+            on: list[str] = []
+            for rung in self.ladder.rungs:
+                on += self._rung_power(rung, raw)
+        values = {n: _text(v, self.types.get(n)) for n, v in raw.items() if _text(v, self.types.get(n)) is not None}
+        return {"ok": True, "on": sorted(set(on)), "values": values}
+
+    def _rung_power(self, rung, raw) -> list[str]:
+        by_id = {e.id: e for e in rung.elements}
+        power: dict[tuple[str, str | None], bool] = {}
+        on = []
+        done: set[str] = set()
+
+        def out(ref: str, pin: str | None) -> bool:
+            src = by_id.get(ref)
+            if src is None:
+                return False
+            if src.kind == "left_rail":
+                return True
+            if ref not in done:
+                visit(src)
+            return bool(power.get((ref, pin), power.get((ref, None), False)))
+
+        def into(pin) -> bool:
+            return any([out(c.ref, c.pin) for c in pin.conns])
+
+        def visit(e) -> None:
+            done.add(e.id)
+            if e.kind == "contact":
+                value = raw.get(e.var) is True
+                p = into(e.inputs[0]) and (not value if e.negated else value)
+                power[(e.id, None)] = p
+            elif e.kind == "coil":
+                power[(e.id, None)] = into(e.inputs[0])
+            elif e.kind == "in_var":
+                power[(e.id, None)] = raw.get(e.var) is True
+            elif e.kind == "block":
+                en = next((p for p in e.inputs if p.name.upper() == "EN"), None)
+                en_on = into(en) if en is not None and en.conns else True
+                for p in e.inputs:
+                    if p.name.upper() != "EN" and p.conns:
+                        into(p)
+                for p in e.outputs:
+                    if p.name.upper() == "ENO":
+                        power[(e.id, p.name)] = en_on
+                    elif e.instance:
+                        power[(e.id, p.name)] = self.read(f"{e.instance}.{p.name}") is True
+                if en is not None and en.conns and en_on:     # a block with EN is lit while it runs
+                    on.append(e.id)
+            elif e.kind in ("out_var", "inout_var", "jump", "return") and e.inputs:
+                power[(e.id, None)] = into(e.inputs[0])
+            if power.get((e.id, None)):
+                on.append(e.id)
+
+        for e in rung.elements:
+            if e.kind == "left_rail":
+                on.append(e.id)                       # wires leaving the left rail always carry power
+            elif e.id not in done and e.kind != "right_rail":
+                visit(e)
+        for (eid, pin), p in power.items():
+            if p:
+                on.append(eid if pin is None or by_id[eid].kind != "block" else f"{eid}:{pin}")
+        return on
+
+
+def _text(v, type_name: str | None = None):
+    if type_name in ("DATE_AND_TIME", "DT") and isinstance(v, int):
+        return format_dt(v)
+    if isinstance(v, bool):
+        return "TRUE" if v else "FALSE"
+    if isinstance(v, (int, float)):
+        return f"{v:g}" if isinstance(v, float) else str(v)
+    if isinstance(v, str):
+        return f"'{v}'" if len(v) <= 40 else f"'{v[:37]}...'"
+    return None
+
+
+class ProgramMonitor:
+    """The ladder POUs of the running PLC (none: the page says so)."""
+
+    def __init__(self, plc) -> None:
+        self.views: dict[str, LadderView] = {}
+        for unit in plc.project.units:
+            for item in unit.items:
+                if getattr(item, "ladder", None) is not None and item.kind == "PROGRAM":
+                    instance = next((inst.i__path for inst in plc.instances.values()
+                                     if inst.i__type.name.upper() == item.name.upper()), item.name)
+                    self.views[item.name.upper()] = LadderView(plc, item, instance)
+
+    def page(self) -> dict:
+        return {"ok": True, "programs": [{"pou": v.pou.name, "instance": v.instance, "svg": v.svg}
+                                         for v in self.views.values()]}
+
+    def state(self, pou: str) -> dict:
+        view = self.views.get(pou.upper())
+        if view is None:
+            raise ProgramError(f"no ladder program named `{pou}` runs in this PLC", HTTPStatus.NOT_FOUND)
+        return view.state()
