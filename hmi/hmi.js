@@ -395,9 +395,10 @@ function mainPage() {
       <a href="moverel.html" id="nav-moverel">Move Relative</a><a href="moveabs.html" id="nav-moveabs">Move Absolute</a>
       <a href="movecircle.html" id="nav-movecircle">Move Circle</a><a href="pnp.html" id="nav-pnp">PnP Sequence</a>
       <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>
-    <div class="area"><h2>PLC</h2><div class="tiles"><a href="program.html" id="nav-program">Program (Ladder)</a></div></div>
     </div><div class="robotview" id="robotview"></div>`;
   robotView(document.getElementById("robotview"));
+  document.querySelector("header h1").insertAdjacentHTML("afterend",
+    '<a class="menu" id="nav-program" href="program.html">Program (Ladder)</a>');
   startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", "Robot_InListenNode", "Robot_QueueDepth",
     "Robot_Stopping", "Robot_LastErrorID"]);
 }
