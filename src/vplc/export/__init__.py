@@ -3,6 +3,8 @@ Sysmac Studio.
 
 * ``iec61131-10`` writes one IEC 61131-10 Ed.1 XML file for Tools > IEC 61131-10 XML > Import
   (:mod:`vplc.export.iec61131_10`);
+* ``plcopen`` writes one PLCopen XML TC6 v2.01 file (CODESYS, Beremiz / OpenPLC, …;
+  :mod:`vplc.export.plcopen`); ladder POUs keep their rungs in both XML formats;
 * ``paste`` writes a folder of clipboard-ready variable tables and bodies plus ORDER.txt for CPU units
   without that menu (:mod:`vplc.export.paste`).
 
@@ -16,19 +18,20 @@ import os
 import sys
 import tempfile
 
-FORMATS = ("iec61131-10", "paste")
+FORMATS = ("iec61131-10", "plcopen", "paste")
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "export", help="export ST sources for Sysmac Studio (IEC 61131-10 XML or paste kit)",
-        description="Check the ST sources, then write them as one IEC 61131-10 XML file (Sysmac Studio: "
-                    "Tools > IEC 61131-10 XML > Import) or as a paste kit folder. Exit 0 written, 1 errors in "
-                    "the sources, 2 usage error.")
-    p.add_argument("paths", nargs="+", metavar="PATH", help="ST file or folder (recursive *.st)")
+        description="Check the sources, then write them as one IEC 61131-10 XML file (Sysmac Studio: "
+                    "Tools > IEC 61131-10 XML > Import), one PLCopen XML TC6 file, or a paste kit folder. Exit 0 "
+                    "written, 1 errors in the sources, 2 usage error.")
+    p.add_argument("paths", nargs="+", metavar="PATH", help="ST or XML file, or folder (recursive *.st, *.xml)")
     p.add_argument("--format", default="iec61131-10", metavar="FORMAT",
-                   help="iec61131-10 (default): one XML file; paste: a folder per data type and POU")
-    p.add_argument("-o", "--output", metavar="OUT", help="XML file (iec61131-10) or folder (paste); required")
+                   help="iec61131-10 (default): one XML file for Sysmac Studio; plcopen: one PLCopen XML TC6 file; "
+                        "paste: a folder per data type and POU")
+    p.add_argument("-o", "--output", metavar="OUT", help="XML file (iec61131-10, plcopen) or folder (paste); required")
     p.add_argument("--flat", action="store_true",
                    help="write every object in the global namespace (no NamespaceDecl), for importers "
                         "that do not take namespaces")
@@ -49,14 +52,14 @@ def run_export(args) -> int:
     from .paste import PasteTargetError, write as write_paste
 
     if args.format not in FORMATS:
-        return _usage(f"unknown format `{args.format}`; use {' or '.join(FORMATS)}")
+        return _usage(f"unknown format `{args.format}`; use {', '.join(FORMATS[:-1])} or {FORMATS[-1]}")
     if not args.output:
-        return _usage("no output given; add -o FILE.xml (iec61131-10) or -o FOLDER (paste)")
+        return _usage("no output given; add -o FILE.xml (iec61131-10, plcopen) or -o FOLDER (paste)")
     missing = [p for p in args.paths if not os.path.exists(p)]
     if missing:
         return _usage(f"file or folder `{missing[0]}` does not exist")
     out = args.output
-    if args.format == "iec61131-10":
+    if args.format in ("iec61131-10", "plcopen"):
         parent = os.path.dirname(os.path.abspath(out))
         if os.path.isdir(out):
             return _usage(f"output `{out}` is a folder; give a file name such as {os.path.join(out, 'Lib.xml')}")
@@ -79,6 +82,9 @@ def run_export(args) -> int:
         if args.format == "iec61131-10":
             data = render(export, proj, flat=args.flat)
             _write_atomic(out, data)
+        elif args.format == "plcopen":
+            from .plcopen import render as render_plcopen
+            _write_atomic(out, render_plcopen(export, proj))
         else:
             write_paste(export, proj, out, flat=args.flat)
     except ExportError as exc:

@@ -30,6 +30,7 @@ import xml.etree.ElementTree as ET
 
 from .. import __version__
 from ..frontend import ast as A
+from ..ladder.iec10_write import ld_body
 from .model import ExportError, ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 
 IEC_NS = "www.iec.ch/public/TC65SC65BWG7TF10"
@@ -170,6 +171,10 @@ def _pou(parent: ET.Element, item: PouItem) -> None:
     else:
         _var_lists(el, item, ("VAR", "VAR_STAT"), "Vars", {"accessSpecifier": "private"})
         _var_lists(el, item, "VAR_TEMP", "TempVars", {})
+    ladder = getattr(pou, "ladder", None)
+    if ladder is not None:                          # a ladder POU keeps its rungs (Sysmac's LdSection)
+        ld_body(_sub(el, "MainBody"), ladder)
+        return
     bc = _sub(_sub(el, "MainBody"), "BodyContent", {"xsi:type": "ST"})
     _sub(bc, "ST", text=item.body)
 
@@ -186,10 +191,13 @@ def _qualifiers(section: A.VarSection) -> dict:
 def _var_lists(el: ET.Element, item: PouItem, kinds, tag: str, base_attrs: dict) -> None:
     """One list element per source section of ``kinds`` (sections differ in CONSTANT / RETAIN)."""
     kinds = (kinds,) if isinstance(kinds, str) else kinds
+    ladder = getattr(item.pou, "ladder", None)
+    helpers = {h.upper() for h in (ladder.helpers if ladder is not None else [])}   # the translation's own
     for section in item.pou.sections:
-        if section.kind in kinds and section.vars:
+        decls = [d for d in section.vars if d.name.upper() not in helpers]
+        if section.kind in kinds and decls:
             lst = _sub(el, tag, {**base_attrs, **_qualifiers(section)})
-            for d in section.vars:
+            for d in decls:
                 _variable(lst, "Variable", d, item.var_comments.get(id(d), ""))
 
 

@@ -26,19 +26,32 @@ SIMPLE = {"contact": "contact", "coil": "coil", "inVariable": "in_var", "outVari
 LD_ELEMENTS = ", ".join(sorted(SIMPLE)) + ", comment"
 
 
+NAMESPACE_DATA = "https://github.com/cbt-commands-lib/vplc/namespace"     # vplc export (vplc.export.plcopen)
+
+
 def read(root: ET.Element) -> list[XmlUnit]:
-    unit = XmlUnit(None)
+    units: dict[str | None, XmlUnit] = {None: XmlUnit(None)}
     types = root.find("types")
     if types is None:
         raise FormatError("", "the PLCopen project has no <types> element")
     for dt in types.iterfind("dataTypes/dataType"):
-        unit.types.append(_data_type(dt))
+        ns = _namespace(dt)
+        units.setdefault(ns, XmlUnit(ns)).types.append(_data_type(dt))
     for pou in types.iterfind("pous/pou"):
-        unit.pous.append(_pou(pou))
+        ns = _namespace(pou)
+        units.setdefault(ns, XmlUnit(ns)).pous.append(_pou(pou))
     for holder in root.iterfind("instances/configurations/configuration"):
         for gl in [*holder.iterfind("globalVars"), *holder.iterfind("resource/globalVars")]:
-            unit.globals.append(_var_list("VAR_GLOBAL", gl, f"configuration {holder.get('name', '')}"))
-    return [unit]
+            units[None].globals.append(_var_list("VAR_GLOBAL", gl, f"configuration {holder.get('name', '')}"))
+    return [u for u in units.values() if u.types or u.pous or u.globals]
+
+
+def _namespace(el: ET.Element) -> str | None:
+    for data in el.iterfind("addData/data"):
+        if data.get("name") == NAMESPACE_DATA:
+            ns = data.find("namespace")
+            return ns.get("name") if ns is not None else None
+    return None
 
 
 # ---- types and values ----------------------------------------------------------------------------
@@ -208,13 +221,19 @@ def _element(el: ET.Element, pou: str) -> Element:
 
 def read_ld(ld: ET.Element, pou: str) -> LadderBody:
     elements: list[Element] = []
+    seen: set[str] = set()
     comments: list[tuple[float, str]] = []
     for el in ld:
         if el.tag == "comment":
             p = el.find("position")
             comments.append((float(p.get("y", 0)) if p is not None else 0.0, text_of(el.find("content"))))
         elif el.tag in SIMPLE:
-            elements.append(_element(el, pou))
+            e = _element(el, pou)
+            if e.id in seen:
+                raise FormatError(f"{pou}:element {e.id}", f"localId {e.id} is used by two elements; every "
+                                  "element needs its own id for the wires to be unambiguous", "ST2103")
+            seen.add(e.id)
+            elements.append(e)
         elif el.tag not in ("addData", "documentation"):
             raise FormatError(f"{pou}:element {el.get('localId', '?')}",
                               f"unknown element <{el.tag}> in a ladder body; a ladder has {LD_ELEMENTS}")

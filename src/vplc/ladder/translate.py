@@ -112,7 +112,6 @@ class Writer:
 def unit_source(path: str, unit: XmlUnit) -> LadderSource:
     w = Writer()
     ladders = []
-    w.put(f"(* generated from {path.replace('*)', '* )')} *)\n")
     for t in unit.types:
         init = f" := {t.init}" if t.init is not None else ""
         w.put(f"TYPE\n{_comment(t.comment)}{t.name} : {t.spec}{init};\nEND_TYPE\n\n", f"data type {t.name}")

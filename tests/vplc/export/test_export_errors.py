@@ -31,10 +31,10 @@ def test_missing_path_is_a_usage_error(tmp_path, capsys):
 
 
 def test_unknown_format_is_a_usage_error(tmp_path, capsys):
-    code, _, err = run(capsys, "export", str(LIB), "--format", "plcopen", "-o", str(tmp_path / "x.xml"))
+    code, _, err = run(capsys, "export", str(LIB), "--format", "tc6", "-o", str(tmp_path / "x.xml"))
     assert code == 2
     _one_line(err)
-    assert "unknown format `plcopen`" in err
+    assert "unknown format `tc6`; use iec61131-10, plcopen or paste" in err
 
 
 def test_unwritable_output_is_a_usage_error(tmp_path, capsys):

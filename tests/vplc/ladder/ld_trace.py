@@ -19,8 +19,9 @@ def example_stimulus(scan: int) -> dict:
     return {name: (scan // (7 + 3 * i)) % 2 == 1 for i, name in enumerate(EXECUTES)}
 
 
-def trace(sources, scans: int = 1000, stimulus=example_stimulus, watched=WATCHED, task: str = "Main@1ms"):
-    plc = load_plc([str(s) for s in sources], task=task)
+def trace(sources, scans: int = 1000, stimulus=example_stimulus, watched=WATCHED, task: str = "Main@1ms",
+          programs=None):
+    plc = load_plc([str(s) for s in sources], task=task, programs=programs)
     rows = []
     try:
         for n in range(scans):

@@ -30,6 +30,11 @@ def test_missing_connection_names_the_element_and_the_missing_id(tmp_path):
                                  "connected to element 77, which is not in this rung")
 
 
+def test_two_elements_with_one_local_id_are_refused(tmp_path):
+    d = one(program(tmp_path, V, [rail(1), contact(1, "A", 1), coil(3, "Q", 1)]))
+    assert d.code == "ST2103" and "localId 1 is used by two elements" in d.message
+
+
 def test_unconnected_coil_is_reported(tmp_path):
     d = one(program(tmp_path, V, [rail(1), contact(2, "A", 1), coil(3, "Q")]))
     assert (d.code, d.location().split(":", 1)[1]) == ("ST2103", "Main:rung 2:coil Q")
