@@ -14,7 +14,7 @@ from .checker.scope import Ambiguous, Tables
 from .frontend.diagnostics import DiagnosticBag, Diagnostic, render_all, sort_key
 from .frontend.parser import parse
 from .frontend.source import SourceFile, Span
-from .ladder.load import attach_ladders, check_operands, is_xml, read_xml
+from .ladder.load import attach_ladders, check_operands, is_project_xml, is_xml, read_xml
 
 PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
 VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st")
@@ -99,7 +99,8 @@ def collect_files(paths, diags: DiagnosticBag) -> list[str]:
             found = []
             for root, dirs, names in os.walk(p):
                 dirs.sort()
-                found += [os.path.join(root, n) for n in sorted(names) if n.lower().endswith(".st") or is_xml(n)]
+                found += [os.path.join(root, n) for n in sorted(names)
+                          if n.lower().endswith(".st") or (is_xml(n) and is_project_xml(os.path.join(root, n)))]
             if not found:
                 diags.warning("ST0004", f"folder `{p}` contains no .st or .xml files", Span(SourceFile(p, ""), 0, 0))
             files += found

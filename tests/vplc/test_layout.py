@@ -8,14 +8,15 @@ SRC = pathlib.Path(__file__).resolve().parents[2] / "src" / "vplc"
 ALLOWED = {
     "frontend": set(),
     "checker": {"frontend"},
-    "project": {"checker", "frontend"},
+    "ladder": {"frontend"},
+    "project": {"ladder", "checker", "frontend"},
     "runtime": {"frontend"},
     "compiler": {"runtime", "frontend"},
     "trace": {"frontend"},
-    "export": {"project", "frontend"},
+    "export": {"project", "ladder", "frontend"},
     "api": {"compiler", "runtime", "project", "frontend"},
-    "cli": {"api", "export", "trace", "compiler", "runtime", "project", "checker", "frontend"},
-    "hmi": {"api", "export", "trace", "compiler", "runtime", "project", "checker", "frontend"},
+    "cli": {"api", "export", "trace", "compiler", "runtime", "project", "ladder", "checker", "frontend"},
+    "hmi": {"api", "export", "trace", "compiler", "runtime", "project", "ladder", "checker", "frontend"},
 }
 
 

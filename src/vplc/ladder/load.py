@@ -6,6 +6,8 @@ Diagnostic codes ST2101-ST2107 (docs/toolchain/diagnostics.md).
 """
 from __future__ import annotations
 
+import re
+
 from ..frontend import ast as A
 from ..frontend.source import SourceFile, Span
 from . import iec10_read, plcopen_read
@@ -19,6 +21,18 @@ PLCOPEN_NS = "http://www.plcopen.org/xml/tc6"
 
 def is_xml(path: str) -> bool:
     return path.lower().endswith(XML_SUFFIXES)
+
+
+def is_project_xml(path: str) -> bool:
+    """Whether an XML file found in a folder is a project to load: its root element is ``project`` (PLCopen)
+    or ``Project`` (IEC 61131-10). Other XML files in a source folder (test reports, settings) are not
+    sources; a file named on the command line is always loaded, and refused with a reason if it is not one."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return True                                      # the loader reports why it cannot be read
+    return re.search(rb"<(?:[A-Za-z_][\w.-]*:)?[pP]roject[\s>/]", head) is not None
 
 
 def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:

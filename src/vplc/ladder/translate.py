@@ -6,7 +6,7 @@
   wired into it), elements that do not depend on each other top to bottom, left to right;
 * a contact passes power ``in AND var`` (NC: ``AND NOT var``; P / N contacts: on the change of ``var``
   since the rung's previous evaluation); wires meeting at one input are an OR;
-* a coil writes its power to ``var`` (negated, set, reset, P / N coils as IEC 61131-3 Table 60) and
+* a coil writes its power to ``var`` (negated, set, reset, P / N coils as IEC 61131-3 defines them) and
   passes it on unchanged;
 * a block is called once; with an ``EN`` input only while EN has power (its outputs then keep their
   values); ``ENO`` carries EN's power;

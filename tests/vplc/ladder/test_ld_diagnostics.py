@@ -163,3 +163,11 @@ def test_cli_check_prints_the_element_location(tmp_path, capsys, name):
         assert '"element": "Main:rung 1:contact Strat"' in out
     else:
         assert "main.xml:Main:rung 1:contact Strat: error[ST1001]" in out
+
+
+def test_other_xml_files_in_a_source_folder_are_not_sources(tmp_path):
+    (tmp_path / "report.xml").write_text('<?xml version="1.0"?><testsuites><testsuite/></testsuites>', encoding="utf-8")
+    program(tmp_path, V, [rail(1), contact(2, "A", 1), coil(3, "Q", 2)])
+    assert diags(tmp_path) == []
+    d = one(tmp_path / "report.xml")
+    assert d.code == "ST2101" and "root element is <testsuites>" in d.message
