@@ -31,6 +31,30 @@ DRIVER_FIELDS = {
 }
 
 
+def driver_packets(buf):
+    """tm_packet.cpp TmPacket::build_packet_from_bytes (decimal length via std::stoi, ',' after the data, '*',
+    two hex digits, CR LF), applied to the front of the receive buffer; complete packets are removed."""
+    out = []
+    while True:
+        start = buf.find(b"$")
+        if start < 0 or len(buf) - start < 9:
+            return out
+        del buf[:start]
+        comma1 = buf.find(b",", 1)
+        comma2 = buf.find(b",", comma1 + 1)
+        if comma1 < 0 or comma2 < 0:
+            return out
+        length = int(buf[comma1 + 1:comma2])
+        end = comma2 + 1 + length
+        if len(buf) < end + 6:
+            return out
+        assert buf[end:end + 2] == b",*" and buf[end + 4:end + 6] == b"\r\n", "driver: end not valid"
+        assert int(buf[end + 2:end + 4], 16) == codec.checksum(bytes(buf[1:end + 1])), "driver: checksum"
+        out.append((buf[1:comma1].decode(), bytes(buf[comma2 + 1:end])))
+        del buf[:end + 6]
+
+
+
 class DriverSvrClient:
     """What tmr_ros2's TmSvrCommunication + TmRobotState do with the bytes of port 5891."""
 
@@ -41,32 +65,10 @@ class DriverSvrClient:
         self.checked = set()
         self.responses, self.read_strings = [], []
 
-    # tm_packet.cpp TmPacket::build_packet_from_bytes (decimal length via std::stoi, ',' after the data,
-    # '*', two hex digits, CR LF), applied to the front of the receive buffer
-    def packets(self):
-        out = []
-        while True:
-            start = self.buf.find(b"$")
-            if start < 0 or len(self.buf) - start < 9:
-                return out
-            del self.buf[:start]
-            comma1 = self.buf.find(b",", 1)
-            comma2 = self.buf.find(b",", comma1 + 1)
-            if comma1 < 0 or comma2 < 0:
-                return out
-            length = int(self.buf[comma1 + 1:comma2])
-            end = comma2 + 1 + length
-            if len(self.buf) < end + 6:
-                return out
-            assert self.buf[end:end + 2] == b",*" and self.buf[end + 4:end + 6] == b"\r\n", "driver: end not valid"
-            assert int(self.buf[end + 2:end + 4], 16) == codec.checksum(bytes(self.buf[1:end + 1])), "driver: checksum"
-            out.append((self.buf[1:comma1].decode(), bytes(self.buf[comma2 + 1:end])))
-            del self.buf[:end + 6]
-
     def pump(self):
         self.buf += b"".join(self.peer.raw_reads)
         self.peer.raw_reads.clear()
-        for header, data in self.packets():
+        for header, data in driver_packets(self.buf):
             assert header == "TMSVR", f"driver: invalid header {header}"
             self.svr_data(data)
 
@@ -196,3 +198,58 @@ def test_techmanpy_tmsvr_client_reads_writes_and_receives_the_broadcast():
     assert do2 == 1
     assert len(broadcasts) >= 3 and broadcasts[0]["Robot_Link"] == 1
     assert broadcasts[-1]["Joint_Angle"] == pytest.approx([0, 0, 90, 0, 90, 0])
+
+
+class DriverSctClient:
+    """tmr_ros2's Listen-node side (tm_listen_node_connect.cpp, tm_sct_communication.cpp): it reads port 5890
+    only while the Ethernet Slave is connected, asks TMSTA 00 with empty data to learn whether the flow is in
+    the node, sends scripts as TMSCT id,script and takes replies starting with OK / ERROR."""
+
+    def __init__(self, peer, svr_driver):
+        self.peer, self.svr = peer, svr_driver
+        self.buf = bytearray()
+        self.sct, self.sta = [], []
+
+    def pump(self):
+        if self.svr.peer.closed:                # while (sct.is_connected() && iface.svr.is_connected())
+            return
+        self.buf += b"".join(self.peer.raw_reads)
+        self.peer.raw_reads.clear()
+        for header, data in driver_packets(self.buf):
+            text = data.decode()
+            if header == "TMSCT":
+                ident, _, script = text.partition(",")
+                self.sct.append((ident, script))
+            elif header == "TMSTA":
+                self.sta.append(tuple(text.split(",", 1)))
+            else:
+                raise AssertionError(f"driver: {header} on the Listen node")
+
+    def send_sta_request(self, subcmd, subdata=""):
+        self.peer.send(codec.encode("TMSTA", f"{subcmd},{subdata}"))
+
+    def send_script_str(self, ident, script):
+        self.peer.send(codec.encode("TMSCT", f"{ident},{script}"))
+
+
+def test_official_driver_sct_and_svr_together_move_the_arm_and_publish_its_joint_states(h):
+    svr = DriverSvrClient(h.connect_svr())
+    sct = DriverSctClient(h.connect(), svr)
+
+    def pump():
+        svr.pump()
+        sct.pump()
+
+    sct.send_sta_request("00")                                  # check_is_on_listen_node: ask_sta_struct("00", "")
+    assert h.until(lambda: (pump(), sct.sta)[1], timeout=2)
+    assert sct.sta[0] == ("00", "true,Listen1")                 # >> std::boolalpha reads "true"
+    sct.send_script_str("Move", 'PTP("JPP",-20,15,70,5,90,10,100,200,0,false)\r\nQueueTag(7,1)')
+    assert h.until(lambda: (pump(), sct.sct)[1], timeout=10)
+    assert sct.sct[0] == ("Move", "OK")
+    h.run(0.3)
+    pump()
+    assert svr.data_table_correct()
+    assert svr.joint_states() == pytest.approx([math.radians(v) for v in (-20, 15, 70, 5, 90, 10)], abs=1e-5)
+    sct.send_script_str("Exit", "ScriptExit()")                 # send_script_exit() when the driver stops
+    assert h.until(lambda: (pump(), len(sct.sct))[1] >= 2, timeout=5)
+    assert sct.sct[1] == ("Exit", "OK")
