@@ -72,8 +72,9 @@ class EthernetSlave:
     def poll(self, now):
         """Stream the data tables that are due and send what is waiting (called by SimServer.poll)."""
         for robot in self.server.robots:
-            robot.svr.advance(now)
-            self._flush(robot)
+            if robot.svr.clients:
+                robot.svr.advance(now)
+                self._flush(robot)
 
     def _accept(self, _none, robot):
         for _ in range(16):
