@@ -14,6 +14,7 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "estop", "robot": 0, "pressed": true}             Ethernet Slave: the operator at the robot
     {"cmd": "operation_mode", "robot": 0, "mode": "manual"}
     {"cmd": "svr_config", "robot": 0, "period": 0.1, "mode": 1, "items": [...], "write_permission": true}
+    {"cmd": "svr_inject", "robot": 0, "fault": "stall", "params": {"enabled": true}}   / "svr_clear_faults"
 
 Every field is checked (type, range, finite numbers, nesting, line length: sim/limits.py); a bad
 request gets ``ok: false`` with the reason and the connection stays usable, except after a line
@@ -86,6 +87,8 @@ class ControlChannel:
             "estop": lambda robot, req: _svr(robot).set_estop(_bool_field(req, "pressed", True)),
             "operation_mode": lambda robot, req: _svr(robot).set_auto_mode(_mode(req.get("mode"))),
             "svr_config": self._svr_config,
+            "svr_inject": self._svr_inject,
+            "svr_clear_faults": self._svr_clear_faults,
         }
 
     # ---- sockets ------------------------------------------------------------------------------
@@ -240,6 +243,14 @@ class ControlChannel:
                 robot.svr.write_permission = _bool_field(request, "write_permission", True)
         return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
                 "write_permission": robot.svr.write_permission}
+
+    def _svr_inject(self, robot, request):
+        _svr(robot)
+        self.server.svr.inject(robot, _text_field(request, "fault"), **_params(request))
+
+    def _svr_clear_faults(self, robot, _request):
+        _svr(robot)
+        self.server.svr.clear_faults(robot)
 
     def _events(self, robot, request):
         since = _int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")

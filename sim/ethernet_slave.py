@@ -15,7 +15,7 @@ import selectors
 import socket
 
 from . import codec
-from .svr_session import DEFAULT_STREAM, HEADERS, SvrSession
+from .svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
 from .svr_source import RobotDataSource
 
 MAX_CLIENTS = 64
@@ -151,6 +151,32 @@ class EthernetSlave:
         conn.sock.close()
         robot.svr.disconnect(conn.id)
         robot._log("svr_closed", conn=conn.id, reason=reason)
+
+    # ---- fault injection ----------------------------------------------------------------------
+    def inject(self, robot, fault, **params):
+        """``stall`` (enabled=True): no data table and no answers, connections stay open;
+        ``corrupt_checksum`` (count=1): the next frames leave with a wrong checksum;
+        ``disconnect``: every Ethernet Slave client of the robot is closed now. ValueError when unknown."""
+        if fault not in FAULTS:
+            raise ValueError(f"unknown Ethernet Slave fault '{fault}'; known: {', '.join(FAULTS)}")
+        unknown = set(params) - {"stall": {"enabled"}, "corrupt_checksum": {"count"}, "disconnect": set()}[fault]
+        if unknown:
+            raise ValueError(f"Ethernet Slave fault '{fault}' has no parameter {', '.join(sorted(unknown))}")
+        if fault == "stall":
+            robot.svr.stalled = bool(params.get("enabled", True))
+        elif fault == "corrupt_checksum":
+            count = params.get("count", 1)
+            if type(count) is not int or not 1 <= count <= 1_000_000:
+                raise ValueError(f"'count' of fault 'corrupt_checksum' must be 1..1000000, got {count!r}")
+            robot.svr.corrupt += count
+        else:
+            for conn in list(robot.svr_conns.values()):
+                self._drop(robot, conn, "fault: disconnect")
+        robot._log("svr_fault", fault=fault, params=params)
+
+    def clear_faults(self, robot):
+        robot.svr.stalled, robot.svr.corrupt = False, 0
+        robot._log("svr_fault", fault="cleared", params={})
 
     def close(self):
         for robot in self.server.robots:

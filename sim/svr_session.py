@@ -44,6 +44,9 @@ DEFAULT_STREAM = (
 )
 
 
+FAULTS = ("stall", "corrupt_checksum", "disconnect")    # fault injection (docs/simulator.md), clear_faults() ends
+
+
 class SvrConfigError(ValueError):
     """A stream configuration the simulator cannot serve (unknown item, mode, period)."""
 
@@ -66,6 +69,8 @@ class SvrSession:
         self.next_stream = 0.0
         self.stream_id = 0
         self.streams_sent = 0
+        self.stalled = False      # fault "stall": no data table, requests read and dropped unanswered
+        self.corrupt = 0          # fault "corrupt_checksum": this many more frames leave with a wrong checksum
 
     def configure(self, items=None, mode=None, period=None):
         """Set the streamed data table (TransmitFile, §17.2): items in order, mode 1/2/3, period in s (0 = off)."""
@@ -94,9 +99,18 @@ class SvrSession:
             self.log("svr_disconnect", conn=conn)
 
     def _send(self, conn, data):
+        self._out(conn, codec.encode("TMSVR", data))
+
+    def _out(self, conn, frame):
         client = self.clients.get(conn)
         if client is not None:
-            client.outbox.append(codec.encode("TMSVR", data))
+            client.outbox.append(self._damage(frame) if self.corrupt else frame)
+
+    def _damage(self, frame):
+        """Fault ``corrupt_checksum``: the frame's checksum digits inverted (a real checksum error)."""
+        self.corrupt -= 1
+        digits = "%02X" % (int(frame[-4:-2], 16) ^ 0xFF)
+        return frame[:-4] + digits.encode() + b"\r\n"
 
     def _status(self, conn, ident, code, item=None):
         text = STATUS_TEXT[code] + (f";{item}" if item is not None else "")
@@ -108,7 +122,7 @@ class SvrSession:
     def advance(self, now: float):
         """Send the data table to every client when a period is due (one frame, however late we are)."""
         self.now = max(self.now, now)
-        if not self.period or not self.clients or self.now < self.next_stream:
+        if not self.period or not self.clients or self.now < self.next_stream or self.stalled:
             return
         self.next_stream = max(self.next_stream + self.period, self.now)
         if self.next_stream <= self.now:
@@ -117,8 +131,8 @@ class SvrSession:
                              + self._content(self.stream_mode, self.stream_items))
         self.stream_id = (self.stream_id + 1) % 10
         self.streams_sent += 1
-        for client in self.clients.values():
-            client.outbox.append(frame)
+        for conn in self.clients:
+            self._out(conn, frame)
 
     def _content(self, mode, names) -> bytes:
         values = self.source.values(names)
@@ -133,7 +147,9 @@ class SvrSession:
     # ---- input --------------------------------------------------------------------------------
     def handle(self, conn: int, item):
         """One decoded item (codec.Frame / BadFrame / Garbage, decoded with HEADERS) from ``conn``."""
-        if isinstance(item, codec.Garbage):
+        if self.stalled:
+            self.log("svr_stalled", conn=conn, bytes=len(item.raw))
+        elif isinstance(item, codec.Garbage):
             self.log("svr_garbage", conn=conn, bytes=len(item.raw))
         elif isinstance(item, codec.BadFrame):
             self.log("svr_bad_frame", conn=conn, code=item.code, reason=item.reason)
@@ -142,9 +158,7 @@ class SvrSession:
             self._tmsvr(conn, item.data)
 
     def _send_cperr(self, conn, code):
-        client = self.clients.get(conn)
-        if client is not None:
-            client.outbox.append(codec.encode("CPERR", code))
+        self._out(conn, codec.encode("CPERR", code))
 
     def _tmsvr(self, conn, data: bytes):
         ident, comma1, rest = data.partition(b",")

@@ -280,6 +280,10 @@ def test_control_channel_presses_the_estop_switches_mode_and_configures_the_stre
         assert config == {"items": ["Robot_Link", "Joint_Angle"], "mode": 3, "period": 0.5,
                           "write_permission": False}
         assert "unknown data table item" in request(port, {"cmd": "svr_config", "items": ["Nope"]})["error"]
+        assert request(port, {"cmd": "svr_inject", "fault": "stall", "params": {"enabled": True}})["ok"]
+        assert srv.robots[0].svr.stalled
+        assert "known: stall" in request(port, {"cmd": "svr_inject", "fault": "fly"})["error"]
+        assert request(port, {"cmd": "svr_clear_faults"})["ok"] and not srv.robots[0].svr.stalled
         state = srv.robots[0].state()
         assert state["project_running"] is False and "emergency stop" in state["last_error"]
     finally:
@@ -372,3 +376,41 @@ def test_poses_follow_the_base_and_tool_in_use(h):
     assert got["Coord_Robot_Flange"][2] == pytest.approx(state["tcp_robot"][2] + 150, abs=1e-3)   # tool points down
     assert got["Base_Value"] == [100, 50, 20, 0, 0, 30] and got["TCP_Value"] == [0, 0, 150, 0, 0, 0]
     assert got["Coord_Base_Flange"] != got["Coord_Robot_Flange"]
+
+
+def test_fault_stall_stops_the_table_and_the_answers_until_cleared(h):
+    peer = h.connect_svr()
+    h.robot.svr.configure(period=0.1)
+    h.srv.svr.inject(h.robot, "stall")
+    h.run(0.5)
+    peer.frames.clear()
+    peer.send(svr("S1,12,Project_Run"))
+    h.run(1.0)
+    assert peer.frames == [] and not peer.closed
+    assert any(e["kind"] == "svr_stalled" for e in h.robot.events)
+    h.srv.svr.clear_faults(h.robot)
+    assert h.until(lambda: len(peer.frames) >= 2, timeout=1)
+
+
+def test_fault_corrupt_checksum_damages_the_next_frames_only(h):
+    peer = h.connect_svr()
+    h.srv.svr.inject(h.robot, "corrupt_checksum", count=2)
+    for ident in ("C1", "C2", "C3"):
+        peer.send(svr(f"{ident},12,Project_Run"))
+    h.run(0.1)
+    buf = bytearray(b"".join(peer.raw_reads))
+    items = codec.decode_all(buf, {"TMSVR"})
+    assert [type(i).__name__ for i in items] == ["BadFrame", "BadFrame", "Frame"]
+    assert items[0].code == codec.CPERR_CHECKSUM and items[2].data == b"C3,12,Project_Run=true"
+
+
+def test_fault_disconnect_closes_the_ethernet_slave_clients_not_the_listen_node(h):
+    node, peer = h.connect(), h.connect_svr()
+    h.srv.svr.inject(h.robot, "disconnect")
+    assert h.until(lambda: peer.closed, timeout=1)
+    assert h.request(node, sta("00")) == [("TMSTA", "00,true,Listen1")]
+    again = h.connect_svr()
+    assert ask(h, again, "D1,12,Robot_Link") == ("TMSVR", b"D1,12,Robot_Link=1")
+    for fault, params in (("fly", {}), ("stall", {"seconds": 1}), ("corrupt_checksum", {"count": 0})):
+        with pytest.raises(ValueError):
+            h.srv.svr.inject(h.robot, fault, **params)
