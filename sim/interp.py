@@ -3,7 +3,10 @@
 ``run_script`` yields wait requests and is resumed with their result:
 
     ("tag", tag, timeout_s)   QueueTag(n,1) (timeout None) and WaitQueueTag(n, ms); resumed with
-                              1 (reached), 0 (timeout or dropped by a stop) or -1 (unknown tag)
+                              1 (completed), 0 (timeout) or -1 (not existed: unknown, forgotten, dropped)
+    ("idle", None, None)      WaitQueueTag(): until every queued motion is done
+    ("delay", None, s)        Sleep(ms), WaitQueueTag(0, ms)
+    ("room", None, None)      a queued statement while the FIFO is full
 
 It returns "exit" when ScriptExit() ran (the rest of the packet is ignored), else None.
 Immediate statements run when reached; motions, queue tags, base/TCP/load changes and DO/AO writes
@@ -434,8 +437,13 @@ def _call(node, args, ctx, line):
             yield ("tag", tag, None)
         return True
     if name == "WaitQueueTag":
-        timeout = args[1] if len(args) > 1 else -1
-        return (yield ("tag", int(args[0]), None if timeout < 0 else timeout / 1000.0))
+        return (yield from _wait_queue_tag(args, robot))
+    if name == "CheckQueueTag":                 # TMscript 2.24 §13.3: WaitQueueTag(tag, 0), one check
+        return robot.tag_result(int(args[0]))
+    if name == "Sleep":
+        if args[0] > 0:
+            yield ("delay", None, args[0] / 1000.0)
+        return None
     if name == "Pause":
         robot.pause()
         return True
@@ -460,6 +468,27 @@ def _call(node, args, ctx, line):
     if name == "GetString":
         return to_text(args[0])
     raise ScriptRuntimeError(f"function {name} cannot run here")
+
+
+def _wait_queue_tag(args, robot):
+    """WaitQueueTag per TMscript 2.24 §13.2. Syntax 3 (no argument): wait until every queued motion is
+    done, no return value. Tag 1..15: timeout < 0 (the default of syntax 2) waits until completed or not
+    existed, 0 checks once, > 0 waits up to that many ms. Tag 0 is invalid but waits for the timeout
+    (returns at once when the timeout is infinite); a tag < 0 or > 15 returns -1 without waiting."""
+    if not args:
+        yield ("idle", None, None)
+        return None
+    tag = int(args[0])
+    timeout = args[1] if len(args) > 1 else -1
+    if tag < 0 or tag > 15:
+        return -1
+    if tag == 0:
+        if timeout > 0:
+            yield ("delay", None, timeout / 1000.0)
+        return 0
+    if timeout == 0:
+        return robot.tag_result(tag)
+    return (yield ("tag", tag, None if timeout < 0 else timeout / 1000.0))
 
 
 def to_text(value) -> str:

@@ -22,7 +22,7 @@ IDENTITY_POSE = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 class RobotModel:
     """One arm. ``tick(dt)`` returns the list of events (dicts) that happened during dt."""
 
-    def __init__(self, tag_history=4, bases=None, tools=None):
+    def __init__(self, tag_history=4, bases=None, tools=None, stop_tags="forget"):
         self.joints = list(HOME_JOINTS)
         self.bases = {"RobotBase": IDENTITY_POSE, **(bases or {})}
         self.tools = {"NOTOOL": IDENTITY_POSE, **(tools or {})}
@@ -36,7 +36,10 @@ class RobotModel:
         self.active_t = 0.0
         self.paused = False
         self.tag_history = tag_history
-        self.tags = {}             # tag -> "true" | "false" in order of last change
+        self.stop_tags = stop_tags     # sim.profiles.STOP_TAGS: what a stop does to the tags it drops
+        self.tags = {}             # tag -> "true" | "false", the last tag_history tags in the order they were queued
+        self.tag_gen = {}          # tag -> generation of its latest QueueTag (a reused tag's older item stays mute)
+        self._gen = 0
         self.fault = None
         self.pvt_mode = None       # None outside PVTEnter .. PVTExit, else 0 (joint) / 1 (Cartesian)
         self.pvt_velocity = (0.0,) * 6   # end velocity of the last PVTPoint (start velocity of the next)
@@ -52,9 +55,17 @@ class RobotModel:
         self.fifo.append(("motion", request))
 
     def enqueue_tag(self, tag: int):
+        """QueueTag(tag): the robot keeps the status of the last four tags only (TMscript 2.24 §13.2, §13.3:
+        "retain the status of the final four tags ... if the tag number did not occur or exceeds them, it
+        returns not existed"); a tag queued earlier than the last ``tag_history`` ones is forgotten, even
+        when its motion has not finished yet. Its FIFO item still pushes 01,NN,true when reached."""
+        self._gen += 1
         self.tags.pop(tag, None)
         self.tags[tag] = "false"
-        self.fifo.append(("tag", tag))
+        self.tag_gen[tag] = self._gen
+        while len(self.tags) > max(1, self.tag_history):
+            del self.tags[next(iter(self.tags))]
+        self.fifo.append(("tag", (tag, self._gen)))
 
     def enqueue_setting(self, kind: str, value):
         self.fifo.append((kind, value))
@@ -75,6 +86,12 @@ class RobotModel:
     def tag_status(self, tag: int) -> str:
         return self.tags.get(tag, "none")
 
+    def tag_result(self, tag: int) -> int:
+        """WaitQueueTag / CheckQueueTag result (TMscript 2.24 §13.2, §13.3): 1 completed, 0 incomplete,
+        -1 not existed (never queued, older than the last four, dropped by a stop, or outside 1..15)."""
+        status = self.tags.get(tag, "none") if 1 <= tag <= 15 else "none"
+        return {"true": 1, "false": 0}.get(status, -1)
+
     # ---- immediate commands -------------------------------------------------------------------
     def pause(self):
         self.paused = True
@@ -83,14 +100,20 @@ class RobotModel:
         self.paused = False
 
     def stop_and_clear(self):
-        """Stop where the arm is now and drop the FIFO; returns the queue tags that were dropped."""
+        """Stop where the arm is now and drop the FIFO; returns the queue tags that were dropped.
+        The manual (TMscript 2.24 §13.1-13.4) does not say what becomes of them; our choice (profile
+        option, docs/simulator.md): 'forget' - they answer "not existed" (TMSTA 01 none, WaitQueueTag -1);
+        'reached' - they answer true / 1, without a push, for clients that poll until true."""
         if self.active is not None:
             self.joints = self.active.joints_at(self.active_t, self.joints)
             self.active = None
-        dropped = [value for kind, value in self.fifo if kind == "tag"]
+        dropped = [value[0] for kind, value in self.fifo if kind == "tag"]
         for tag in dropped:
             if self.tags.get(tag) == "false":
-                del self.tags[tag]
+                if self.stop_tags == "reached":
+                    self.tags[tag] = "true"
+                else:
+                    del self.tags[tag]
         self.fifo.clear()
         self.pvt_mode, self.pvt_velocity = None, (0.0,) * 6       # a stop also ends PVT mode
         return dropped
@@ -150,12 +173,10 @@ class RobotModel:
                 "from": _frozen(plan.start_pose), "to": _frozen(plan.end_pose),
                 "joints_to": _frozen(plan.end_joints), "duration_s": round(plan.total, 4)}
 
-    def _run_tag(self, tag):
-        self.tags.pop(tag, None)
-        self.tags[tag] = "true"
-        reached = [t for t, s in self.tags.items() if s == "true"]
-        for old in reached[:-self.tag_history] if self.tag_history > 0 else reached:
-            del self.tags[old]
+    def _run_tag(self, value):
+        tag, gen = value
+        if self.tag_gen.get(tag) == gen and tag in self.tags:
+            self.tags[tag] = "true"
         return {"kind": "tag_reached", "tag": tag}
 
     def _run_base(self, value):

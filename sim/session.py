@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from . import codec
 from .checker import check_script
 from .interp import Context, ScriptRuntimeError, run_script
+from .profiles import Profile
 from .robot import RobotModel
 from .script import split_lines
 
@@ -66,8 +67,10 @@ class TransitionError(Exception):
 
 class ListenSession:
     def __init__(self, robot: RobotModel | None = None, send_message="Listen1", log=None,
-                 auto_enter=True, data_timeout=None, connection_timeout=None):
+                 auto_enter=True, data_timeout=None, connection_timeout=None, profile: Profile | None = None):
+        self.profile = profile or Profile()
         self.robot = robot or RobotModel()
+        self.robot.tag_history, self.robot.stop_tags = self.profile.tag_history, self.profile.stop_tags
         self.send_message = send_message
         self.log = log or (lambda kind, **fields: None)
         self.state = STOPPED
@@ -300,24 +303,27 @@ class ListenSession:
         run.wait = (kind, tag, None if timeout is None else self.now + timeout)
 
     def _resume_waits(self):
-        """Resume the running script if what it waits for has happened."""
+        """Resume the running script if what it waits for has happened. Waits (see sim.interp):
+        room (FIFO full), idle (WaitQueueTag(): every queued motion done), delay (Sleep, tag 0), and
+        tag: 1 completed / -1 not existed end the wait at once, 0 when the timeout passes (§13.2)."""
         while self.running is not None and self.running.wait is not None:
             kind, tag, deadline = self.running.wait
             if kind == "room":                  # a queued statement waits for room in the full FIFO
                 if not self.robot.has_room:
                     return
-                self.running.wait = None
-                self._step(None)
-                continue
-            status = self.robot.tag_status(tag)
-            if status == "true":
-                result = 1
-            elif status == "none" and deadline is None:
-                result = -1             # never queued, forgotten, or dropped by a stop
-            elif deadline is not None and self.now >= deadline:
+                result = None
+            elif kind == "idle":
+                if not self.robot.idle:
+                    return
+                result = None
+            elif kind == "delay":
+                if self.now < deadline:
+                    return
                 result = 0
             else:
-                return
+                result = self.robot.tag_result(tag)
+                if result == 0 and (deadline is None or self.now < deadline):
+                    return
             self.running.wait = None
             self._step(result)
 
