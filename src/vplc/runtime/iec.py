@@ -40,7 +40,7 @@ def wrap_expr(code: str, bits: int, signed: bool) -> str:
     mask = (1 << bits) - 1
     if signed:
         half = 1 << (bits - 1)
-        return f"((({code}) + {half}) & {mask}) - {half}"
+        return f"(((({code}) + {half}) & {mask}) - {half})"
     return f"(({code}) & {mask})"
 
 

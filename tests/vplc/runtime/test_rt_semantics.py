@@ -18,6 +18,12 @@ def test_integer_addition_wraps_at_the_type_width(tmp_path):
     assert (plc.read("Main.i"), plc.read("Main.u"), plc.read("Main.b"), plc.read("Main.s")) == (-32768, 0, 0, 127)
 
 
+def test_a_wrapped_signed_result_keeps_its_value_inside_a_larger_expression(tmp_path):
+    plc = run1(tmp_path, "r := 1; i := (r - 1) * 16 + 3; j := -(r - 2) * 4; k := (r - 1) * 2 - 5;",
+               "r : INT; i : INT; j : INT; k : DINT;")
+    assert (plc.read("Main.i"), plc.read("Main.j"), plc.read("Main.k")) == (3, 4, -5)
+
+
 def test_real_is_rounded_to_32_bits_on_every_store_and_lreal_is_not(tmp_path):
     plc = run1(tmp_path, "r := 1.0 / 3.0; l := 1.0 / 3.0;", "r : REAL; l : LREAL;")
     assert plc.read("Main.r") == f32(1 / 3)
