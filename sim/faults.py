@@ -5,7 +5,7 @@
 | reply_delay          | seconds=0.5 (0..3600), count=None (1..10^6) | every frame (or the next ``count``) leaves ``seconds`` later (virtual time) |
 | split_replies        | size=1 (1..65536)                 | frames are written in ``size``-byte pieces, one piece per poll |
 | glue_replies         | count=2 (2..1000), max_wait=0.05 (0..60) | frames are held until ``count`` are waiting (or ``max_wait`` s passed), then sent in one send |
-| corrupt_checksum     | count=1                           | the next ``count`` frames carry a wrong checksum     |
+| corrupt_checksum     | count=1, match="" (text)          | the next ``count`` frames (containing ``match``) carry a wrong checksum |
 | close_after          | frames=1                          | the connection is closed after ``frames`` more received frames (replies to them are sent first) |
 | close_mid_frame      | -                                 | the next frame is cut in half and the connection closed |
 | black_hole           | enabled=True                      | received bytes are discarded, nothing is answered    |
@@ -24,7 +24,7 @@ PARAMS = {
     "reply_delay": {"seconds": ("number", 0.5, 0.0, 3600.0), "count": ("int", None, 1, 10 ** 6)},
     "split_replies": {"size": ("int", 1, 1, 65536)},
     "glue_replies": {"count": ("int", 2, 2, 1000), "max_wait": ("number", 0.05, 0.0, 60.0)},
-    "corrupt_checksum": {"count": ("int", 1, 1, 10 ** 6)},
+    "corrupt_checksum": {"count": ("int", 1, 1, 10 ** 6), "match": ("text", "", 0, 200)},
     "close_after": {"frames": ("int", 1, 0, 10 ** 6)},
     "close_mid_frame": {},
     "black_hole": {"enabled": ("bool", True, None, None)},
@@ -54,6 +54,10 @@ def check_params(fault: str, params: dict) -> dict:
         if kind == "bool":
             if not isinstance(value, bool):
                 raise ValueError(f"bad parameter for fault '{fault}': {name} must be true or false, got {value!r}")
+        elif kind == "text":
+            if not isinstance(value, str) or len(value) > high:
+                raise ValueError(f"bad parameter for fault '{fault}': {name} must be text of at most {high} "
+                                 f"characters, got {value!r}")
         elif kind == "choice":
             if value not in high:
                 raise ValueError(f"bad parameter for fault '{fault}': {name} must be one of "
@@ -79,6 +83,7 @@ class FaultState:
         self.glue = 0
         self.glue_wait = 0.05
         self.corrupt = 0
+        self.corrupt_match = b""
         self.close_after = None
         self.close_mid = False
         self.black_hole = False
@@ -98,6 +103,7 @@ class FaultState:
             self.glue_wait = params["max_wait"]
         elif fault == "corrupt_checksum":
             self.corrupt = min(self.corrupt + params["count"], 10 ** 6)
+            self.corrupt_match = params["match"].encode()
         elif fault == "close_after":
             self.close_after = params["frames"]
         elif fault == "close_mid_frame":
@@ -124,7 +130,7 @@ class FaultState:
     def queue(self, conn, frames, now):
         out = self._queues.setdefault(conn, deque())
         for frame in frames:
-            if self.corrupt > 0:
+            if self.corrupt > 0 and self.corrupt_match in frame:
                 self.corrupt -= 1
                 bad = (int(frame[-4:-2], 16) ^ 0x5A)
                 frame = frame[:-4] + b"%02X" % bad + b"\r\n"
