@@ -32,6 +32,7 @@ from .ethernet_slave import EthernetSlave
 from .faults import FaultState, check_params as check_fault_params
 from .limits import (ACCEPT_BACKOFF_S, CPERR_BURST, CPERR_PER_S, EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX,
                      SERVE_ITEMS, SERVE_SCAN)
+from .profiles import Profile
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
 
@@ -67,7 +68,7 @@ class _Conn:
 class Robot:
     """Control interface of one simulated robot (``SimServer.robots[i]``)."""
 
-    def __init__(self, server, index, port, send_message, auto_enter, tag_history, timeouts, frames=(None, None)):
+    def __init__(self, server, index, port, send_message, auto_enter, profile, timeouts, frames=(None, None)):
         self._server = server
         self.index = index
         self.port = port
@@ -77,9 +78,10 @@ class Robot:
         self.event_bytes = 0
         self._waiters: list[tuple] = []          # (predicate, threading.Event, [match]) of wait_event
         self.faults = FaultState()
-        self.session = ListenSession(RobotModel(tag_history=tag_history, bases=frames[0], tools=frames[1]),
+        self.session = ListenSession(RobotModel(bases=frames[0], tools=frames[1]),
                                      send_message, self._log,
-                                     auto_enter=auto_enter, data_timeout=timeouts[0], connection_timeout=timeouts[1])
+                                     auto_enter=auto_enter, data_timeout=timeouts[0], connection_timeout=timeouts[1],
+                                     profile=profile)
         self.listener = None
         self.accept_paused_until = None          # out of descriptors: the listener is not watched until then
         self.conns: dict[int, _Conn] = {}
@@ -203,7 +205,8 @@ class SimServer:
     def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
                  send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
                  control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None,
-                 manage_gc=False, svr_port=None, svr_options=None, control_host="127.0.0.1"):
+                 manage_gc=False, svr_port=None, svr_options=None, control_host="127.0.0.1",
+                 profile=None):
         if not 1 <= robots <= 512:
             raise ValueError(f"robots must be 1..512, got {robots}")
         if not (math.isfinite(speedup) and speedup > 0):
@@ -217,7 +220,8 @@ class SimServer:
         except OSError as exc:
             raise OSError(exc.errno, f"cannot open the event log {log_path}: {exc.strerror}") from None
         self.selector = selectors.DefaultSelector()
-        self.robots = [Robot(self, i, port + i if port else 0, send_message, auto_enter, tag_history,
+        profile = profile or Profile(tag_history=tag_history)
+        self.robots = [Robot(self, i, port + i if port else 0, send_message, auto_enter, profile,
                              (data_timeout, connection_timeout), (bases, tools)) for i in range(robots)]
         self._next_conn = 1
         self._thread = None
