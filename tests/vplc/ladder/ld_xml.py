@@ -97,3 +97,24 @@ def program(tmp_path, variables: dict, body: list[str], name="Main", file="main.
     path = tmp_path / file
     path.write_text(document(variables, body, name), encoding="utf-8")
     return path
+
+
+def inoutvar(lid, expr, *refs, y=0):
+    return (f'<inOutVariable localId="{lid}">{_pos(y)}{_conns(*refs)}<connectionPointOut/>'
+            f'<expression>{escape(expr)}</expression></inOutVariable>')
+
+
+IEC10_HEAD = ('<?xml version="1.0" encoding="utf-8"?>\n<Project xmlns="www.iec.ch/public/TC65SC65BWG7TF10" '
+              'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xmlns:smcext="https://www.ia.omron.com/Smc" '
+              'schemaVersion="1"><FileHeader companyName="t" productName="t" productVersion="1"/>'
+              '<ContentHeader name="t" creationDateTime="2024-01-01T00:00:00"/><Types><GlobalNamespace>')
+
+
+def iec10_program(variables: dict, rungs: list[str], name="Main") -> str:
+    """An IEC 61131-10 program in Sysmac's ladder shape; ``rungs`` are the inner XML of each Rung."""
+    vars_xml = "".join(f'<Variable name="{n}"><Type><TypeName>{t}</TypeName></Type></Variable>'
+                       for n, t in variables.items())
+    body = "".join(f'<Rung evaluationOrder="{i}">{r}</Rung>' for i, r in enumerate(rungs, start=1))
+    return (IEC10_HEAD + f'<Program name="{name}"><Vars accessSpecifier="private">{vars_xml}</Vars><MainBody>'
+            f'<BodyContent xsi:type="smcext:LdSection" name="S" evaluationOrder="1">{body}</BodyContent>'
+            '</MainBody></Program></GlobalNamespace></Types><Instances/></Project>\n')

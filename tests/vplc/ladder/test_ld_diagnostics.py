@@ -171,3 +171,23 @@ def test_other_xml_files_in_a_source_folder_are_not_sources(tmp_path):
     assert diags(tmp_path) == []
     d = one(tmp_path / "report.xml")
     assert d.code == "ST2101" and "root element is <testsuites>" in d.message
+
+
+def test_unknown_object_in_a_sysmac_rung(tmp_path):
+    from ld_xml import iec10_program
+    rung = ('<LdObject xsi:type="LeftPowerRail"><ConnectionPointOut connectionPointOutId="1"/></LdObject>'
+            '<LdObject xsi:type="smcext:InlineST"><ConnectionPointIn><Connection refConnectionPointOutId="1"/>'
+            '</ConnectionPointIn></LdObject>')
+    path = write(tmp_path, iec10_program({"A": "BOOL"}, [rung]))
+    d = one(path)
+    assert d.code == "ST2102" and d.location().endswith("x.xml:Main:rung 1:element 2")
+    assert 'unknown element <LdObject xsi:type="InlineST"> in a rung' in d.message
+
+
+def test_sysmac_rung_wire_to_a_missing_point(tmp_path):
+    from ld_xml import iec10_program
+    rung = ('<LdObject xsi:type="LeftPowerRail"><ConnectionPointOut connectionPointOutId="1"/></LdObject>'
+            '<LdObject xsi:type="Coil" operand="A"><ConnectionPointIn><Connection refConnectionPointOutId="9"/>'
+            '</ConnectionPointIn></LdObject>')
+    d = one(write(tmp_path, iec10_program({"A": "BOOL"}, [rung])))
+    assert d.code == "ST2103" and "connected to element 9, which is not in this rung" in d.message

@@ -173,3 +173,36 @@ def test_edge_on_a_block_input_pin(tmp_path, edge):
     for x in (True, True, False, True, False):
         r.scan(X=x)
     assert r["N"] == (2 if edge == "rising" else 2)
+
+
+def test_in_out_variable_is_written_and_read_on_in_the_rung(tmp_path):
+    from ld_xml import inoutvar
+    r = Run(tmp_path, {"A": "BOOL", "X": "BOOL", "Q": "BOOL"},
+            [rail(1), contact(2, "A", 1), inoutvar(3, "X", 2), contact(4, "P_On", 3), coil(5, "Q", 4), right(6, 5)])
+    r.scan(A=True)
+    assert (r["X"], r["Q"]) == (True, True)
+    r.scan(A=False)
+    assert (r["X"], r["Q"]) == (False, False)
+
+
+def test_sysmac_ladder_shape_runs(tmp_path):
+    """IEC 61131-10 with smcext:LdSection (the shape of docs/toolchain/export.md): NC contact, set coil."""
+    from ld_xml import iec10_program
+    rung = ('<LdObject xsi:type="LeftPowerRail"><ConnectionPointOut connectionPointOutId="1"/></LdObject>'
+            '<LdObject xsi:type="Contact" operand="A" negated="true"><ConnectionPointIn><Connection '
+            'refConnectionPointOutId="1"/></ConnectionPointIn><ConnectionPointOut connectionPointOutId="2"/></LdObject>'
+            '<LdObject xsi:type="Coil" operand="Q" storage="set"><ConnectionPointIn><Connection '
+            'refConnectionPointOutId="2"/></ConnectionPointIn><ConnectionPointOut connectionPointOutId="3"/></LdObject>'
+            '<LdObject xsi:type="RightPowerRail"><ConnectionPointIn><Connection refConnectionPointOutId="3"/>'
+            '</ConnectionPointIn></LdObject>')
+    path = tmp_path / "sysmac.xml"
+    path.write_text(iec10_program({"A": "BOOL", "Q": "BOOL"}, [rung]), encoding="utf-8")
+    plc = load_plc([str(path)], task="Main@1ms")
+    plc.write("Main.A", True)
+    plc.scan(0)
+    assert plc.read("Main.Q") is False
+    plc.write("Main.A", False)
+    plc.scan(MS)
+    plc.write("Main.A", True)
+    plc.scan(2 * MS)
+    assert plc.read("Main.Q") is True, "a set coil holds"
