@@ -24,8 +24,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-KINDS = ("left_rail", "right_rail", "contact", "coil", "block", "in_var", "out_var", "inout_var",
-         "jump", "label", "return")
 EDGES = ("none", "rising", "falling")
 STORAGES = ("none", "set", "reset")
 
@@ -80,12 +78,6 @@ class Rung:
     elements: list[Element]
     comment: str = ""
     label: str = ""                 # a label standing in this rung (jump target)
-
-    def element(self, ref: str) -> Element | None:
-        for el in self.elements:
-            if el.id == ref:
-                return el
-        return None
 
 
 @dataclass

@@ -103,8 +103,6 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
                 did = c.ref if src is None or src.kind != "block" else f"{c.ref}:{c.pin}"
                 out.append(_line(start[0], start[1], x, ty, "wire", did))
         out.append(_element(p, y, lay))
-        if e.kind == "coil" or (e.kind in ("jump", "return")):
-            pass
     rail_in = next((e for e in lay.rung.elements if e.kind == "right_rail"), None)
     if rail_in is not None:
         for pin in rail_in.inputs:

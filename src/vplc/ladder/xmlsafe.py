@@ -83,10 +83,6 @@ def xsi_type(el: ET.Element) -> str:
     return el.get(XSI_TYPE, "").split(":")[-1]
 
 
-def child(el: ET.Element, tag: str) -> ET.Element | None:
-    return el.find(tag)
-
-
 def text_of(el: ET.Element | None) -> str:
     """All text below ``el`` (a formatted text: plain, or XHTML paragraphs)."""
     if el is None:
