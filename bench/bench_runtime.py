@@ -15,6 +15,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "src"))
 
 from vplc.api import load_plc            # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import engine_compare                    # noqa: E402
 from vplc.runtime.stats import ScanStats, percentile   # noqa: E402
 
 EMPTY = "PROGRAM Main\nVAR x : BOOL; END_VAR\n;\nEND_PROGRAM\n"
@@ -96,8 +98,24 @@ def per_scan(tmp, label, text, scans=5000):
     return plc
 
 
+def versus_baseline(rev: str) -> None:
+    """Issue 15, target 3: this engine against the engine of commit ``rev`` on the same programs, same run."""
+    targets = {"100 R_TRIG + 100 TON": 2.5, "300-line CASE sequence": 1.5}
+    rows = engine_compare.compare({"100 R_TRIG + 100 TON": trig_program(), "300-line CASE sequence": sequence_program()},
+                                  rev)
+    print(f"this engine against commit {rev}'s (best of 9 rounds of 1000 scans each, taken in turns):")
+    for row in rows:
+        target = targets[row["label"]]
+        mark = "ok" if row["speedup"] >= target and row["identical"] else "--"
+        print(f"  {row['label']:<24} {row['old']:7.1f} us -> {row['new']:6.1f} us per scan   "
+              f"{mark} {row['speedup']:.2f}x (target >= {target}x)   "
+              f"variables after each of 2000 scans: {'identical' if row['identical'] else 'DIFFERENT'}")
+
+
 def main() -> int:
     print("vplc runtime benchmark (Python %s)" % sys.version.split()[0])
+    rev = sys.argv[sys.argv.index("--against") + 1] if "--against" in sys.argv else engine_compare.BASELINE
+    versus_baseline(rev)
     with tempfile.TemporaryDirectory() as tmp:
         print("per-scan cost (virtual time, 1 ms task):")
         per_scan(tmp, "empty program", EMPTY)

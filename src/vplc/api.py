@@ -211,7 +211,7 @@ class Plc:
 
     def scan(self, now_ns: int) -> None:
         with self.lock:
-            self.engine.scan(int(now_ns))
+            self.engine.scan(now_ns if type(now_ns) is int else int(now_ns))
 
     def read(self, path: str):
         with self.lock:

@@ -8,23 +8,35 @@ runtime reports a fault at the ST source line and never shows Python. Expression
 """
 from __future__ import annotations
 
+import re
+
 from ..frontend import ast as A
 from ..frontend import types as T
-from .codegen_expr import ExprGen, attr, is_scalar
+from .codegen_expr import ExprGen, attr, cut, is_scalar
+from .inline import constant_bounds, inlinable, kept_inputs, loop_range, unguarded
 from ..runtime.program import GEN_FILE, PouClass, Program
 
 CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)
 
 
+_LITERAL = re.compile(r"-?\d+(\.\d*)?(e[-+]?\d+)?|True|False|'[^'\\]*'")
+# code of an FB instance that names the same instance wherever it is read within one block: attributes, constant
+# indexes and FOR loop counters (FB instances are never assigned, so a fetched instance stays the one named)
+_STABLE = re.compile(r"[A-Za-z_][\w.]*(\[(_v\d+|_v\d+ [-+] \d+|\d+)\](\.[A-Za-z_]\w*)*)*")
+
+
 class CodeGen(ExprGen):
-    def __init__(self, proj, count_statements: bool = False) -> None:
+    def __init__(self, proj, count_statements: bool = False, optimise: bool = True) -> None:
         super().__init__(proj)
         self.count = count_statements
+        self.optimise = optimise     # False: every FB call is a call and every loop checks the watchdog (tests)
         self.lines: list[str] = []
         self.linemap: dict[int, tuple[str, int]] = {}
         self.ind = 0
         self._tmp = 0
         self.loc = ("", 0)
+        self.inline_cache: dict = {}
+        self.unguarded_loops = False
 
     # ---- output helpers -----------------------------------------------------------------------
     def emit(self, text: str) -> None:
@@ -61,6 +73,7 @@ class CodeGen(ExprGen):
         for t, name in self.struct_names.values():
             prog.structs.append((name, {k.upper(): (attr(f.name), f.type) for k, f in t.fields.items()}, t))
         prog.globals_vars = {s.name.upper(): (attr(s.name), s.type) for s in proj.globals.values()}
+        prog.unguarded_loops = self.unguarded_loops
         return prog
 
     def all_struct_types(self):
@@ -140,6 +153,7 @@ class CodeGen(ExprGen):
         cname = self.cls_name(pt)
         bname = "B" + cname[1:]
         self.current = pt
+        self.inst_temps = {}
         self.at(pou.span)
         self.emit(f"class {cname}:")
         self.ind += 1
@@ -210,8 +224,10 @@ class CodeGen(ExprGen):
     # ---- statements ---------------------------------------------------------------------------
     def block(self, stmts) -> None:
         start = len(self.lines)
+        outer = dict(self.inst_temps)       # instances fetched inside this block are not known after it
         for st in stmts:
             self.stmt(st)
+        self.inst_temps = outer
         if len(self.lines) == start:
             self.emit("pass")
 
@@ -254,7 +270,7 @@ class CodeGen(ExprGen):
             sb = T.base_of(st_ty) if st_ty is not None else None
             if not (isinstance(sb, T.StringType) and sb.capacity <= tt.capacity) or \
                     (isinstance(value, A.Literal) and len(value.value) > tt.capacity):
-                code = f"({code})[:{tt.capacity}]"
+                code = cut(code, tt.capacity)
         elif isinstance(tt, T.ElementaryType) and tt.kind == "real" and tt.bits == 32:
             sb = T.base_of(st_ty) if st_ty is not None else None
             if not (isinstance(sb, T.ElementaryType) and sb is T.REAL):
@@ -348,17 +364,32 @@ class CodeGen(ExprGen):
 
     def st_For(self, st: A.For) -> None:
         var = self.lvalue(st.var)
-        v, e, sp = self.tmp("_v"), self.tmp("_e"), self.tmp("_s")
-        self.emit(f"{v} = {self.expr(st.start)}")
-        self.emit(f"{e} = {self.expr(st.end)}")
-        self.emit(f"{sp} = {self.expr(st.step) if st.step is not None else '1'}")
-        self.emit(f"if {sp} == 0: _fault('FOR loop with step 0')")
-        self.emit(f"{var} = {v}")
-        self.emit(f"for {v} in range({v}, {e} + (1 if {sp} > 0 else -1), {sp}):")
+        v = self.tmp("_v")
+        bounds = constant_bounds(st)
+        if bounds is not None:
+            start, end, step = bounds
+            self.emit(f"{var} = {start}")
+            self.emit(f"for {v} in range({start}, {end + (1 if step > 0 else -1)}, {step}):")
+        else:
+            e, sp = self.tmp("_e"), self.tmp("_s")
+            self.emit(f"{v} = {self.expr(st.start)}")
+            self.emit(f"{e} = {self.expr(st.end)}")
+            self.emit(f"{sp} = {self.expr(st.step) if st.step is not None else '1'}")
+            self.emit(f"if {sp} == 0: _fault('FOR loop with step 0')")
+            self.emit(f"{var} = {v}")
+            self.emit(f"for {v} in range({v}, {e} + (1 if {sp} > 0 else -1), {sp}):")
         self.ind += 1
         self.emit(f"{var} = {v}")
-        self.loop_guard()
+        if self.optimise and unguarded(st):
+            self.unguarded_loops = True
+        else:
+            self.loop_guard()
+        known = loop_range(st) if self.optimise else None
+        if known is not None:
+            self.loop_index[id(st.var.sym)] = (v, *known)
         self.block(st.body)
+        if known is not None:
+            del self.loop_index[id(st.var.sym)]
         self.ind -= 1
 
     def st_While(self, st: A.While) -> None:
@@ -401,16 +432,44 @@ class CodeGen(ExprGen):
         else:
             self.emit(self.call_expr(call))
 
+    def inline_body(self, pt, inst: str, forward: dict) -> None:
+        """The callee's statements in place of the call, reading and writing the instance ``inst``; the inputs
+        in ``forward`` (variable id -> code) are read from the value just stored instead of the instance."""
+        saved = self.current, self.self_name, self.loop_index, self.forward, self.inst_temps, self.loc
+        self.current, self.self_name, self.loop_index, self.forward, self.inst_temps = pt, inst, {}, forward, {}
+        try:
+            self.block(pt.pou.body)
+        finally:
+            self.current, self.self_name, self.loop_index, self.forward, self.inst_temps, self.loc = saved
+
     def fb_call(self, b, inst_code: str | None = None) -> None:
         pt = b.pou
-        inst = self.tmp("_i")
-        self.emit(f"{inst} = {inst_code or self.expr(b.instance)}")
+        code = inst_code or self.expr_raw(b.instance)
+        inst = self.inst_temps.get(code)
+        if inst is None:
+            inst = self.tmp("_i")
+            self.emit(f"{inst} = {code}")
+            if self.optimise and _STABLE.fullmatch(code):
+                self.inst_temps[code] = inst
         outs = []
+        inline = self.optimise and not pt.native and inst_code is None and inlinable(pt, self.inline_cache)
+        forward = {}                   # input name -> code of its value, read by the inlined body
+        kept = kept_inputs(pt) if inline else {}
         for ba in b.args:
             p = ba.param
             a = attr(p.name)
             if p.direction == "in":
-                self.emit(f"{inst}.{a} = {self.input_value(ba, p)}")
+                value = self.input_value(ba, p)
+                sym = kept.get(p.name.upper())
+                if sym is None:
+                    self.emit(f"{inst}.{a} = {value}")
+                elif _LITERAL.fullmatch(value):
+                    self.emit(f"{inst}.{a} = {value}")
+                    forward[id(sym)] = value
+                else:
+                    local = self.tmp("_a")
+                    self.emit(f"{inst}.{a} = {local} = {value}")
+                    forward[id(sym)] = local
             elif p.direction == "inout":
                 if is_scalar(p.type) and not pt.native:
                     self.emit(f"{inst}.{a}__r, {inst}.{a}__k = {self.ref(ba.expr)}")
@@ -422,6 +481,8 @@ class CodeGen(ExprGen):
                 outs.append(ba)
         if pt.native:
             self.emit(f"{inst}.i__run()")
+        elif inline:
+            self.inline_body(pt, inst, forward)
         else:
             self.emit(f"B{self.cls_name(pt)[1:]}({inst})")
         for ba in outs:

@@ -6,6 +6,7 @@ indexing go through checking helpers of :mod:`vplc.runtime.iec` that raise a run
 from __future__ import annotations
 
 import keyword
+import re
 
 from ..frontend import ast as A
 from ..frontend import types as T
@@ -40,6 +41,10 @@ class ExprGen:
         self.struct_names: dict[int, tuple] = {}
         self.pou_names: dict[int, str] = {}
         self.current = None
+        self.self_name = "s"        # the instance whose variables the code being generated reads
+        self.loop_index: dict[int, tuple] = {}   # id(FOR variable) -> (python loop variable, lo, hi): see st_For
+        self.forward: dict[int, str] = {}        # id(input variable) -> code of its value: see CodeGen.fb_call
+        self.inst_temps: dict[str, str] = {}     # code of an FB instance -> local holding it: see CodeGen.fb_call
 
     # ---- names of generated things ----------------------------------------------------------
     def struct_name(self, t) -> str:
@@ -142,7 +147,7 @@ class ExprGen:
         if isinstance(d, T.StringType):
             if isinstance(s, T.StringType) and s.capacity <= d.capacity:
                 return code
-            return f"({code})[:{d.capacity}]"
+            return cut(code, d.capacity)
         if not isinstance(d, T.ElementaryType):
             return code
         if d.kind == "real":
@@ -160,7 +165,7 @@ class ExprGen:
         if isinstance(tt, T.StringType):
             if not (isinstance(et, T.StringType) and et.capacity <= tt.capacity) or \
                     (isinstance(e, A.Literal) and isinstance(e.value, str) and len(e.value) > tt.capacity):
-                return f"({code})[:{tt.capacity}]"
+                return cut(code, tt.capacity)
             return code
         if isinstance(tt, T.ElementaryType) and tt.kind == "real":
             if isinstance(et, T.ElementaryType) and et.kind == "real" and et.bits <= tt.bits:
@@ -197,7 +202,10 @@ class ExprGen:
         if kind == "EnumValueSymbol":
             return str(sym.value)
         if kind == "VarSymbol":
-            container, key = _cell(sym)
+            known = self.forward.get(id(sym))
+            if known is not None:
+                return known
+            container, key = _cell(sym, self.self_name)
             if container.endswith(".__dict__"):            # plain attribute access: the fast path
                 return f"{container[:-len('.__dict__')]}.{key[1:-1]}"
             return f"{container}[{key}]"
@@ -207,6 +215,7 @@ class ExprGen:
 
     def ex_Member(self, e) -> str:
         base = self.expr_raw(e.base)
+        base = self.inst_temps.get(base, base)
         sym = e.sym
         name = sym.name if sym is not None else e.member
         bt = T.base_of(e.base.ty) if e.base.ty is not None else None
@@ -232,9 +241,14 @@ class ExprGen:
             return f"{base}[_ixo({idx[0]}, {base}, {what})]"
         if len(at.dims) == 1:
             lo, hi = at.dims[0]
-            if isinstance(e.indices[0], A.Literal) and isinstance(e.indices[0].value, int) \
-                    and lo <= e.indices[0].value <= hi:
-                return f"{base}[{e.indices[0].value - lo}]"
+            first = e.indices[0]
+            if isinstance(first, A.Literal) and isinstance(first.value, int) and lo <= first.value <= hi:
+                return f"{base}[{first.value - lo}]"
+            known = self.loop_index.get(id(first.sym)) if isinstance(first, A.Name) and first.conv is None else None
+            if known is not None and lo <= known[1] and known[2] <= hi:    # a FOR variable that stays in range
+                return f"{base}[{_offset(known[0], lo)}]"
+            if isinstance(first, (A.Name, A.Member)) and _plain(idx[0]):   # cheap to read twice: check inline
+                return f"{base}[{_offset(idx[0], lo)} if {lo} <= {idx[0]} <= {hi} else _ix1({idx[0]}, {lo}, {hi}, {what})]"
             return f"{base}[_ix1({idx[0]}, {lo}, {hi}, {what})]"
         dims = self.const(tuple(at.dims), "_d")
         return f"{base}[_ixn(({', '.join(idx)},), {dims}, {what})]"
@@ -282,6 +296,12 @@ class ExprGen:
                 r = f"({a} {op} {b})"
             return f"_f32({r})" if t.bits == 32 else r
         signed = t.kind in ("int", "time", "date", "tod", "dt")
+        k = e.right.value if isinstance(e.right, A.Literal) and type(e.right.value) is int and e.right.conv is None \
+            else 0
+        if op in ("/", "MOD") and k > 0 and _plain(a):
+            # a positive constant divisor: never zero, and |result| <= |a| fits the type; truncate toward zero
+            py = "//" if op == "/" else "%"
+            return f"({a} {py} {k})" if not signed else f"({a} {py} {k} if {a} >= 0 else -(-{a} {py} {k}))"
         if op == "/":
             if t.kind == "time" and _width(e.right.ty) is not None and _width(e.right.ty).kind == "real":
                 return f"int(_rdiv({a}, {b}))"
@@ -310,7 +330,7 @@ class ExprGen:
     def ref(self, e) -> str:
         """(container, key) tuple addressing the lvalue ``e``."""
         if isinstance(e, A.Name):
-            container, key = _cell(e.sym)
+            container, key = _cell(e.sym, self.self_name)
             return f"({container}, {key})"
         if isinstance(e, A.Member):
             return f"({self.expr_raw(e.base)}.__dict__, {attr(e.sym.name if e.sym else e.member)!r})"
@@ -356,6 +376,8 @@ class ExprGen:
             from ..runtime.stdlib import gen_builtin
             return gen_builtin(self, b)
         pt = b.pou
+        if pt.native and pt.name == "VPLC_ScanTime":
+            return "_NOW[0]"                  # the scan time cell the engine sets once per scan
         by_param = {ba.param.name.upper(): ba for ba in b.args}
         args = []
         for p in pt.params:
@@ -391,17 +413,60 @@ def _sign_cast(code: str, src, dst) -> str:
     return code
 
 
-def _cell(sym) -> tuple[str, str]:
-    """(container, key) code of a variable: globals live in ``G``, POU variables in ``s``; a scalar VAR_IN_OUT
-    holds a reference cell (``s.X__r``, ``s.X__k``)."""
+def _cell(sym, s: str = "s") -> tuple[str, str]:
+    """(container, key) code of a variable: globals live in ``G``, POU variables in the instance ``s``; a scalar
+    VAR_IN_OUT holds a reference cell (``s.X__r``, ``s.X__k``)."""
     if sym.section == "VAR_EXTERNAL" and sym.target is not None:
         sym = sym.target
     a = attr(sym.name)
     if sym.section in ("VAR_GLOBAL", "VAR_EXTERNAL"):
         return "G.__dict__", repr(a)
     if sym.section == "VAR_IN_OUT" and is_scalar(sym.type):
-        return f"s.{a}__r", f"s.{a}__k"
-    return "s.__dict__", repr(a)
+        return f"{s}.{a}__r", f"{s}.{a}__k"
+    return f"{s}.__dict__", repr(a)
+
+
+_CUT = re.compile(r"(''\.join\(\(.*\)\)|\(.*\))\[:(\d+)\]", re.S)
+
+
+def cut(code: str, capacity: int) -> str:
+    """``code`` (a string) cut to ``capacity`` characters; a value already cut to a longer length (CONCAT,
+    LEFT) is cut once, to the shorter length."""
+    inner = _CUT.fullmatch(code)
+    if inner and int(inner.group(2)) >= capacity and _one_group(inner.group(1).removeprefix("''.join")):
+        return f"{inner.group(1)}[:{capacity}]"
+    return f"({code})[:{capacity}]"
+
+
+def _one_group(code: str) -> bool:
+    """``code`` is one parenthesised group: its first ``(`` closes only at its last character."""
+    depth, quote, escaped = 0, None, False
+    for i, ch in enumerate(code):
+        if quote:
+            if escaped:
+                escaped = False
+            elif ch == "\\":
+                escaped = True
+            elif ch == quote:
+                quote = None
+        elif ch in "'\"":
+            quote = ch
+        elif ch in "([{":
+            depth += 1
+        elif ch in ")]}":
+            depth -= 1
+            if depth == 0 and i < len(code) - 1:
+                return False
+    return depth == 0
+
+
+def _offset(code: str, lo: int) -> str:
+    return f"{code} - {lo}" if lo > 0 else f"{code} + {-lo}" if lo < 0 else code
+
+
+def _plain(code: str) -> bool:
+    """``code`` is a dotted name (``s.i``, ``G.k``, ``_i3.Index``): reading it has no effect and costs little."""
+    return all(part.isidentifier() for part in code.split("."))
 
 
 def _depth(code: str) -> int:

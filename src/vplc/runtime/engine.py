@@ -10,6 +10,7 @@ import gc
 import math
 import time
 import traceback
+import weakref
 from dataclasses import dataclass, field
 
 from ..frontend.types import StructType
@@ -27,22 +28,23 @@ class Task:
     cycles: int = 0                                   # completed executions of the task's programs
 
 
-_SCANNING: dict = {}          # id -> watchdog deadline list of every scan in progress (any thread)
+_ENGINES: "weakref.WeakSet[Engine]" = weakref.WeakSet()    # every engine; scanning when its deadline is set
 _GC_START = [0.0]
+_perf_counter = time.perf_counter
 
 
 def _gc_pause(phase: str, _info) -> None:
     """Python's garbage collector is the host's time, not the program's: a collection during a scan moves
     the watchdog deadline of every scan in progress by its duration (it must not look like an endless loop)."""
-    if not _SCANNING:
-        return
     if phase == "start":
         _GC_START[0] = time.perf_counter()
     elif _GC_START[0]:
         pause = time.perf_counter() - _GC_START[0]
         _GC_START[0] = 0.0
-        for deadline in list(_SCANNING.values()):
-            deadline[0] += pause
+        for engine in list(_ENGINES):
+            deadline = engine.deadline
+            if deadline[0] != math.inf:
+                deadline[0] += pause
 
 
 gc.callbacks.append(_gc_pause)
@@ -56,13 +58,18 @@ class Engine:
         self.now_ns = 0
         self.started = False
         self.watchdog_ns = watchdog_ns
+        self.watchdog_s = watchdog_ns / 1e9
+        self.end_check = getattr(module.program, "unguarded_loops", True)   # see compiler/inline.py, unguarded
         self.sockets = SocketManager(socket_limit, socket_latency_ns)
         self.clock_base_ns = clock_base_ns
         self.fault: PlcFault | None = None
         self.scan_count = 0
         self.deadline = module.namespace["_DL"]
+        _ENGINES.add(self)
         self.stmt_counter = module.namespace["_NST"]
+        self.now_cell = module.namespace["_NOW"]          # what VPLC_ScanTime() returns in generated code
         self.system_vars = None           # (globals dict, first-run attrs, [(attr, period ns)]): see bind_system_vars
+        self.system_vars_next = 0         # scan time at which a clock pulse changes next
 
     def bind_system_vars(self, globals_obj) -> None:
         """Let the scan update the Sysmac system-defined variables of prelude/sysmac_sysvars.st that the
@@ -74,6 +81,19 @@ class Engine:
                                                          ("P_1MIN", 60_000_000_000)) if n in info]
         if first or clocks:
             self.system_vars = (globals_obj.__dict__, first, clocks)
+
+    def update_system_vars(self, task: Task, now_ns: int) -> None:
+        """First-run flags for the task's first cycle; clock pulses (half period on, half off). The next call is
+        due when the next pulse changes (the scan skips the work until then)."""
+        values, first, clocks = self.system_vars
+        for attr in first:
+            values[attr] = task.cycles == 0
+        nxt = math.inf
+        for attr, period in clocks:
+            half = period // 2
+            values[attr] = now_ns % period < half
+            nxt = min(nxt, now_ns - now_ns % half + half)
+        self.system_vars_next = nxt
 
     # ---- services used by native POUs -----------------------------------------------------------
     def new_struct(self, name: str):
@@ -104,36 +124,34 @@ class Engine:
     def scan(self, now_ns: int) -> None:
         if self.fault is not None:
             raise self.fault
-        if self.started and now_ns < self.now_ns:
+        if now_ns < self.now_ns and self.started:
             raise ValueError(f"scan time must not go backwards ({now_ns} ns < {self.now_ns} ns)")
         self.started = True
-        self.now_ns = now_ns
-        self.deadline[0] = time.perf_counter() + self.watchdog_ns / 1e9
-        _SCANNING[id(self)] = self.deadline
+        self.now_ns = self.now_cell[0] = now_ns
+        deadline = self.deadline
+        deadline[0] = _perf_counter() + self.watchdog_s
         try:
             for task in self.tasks:
-                if task.next_due is None:
-                    task.next_due = now_ns
-                if now_ns < task.next_due:
+                due = task.next_due
+                if due is None:
+                    due = now_ns
+                elif now_ns < due:
                     continue
-                if self.system_vars is not None:
-                    values, first, clocks = self.system_vars
-                    for attr in first:
-                        values[attr] = task.cycles == 0
-                    for attr, period in clocks:
-                        values[attr] = now_ns % period < period // 2
+                if self.system_vars is not None and (task.cycles < 2 or now_ns >= self.system_vars_next):
+                    self.update_system_vars(task, now_ns)
                 for inst, body in task.programs:
                     body(inst)
+                if self.end_check and _perf_counter() > deadline[0]:   # short loops have no check of their own
+                    raise WatchdogError("the task's programs did not finish in time")
                 task.cycles += 1
-                missed = (now_ns - task.next_due) // task.period_ns
-                task.next_due += (missed + 1) * task.period_ns
+                period = task.period_ns
+                task.next_due = due + ((now_ns - due) // period + 1) * period
         except Exception as exc:          # noqa: BLE001 - every Python error becomes a PLC major fault
             self.fault = self.make_fault(exc)
             self.sockets.close_all()
             raise self.fault from None
         finally:
-            self.deadline[0] = math.inf
-            _SCANNING.pop(id(self), None)
+            deadline[0] = math.inf
         self.scan_count += 1
 
     def make_fault(self, exc: BaseException) -> PlcFault:

@@ -16,14 +16,14 @@ _F32 = struct.Struct("<f")
 F32_MAX = 3.4028234663852886e38
 
 
-def f32(x: float) -> float:
+def f32(x: float, _pack=_F32.pack, _unpack=_F32.unpack) -> float:
     """Round a Python float to IEEE single precision (overflow gives +/-inf like the FPU)."""
     try:
-        return _F32.unpack(_F32.pack(x))[0]
+        return _unpack(_pack(x))[0]
     except OverflowError:
         return math.copysign(math.inf, x)
     except TypeError:
-        return _F32.unpack(_F32.pack(float(x)))[0]
+        return _unpack(_pack(float(x)))[0]
 
 
 def wrapper(bits: int, signed: bool):
@@ -232,3 +232,11 @@ def fmt_real(x: float, single: bool) -> str:
         return "inf" if x > 0 else "-inf"
     text = repr(float(f"{x:.7g}")) if single else repr(x)
     return text[:-2] if text.endswith(".0") else text
+
+
+def fmt_real32(x: float) -> str:
+    return fmt_real(x, True)
+
+
+def fmt_real64(x: float) -> str:
+    return fmt_real(x, False)

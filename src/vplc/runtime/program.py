@@ -57,13 +57,14 @@ class Program:
     pous: dict = field(default_factory=dict)            # upper POU qualified name -> PouClass
     structs: list = field(default_factory=list)         # (class name, vars, StructType)
     globals_vars: dict = field(default_factory=dict)
+    unguarded_loops: bool = False                       # some loops leave the watchdog check to the scan loop
 
     def load(self) -> "Image":
         """Run the compiled code in a fresh namespace: the classes and state of one PLC instance."""
         ns = dict(stdlib.NAMESPACE)
         ns.update(HELPERS)
         ns.update(self.consts)
-        ns.update({"_DL": [math.inf], "_NST": [0], "_PROGRAMS": {}})
+        ns.update({"_DL": [math.inf], "_NST": [0], "_NOW": [0], "_PROGRAMS": {}})
         exec(self.code, ns)
         image = Image(self, ns)
         for key, info in self.pous.items():

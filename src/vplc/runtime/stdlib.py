@@ -160,6 +160,18 @@ def to_string(v, t, dialect: str = "sysmac") -> str:
     return str(v)
 
 
+def string_converter(t, dialect: str = "sysmac"):
+    """``to_string`` specialised to the source type ``t`` once, at compile time (no type dispatch per call)."""
+    k, bt = _kind(t)
+    if k == "bool":
+        return lambda v: "TRUE" if v else "FALSE"
+    if k == "int" and not (dialect == "sysmac" and isinstance(bt, T.ElementaryType) and bt.kind == "bit"):
+        return str
+    if k == "real":
+        return iec.fmt_real32 if bt.bits == 32 else iec.fmt_real64
+    return lambda v: to_string(v, t, dialect)
+
+
 def _parse_number(s: str, real: bool):
     text = s.strip().replace("_", "")
     try:
@@ -179,16 +191,20 @@ def conversion(src, dst, dialect: str = "sysmac"):
     dk, dt = _kind(dst)
     if dk == "string":
         cap = dt.capacity
-        return lambda v: to_string(v, src, dialect)[:cap]
+        text = string_converter(src, dialect)
+        if sk in ("bool", "int") and cap >= 66:       # no bool or integer text is longer (LWORD in binary: 64)
+            return text
+        return lambda v: text(v)[:cap]
     if dk == "bool":
         if sk == "string":
             return lambda v: v.strip().upper() in ("TRUE", "1")
         return lambda v: v != 0
     if dk == "real":
-        f = iec.f32 if dt.bits == 32 else float
+        exact = sk == "int" and st.bits <= 24        # every value of a 24-bit integer is a REAL exactly
+        f = iec.f32 if dt.bits == 32 and not exact else float
         if sk == "string":
             return lambda v: f(_parse_number(v, True))
-        return lambda v: f(v)
+        return f
     if dk in ("int", "time", "date", "tod", "dt"):
         bits = dt.bits
         signed = dt.kind in ("int", "time")
@@ -280,6 +296,8 @@ def gen_builtin(gen, b) -> str:
         return f"len({args[0]})"
     cap = rt.capacity if isinstance(rt, T.StringType) else 1985
     if name == "LEFT":
+        if args[1].isdigit():                       # a constant length: a plain slice
+            return f"({args[0]})[:{args[1]}]"
         return f"_left({args[0]}, {args[1]})"
     if name == "RIGHT":
         return f"_right({args[0]}, {args[1]})"
