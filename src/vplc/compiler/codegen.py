@@ -36,7 +36,6 @@ class CodeGen(ExprGen):
         self._tmp = 0
         self.loc = ("", 0)
         self.inline_cache: dict = {}
-        self.unguarded_loops = False
 
     # ---- output helpers -----------------------------------------------------------------------
     def emit(self, text: str) -> None:
@@ -73,7 +72,6 @@ class CodeGen(ExprGen):
         for t, name in self.struct_names.values():
             prog.structs.append((name, {k.upper(): (attr(f.name), f.type) for k, f in t.fields.items()}, t))
         prog.globals_vars = {s.name.upper(): (attr(s.name), s.type) for s in proj.globals.values()}
-        prog.unguarded_loops = self.unguarded_loops
         return prog
 
     def all_struct_types(self):
@@ -380,9 +378,8 @@ class CodeGen(ExprGen):
             self.emit(f"for {v} in range({v}, {e} + (1 if {sp} > 0 else -1), {sp}):")
         self.ind += 1
         self.emit(f"{var} = {v}")
-        if self.optimise and unguarded(st):
-            self.unguarded_loops = True
-        else:
+        short = self.optimise and unguarded(st)
+        if not short:
             self.loop_guard()
         known = loop_range(st) if self.optimise else None
         if known is not None:
@@ -391,6 +388,9 @@ class CodeGen(ExprGen):
         if known is not None:
             del self.loop_index[id(st.var.sym)]
         self.ind -= 1
+        if short:                   # a short loop is checked once, when it ends
+            self.at(st.span)
+            self.loop_guard()
 
     def st_While(self, st: A.While) -> None:
         self.emit("while True:")

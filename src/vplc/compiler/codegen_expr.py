@@ -312,7 +312,13 @@ class ExprGen:
             r = f"int(round({a} * {b}))"
         else:
             r = f"{a} {op} {b}"
-        return iec.wrap_expr(r, t.bits if t.bits > 1 else 64, signed)
+        bits = t.bits if t.bits > 1 else 64
+        if bits == 64 and signed and op in ("+", "-"):
+            # 64-bit values are Python big integers past 2**62: comparing is cheaper than wrapping every time
+            z = self.tmp("_z")
+            half = 1 << 63
+            return f"({z} if {-half} <= ({z} := {r}) <= {half - 1} else {iec.wrap_expr(z, 64, True)})"
+        return iec.wrap_expr(r, bits, signed)
 
     def ex_Call(self, e) -> str:
         return self.call_expr(e)

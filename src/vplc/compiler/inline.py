@@ -6,7 +6,7 @@
   control flow of its own.
 * ``loop_range(st)``: the values a FOR variable takes when its bounds are constants, so ``a[i]`` inside the
   loop needs no range check when every value is a valid index; ``unguarded(st)``: a short innermost FOR
-  loop that cannot run away, so it needs no watchdog check per iteration.
+  loop that cannot run away, so the watchdog is checked once when it ends instead of in every iteration.
 """
 from __future__ import annotations
 
@@ -155,9 +155,8 @@ def constant_bounds(st: A.For):
 
 
 def unguarded(st: A.For) -> bool:
-    """A FOR loop that needs no watchdog check per iteration: constant bounds, at most MAX_UNGUARDED
-    iterations and no loop inside its body (the innermost loops of a nest keep their checks, and the scan
-    loop checks the deadline again when the task's programs end)."""
+    """A FOR loop that needs no watchdog check per iteration, only one when it ends: constant bounds, at most
+    MAX_UNGUARDED iterations and no loop inside its body (the innermost loops of a nest keep their checks)."""
     bounds = constant_bounds(st)
     if bounds is None:
         return False

@@ -59,7 +59,6 @@ class Engine:
         self.started = False
         self.watchdog_ns = watchdog_ns
         self.watchdog_s = watchdog_ns / 1e9
-        self.end_check = getattr(module.program, "unguarded_loops", True)   # see compiler/inline.py, unguarded
         self.sockets = SocketManager(socket_limit, socket_latency_ns)
         self.clock_base_ns = clock_base_ns
         self.fault: PlcFault | None = None
@@ -141,8 +140,6 @@ class Engine:
                     self.update_system_vars(task, now_ns)
                 for inst, body in task.programs:
                     body(inst)
-                if self.end_check and _perf_counter() > deadline[0]:   # short loops have no check of their own
-                    raise WatchdogError("the task's programs did not finish in time")
                 task.cycles += 1
                 period = task.period_ns
                 task.next_due = due + ((now_ns - due) // period + 1) * period

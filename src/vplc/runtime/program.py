@@ -57,7 +57,6 @@ class Program:
     pous: dict = field(default_factory=dict)            # upper POU qualified name -> PouClass
     structs: list = field(default_factory=list)         # (class name, vars, StructType)
     globals_vars: dict = field(default_factory=dict)
-    unguarded_loops: bool = False                       # some loops leave the watchdog check to the scan loop
 
     def load(self) -> "Image":
         """Run the compiled code in a fresh namespace: the classes and state of one PLC instance."""

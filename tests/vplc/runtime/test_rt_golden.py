@@ -18,7 +18,7 @@ def generated_main(path: str) -> str:
     body = next(i for i in range(start, len(lines)) if re.match(r"def B\d+_Main\(s\):", lines[i]))
     end = next(i for i in range(body, len(lines)) if lines[i] == "    return")
     text = "\n".join(lines[start:end + 1])
-    text = re.sub(r"\b(_cv|_w|_ty|_d|_k)\d+\b", r"\1N", text)
+    text = re.sub(r"\b(_cv|_w|_ty|_d|_k|_i|_a|_z|_c|_v|_e|_s|_x)\d+\b", r"\1N", text)
     return re.sub(r"\b([PB])\d+_", r"\1_", text) + "\n"
 
 
