@@ -9,65 +9,18 @@ checked here: like on the robot they fail at run time.
 from __future__ import annotations
 
 from . import script as ast
+from . import tmscript as table
 
 F, I, S, B, FA, IA, ANY = "float", "int", "string", "bool", "float[]", "int[]", "any"
-
-# function -> list of (parameter types, return type)
-SIGNATURES: dict[str, list[tuple[tuple[str, ...], str]]] = {
-    "PTP": [((S, FA, I, I, I, B), B), ((S, FA, I, I, I, B, IA), B),
-            ((S,) + (F,) * 6 + (I, I, I, B), B), ((S,) + (F,) * 6 + (I, I, I, B, I, I, I), B)],
-    "Line": [((S, FA, I, I, I, B), B), ((S,) + (F,) * 6 + (I, I, I, B), B)],
-    "Circle": [((S, FA, FA, I, I, I, I, B), B), ((S,) + (F,) * 12 + (I, I, I, I, B), B)],
-    "PLine": [((S, FA, I, I, I), B), ((S,) + (F,) * 6 + (I, I, I), B)],
-    "Move_PTP": [((S, FA, I, I, I, B), B), ((S,) + (F,) * 6 + (I, I, I, B), B)],
-    "Move_Line": [((S, FA, I, I, I, B), B), ((S,) + (F,) * 6 + (I, I, I, B), B)],
-    "Move_PLine": [((S, FA, I, I, I), B), ((S,) + (F,) * 6 + (I, I, I), B)],
-    "ChangeBase": [((S,), B), ((FA,), B), ((F,) * 6, B)],
-    "ChangeTCP": [((S,), B), ((FA,), B), ((FA, F), B), ((FA, F, FA), B),
-                  ((F,) * 6, B), ((F,) * 7, B), ((F,) * 16, B)],
-    "ChangeLoad": [((F,), B)],
-    "PVTEnter": [((), B), ((I,), B)],
-    "PVTPoint": [((FA, FA, F), B), ((F,) * 13, B)],
-    "PVTExit": [((), B)],
-    "PVTPause": [((), B)],
-    "PVTResume": [((), B)],
-    "QueueTag": [((I,), B), ((I, I), B)],
-    "WaitQueueTag": [((), "void"), ((I,), I), ((I, I), I)],
-    "CheckQueueTag": [((I,), I)],
-    "Sleep": [((I,), "void")],
-    "StopAndClearBuffer": [((), B), ((I,), B)],
-    "Pause": [((), B)],
-    "Resume": [((), B)],
-    "ScriptExit": [((), B), ((I,), B)],
-    "ListenSend": [((I, ANY), I), ((S, I, ANY), I)],
-    "GetString": [((ANY,), S), ((ANY, I), S), ((ANY, I, I), S)],
-    "ListenPacket": [((S,), S), ((S, S), S)],
-}
-
-FORMATS = {
-    "PTP": ("JPP", "CPP"),
-    "Line": ("CPP", "CPR", "CAP", "CAR"),
-    "Circle": ("CPP", "CAP"),
-    "PLine": ("CAP", "JAP"),
-    "Move_PTP": ("CPP", "TPP", "JPP"),
-    "Move_Line": ("CPP", "CPR", "CAP", "CAR", "TPP", "TPR", "TAP", "TAR"),
-    "Move_PLine": ("CAP", "TAP", "JAP"),
-}
-
-IO_MODULES = ("ControlBox", "EndModule", "Safety") + tuple(f"ExtModule{n}" for n in range(16))
-IO_WRITABLE = {"DO": I, "AO": F, "InstantDO": I, "InstantAO": F}
-IO_READONLY = {"DI": I, "AI": F, "SI": I, "SO": I}
-ROBOT_MEMBERS = {"CoordRobot": FA, "CoordBase": FA, "Joint": FA, "BaseName": S, "TCPName": S,
-                 "CameraLight": I, "TCPForce3D": F, "TCPSpeed3D": F}
-ROBOT_WRITABLE = ("CameraLight",)
 
 
 class CheckError(Exception):
     """A rule violation on one line."""
 
 
-def check_script(lines: list[ast.Line], variables: dict[str, str]) -> dict[str, str]:
-    """Check every line in place (sets ``line.error`` / ``line.warnings``).
+def check_script(lines: list[ast.Line], variables: dict[str, str], version: str = table.V224) -> dict[str, str]:
+    """Check every line in place (sets ``line.error`` / ``line.warnings``) against the function set of
+    TMflow ``version`` (sim.tmscript: a function, format or attribute of another version is unknown).
 
     ``variables`` are the node-session variables (name -> type). Returns the variables the script
     would declare; the caller adds them only if the script runs.
@@ -77,7 +30,7 @@ def check_script(lines: list[ast.Line], variables: dict[str, str]) -> dict[str, 
     for line in lines:
         if line.error:
             continue
-        checker = _LineChecker(scope, line.warnings)
+        checker = _LineChecker(scope, line.warnings, version)
         try:
             checker.statement(line.stmt)
         except CheckError as exc:
@@ -102,9 +55,10 @@ def _assignable(target: str, value: str) -> str | None:
 
 
 class _LineChecker:
-    def __init__(self, scope, warnings):
+    def __init__(self, scope, warnings, version):
         self.scope = scope
         self.warnings = warnings
+        self.version = version
 
     def warn(self, text):
         if text not in self.warnings:
@@ -152,13 +106,16 @@ class _LineChecker:
         io = self.io_point(node)
         if io is not None:
             member, kind = io
-            if member in IO_READONLY:
+            if not table.IO_POINTS[member][1]:
                 raise CheckError(f"IO point {member} is read-only")
             return kind
+        if self.io_array(node) is not None:
+            raise CheckError(f"IO[...].{node.name} as a whole is read-only: write one point, e.g. {node.name}[0]")
         if isinstance(node, ast.Member) and _is_robot(node.obj):
-            if node.name not in ROBOT_WRITABLE:
+            kind, writable = self.robot_member(node.name)
+            if not writable:
                 raise CheckError(f"Robot[0].{node.name} is read-only")
-            return ROBOT_MEMBERS[node.name]
+            return kind
         if isinstance(node, ast.Index) and isinstance(node.obj, ast.Name):
             base = self.target(node.obj)
             if not base.endswith("[]"):
@@ -166,6 +123,37 @@ class _LineChecker:
             self.index(node.index)
             return base[:-2]
         raise CheckError("this expression cannot be assigned to")
+
+    def robot_member(self, name):
+        """(type, writable) of Robot[0].name in this version (TMscript 2.24 §11.6)."""
+        entry = table.ROBOT.get(name)
+        if entry is None or self.version not in entry[2]:
+            raise CheckError(f"unknown Robot member '{name}'")
+        return entry[0], entry[1]
+
+    def io_array(self, node):
+        """Element type of a whole IO array IO["Module"].MEMBER (2.x, read only), else None."""
+        if not (isinstance(node, ast.Member) and isinstance(node.obj, ast.Index)
+                and isinstance(node.obj.obj, ast.Name) and node.obj.obj.id == "IO"):
+            return None
+        if self.version not in table.IO_WHOLE_ARRAYS:
+            raise CheckError(f"IO[...].{node.name} needs an index in TMflow {self.version}")
+        self.io_module(node.obj.index)
+        if node.name not in table.IO_POINTS:
+            raise CheckError(f"unknown IO member '{node.name}'")
+        return table.IO_POINTS[node.name][0]
+
+    def io_module(self, module):
+        if isinstance(module, ast.Name):
+            self.warn("IO module name without quotes")
+            name = module.id
+        elif isinstance(module, ast.Str):
+            name = module.value
+        else:
+            raise CheckError("IO module must be a name such as \"ControlBox\"")
+        if name not in table.IO_MODULES:
+            raise CheckError(f"unknown IO module '{name}'")
+        return name
 
     def io_point(self, node):
         """(member, type) for IO["Module"].MEMBER[n], else None."""
@@ -175,21 +163,11 @@ class _LineChecker:
         if not (isinstance(member.obj, ast.Index) and isinstance(member.obj.obj, ast.Name)
                 and member.obj.obj.id == "IO"):
             return None
-        module = member.obj.index
-        if isinstance(module, ast.Name):
-            self.warn("IO module name without quotes")
-            name = module.id
-        elif isinstance(module, ast.Str):
-            name = module.value
-        else:
-            raise CheckError("IO module must be a name such as \"ControlBox\"")
-        if name not in IO_MODULES:
-            raise CheckError(f"unknown IO module '{name}'")
-        kinds = {**IO_WRITABLE, **IO_READONLY}
-        if member.name not in kinds:
+        self.io_module(member.obj.index)
+        if member.name not in table.IO_POINTS:
             raise CheckError(f"unknown IO member '{member.name}'")
         self.index(node.index)
-        return member.name, kinds[member.name]
+        return member.name, table.IO_POINTS[member.name][0]
 
     def index(self, node):
         if self.expr(node) not in ("int", "byte"):
@@ -231,10 +209,11 @@ class _LineChecker:
         io = self.io_point(node)
         if io is not None:
             return io[1]
+        element = self.io_array(node)
+        if element is not None:
+            return element + "[]"
         if isinstance(node, ast.Member) and _is_robot(node.obj):
-            if node.name not in ROBOT_MEMBERS:
-                raise CheckError(f"unknown Robot member '{node.name}'")
-            return ROBOT_MEMBERS[node.name]
+            return self.robot_member(node.name)[0]
         if isinstance(node, ast.Index):
             base = self.expr(node.obj)
             if not base.endswith("[]") and base != S:
@@ -256,7 +235,7 @@ class _LineChecker:
         return F if F in (left, right) else I
 
     def call(self, node):
-        overloads = SIGNATURES.get(node.name)
+        overloads = table.overloads(node.name, self.version)
         if overloads is None:
             raise CheckError(f"unknown function '{node.name}'")
         arg_types = []
@@ -300,7 +279,7 @@ class _LineChecker:
         return self.expr(node)
 
     def format(self, node, params):
-        allowed = FORMATS.get(node.name)
+        allowed = table.formats(node.name, self.version)
         if allowed is None or not node.args:
             return
         first = node.args[0]

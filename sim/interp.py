@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import math
 import struct
+from decimal import Decimal
 
 from . import script as ast
-from .checker import IO_WRITABLE
+from . import tmscript as table
 from .codec import encode as encode_frame
 from .limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
                      VARIABLES_MAX)
@@ -186,7 +187,7 @@ def _coerce(type_name, value, ctx):
 
 def _arith(op, a, b, ctx):
     if op == "+" and (isinstance(a, str) or isinstance(b, str)):
-        a, b = str(a), str(b)
+        a, b = to_text(a), to_text(b)
         if len(a) + len(b) > STRING_MAX:
             raise ScriptRuntimeError(f"a string holds at most {STRING_MAX} characters")
         _work(ctx, (len(a) + len(b)) // 256)
@@ -240,7 +241,7 @@ def _store(target, value, ctx, line):
         return
     if _is_io(target):
         key, member = yield from _io_key(target, ctx, line)
-        level = int(value) if IO_WRITABLE[member] == "int" else float(value)
+        level = int(value) if table.IO_POINTS[member][0] == "int" else float(value)
         if member.startswith("Instant"):
             point = key.replace("Instant", "")
             ctx.robot.io[point] = level
@@ -250,7 +251,7 @@ def _store(target, value, ctx, line):
                 yield ("room", None, None)        # the FIFO is full: wait until an item has run
             ctx.robot.enqueue_setting("io", (key, level))
         return
-    if isinstance(target, ast.Member):          # Robot[0].CameraLight
+    if isinstance(target, ast.Member):          # Robot[0].CameraLight / InstantCameraLight
         ctx.robot.io["CameraLight"] = int(value)
         return
     name = target.obj.id
@@ -276,8 +277,7 @@ def _store(target, value, ctx, line):
 
 
 _LITERALS = frozenset({ast.Num, ast.Str, ast.Bool})
-_QUEUED = frozenset(MOTIONS + ("ChangeBase", "ChangeTCP", "ChangeLoad", "QueueTag", "PVTEnter", "PVTPoint",
-                                "PVTExit"))
+_QUEUED = frozenset(name for name in table.FUNCTIONS if table.queued(name))
 
 
 def _eval(node, ctx, line):
@@ -322,6 +322,8 @@ def _eval(node, ctx, line):
     if _is_io(node):
         key, _member = yield from _io_key(node, ctx, line)
         return ctx.robot.io.get(key, 0)
+    if isinstance(node, ast.Member) and isinstance(node.obj, ast.Index) and node.obj.obj.id == "IO":
+        return _io_array(node, ctx.robot)                # IO["Module"].DI: the whole array (2.x)
     if isinstance(node, ast.Member):                    # Robot[0].X
         return _robot_member(node.name, ctx.robot)
     if isinstance(node, ast.Index):
@@ -333,7 +335,16 @@ def _eval(node, ctx, line):
     raise ScriptRuntimeError("unsupported expression")
 
 
+def _io_array(node, robot):
+    """IO["Module"].ATTR as an array (TMscript 2.24 §11.5); sizes: sim.tmscript.IO_SIZES."""
+    module = node.obj.index
+    name = module.id if isinstance(module, ast.Name) else module.value
+    attribute = node.name.replace("Instant", "")
+    return [robot.io.get(f"{name}.{attribute}[{i}]", 0) for i in range(table.io_size(name, node.name))]
+
+
 def _robot_member(name, robot):
+    """Robot[0].attribute (TMscript 2.24 §11.6). The model has no force sensing: TCPForce3D is 0."""
     if name == "CoordRobot":
         return robot.tcp_pose_robot()
     if name == "CoordBase":
@@ -344,8 +355,12 @@ def _robot_member(name, robot):
         return robot.base_name
     if name == "TCPName":
         return robot.tool_name
-    if name == "CameraLight":
+    if name in ("CameraLight", "InstantCameraLight"):
         return robot.io.get("CameraLight", 0)
+    if name == "Payload":
+        return robot.load
+    if name == "TCPSpeed3D":
+        return robot.tcp_speed()
     return 0.0
 
 
@@ -416,9 +431,9 @@ def _call(node, args, ctx, line):
         robot.enqueue_setting("pvt", None)
         return True
     if name == "PVTPoint":
-        if len(args) == 3:
-            pos, vel, duration = args
-        else:
+        if isinstance(args[0], list):           # §13.19 syntax 1/2: arrays, duration [, sync to project speed]
+            pos, vel, duration = args[:3]
+        else:                                   # syntax 3/4: 13 numbers [, sync]; the sim runs at 100 %
             pos, vel, duration = list(args[:6]), list(args[6:12]), args[12]
         if len(pos) != 6 or len(vel) != 6:
             raise ScriptRuntimeError("PVTPoint needs 6 positions and 6 velocities")
@@ -492,13 +507,39 @@ def _wait_queue_tag(args, robot):
 
 
 def to_text(value) -> str:
+    """A value as GetString and string concatenation print it."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
-        return repr(value) if value != int(value) or abs(value) >= 1e15 else str(int(value))
+        return float_text(value)
     if isinstance(value, list):
         return "{" + ",".join(to_text(v) for v in value) + "}"
     return str(value)
+
+
+def float_text(value: float) -> str:
+    """A TM ``float`` is 32 bits: printed with the fewest digits that read back as the same 32-bit value
+    (0.1 -> "0.1", 417.5 -> "417.5", 1/3 -> "0.33333334"), fixed point for exponents -5..14, else
+    "1E+15" / "1.5E-07" (our reading of the robot's .NET-style output; docs/simulator.md)."""
+    if not math.isfinite(value):
+        return "NaN" if math.isnan(value) else ("Infinity" if value > 0 else "-Infinity")
+    try:
+        single = struct.unpack("<f", struct.pack("<f", value))[0]
+    except OverflowError:
+        return "Infinity" if value > 0 else "-Infinity"
+    if single == 0:
+        return "0"
+    for digits in range(1, 10):
+        text = f"{single:.{digits}g}"
+        if struct.unpack("<f", struct.pack("<f", float(text)))[0] == single:
+            break
+    number = Decimal(text)
+    exponent = number.adjusted()
+    if -5 <= exponent < 15:
+        fixed = format(number, "f")
+        return fixed.rstrip("0").rstrip(".") if "." in fixed else fixed
+    mantissa, _, power = f"{number:E}".partition("E")
+    return f"{mantissa}E{power[0]}{int(power[1:]):02d}"
 
 
 def encode_value(value, type_name=None) -> bytes:

@@ -179,6 +179,9 @@ def rotation_angle(m0, m1):
 def _check_common(req):
     if not all(math.isfinite(v) for v in (*req.target, req.speed, req.accel_ms, req.blend)):
         raise MotionError(f"{req.function}: a value is not a finite number")
+    if req.speed == -1:         # TMscript 2.24 §13.8-13.12: speed -1 = acceleration table, S-series models only
+        raise MotionError(f"{req.function} speed -1 selects the acceleration table, which only TM S-series "
+                          f"robots have (this is a TM5-700)")
     if req.fmt[1:2] == "P" or req.function.startswith(("PTP", "Move_PTP")):
         if not 0 < req.speed <= 100:
             raise MotionError(f"{req.function} speed {req.speed:g} % is outside 1..100 %")

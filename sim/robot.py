@@ -255,6 +255,16 @@ class RobotModel:
                        kin.forward(joints, self._matrix(self.tool_pose)))
         return kin.matrix_to_pose(m)
 
+    def tcp_speed(self, dt=0.01) -> float:
+        """TCP speed in mm/s (Robot[0].TCPSpeed3D), from the position now and ``dt`` s before."""
+        if self.active is None or self.paused or self.active_t <= 0:
+            return 0.0
+        before = max(0.0, self.active_t - dt)
+        tool = self._matrix(self.tool_pose)
+        p0 = kin.forward(self.active.joints_at(before, self.joints), tool)
+        p1 = kin.forward(self.active.joints_at(self.active_t, self.joints), tool)
+        return math.dist([p0[i][3] for i in range(3)], [p1[i][3] for i in range(3)]) / (self.active_t - before)
+
     def tcp_pose_robot(self):
         return kin.matrix_to_pose(kin.forward(self.current_joints(), self._matrix(self.tool_pose)))
 

@@ -266,7 +266,7 @@ class ListenSession:
             self.log("fault", fault="reply_error", id=packet.id)
             self._reply(packet, "ERROR;1")
             return
-        check_script(lines, self.types)
+        check_script(lines, self.types, self.profile.tmflow)
         errors = [line.number for line in lines if line.error]
         for line in lines:
             if line.error:

@@ -4,7 +4,7 @@
                                   [--realtime | --speedup K] [--log FILE.jsonl]
                                   [--no-auto-enter] [--send-message Listen1]
                                   [--control-port 5889 | --no-control] [--control-host 127.0.0.1]
-                                  [--tag-history 4] [--stop-tags forget|reached]
+                                  [--tmflow 1.8|2.24] [--tag-history 4] [--stop-tags forget|reached]
                                   [--data-timeout S] [--connection-timeout S]
                                   [--svr-port PORT | --no-svr] [--svr-period S]
                                   [--svr-format binary|string|json] [--svr-items A,B,...]
@@ -24,7 +24,7 @@ import threading
 if __package__ in (None, ""):
     sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from sim.profiles import STOP_TAGS, Profile  # noqa: E402
+from sim.profiles import STOP_TAGS, VERSIONS, Profile  # noqa: E402
 from sim.server import SimServer  # noqa: E402
 from sim.svr_session import DEFAULT_STREAM  # noqa: E402
 from sim.svr_table import ITEMS  # noqa: E402
@@ -60,6 +60,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help="leave the node via Fail when no client connected within S seconds (0 = none)")
     parser.add_argument("--tag-history", type=int, default=4, metavar="N",
                         help="number of queue tags the robot remembers (1..1000, default 4, TMscript 2.24 13.2)")
+    parser.add_argument("--tmflow", choices=VERSIONS, default="2.24",
+                        help="TMflow version whose TM script functions and formats the robot knows (default 2.24)")
     parser.add_argument("--stop-tags", choices=STOP_TAGS, default="forget",
                         help="what the queue tags dropped by a stop answer: forget = 'none' (default), "
                              "reached = 'true'")
@@ -123,7 +125,8 @@ def main(argv=None) -> int:
         server = SimServer(host=args.host, port=args.port, robots=args.robots, speedup=args.speedup,
                            auto_enter=not args.no_auto_enter, send_message=args.send_message,
                            log_path=args.log,
-                           profile=Profile(tag_history=args.tag_history, stop_tags=args.stop_tags),
+                           profile=Profile(tmflow=args.tmflow, tag_history=args.tag_history,
+                                           stop_tags=args.stop_tags),
                            control_port=None if args.no_control else args.control_port,
                            data_timeout=args.data_timeout if args.data_timeout > 0 else None,
                            connection_timeout=args.connection_timeout if args.connection_timeout > 0 else None,

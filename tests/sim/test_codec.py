@@ -138,3 +138,11 @@ def test_data_may_contain_dollar_star_comma_and_crlf():
 def test_length_counts_utf8_bytes():
     raw = codec.encode("TMSCT", '7,string s = "Über"')
     assert raw == '$TMSCT,20,7,string s = "Über",*39\r\n'.encode("utf-8")
+
+
+def test_manual_13_3_queue_tag_example_is_172_bytes_with_checksum_49():
+    """TMscript 2.24 §13.3 "Motion Function Queue Tag": the packet as printed, with real CR LF bytes."""
+    data = ('2,float[] targetP1= {0,0,90,0,90,0}\r\nPTP("JPP",targetP1,10,200,0,false)\r\nQueueTag(1)\r\n'
+            'float[] targetP2 = {0,0,90,90,0,0}\r\nPTP("JPP",targetP2,10,200,10,false)\r\nQueueTag(2)\r\n')
+    assert len(data.encode()) == 172
+    assert codec.encode("TMSCT", data) == b"$TMSCT,172," + data.encode() + b",*49\r\n"

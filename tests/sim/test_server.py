@@ -270,6 +270,7 @@ def test_cli_starts_prints_one_line_per_robot_and_stops_on_terminate(tmp_path):
     (["--speedup", "0"], "--speedup must be positive"),
     (["--port", "65535", "--robots", "2"], "leaves the port range"),
     (["--stop-tags", "maybe"], "invalid choice: 'maybe'"),
+    (["--tmflow", "3.0"], "invalid choice: '3.0'"),
 ])
 def test_cli_rejects_bad_arguments_with_a_clear_message(args, message):
     result = subprocess.run([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), *args],

@@ -1,0 +1,137 @@
+"""Version profiles (--tmflow 1.8 / 2.24) from the one function table sim.tmscript: every function, data
+format and Robot[0] attribute passes where its version has it and is refused (ERROR;line, as an unknown
+name) where it does not; values print as a 32-bit TM float does."""
+import pytest
+
+from sim import codec, tmscript
+from sim.interp import float_text
+from sim.profiles import Profile
+from test_session import S, sct
+
+# one call per overload that the checker accepts, and one it refuses (wrong type or arity)
+EXAMPLES = {
+    "PTP": ('PTP("JPP",0,0,90,0,90,5,50,200,0,false)', 'PTP("JPP",0,0,90)'),
+    "Line": ('Line("CAP",417.5,-122.3,343.9,180,0,90,100,200,0,false)', 'Line("CAP",{1,2,3,4,5,6},"x",200,0,false)'),
+    "Circle": ('Circle("CPP",{417.5,-100,343.9,180,0,90},{417.5,-80,343.9,180,0,90},50,200,0,0,false)',
+               'Circle("CPP",{1,2,3,4,5,6},50,200,0,0,false)'),
+    "PLine": ('PLine("CAP",417.5,-122.3,343.9,180,0,90,100,200,0)', 'PLine("CAP",true,100,200,0)'),
+    "Move_PTP": ('Move_PTP("JPP",0,0,0,0,0,5,50,200,0,false)', 'Move_PTP("JPP",0,0,0,0,0,5)'),
+    "Move_Line": ('Move_Line("CAP",0,0,-5,0,0,0,100,200,0,false)', 'Move_Line("CAP",{0,0,5})'),
+    "Move_PLine": ('Move_PLine("CAP",0,0,-5,0,0,0,100,200,0)', 'Move_PLine()'),
+    "ChangeBase": ('ChangeBase("RobotBase")', 'ChangeBase(true)'),
+    "ChangeTCP": ('ChangeTCP("NOTOOL")', 'ChangeTCP(1,2)'),
+    "ChangeLoad": ("ChangeLoad(1.5)", 'ChangeLoad("a")'),
+    "PVTEnter": ("PVTEnter(0)", 'PVTEnter("joint")'),
+    "PVTPoint": ("PVTPoint({0,0,90,0,90,0},{0,0,0,0,0,0},0.5)", 'PVTPoint("JPP",{0,0,90,0,90,0},{0,0,0,0,0,0},500)'),
+    "PVTExit": ("PVTExit()", "PVTExit(1)"),
+    "PVTPause": ("PVTPause()", "PVTPause(1)"),
+    "PVTResume": ("PVTResume()", "PVTResume(1)"),
+    "QueueTag": ("QueueTag(3)", 'QueueTag("3")'),
+    "WaitQueueTag": ("WaitQueueTag(3, 0)", 'WaitQueueTag("3")'),
+    "CheckQueueTag": ("CheckQueueTag(3)", "CheckQueueTag()"),
+    "StopAndClearBuffer": ("StopAndClearBuffer()", 'StopAndClearBuffer("x")'),
+    "Pause": ("Pause()", "Pause(1)"),
+    "Resume": ("Resume()", "Resume(1)"),
+    "ScriptExit": ("ScriptExit()", 'ScriptExit("x")'),
+    "ListenSend": ('ListenSend(90, "x")', "ListenSend()"),
+    "ListenPacket": ('ListenPacket("x")', "ListenPacket(1,2,3)"),
+    "GetString": ("GetString(1.5)", "GetString()"),
+    "Sleep": ("Sleep(0)", 'Sleep("1")'),
+}
+
+
+def reply(node, script):
+    return node.send(1, sct("T", script))[-1]
+
+
+def node_of(version):
+    n = S(profile=Profile(tmflow=version))
+    n.connect(1)
+    n.out(1)
+    return n
+
+
+def ok(status):
+    return codec.encode("TMSCT", f"T,{status}").decode()
+
+
+def test_every_function_of_the_table_has_a_passing_and_a_failing_example():
+    assert sorted(EXAMPLES) == sorted(tmscript.FUNCTIONS)
+
+
+@pytest.mark.parametrize("name", sorted(tmscript.FUNCTIONS))
+@pytest.mark.parametrize("version", tmscript.ALL)
+def test_each_function_passes_where_its_version_has_it_and_fails_with_bad_arguments(name, version):
+    good, bad = EXAMPLES[name]
+    node = node_of(version)
+    assert reply(node, bad) == ok("ERROR;1"), bad
+    assert reply(node, good) == (ok("OK") if tmscript.overloads(name, version) else ok("ERROR;1")), good
+
+
+@pytest.mark.parametrize("script", ['Line("CDP",417.5,-122.3,343.9,180,0,90,100,200,0,false)',
+                                    'Line("CDR",{417.5,-122.3,343.9,180,0,90},100,200,0,false)',
+                                    'Move_Line("TDP",{0,0,-5,0,0,0},100,200,0,false)',
+                                    'Circle("CDP",{417.5,-100,343.9,180,0,90},{417.5,-80,343.9,180,0,90},50,200,0,0,false)',
+                                    "PVTPoint(0,0,90,0,90,0,0,0,0,0,0,0,0.5,false)", "WaitQueueTag()",
+                                    "float p = Robot[0].Payload", 'byte[] d = IO["ControlBox"].DI'])
+def test_manual_2_24_additions_run_on_2_24_and_are_unknown_on_1_8(script):
+    assert reply(node_of("2.24"), script) == ok("OK")
+    assert reply(node_of("1.8"), script) == ok("ERROR;1")
+
+
+def test_cdp_is_an_absolute_speed_in_mm_per_s_like_cap_the_simulator_has_no_project_speed():
+    durations = {}
+    for fmt in ("CDP", "CAP"):
+        node = node_of("2.24")
+        node.send(1, sct("A", f'Line("{fmt}",417.5,-122.3,243.9,180,0,90,100,0,0,false)'))
+        node.advance(0.1)
+        durations[fmt] = [f for kind, f in node.events if kind == "motion_start"][-1]["duration_s"]
+    assert durations["CDP"] == durations["CAP"] > 1.0                  # > 100 mm at 100 mm/s
+
+
+def test_manual_13_10_speed_minus_1_selects_the_acceleration_table_which_a_tm5_700_does_not_have():
+    node = node_of("2.24")
+    assert reply(node, 'PTP("JPP",0,0,90,0,90,5,-1,500,0,false)') == ok("OK")
+    node.advance(0.1)
+    assert node.s.state == "project_stopped" and "acceleration table" in node.s.last_error
+
+
+def test_manual_11_5_whole_io_arrays_read_as_arrays_and_are_read_only():
+    node = node_of("2.24")
+    node.send(1, sct("A", 'IO["ControlBox"].DO[2] = 1\r\nIO["ControlBox"].AO[1] = 2.5'))
+    node.advance(0.1)
+    node.out(1)
+    frames = node.send(1, sct("B", 'byte[] d = IO["ControlBox"].DO\r\nfloat[] a = IO["ControlBox"].AO\r\n'
+                                   'ListenSend(90, GetString(d) + "|" + GetString(a))'))
+    assert frames[0].split(",", 3)[3].startswith("{0,0,1,0,0,0,0,0,0,0,0,0,0,0,0,0}|{0,2.5}")
+    assert reply(node, 'IO["ControlBox"].DO = {1,1}') == ok("ERROR;1")
+    assert reply(node, 'float[] x = IO["Nowhere"].DI') == ok("ERROR;1")
+
+
+def test_manual_11_6_robot_attributes_payload_and_instant_camera_light():
+    node = node_of("2.24")
+    node.send(1, sct("A", "ChangeLoad(2.5)"))
+    node.advance(0.1)
+    node.out(1)
+    frames = node.send(1, sct("B", "Robot[0].InstantCameraLight = 1\r\n"
+                                   'ListenSend(90, GetString(Robot[0].Payload) + "," + GetString(Robot[0].CameraLight))'))
+    assert frames[0].split(",", 3)[3].startswith("2.5,1,")
+    assert reply(node, "Robot[0].Payload = 1") == ok("ERROR;1")
+
+
+@pytest.mark.parametrize("value,text", [(0.1, "0.1"), (417.5, "417.5"), (1 / 3, "0.33333334"),
+                                        (399.99999999999994, "400"), (-122.30000000000001, "-122.3"),
+                                        (1e15, "1E+15"), (1.5e-7, "1.5E-07"), (0.0001, "0.0001"), (-0.0, "0")])
+def test_floats_print_as_a_32_bit_tm_float(value, text):
+    assert float_text(value) == text
+
+
+def test_get_string_of_a_pose_prints_32_bit_floats():
+    node = node_of("2.24")
+    frames = node.send(1, sct("B", "float f = 0.1 + 0.2\r\nListenSend(90, GetString(f) + \";\" + 1.1)"))
+    assert frames[0].split(",", 3)[3].startswith("0.3;1.1,")
+
+
+def test_a_pvt_mode_outside_0_and_1_is_a_run_time_error_as_in_the_manual():
+    node = node_of("2.24")
+    assert reply(node, "PVTEnter(2)") == ok("ERROR;1")                  # §13.17: 0 joint, 1 Cartesian only
