@@ -6,8 +6,8 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "ping"}
     {"cmd": "robots"}                                         ports and node state of every robot
     {"cmd": "state", "robot": 0}
-    {"cmd": "events", "robot": 0, "since": 0}                 up to 1,000 events from index ``since``
-                                                              on, plus "next" (the index to ask next)
+    {"cmd": "events", "robot": 0, "since": 0}                 up to 1,000 events (1 MiB) from index
+                                                              ``since`` on, plus "next" (the index to ask next)
     {"cmd": "enter_listen_node" | "leave_listen_node" | "stop_project" | "start_project", "robot": 0}
     {"cmd": "inject", "robot": 0, "fault": "reply_delay", "params": {"seconds": 0.5}}
     {"cmd": "clear_faults", "robot": 0}
@@ -30,8 +30,8 @@ import re
 import selectors
 import socket
 
-from .limits import (ACCEPT_BACKOFF_S, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
-                     CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX)
+from .limits import (ACCEPT_BACKOFF_S, CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX,
+                     CONTROL_EVENTS_MAX, CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX)
 from .session import TransitionError
 
 _FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission"}
@@ -161,14 +161,15 @@ class ControlChannel:
             self._close(sock)
 
     def _answer(self, client, answer) -> bool:
-        """Queue one answer and write what the socket takes; False when the client was closed."""
+        """Queue one answer and write what the socket takes; False when the client was closed. A client is
+        closed when CONTROL_OUTBOX_MAX bytes of earlier answers are still unread (one answer may be larger)."""
+        if len(client.wbuf) > CONTROL_OUTBOX_MAX:
+            self._close(client.sock, f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)")
+            return False
         try:
             client.wbuf += _encode(answer)
         except ValueError as exc:           # e.g. a value JSON cannot carry
             client.wbuf += _encode(_error(f"the answer cannot be written as JSON ({exc})"))
-        if len(client.wbuf) > CONTROL_OUTBOX_MAX:
-            self._close(client.sock, f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)")
-            return False
         return self._write(client)
 
     def _write(self, client) -> bool:
@@ -256,7 +257,13 @@ class ControlChannel:
         since = _int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")
         first = robot.events_dropped
         start = max(since, first)
-        events = robot.events[start - first: start - first + CONTROL_EVENTS_MAX]
+        sizes = robot.event_sizes(start - first, CONTROL_EVENTS_MAX)
+        count, total = 0, 0
+        for size in sizes:                  # at most CONTROL_ANSWER_BYTES of events (at least one)
+            if count and total + size > CONTROL_ANSWER_BYTES:
+                break
+            count, total = count + 1, total + size
+        events = robot.events[start - first: start - first + count]
         return {"events": events, "next": start + len(events), "first": first}
 
 

@@ -36,7 +36,8 @@ VARIABLE_BYTES_MAX = 8 << 20                # their memory: 8 bytes a number, 1 
 CONTROL_LINE_MAX = 65_536                   # bytes of one request line
 CONTROL_DEPTH_MAX = 8                       # JSON nesting of one request
 CONTROL_OUTBOX_MAX = 4 << 20                # unsent answer bytes per client; beyond: the client is closed
-CONTROL_EVENTS_MAX = 1_000                  # events in one "events" answer (page on with "next")
+CONTROL_EVENTS_MAX = 1_000                  # events in one "events" answer (page on with "next") ...
+CONTROL_ANSWER_BYTES = 1 << 20              # ... and their bytes as the event log counts them (at least one)
 CONTROL_CLIENTS_MAX = 16
 
 # ---- robot servers (per robot unless noted) -----------------------------------------------------

@@ -125,6 +125,10 @@ class Robot:
         self.event_bytes -= dropped_bytes
         self.events_dropped += cut
 
+    def event_sizes(self, start: int, count: int) -> list[int]:
+        """Bytes the event log counts for events[start:start + count]."""
+        return self._event_sizes[start:start + count]
+
     def wait_event(self, kind: str, timeout: float = 5.0, since: int = 0, **fields) -> dict | None:
         """First event of ``kind`` whose fields equal ``fields``, among events[since:] or logged later
         (from another thread, e.g. start_background()); None after ``timeout`` wall-clock seconds."""

@@ -106,3 +106,26 @@ def test_events_are_paged_by_absolute_index_across_the_log_trimming():
     finally:
         client.close()
         srv.close()
+
+
+def test_events_of_large_frames_are_paged_by_bytes_and_a_reading_client_is_never_closed():
+    srv = SimServer(port=0, control_port=0).start_background()
+    client = ControlClient(srv.control.port)
+    try:
+        for n in range(60):                                   # 60 events of ~120 KB: 7 MB in all
+            srv.robots[0]._log("frame_in", conn=1, raw="r" * 60_000, header="TMSTA", data="d" * 60_000, n=n)
+        since, seen = 0, []
+        while True:
+            page = client.ask({"cmd": "events", "since": since})
+            assert page["ok"], page
+            if not page["result"]["events"]:
+                break
+            assert sum(e["kind"] == "frame_in" for e in page["result"]["events"]) <= 9    # ~1 MiB a page
+            seen += [e.get("n") for e in page["result"]["events"] if e["kind"] == "frame_in"]
+            since = page["result"]["next"]
+        assert seen == list(range(60))
+        big = client.ask({"cmd": "state"})                          # the connection is still open
+        assert big["ok"]
+    finally:
+        client.close()
+        srv.close()
