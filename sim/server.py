@@ -10,16 +10,14 @@ Limits (per robot unless noted):
   (TCP back-pressure) until the queue shrinks
 * MAX_OUTBOX bytes waiting to be sent to one client, OUTBOX_TOTAL_MAX to all clients of a robot; a client
   that does not read (the one with most waiting, for the total) is dropped
-* fairness: one turn processes at most SERVE_ITEMS items of one client's input (and decodes at most
-  SERVE_SCAN); the rest waits in its receive buffer, which is not read further meanwhile, while the other
-  clients get their turn. Bad packets are answered with CPERR at most CPERR_BURST at once, then
-  CPERR_PER_S per second (robot clock) per client; the others are counted (event ``cperr_suppressed``)
+* fairness: each client's input is processed in bounded turns, floods after the others, CPERR answers
+  to bad packets limited per client (sim/fairness.py)
+* the event log: bounded by count and bytes (sim/eventlog.py)
 """
 from __future__ import annotations
 
 import errno
 import gc
-import json
 import math
 import selectors
 import socket
@@ -29,25 +27,23 @@ import time
 from . import codec
 from .control import ControlChannel
 from .ethernet_slave import EthernetSlave
+from .eventlog import EventLog, text as _text
+from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
 from .faults import FaultState, check_params as check_fault_params
-from .limits import (ACCEPT_BACKOFF_S, CPERR_BURST, CPERR_PER_S, EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX,
-                     SERVE_ITEMS, SERVE_SCAN)
+from .limits import ACCEPT_BACKOFF_S, CPERR_BURST, EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX
 from .profiles import Profile
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
 
 MAX_CLIENTS = 256
-MAX_PENDING = 1000
 MAX_OUTBOX = 1 << 20
 RECV_SIZE = 65536
 RBUF_READ_BELOW = codec.MAX_DATA + 64     # a receive buffer this full holds a complete item: process it first
-EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all) ...
-EVENT_OVERHEAD = 200        # ... and at most limits.EVENT_BYTES_MAX bytes: an event counts this + its texts
+EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all), and at
+                            # most limits.EVENT_BYTES_MAX bytes (sim/eventlog.py)
 _OUT_OF_DESCRIPTORS = (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM)
-POLL_BUDGET_S = 0.004       # after this long, one poll() stops serving sockets in between and ends
 GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
-IO_SLICE_S = 0.0003          # at most this much work (planning, advancing) between two socket polls
 
 
 class _Conn:
@@ -65,18 +61,14 @@ class _Conn:
         self.greedy = False                     # its last read filled RECV_SIZE, or input is left over
 
 
-class Robot:
+class Robot(EventLog):
     """Control interface of one simulated robot (``SimServer.robots[i]``)."""
 
     def __init__(self, server, index, port, send_message, auto_enter, profile, timeouts, frames=(None, None)):
         self._server = server
         self.index = index
         self.port = port
-        self.events: list[dict] = []
-        self.events_dropped = 0                  # events removed from the front of ``events`` so far
-        self._event_sizes: list[int] = []
-        self.event_bytes = 0
-        self._waiters: list[tuple] = []          # (predicate, threading.Event, [match]) of wait_event
+        self._init_event_log()
         self.faults = FaultState()
         self.session = ListenSession(RobotModel(bases=frames[0], tools=frames[1]),
                                      send_message, self._log,
@@ -86,64 +78,6 @@ class Robot:
         self.accept_paused_until = None          # out of descriptors: the listener is not watched until then
         self.conns: dict[int, _Conn] = {}
         self.reading_paused = False
-
-    # ---- event log ----------------------------------------------------------------------------
-    def _log(self, kind, **fields):
-        session = self.__dict__.get("session")
-        event = {"t": round(session.now, 6) if session is not None else 0.0, "robot": self.index, "kind": kind,
-                 **fields}
-        if self._server.log_file is not None:
-            self._server.log_file.write(json.dumps(event, ensure_ascii=False) + "\n")
-        size = EVENT_OVERHEAD
-        for value in fields.values():
-            if type(value) is str:
-                size += len(value)
-        budget = self._server.event_bytes_limit
-        if size > budget // 4:                   # one huge event must not push out all others
-            event, size = _shortened(event, budget // 4), budget // 4
-        self.events.append(event)
-        self._event_sizes.append(size)
-        self.event_bytes += size
-        if self._waiters:
-            for predicate, flag, found in list(self._waiters):
-                if not flag.is_set() and predicate(event):
-                    found.append(event)
-                    flag.set()
-        if len(self.events) > self._server.event_limit or self.event_bytes > budget:
-            self._drop_old_events()
-
-    def _drop_old_events(self):
-        """Drop the oldest events until at most half the count and half the bytes are kept."""
-        keep_bytes, count = self._server.event_bytes_limit // 2, len(self.events)
-        cut, excess = max(0, count - self._server.event_limit // 2), self.event_bytes - keep_bytes
-        dropped_bytes = sum(self._event_sizes[:cut])
-        while cut < count and dropped_bytes < excess:
-            dropped_bytes += self._event_sizes[cut]
-            cut += 1
-        del self.events[:cut]
-        del self._event_sizes[:cut]
-        self.event_bytes -= dropped_bytes
-        self.events_dropped += cut
-
-    def event_sizes(self, start: int, count: int) -> list[int]:
-        """Bytes the event log counts for events[start:start + count]."""
-        return self._event_sizes[start:start + count]
-
-    def wait_event(self, kind: str, timeout: float = 5.0, since: int = 0, **fields) -> dict | None:
-        """First event of ``kind`` whose fields equal ``fields``, among events[since:] or logged later
-        (from another thread, e.g. start_background()); None after ``timeout`` wall-clock seconds."""
-        def predicate(event):
-            return event["kind"] == kind and all(event.get(k) == v for k, v in fields.items())
-        flag, found = threading.Event(), []
-        entry = (predicate, flag, found)
-        self._waiters.append(entry)
-        try:
-            for event in list(self.events[since:]):
-                if predicate(event):
-                    return event
-            return found[0] if flag.wait(timeout) else None
-        finally:
-            self._waiters.remove(entry)
 
     # ---- control ------------------------------------------------------------------------------
     def enter_listen_node(self):
@@ -205,7 +139,7 @@ class Robot:
             return data
 
 
-class SimServer:
+class SimServer(FairInput):
     def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
                  send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
                  control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None,
@@ -523,87 +457,6 @@ class SimServer:
         if (robot.index, conn.id) not in self._backlog:     # else it waits for its turn in _serve_backlog
             self._process(robot, conn)
 
-    def _process(self, robot, conn):
-        """One turn of ``conn``'s input: at most SERVE_ITEMS items handled, SERVE_SCAN decoded. What is left
-        waits for the next turn (``_backlog``), after the other clients' turns."""
-        handled, key = 0, (robot.index, conn.id)
-        for _ in range(SERVE_SCAN):
-            if conn.rbuf[:2] == b"$$" and self._cperr_tokens(conn) < 1.0:
-                # a '$' followed by another '$' is always a bad packet (header missing, CPERR 01): a run of
-                # them that gets no answer anyway is skipped at once
-                run = len(conn.rbuf) - len(conn.rbuf.lstrip(b"$")) - 1
-                del conn.rbuf[:run]
-                conn.suppressed += run
-                continue
-            item, used = codec.decode(conn.rbuf)
-            if not used:
-                self._backlog.pop(key, None)
-                break
-            del conn.rbuf[:used]
-            if type(item) is codec.BadFrame and not self._may_answer_bad(conn):
-                conn.suppressed += 1
-                continue
-            if conn.suppressed:
-                robot._log("cperr_suppressed", conn=conn.id, count=conn.suppressed)
-                conn.suppressed = 0
-            if type(item) is codec.Frame:
-                conn.frames_in += 1
-                robot._log("frame_in", conn=conn.id, raw=_text(item.raw), header=item.header,
-                           data=_text(item.data))
-            robot.session.handle(conn.id, item)
-            if robot.faults.close_after is not None and conn.frames_in >= robot.faults.close_after:
-                robot.faults.close_after = None
-                self._flush(robot)
-                self._drop(robot, conn, "fault: close_after")
-                return
-            handled += 1
-            if handled >= SERVE_ITEMS or len(robot.session.pending) >= MAX_PENDING:
-                self._backlog[key] = (robot, conn)
-                conn.greedy = True
-                break
-        else:
-            self._backlog[key] = (robot, conn)
-            conn.greedy = True
-
-    def _cperr_tokens(self, conn) -> float:
-        """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""
-        conn.cperr_tokens = min(CPERR_BURST, conn.cperr_tokens + (self._now - conn.cperr_at) * CPERR_PER_S)
-        conn.cperr_at = self._now
-        return conn.cperr_tokens
-
-    def _may_answer_bad(self, conn) -> bool:
-        if self._cperr_tokens(conn) < 1.0:
-            return False
-        conn.cperr_tokens -= 1.0
-        return True
-
-    def _serve_backlog(self):
-        """Turns for the clients with input left over, round robin, until none is left or POLL_BUDGET_S has
-        passed; every IO_SLICE_S the sockets are polled, so fresh requests of other clients go first."""
-        served = start = time.perf_counter()
-        while self._backlog and time.perf_counter() - start < POLL_BUDGET_S:
-            served = self._backlog_round(served)
-
-    def _backlog_round(self, served):
-        for key, (robot, conn) in list(self._backlog.items()):
-            if time.perf_counter() - served > IO_SLICE_S:
-                self._serve(0.0, quick_only=True)
-                served = time.perf_counter()
-            if conn.id not in robot.conns:
-                self._backlog.pop(key, None)
-                continue
-            if len(robot.session.pending) >= MAX_PENDING:
-                self._backlog.pop(key, None)      # the script buffer is full: _set_reading resumes it
-                if not robot.reading_paused:
-                    self._set_reading(robot, False)
-                continue
-            self._process(robot, conn)
-            if robot not in self._touched:
-                self._touched.append(robot)
-            if not robot.faults.active:
-                self._flush(robot, conn)
-        return served
-
     def _flush(self, robot, only=None):
         """Write what the robot's session produced; ``only``: just that client's output (cheap, right after
         its request), else every client's plus the per-robot checks (once a poll at least)."""
@@ -697,18 +550,6 @@ def _collect_garbage(idle: bool):
         gc.collect(2 if old >= 10 else 1 if middle >= 10 else 0)
 
 
-def _shortened(event, size):
-    """A copy of ``event`` whose long texts are cut so that it counts about ``size`` bytes."""
-    room = max(64, (size - EVENT_OVERHEAD) // max(1, sum(type(v) is str for v in event.values())))
-    return {key: (value[:room] + f"...[{len(value)} characters]" if type(value) is str and len(value) > room
-                  else value) for key, value in event.items()}
-
-
-def _is_greedy(ready_item) -> bool:
-    conn = ready_item[0].data[2]
-    return type(conn) is _Conn and conn.greedy
-
-
 def _send(sock, data) -> int:
     try:
         return sock.send(data)
@@ -728,9 +569,3 @@ _HEADERS = {b"TMSCT": "TMSCT", b"TMSTA": "TMSTA", b"CPERR": "CPERR"}
 def _header_text(raw: bytes) -> str:
     """The header as text; the three known headers share one string each (the event log keeps many)."""
     return _HEADERS.get(raw) or _text(raw)
-
-
-def _text(raw: bytes) -> str:
-    return raw.decode("utf-8", "backslashreplace")
-
-
