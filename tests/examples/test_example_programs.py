@@ -21,11 +21,12 @@ class Rig:
     """PLC + simulator in one thread; the simulator is polled before every scan at the PLC's time."""
 
     def __init__(self):
-        self.sim = SimServer(port=0, robots=1)
+        self.sim = SimServer(port=0, robots=1, svr_port=0)
         self.sim.start()
         self.robot = self.sim.robots[0]
         self.plc = load_plc(SOURCES)
         self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
+        self.plc.write("Connect_SvrPort", self.robot.svr_port)
         self.plc.write("Connect_AddressIP", "127.0.0.1")
 
     def close(self):

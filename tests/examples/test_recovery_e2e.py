@@ -1,0 +1,155 @@
+"""Done-when scenarios of issue 14 on the examples as shipped (Commands_Example + PnP_Example on the virtual PLC,
+virtual time) against the simulator with its Ethernet Slave over real loopback sockets; the simulator's event
+log is the witness that nothing ran twice."""
+from __future__ import annotations
+
+import os
+import pathlib
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+from sim.server import SimServer
+from vplc.api import load_plc
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
+SECOND = 1_000_000_000
+UNREACHABLE = dict(X=1900.0, Y=0.0, Z=300.0, RX=180.0, RY=0.0, RZ=90.0)
+
+
+class Plant:
+    """The examples on the virtual PLC and a simulator robot with its Ethernet Slave."""
+
+    def __init__(self):
+        self.sim = SimServer(port=0, robots=1, svr_port=0)
+        self.sim.start()
+        self.robot = self.sim.robots[0]
+        self.plc = load_plc(SOURCES)
+        self.plc.write("Connect_AddressIP", "127.0.0.1")
+        self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
+        self.plc.write("Connect_SvrPort", self.robot.svr_port)
+
+    def close(self):
+        self.plc.close()
+        self.sim.close()
+
+    def read(self, name):
+        return self.plc.read(name)
+
+    def until(self, predicate, what, seconds=10.0):
+        ok = self.plc.run_until(predicate, timeout_ns=int(seconds * SECOND),
+                                on_scan=lambda now_ns: self.sim.poll(now_ns / 1e9))
+        assert ok, f"{what} did not happen within {seconds} s of PLC time"
+
+    def pulse(self, name, done, what):
+        self.plc.write(name, False)
+        self.until(lambda: True, "one scan")
+        self.plc.write(name, True)
+        self.until(lambda: self.read(done), what)
+        self.plc.write(name, False)
+
+    def events(self, kind):
+        return [e for e in self.robot.events if e["kind"] == kind]
+
+
+@pytest.fixture
+def plant():
+    p = Plant()
+    p.plc.write("Connect_Execute", True)
+    p.until(lambda: p.read("Connect_Connected") and p.read("RobotStatus_Valid"), "connected with status")
+    yield p
+    p.close()
+
+
+def set_target(plant, segment, pose):
+    for axis, value in pose.items():
+        plant.plc.write(f"PnP_MoveParameters[{segment}].TargetPosition.{axis}", value)
+
+
+def test_out_of_reach_mid_pnp_is_a_robot_error_acknowledged_and_resumed_without_repeats(plant):
+    original = {a: plant.read(f"PnP_MoveParameters[3].TargetPosition.{a}") for a in UNREACHABLE}
+    set_target(plant, 3, UNREACHABLE)                 # an operator typo: the place approach out of reach
+    plant.plc.write("PnP_Example_Execute", True)
+    plant.until(lambda: plant.read("PnP_MoveError"), "the failed move", 30)
+    # segment 3 is blended (Done when accepted): the robot stops on it while segment 4 is either sent
+    # (outcome unknown) or refused because the link is already gone (not connected)
+    assert plant.read("PnP_MoveErrorID") in (0x200B, 0x2001)
+    plant.until(lambda: plant.read("Connect_ErrorID") == 0x4006, "robot error on CBT_Connect", 2)
+    plant.until(lambda: plant.read("RobotStatus.RobotError"), "robot error in CBT_RobotStatus", 1)
+    assert plant.read("RobotStatus.ErrorCode") != 0 and "reach" in plant.read("RobotStatus.ErrorText")
+    assert plant.read("PnP_GripperClosed") and plant.read("PnP_Segment") in (3, 4)
+    picks = len([e for e in plant.events("io") if e.get("value") in (1, True)])
+    # operator: correct the target, acknowledge and play the project, restart the cycle
+    set_target(plant, 3, original)
+    plant.plc.write("PnP_Example_Execute", False)
+    plant.plc.write("Project_Command", "ProjectPlay")
+    plant.pulse("Project_Execute", "Project_Done", "project play")
+    plant.until(lambda: plant.read("Connect_Connected"), "automatic reconnect", 8)
+    assert not plant.read("RobotStatus.RobotError") and plant.read("RobotStatus.ProjectRunning")
+    starts_before = len(plant.events("motion_start"))
+    plant.plc.write("PnP_Example_Execute", True)
+    plant.until(lambda: plant.read("PnP_MoveBusy"), "the first move after the start", 1)
+    assert plant.read("PnP_Segment") == 3                # with the part: on to the place approach
+    plant.until(lambda: plant.read("PnP_CycleCount") >= 1, "the cycle to complete", 40)
+    # resumed at the place approach with the part: no second pick, the part placed once
+    lines = [e["line"] for e in plant.events("motion_start")[starts_before:]]
+    assert lines and plant.read("PnP_CycleCount") == 1
+    closes = [e for e in plant.events("io") if e.get("value") in (1, True)]
+    assert len(closes) == picks                       # the gripper did not close again
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp_path):
+    """SIGKILL: no FIN, no RST from a process that is gone — the kernel answers for it. CBT_Connect (Execute held)
+    reports the loss and reconnects by itself once the simulator is back; the cycle resumes with an operator
+    start. The simulator runs as its own process in real time, so this test runs the PLC in real time too."""
+    port = free_port()
+    cmd = [sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(port), "--no-svr"]
+    env = {**os.environ, "PYTHONPATH": f"{ROOT / 'src'}{os.pathsep}{ROOT}"}
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    plc = load_plc(SOURCES)
+    try:
+        plc.write("Connect_AddressIP", "127.0.0.1")
+        plc.write("Connect_Dest_PortIP", port)
+        plc.write("Connect_SvrPort", 0)
+        plc.write("Connect_Execute", True)
+
+        def run(pred, seconds):
+            end = time.monotonic() + seconds
+            while time.monotonic() < end:
+                now = plc.now_ns + plc.period_ns
+                plc.scan(now)
+                if pred():
+                    return True
+                time.sleep(0.001)
+            return False
+        assert run(lambda: plc.read("Connect_Connected"), 15), plc.read("Connect_ErrorDescrip")
+        plc.write("PnP_Example_Execute", True)
+        assert run(lambda: plc.read("PnP_Segment") >= 1, 30)
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(5)
+        assert run(lambda: plc.read("PnP_MoveError") or plc.read("Connect_Reconnecting"), 5)
+        assert run(lambda: plc.read("Connect_Reconnecting") and not plc.read("Connect_Connected"), 5)
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        assert run(lambda: plc.read("Connect_Connected"), 15), plc.read("Connect_ErrorDescrip")
+        assert plc.read("Connect_RetryCount") >= 1
+        cycles = plc.read("PnP_CycleCount")
+        plc.write("PnP_Example_Execute", False)
+        assert run(lambda: not plc.read("PnP_MoveBusy"), 10)
+        plc.write("PnP_Example_Execute", True)            # operator start
+        assert run(lambda: plc.read("PnP_Segment") != 0 or plc.read("PnP_CycleCount") > cycles, 30)
+        assert run(lambda: plc.read("PnP_MoveDone") or plc.read("PnP_Waiting"), 30)
+    finally:
+        plc.close()
+        proc.kill()
+        proc.wait(5)
