@@ -26,7 +26,7 @@ SIM_SPEEDUP = 4.0     # the robot model runs 4x faster than the wall clock; PLC 
 class System:
     def __init__(self):
         self.mapping = Mapping.load()
-        self.sim = SimServer(port=0, robots=1, speedup=SIM_SPEEDUP)
+        self.sim = SimServer(port=0, robots=1, speedup=SIM_SPEEDUP, svr_port=0)
         self.sim.start_background()
         self.robot = self.sim.robots[0]
         self.plc = load_plc(SOURCES)
@@ -34,6 +34,7 @@ class System:
         with self.plc.lock:
             self.plc.write("Connect_AddressIP", "127.0.0.1")
             self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
+            self.plc.write("Connect_SvrPort", self.robot.svr_port)
         self.stop_event = threading.Event()
         self.plc_thread = threading.Thread(target=self.plc.run_realtime, args=(self.stop_event,), daemon=True)
         self.plc_thread.start()
@@ -276,7 +277,9 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
     browser.wait_for(lambda d: int(browser.status("PnP_CycleCount") or 0) >= cycles + 2, "the cycle count")
     browser.screenshot("e2e_pnp_running")
     browser.click("btn-stop")
-    connected.wait(lambda: not connected.read("PnP_MoveBusy") and connected.read("PnP_Segment") == 0,
+    # stopped: the next start begins where the part is (place approach with a part in the gripper)
+    connected.wait(lambda: not connected.read("PnP_MoveBusy")
+                   and connected.read("PnP_Segment") == (3 if connected.read("PnP_GripperClosed") else 0),
                    "the sequence to stop")
     ends = [e["pose"][:3] for e in connected.events("motion_end", since)]
     for segment in range(6):
