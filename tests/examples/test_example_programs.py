@@ -137,7 +137,9 @@ def test_pnp_runs_two_cycles_with_dwell_pause_resume_and_stops_cleanly(rig):
 
     rig.until(lambda: rig.read("PnP_CycleCount") >= 2, "two complete cycles", 120)
     rig.plc.write("PnP_Example_Execute", False)
-    rig.until(lambda: not rig.read("PnP_MoveBusy") and rig.read("PnP_Segment") == 0, "a clean stop", 30)
+    # stopped: PnP_Segment shows where the next start begins (place approach while a part is in the gripper)
+    rig.until(lambda: not rig.read("PnP_MoveBusy")
+              and rig.read("PnP_Segment") == (3 if rig.read("PnP_GripperClosed") else 0), "a clean stop", 30)
     moves_after_stop = len([e for e in rig.robot.events if e["kind"] == "motion_start"])
     rig.run_for(3)
     assert len([e for e in rig.robot.events if e["kind"] == "motion_start"]) == moves_after_stop
