@@ -64,6 +64,15 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
         place = LadderSource(path, "", [(0, 1, "project")])
         diags.error("ST2102", f"the XML does not follow the format: {exc}", Span(place, 0, 1))
         return []
+    except RecursionError:
+        place = LadderSource(path, "", [(0, 1, "project")])
+        diags.error("ST2101", "the XML is nested too deeply to be a project file", Span(place, 0, 1))
+        return []
+    except Exception as exc:  # noqa: BLE001 - a loader defect must not show a traceback
+        place = LadderSource(path, "", [(0, 1, "project")])
+        diags.error("ST2102", f"internal error of the ladder loader ({type(exc).__name__}: {exc}); please report it "
+                    "with the XML file", Span(place, 0, 1))
+        return []
 
 
 def attach_ladders(unit: A.CompilationUnit) -> None:

@@ -305,7 +305,10 @@ class RungCompiler:
         if src.id in self.guard and (pin or "").upper() != "ENO" and e.kind not in ("out_var", "inout_var"):
             raise _error(self.label(e), f"reads the result of {src.describe()}, a function with EN; wire the "
                                         "result to a variable and read the variable", "ST2107")
-        return self.out[(src.id, pin)]
+        value = self.out.get((src.id, pin))
+        if value is None:
+            raise _error(self.label(e), f"is wired to {src.describe()}, which has no output to read", "ST2103")
+        return value
 
     def power(self, e: Element, pin: Pin) -> Txt:
         if not pin.conns:
