@@ -59,10 +59,12 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
     if lay.number % 2 == 0:
         out.append(f'<rect class="band" x="0" y="-4" width="{width:.0f}" height="{h:.0f}"/>')
     out.append(_t(4, 15, str(lay.number), "num"))
+    x = 40
+    if lay.rung.label:                                 # a jump target, written first as Sysmac shows labels
+        out.append(_t(x, 15, lay.rung.label + ":", "type"))
+        x += 12 + 8 * len(lay.rung.label)
     if lay.rung.comment:
-        out.append(_t(40, 15, lay.rung.comment.splitlines()[0][:140], "cmt"))
-    if lay.rung.label:
-        out.append(_t(width - 30, 15, lay.rung.label + ":", "num", "end"))
+        out.append(_t(x, 15, lay.rung.comment.splitlines()[0][:140], "cmt"))
     oy = COMMENT_H
     left, right = 18, width - 14
     out.append(f'<path class="rail" d="M{left} {oy} V{oy + lay.height + 8:.0f}"/>')
@@ -103,13 +105,12 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
                 did = c.ref if src is None or src.kind != "block" else f"{c.ref}:{c.pin}"
                 out.append(_line(start[0], start[1], x, ty, "wire", did))
         out.append(_element(p, y, lay))
-    rail_in = next((e for e in lay.rung.elements if e.kind == "right_rail"), None)
-    if rail_in is not None:
-        for pin in rail_in.inputs:
-            for c in pin.conns:
-                pt = out_point(c.ref, c.pin)
-                if pt is not None:
-                    out.append(_line(pt[0], pt[1], right, pt[1], "wire", c.ref))
+    read = {c.ref for e in lay.rung.elements if e.kind != "right_rail" for pin in [*e.inputs, *e.inouts]
+            for c in pin.conns}
+    for p in lay.placed.values():                      # a coil's right side always reaches the right rail
+        if p.element.kind == "coil" and p.element.id not in read:
+            pt = out_point(p.element.id, None)
+            out.append(_line(pt[0], pt[1], right, pt[1], "wire", p.element.id))
     out.append("</g>")
     return "".join(out)
 
