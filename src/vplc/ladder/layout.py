@@ -122,7 +122,7 @@ def layout_rung(rung: Rung, number: int) -> RungLayout:
         if p.element.kind == "block":
             w += PIN_LABEL_W * 2
         widths[p.col] = max(widths[p.col], w)
-    xs = [30.0]
+    xs = [44.0]
     for w in widths:
         xs.append(xs[-1] + w)
     for p in lay.placed.values():
