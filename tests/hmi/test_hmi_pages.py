@@ -69,7 +69,7 @@ def test_enumerations_are_drop_down_lists_with_the_library_names(page):
     browser = open_page("moverel")
     options = [o.text for o in browser.field("MoveRel_Param.DataFormat").find_elements(By.TAG_NAME, "option")]
     assert options == ["JPP_Rel", "CPP_Rel", "CPR_Rel", "CAP_Rel", "CAR_Rel", "TPP_Rel", "TPR_Rel", "TAP_Rel",
-                       "TAR_Rel"]
+                       "TAR_Rel", "CDP_Rel", "CDR_Rel", "TDP_Rel", "TDR_Rel"]
 
 
 def test_out_of_range_speed_shows_the_error_and_sends_nothing(page):

@@ -10,7 +10,7 @@ from rig import move_abs
 TEXT = {
     0x1010: "MovementCommand invalid: Line or PTP",
     0x1019: "RobotPose invalid: Pose1 Righty/Lefty, Pose2 Above/Below, Pose3 NoFlip/Flip",
-    0x101C: "DataFormat invalid for Circle: CPP_Circle or CAP_Circle",
+    0x101C: "DataFormat invalid for Circle: CPP_Circle, CAP_Circle or CDP_Circle",
     0x1022: "Command invalid: Pause or Resume",
     0x1023: "Mode invalid: StopNormal/StopImmediate/StopAbortScript/StopDiscardAll",
     0x1024: "Module invalid: ControlBox or EndModule",
@@ -31,7 +31,7 @@ CASES = [
     ("mover", "MoveExec", "MoveParam", move_abs(**POSE), "RobotPose.Pose1", 2, 0x1019),
     ("mover", "MoveExec", "MoveParam", move_abs(**POSE), "RobotPose.Pose2", 5, 0x1019),
     ("mover", "MoveExec", "MoveParam", move_abs(**POSE), "RobotPose.Pose3", 32767, 0x1019),
-    ("circ", "CircExec", "CircParam", CIRC, "DataFormat", 2, 0x101C),
+    ("circ", "CircExec", "CircParam", CIRC, "DataFormat", 3, 0x101C),
     ("prg", "PrgExec", "PrgParam", dict(Command=0), "Command", 2, 0x1022),
     ("stop", "StopExec", "StopParam", dict(Mode=0), "Mode", 4, 0x1023),
     ("stop", "StopExec", "StopParam", dict(Mode=0), "Mode", -32768, 0x1023),
