@@ -68,7 +68,6 @@ class SvrSession:
         self.configure(stream_items, stream_mode, period)
         self.next_stream = 0.0
         self.stream_id = 0
-        self.streams_sent = 0
         self.stalled = False      # fault "stall": no data table, requests read and dropped unanswered
         self.corrupt = 0          # fault "corrupt_checksum": this many more frames leave with a wrong checksum
 
@@ -130,7 +129,6 @@ class SvrSession:
         frame = codec.encode("TMSVR", f"{self.stream_id},{self.stream_mode},".encode()
                              + self._content(self.stream_mode, self.stream_items))
         self.stream_id = (self.stream_id + 1) % 10
-        self.streams_sent += 1
         for conn in self.clients:
             self._out(conn, frame)
 

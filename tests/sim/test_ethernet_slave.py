@@ -414,3 +414,12 @@ def test_fault_disconnect_closes_the_ethernet_slave_clients_not_the_listen_node(
     for fault, params in (("fly", {}), ("stall", {"seconds": 1}), ("corrupt_checksum", {"count": 0})):
         with pytest.raises(ValueError):
             h.srv.svr.inject(h.robot, fault, **params)
+
+
+def test_clients_beyond_the_limit_are_closed_at_once(h, monkeypatch):
+    from sim import ethernet_slave
+    monkeypatch.setattr(ethernet_slave, "MAX_CLIENTS", 2)
+    first, second, third = h.connect_svr(), h.connect_svr(), h.connect_svr()
+    assert h.until(lambda: third.closed, timeout=1)
+    assert not first.closed and not second.closed
+    assert any(e["kind"] == "svr_rejected_connection" for e in h.robot.events)
