@@ -63,6 +63,15 @@ class FairInput:
             self._backlog[key] = (robot, conn)
             conn.greedy = True
 
+    def _buffer_full(self, robot, fraction=1.0) -> bool:
+        """The robot's buffered scripts reach MAX_PENDING or its share of PENDING_BYTES_MAX (times
+        ``fraction``). Checked once a turn: one turn may add SERVE_ITEMS frames more."""
+        pending = robot.session.pending
+        if len(pending) >= MAX_PENDING * fraction:
+            return True
+        limit = self.pending_bytes_limit * fraction
+        return len(pending) * codec.MAX_DATA >= limit and sum(len(p.script) for p in pending) >= limit
+
     def _cperr_tokens(self, conn) -> float:
         """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""
         conn.cperr_tokens = min(CPERR_BURST, conn.cperr_tokens + (self._now - conn.cperr_at) * CPERR_PER_S)
@@ -90,7 +99,7 @@ class FairInput:
             if conn.id not in robot.conns:
                 self._backlog.pop(key, None)
                 continue
-            if len(robot.session.pending) >= MAX_PENDING:
+            if self._buffer_full(robot):
                 self._backlog.pop(key, None)      # the script buffer is full: _set_reading resumes it
                 if not robot.reading_paused:
                     self._set_reading(robot, False)

@@ -187,7 +187,7 @@ def _coerce(type_name, value, ctx):
 
 def _arith(op, a, b, ctx):
     if op == "+" and (isinstance(a, str) or isinstance(b, str)):
-        a, b = to_text(a), to_text(b)
+        a, b = _text_of(a, ctx), _text_of(b, ctx)
         if len(a) + len(b) > STRING_MAX:
             raise ScriptRuntimeError(f"a string holds at most {STRING_MAX} characters")
         _work(ctx, (len(a) + len(b)) // 256)
@@ -481,7 +481,7 @@ def _call(node, args, ctx, line):
             raise ScriptRuntimeError(f"ListenPacket header {header!r} is not TMSCT, TMSTA or CPERR")
         return encode_frame(header, data).decode("utf-8")[:-2]
     if name == "GetString":
-        return to_text(args[0])
+        return _text_of(args[0], ctx)
     raise ScriptRuntimeError(f"function {name} cannot run here")
 
 
@@ -504,6 +504,13 @@ def _wait_queue_tag(args, robot):
     if timeout == 0:
         return robot.tag_result(tag)
     return (yield ("tag", tag, None if timeout < 0 else timeout / 1000.0))
+
+
+def _text_of(value, ctx) -> str:
+    """to_text, counting its work: an array's elements are printed one by one (4 steps each)."""
+    if isinstance(value, list):
+        _work(ctx, 4 * len(value))
+    return to_text(value)
 
 
 def to_text(value) -> str:

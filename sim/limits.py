@@ -48,3 +48,5 @@ SERVE_SCAN = 256                            # ... and decoded (bad packets not a
 CPERR_BURST = 16                            # CPERR answers to bad packets a client gets at once ...
 CPERR_PER_S = 100                           # ... then at most this many per second (robot clock)
 OUTBOX_TOTAL_MAX = 16 << 20                 # unsent bytes of all clients of one robot
+PENDING_BYTES_MAX = 32 << 20                # bytes of buffered scripts, all robots together (each robot at
+                                            # least 4 frames of 64 KiB)

@@ -6,8 +6,8 @@ read, process, write. ``start_background()`` runs the same step in a thread on t
 Limits (per robot unless noted):
 * frame DATA <= codec.MAX_DATA (64 KiB); longer declared lengths are answered with CPERR 01
 * MAX_CLIENTS simultaneous connections; more are accepted and closed at once
-* MAX_PENDING buffered scripts; beyond that the server stops reading from that robot's clients
-  (TCP back-pressure) until the queue shrinks
+* MAX_PENDING buffered scripts or their share of PENDING_BYTES_MAX (all robots together); beyond that the
+  server stops reading from that robot's clients (TCP back-pressure) until the buffer is half empty
 * MAX_OUTBOX bytes waiting to be sent to one client, OUTBOX_TOTAL_MAX to all clients of a robot; a client
   that does not read (the one with most waiting, for the total) is dropped
 * fairness: each client's input is processed in bounded turns, floods after the others, CPERR answers
@@ -30,7 +30,7 @@ from .ethernet_slave import EthernetSlave
 from .eventlog import EventLog, text as _text
 from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
 from .faults import FaultState, check_params as check_fault_params
-from .limits import ACCEPT_BACKOFF_S, CPERR_BURST, EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX
+from .limits import ACCEPT_BACKOFF_S, CPERR_BURST, EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX
 from .profiles import Profile
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
@@ -153,6 +153,7 @@ class SimServer(FairInput):
         self.lock = threading.RLock()
         self.event_limit = event_limit or EVENT_BUDGET // robots    # per robot: all robots together keep <= 40,000
         self.event_bytes_limit = EVENT_BYTES_MAX // robots           # per robot: all together keep <= 20 MiB
+        self.pending_bytes_limit = max(4 * codec.MAX_DATA, PENDING_BYTES_MAX // robots)
         try:
             self.log_file = open(log_path, "a", encoding="utf-8", buffering=1) if log_path else None
         except OSError as exc:
@@ -313,7 +314,7 @@ class SimServer(FairInput):
                 self._flush(robot)
                 if robot.session.state == STOPPED and (robot.listener is not None or robot.conns):
                     self._close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
-                if robot.reading_paused and len(robot.session.pending) < MAX_PENDING // 2:
+                if robot.reading_paused and not self._buffer_full(robot, 0.5):
                     self._set_reading(robot, True)
             if self.manage_gc:
                 _collect_garbage(idle=not ready)
@@ -433,7 +434,7 @@ class SimServer(FairInput):
     def _read(self, robot, conn):
         if conn.id not in robot.conns or conn.eof:
             return
-        if len(robot.session.pending) >= MAX_PENDING:
+        if self._buffer_full(robot):
             self._set_reading(robot, False)
             return
         if len(conn.rbuf) < RBUF_READ_BELOW:     # else: what is buffered is processed first (fairness)

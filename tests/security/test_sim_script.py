@@ -164,3 +164,13 @@ def test_long_sum_queued_behind_a_blocking_script_is_an_error_not_an_internal_er
     assert h.robot.state()["node_state"] == "in_node"
     assert not [e for e in h.robot.events if e["kind"] == "internal_error"]
     assert h.request(h.peer, sta("00")) == [("TMSTA", "00,true,Listen1")]
+
+
+def test_printing_arrays_counts_against_the_work_of_a_script(robot):
+    """Each element of an array printed by GetString or '+' costs work (a 2048-float array is ~40 ms of text)."""
+    prints = STEPS_MAX // (4 * ARRAY_MAX) + 2
+    text = ("float[] f = {" + ",".join(["0.1"] * ARRAY_MAX) + "}\r\n" +
+            "\r\n".join([f'string s{n} = GetString(f)' for n in range(prints)]))
+    reply = run(robot, text)
+    assert reply.startswith("ERROR;") and int(reply[6:]) <= prints + 1
+    assert f"more than {STEPS_MAX} steps" in last_error(robot)["reason"]

@@ -205,3 +205,20 @@ def test_listen_send_fan_out_to_lazy_clients_is_bounded_in_memory(monkeypatch):
             sock.close()
     finally:
         h.close()
+
+
+def test_buffered_scripts_are_bounded_in_bytes_not_only_in_count():
+    """64 KiB scripts queued behind a blocking one: reading pauses at the robot's share of PENDING_BYTES_MAX
+    (with 512 robots: 256 KiB each), long before 1,000 of them (64 MB) are held."""
+    h = Harness(robots=512)
+    try:
+        peer = h.connect()
+        peer.send(sct("A", 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)\r\nQueueTag(1,1)'))
+        h.run(0.01)
+        big = sct("B", "int q = 1\r\n" + "\r\n".join(["q++"] * 6000)[:60_000])
+        _flood(h, peer.sock, big * 30, max_steps=300)          # 900 KB; the kernel's buffers take what we do not
+        pending = h.robot.session.pending
+        assert h.robot.reading_paused and sum(len(p.script) for p in pending) <= h.srv.pending_bytes_limit + 8 * len(big)
+        assert len(pending) < 20
+    finally:
+        h.close()
