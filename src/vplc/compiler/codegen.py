@@ -130,6 +130,29 @@ class CodeGen(ExprGen):
             self.at(f.decl.span if f.decl is not None else None)
             self.emit(f"s.{attr(f.name)} = {self.default(f.type, f.init, 'None')}")
         self.ind -= 2
+        # the copier: a structure passed or assigned by value, field by field without type dispatch
+        self.emit(f"def C{name[1:]}(v):")
+        self.ind += 1
+        self.emit(f"o = _new({name})")
+        for f in t.fields.values():
+            a = attr(f.name)
+            self.emit(f"o.{a} = {self.field_copy(f'v.{a}', f.type)}")
+        self.emit("return o")
+        self.ind -= 1
+
+    def field_copy(self, code: str, t) -> str:
+        u = T.unalias(t)
+        if is_scalar(u):
+            return code
+        if isinstance(u, T.StructType):
+            return self.copy_code(code, u)
+        if isinstance(u, T.ArrayType) and not u.open:
+            el = T.unalias(u.element)
+            if is_scalar(el):
+                return f"{code}[:]"
+            if isinstance(el, T.StructType):
+                return f"[{self.copy_code('x', el)} for x in {code}]"
+        return f"_copy({code})"
 
     # ---- globals ------------------------------------------------------------------------------
     def gen_globals(self) -> None:
@@ -198,21 +221,33 @@ class CodeGen(ExprGen):
         self.emit(f"s.{a} = {self.default(t, d.init, sub)}")
 
     def gen_function_wrapper(self, pt: T.PouType, cname: str, bname: str) -> None:
-        names = [f"p{i}" for i in range(len(pt.params))]
-        self.emit(f"def F{cname[1:]}({', '.join(names)}):")
+        """``F_<n>(p0, p1, ...)``: a fresh frame per call. Variables the caller supplies are not built first
+        and then replaced: the frame gets each argument, and the defaults only of what the call leaves out."""
+        names = {p.name.upper(): (p, f"p{i}") for i, p in enumerate(pt.params)}
+        self.emit(f"def F{cname[1:]}({', '.join(n for _p, n in names.values())}):")
         self.ind += 1
-        self.emit(f"s = {cname}({pt.qualified_name!r})")
-        for p, n in zip(pt.params, names):
-            a = attr(p.name)
-            if p.direction == "in":
-                self.emit(f"if {n} is not None: s.{a} = {n}")
-            elif p.direction == "inout":
-                if is_scalar(p.type):
+        self.emit(f"path = {pt.qualified_name!r}")
+        self.emit(f"s = _new({cname})")
+        self.emit("s.i__path = path")
+        for sec in pt.pou.sections:
+            for d in sec.vars:
+                self.at(d.span)
+                p, n = names.get(d.name.upper(), (None, None))
+                a = attr(d.name)
+                t = d.sym.type if d.sym is not None else T.INT
+                if p is None or p.direction == "out":
+                    self.init_var(sec.kind, d)
+                elif p.direction == "in":
+                    default = self.default(t, d.init, "path + " + repr("." + d.name))
+                    self.emit(f"s.{a} = {n} if {n} is not None else {default}")
+                elif is_scalar(p.type):
                     self.emit(f"s.{a}__r, s.{a}__k = {n}")
                 else:
                     self.emit(f"s.{a} = {n}")
+        if pt.ret is not None and pt.ret is not T.VOID:
+            self.emit(f"s.{attr(pt.name)} = {self.default(pt.ret, None, 'path')}")
         self.emit(f"{bname}(s)")
-        for p, n in zip(pt.params, names):
+        for p, n in names.values():
             if p.direction == "out":
                 self.emit(f"if {n} is not None: {n}[0][{n}[1]] = s.{attr(p.name)}")
         ret = f"s.{attr(pt.name)}" if pt.ret is not None and pt.ret is not T.VOID else "None"

@@ -10,6 +10,7 @@ import re
 
 from ..frontend import ast as A
 from ..frontend import types as T
+from .inline import readonly_inputs
 from ..runtime import iec
 
 _PY_RESERVED = set(keyword.kwlist) | {"None", "True", "False", "s", "G"}
@@ -172,8 +173,14 @@ class ExprGen:
                 return code
             return f"_f32({code})" if tt.bits == 32 else f"float({code})"
         if isinstance(tt, (T.StructType, T.ArrayType)):
-            return f"_copy({code})"
+            return self.copy_code(code, tt)
         return _sign_cast(code, et, tt)
+
+    def copy_code(self, code: str, t) -> str:
+        """A fresh copy of the structure or array value ``code`` of type ``t``: a structure through the copier
+        generated for its type (CodeGen.gen_struct), anything else through the generic deep copy."""
+        entry = self.struct_names.get(id(t)) if isinstance(t, T.StructType) else None
+        return f"C{entry[1][1:]}({code})" if entry is not None else f"_copy({code})"
 
     def ex_Literal(self, e) -> str:
         t = T.base_of(e.ty) if e.ty is not None else None
@@ -375,6 +382,11 @@ class ExprGen:
             return f"_copy({view})" if n is None else f"_fill(_copy({view}), {n}, lambda: {self.default(pt.element, None, repr(p.name))})"
         return self.store_conv(self.expr(ba.expr), ba.expr, p.type)
 
+    def by_reference(self, pt, p, ba) -> bool:
+        """A structure or array the function only reads is handed over as it is, not copied."""
+        return getattr(self, "optimise", False) and not pt.native and not is_scalar(p.type) and \
+            not ba.from_element and ba.expr.conv is None and p.name.upper() in readonly_inputs(pt, self.inline_cache)
+
     # ---- calls -------------------------------------------------------------------------------
     def call_expr(self, e) -> str:
         b = e.binding
@@ -398,7 +410,12 @@ class ExprGen:
                     args.append("None")
                 continue
             if p.direction == "in":
-                args.append(self.expr(ba.expr) if generic else self.input_value(ba, p))
+                if generic:
+                    args.append(self.expr(ba.expr))
+                elif self.by_reference(pt, p, ba):
+                    args.append(self.expr_raw(ba.expr))
+                else:
+                    args.append(self.input_value(ba, p))
             elif p.direction == "inout":
                 args.append(self.ref(ba.expr) if is_scalar(p.type) and not generic or
                             (generic and is_scalar(ba.expr.ty)) else self.aggregate_arg(ba))

@@ -94,16 +94,42 @@ def inlinable(pt, cache: dict) -> bool:
     return ok
 
 
-def kept_inputs(pt) -> dict:
-    """Scalar inputs of ``pt`` (upper name -> variable symbol) that its body never writes: inside an inlined
-    body they still hold the value the call just stored."""
+def _written(pt) -> set:
+    """Ids of the variables ``pt``'s body writes: assignment targets and what it passes to calls as an output
+    or in-out (a member or element written counts as its whole variable)."""
     written = set()
     for node in pt.pou.body:
         for st in _walk(node):
             if isinstance(st, A.Assign):
                 written.add(id(_root(st.target)))
-            elif isinstance(st, A.CallStmt) and st.call.binding is not None:
-                written.update(id(_root(ba.expr)) for ba in st.call.binding.args if ba.param.direction != "in")
+            elif isinstance(st, (A.CallStmt, A.Call)):
+                call = st.call if isinstance(st, A.CallStmt) else st
+                if call.binding is not None:
+                    written.update(id(_root(ba.expr)) for ba in call.binding.args if ba.param.direction != "in")
+    return written
+
+
+def readonly_inputs(pt, cache: dict) -> set:
+    """Upper names of the structure and array inputs of FUNCTION ``pt`` that its body only reads, when the body
+    writes no global variable either (so nothing can change the caller's value during the call): the caller
+    may hand over its value itself instead of a copy."""
+    known = cache.get(("ro", id(pt)))
+    if known is not None:
+        return known
+    written = _written(pt)
+    syms = [d.sym for sec in pt.pou.sections for d in sec.vars if getattr(d, "sym", None) is not None]
+    writes_global = any(id(sym) in written for sym in syms if sym.section in ("VAR_EXTERNAL", "VAR_GLOBAL")) or \
+        any(sec.kind == "VAR_EXTERNAL" for sec in pt.pou.sections)
+    out = set() if writes_global else {sym.name.upper() for sym in syms
+                                       if sym.section == "VAR_INPUT" and id(sym) not in written}
+    cache[("ro", id(pt))] = out
+    return out
+
+
+def kept_inputs(pt) -> dict:
+    """Scalar inputs of ``pt`` (upper name -> variable symbol) that its body never writes: inside an inlined
+    body they still hold the value the call just stored."""
+    written = _written(pt)
     out = {}
     for sec in pt.pou.sections:
         if sec.kind == "VAR_INPUT":

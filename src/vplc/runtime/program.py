@@ -33,7 +33,7 @@ HELPERS = {
     "_f32": iec.f32, "_idiv": iec.idiv, "_imod": iec.imod, "_rdiv": iec.rdiv, "_expt": iec.expt,
     "_ix1": iec.ix1, "_ixn": iec.ixn, "_ixo": iec.ixo, "_View": iec.ArrView,
     "_assign": iec.assign_into, "_copy": iec.copy_value,
-    "_pc": time.perf_counter, "_watchdog": watchdog, "_fault": fault,
+    "_pc": time.perf_counter, "_watchdog": watchdog, "_fault": fault, "_new": object.__new__,
 }
 
 
