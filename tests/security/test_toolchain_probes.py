@@ -75,3 +75,16 @@ def test_trace_into_a_missing_folder_is_refused_before_the_run(tmp_path):
     code, out = vplc("run", src, "--virtual-time", "--cycles", "5", "--trace", "P.x",
                      "--trace-out", str(tmp_path / "missing" / "t.vcd"))
     assert code == 2 and "does not exist or is not writable" in out and "Traceback" not in out
+
+
+def test_absurd_run_and_test_limits_are_refused_with_their_range(tmp_path):
+    src = write(tmp_path, "p.st", "PROGRAM P\nVAR x : DINT; END_VAR\nx := x + 1;\nEND_PROGRAM\n")
+    for flags, expected in ((["--duration", "99999999d"], "from 1ns to 30d"),
+                            (["--duration", "0s"], "from 1ns to 30d"),
+                            (["--cycles", "999999999999"], "--cycles must be 0 .. 2,147,483,648"),
+                            (["--watchdog", "3650d"], "from 1ns to 60s"),
+                            (["--spin-us", "-5"], "--spin-us must be 0 .. 10,000")):
+        code, out = vplc("run", src, "--virtual-time", *flags)
+        assert code == 2 and expected in out and "Traceback" not in out, (flags, out)
+    code, out = vplc("test", src, "--timeout", "1000000d")
+    assert code == 2 and "from 1ns to 1d of virtual time" in out

@@ -41,6 +41,12 @@ def _err(msg: str) -> int:
     return 2
 
 
+MAX_CYCLES = 2**31                       # about 24 days of a 1 ms task
+MAX_DURATION_NS = 30 * 86_400 * 10**9
+MAX_WATCHDOG_NS = 60 * 10**9
+MAX_SPIN_US = 10_000
+
+
 def run_cmd(args) -> int:
     from ..api import LoadError, PlcFault, load_plc, parse_task
     from ..runtime.stats import ScanStats
@@ -54,14 +60,16 @@ def run_cmd(args) -> int:
         folder = os.path.dirname(os.path.abspath(args.trace_out))
         if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
             return _err(f"--trace-out {args.trace_out!r}: the folder {folder} does not exist or is not writable")
-    if args.cycles is not None and args.cycles < 0:
-        return _err("--cycles must be 0 or more")
+    if args.cycles is not None and not 0 <= args.cycles <= MAX_CYCLES:
+        return _err(f"--cycles must be 0 .. {MAX_CYCLES:,}")
     duration = parse_duration(args.duration) if args.duration else None
-    if args.duration and duration is None:
-        return _err(f"--duration {args.duration!r} is not a duration like 5s or 250ms")
+    if args.duration and (duration is None or not 0 < duration <= MAX_DURATION_NS):
+        return _err(f"--duration {args.duration!r} must be a duration from 1ns to 30d, like 5s or 250ms")
     wd = parse_duration(args.watchdog)
-    if wd is None or wd <= 0:
-        return _err(f"--watchdog {args.watchdog!r} is not a duration like 500ms")
+    if wd is None or not 0 < wd <= MAX_WATCHDOG_NS:
+        return _err(f"--watchdog {args.watchdog!r} must be a duration from 1ns to 60s, like 500ms")
+    if not 0 <= args.spin_us <= MAX_SPIN_US:
+        return _err(f"--spin-us must be 0 .. {MAX_SPIN_US:,} microseconds")
     try:
         if args.task is not None:
             parse_task(args.task)

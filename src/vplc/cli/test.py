@@ -18,6 +18,8 @@ from ..runtime.values import parse_duration
 
 RUNNER = "VPLC_TestRunner"
 
+MAX_TIMEOUT_NS = 86_400 * 10**9          # one day of virtual time
+
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("test", help="run ST unit-test suites (TcUnit style)",
@@ -63,8 +65,9 @@ def run_tests(args) -> int:
     from ..api import LoadError, PlcFault, load_plc
     from ..project import load_project
     timeout = parse_duration(args.timeout)
-    if timeout is None:
-        print(f"vplc test: error: --timeout {args.timeout!r} is not a duration like 10s or 500ms", file=sys.stderr)
+    if timeout is None or not 0 < timeout <= MAX_TIMEOUT_NS:
+        print(f"vplc test: error: --timeout {args.timeout!r} must be a duration from 1ns to 1d of virtual time, "
+              f"like 10s or 500ms", file=sys.stderr)
         return 2
     proj = load_project(args.paths)
     if proj.has_errors:
