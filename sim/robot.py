@@ -48,7 +48,7 @@ class RobotModel:
         self.error_code, self.error_text, self.error_time = 0, "", None    # the last error, kept
         self.estop = False               # ESTOP: pressed stops the project; Play is refused while pressed
         self.auto_mode = True            # Operation_Mode: True auto, False manual
-        self.project_speed = 100         # Project_Speed in %: motions advance at this share of time
+        self.project_speed = 100         # Project_Speed in %: motions advance at this share of time (motion_rate)
 
     # ---- queue --------------------------------------------------------------------------------
     def enqueue_motion(self, request: MotionRequest):
@@ -123,15 +123,23 @@ class RobotModel:
         self.error_active = True
         self.error_code, self.error_text, self.error_time = classify(text)[0], text, now
 
+    def motion_rate(self, request) -> float:
+        """Share of time a motion advances at: Project_Speed, except the D formats (absolute mm/s, not scaled
+        by the project speed, TMscript 2.24 §13.10-13.12) and PVT points (their durations; the
+        syncToProjectSpeed flag of §13.19 is not modelled)."""
+        if self.project_speed == 100 or request.function == "PVTPoint" or request.fmt[1:2] == "D":
+            return 1.0
+        return self.project_speed / 100.0
+
     # ---- time ---------------------------------------------------------------------------------
     def tick(self, dt: float) -> list[dict]:
         events = []
-        dt *= self.project_speed / 100.0
         while not self.paused:
             if self.active is not None:
-                remaining = self.active.total - self.active_t
+                rate = self.motion_rate(self.active.request)
+                remaining = (self.active.total - self.active_t) / rate
                 if dt < remaining:
-                    self.active_t += dt
+                    self.active_t += dt * rate
                     break
                 dt -= remaining
                 finished, self.active = self.active, None

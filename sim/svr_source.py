@@ -210,7 +210,7 @@ class _Moment:
                 self._speeds = {"Joint_Speed": [0.0] * 6, "TCP_Speed": [0.0] * 6, "TCP_Speed3D": 0.0}
             else:
                 later = plan.joints_at(min(plan.total, model.active_t + _SPEED_STEP_S), self.joints)
-                scale = model.project_speed / 100.0 / _SPEED_STEP_S
+                scale = model.motion_rate(plan.request) / _SPEED_STEP_S
                 then = kin.matrix_to_pose(kin.forward(later, model._matrix(model.tool_pose)))
                 tcp = [(b - a) * scale for a, b in zip(self.pose("Coord_Robot_Tool"), then)]
                 self._speeds = {"Joint_Speed": [(b - a) * scale for a, b in zip(self.joints, later)],

@@ -423,3 +423,20 @@ def test_clients_beyond_the_limit_are_closed_at_once(h, monkeypatch):
     assert h.until(lambda: third.closed, timeout=1)
     assert not first.closed and not second.closed
     assert any(e["kind"] == "svr_rejected_connection" for e in h.robot.events)
+
+
+def test_project_speed_leaves_absolute_speed_d_formats_alone_13_10(h):
+    node, peer = h.connect(), h.connect_svr()
+    assert ask(h, peer, "V1,2,Project_Speed=50")[1] == b"V1,0,00,OK"
+
+    def timed(script):
+        start, count = h.t, sum(e["kind"] == "motion_end" for e in h.robot.events)
+        h.request(node, sct("1", script))
+        assert h.until(lambda: sum(e["kind"] == "motion_end" for e in h.robot.events) > count, dt=0.002)
+        planned = [e for e in h.robot.events if e["kind"] == "motion_start"][-1]["duration_s"]
+        return h.t - start, planned
+
+    taken, planned = timed('Line("CAP",417.5,-22.3,359.7,180,0,90,100,200,0,false)')
+    assert taken == pytest.approx(2 * planned, abs=0.01)                 # A: scaled by the project speed
+    taken, planned = timed('Line("CDP",417.5,-122.3,359.7,180,0,90,100,200,0,false)')
+    assert taken == pytest.approx(planned, abs=0.01)                     # D: absolute speed, not scaled
