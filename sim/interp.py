@@ -427,7 +427,9 @@ def _call(node, args, ctx, line):
             raise ScriptRuntimeError(f"PVT mode {mode} is not 0 (joint) or 1 (Cartesian)")
         robot.enqueue_setting("pvt", mode)
         return True
-    if name == "PVTExit":
+    if name == "PVTExit":                       # §13.18; outside PVT mode: "command rejected" (false), no effect
+        if robot.pvt_mode_queued() is None:
+            return False
         robot.enqueue_setting("pvt", None)
         return True
     if name == "PVTPoint":
@@ -440,7 +442,9 @@ def _call(node, args, ctx, line):
         robot.enqueue_motion(MotionRequest("PVTPoint", "", tuple(float(v) for v in pos + vel), 0.0, 0.0, 0.0,
                                            False, line=line.text, duration=float(duration)))
         return True
-    if name in ("PVTPause", "PVTResume"):
+    if name in ("PVTPause", "PVTResume"):      # §13.20, §13.21; outside PVT mode: rejected (false), no effect
+        if robot.pvt_mode is None:
+            return False
         (robot.pause if name == "PVTPause" else robot.resume)()
         return True
     if name == "QueueTag":

@@ -132,6 +132,13 @@ class RobotModel:
         return self.project_speed / 100.0
 
     # ---- time ---------------------------------------------------------------------------------
+    def pvt_mode_queued(self):
+        """The PVT mode once every queued item has run (None = not in PVT mode)."""
+        for kind, value in reversed(self.fifo):
+            if kind == "pvt":
+                return value
+        return self.pvt_mode
+
     def tick(self, dt: float) -> list[dict]:
         events = []
         while not self.paused:

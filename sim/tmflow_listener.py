@@ -18,6 +18,7 @@ import gc
 import math
 import os
 import signal
+import socket
 import sys
 import threading
 
@@ -49,8 +50,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--no-auto-enter", action="store_true",
                         help="start with the flow outside the Listen node (enter it via the control channel)")
     parser.add_argument("--send-message", default="Listen1", metavar="TEXT", help="the node's Send Message (default Listen1)")
-    parser.add_argument("--control-port", type=int, default=5889, metavar="PORT",
-                        help="port of the local JSON control channel (default 5889, 0 = any free port)")
+    parser.add_argument("--control-port", type=int, default=None, metavar="PORT",
+                        help="port of the local JSON control channel (default: the port before robot 1's, 5889 "
+                             "for 5890, or any free port when that one is taken; 0 = any free port)")
     parser.add_argument("--no-control", action="store_true", help="do not open the control channel")
     parser.add_argument("--control-host", default="127.0.0.1", metavar="ADDRESS",
                         help="address of the control channel (default 127.0.0.1, whatever --host says)")
@@ -93,7 +95,7 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
         problems.append(f"--port {args.port} with {args.robots} robot(s) leaves the port range 1..65535")
     if not (math.isfinite(args.speedup) and 0 < args.speedup <= MAX_SPEEDUP):
         problems.append(f"--speedup must be positive and at most {MAX_SPEEDUP:g} (got {args.speedup:g})")
-    if not 0 <= args.control_port <= 65535:
+    if args.control_port is not None and not 0 <= args.control_port <= 65535:
         problems.append(f"--control-port must be 0..65535 (got {args.control_port})")
     if not 1 <= args.tag_history <= 1000:
         problems.append(f"--tag-history must be between 1 and 1000 (got {args.tag_history})")
@@ -113,6 +115,23 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
     return problems, svr_port, svr_items
 
 
+def control_port(args) -> int:
+    """--control-port as given; by default the port before robot 1's (5889 for 5890), so two simulators on
+    different --port values do not collide, and any free port (printed at start) when that one is taken."""
+    if args.control_port is not None:
+        return args.control_port
+    derived = args.port - 1 if args.port > 1 else 0
+    if derived:
+        probe = socket.socket()
+        try:
+            probe.bind((args.control_host, derived))
+        except OSError:
+            derived = 0
+        finally:
+            probe.close()
+    return derived
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -127,7 +146,7 @@ def main(argv=None) -> int:
                            log_path=args.log,
                            profile=Profile(tmflow=args.tmflow, tag_history=args.tag_history,
                                            stop_tags=args.stop_tags),
-                           control_port=None if args.no_control else args.control_port,
+                           control_port=None if args.no_control else control_port(args),
                            data_timeout=args.data_timeout if args.data_timeout > 0 else None,
                            connection_timeout=args.connection_timeout if args.connection_timeout > 0 else None,
                            manage_gc=True, control_host=args.control_host, svr_port=svr_port,

@@ -154,3 +154,15 @@ def test_sleep_delays_the_rest_of_the_script(node):
     assert node.out(1)[-1] == reply("A", "OK")
     assert node.send(1, sct("B", "Sleep(0)")) == [reply("B", "OK")]
     assert node.send(1, sct("C", "Sleep()")) == [reply("C", "ERROR;1")]
+
+
+def test_manual_13_18_to_13_21_pvt_exit_pause_resume_outside_pvt_mode_are_rejected_false_without_effect(node):
+    def answer(call):
+        name = f"b{next(_names)}"
+        frames = node.send(1, sct("B", f"bool {name} = {call}\r\nListenSend(90, GetString({name}))"))
+        return frames[0].split(",")[3]
+    assert answer("PVTPause()") == "false" and node.s.robot.paused is False
+    assert answer("PVTExit()") == "false" and node.s.robot.queue_length == 0
+    assert answer("PVTResume()") == "false"
+    node.send(1, sct("P", "PVTEnter(0)"))
+    assert answer("PVTExit()") == "true"                               # PVTEnter still queued: accepted

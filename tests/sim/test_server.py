@@ -374,3 +374,52 @@ def test_event_log_is_bounded_per_robot_and_overall():
     single = SimServer(port=0, robots=1)
     assert single.event_limit == 40_000
     single.close()
+
+
+def _port_pair():
+    """A listening socket on some port q whose neighbour q + 1 was free a moment ago."""
+    for _ in range(20):
+        blocker = socket.socket()
+        blocker.bind(("127.0.0.1", 0))
+        q = blocker.getsockname()[1]
+        probe = socket.socket()
+        try:
+            probe.bind(("127.0.0.1", q + 1))
+        except OSError:
+            blocker.close()
+            continue
+        finally:
+            probe.close()
+        blocker.listen(1)
+        return blocker, q
+    pytest.skip("no free neighbouring ports")
+
+
+def test_cli_control_port_is_the_port_before_robot_1_or_a_free_one_when_that_is_taken(tmp_path):
+    blocker, q = _port_pair()                          # q busy, robot 1 on q + 1: the derived port q is taken
+    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
+                             "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        lines = [proc.stdout.readline() for _ in range(2)]
+        assert lines[0].startswith(f"robot 1: TM5-700 listening on 127.0.0.1:{q + 1} ")
+        port = int(lines[1].split(":")[2].split()[0])
+        assert lines[1].startswith("control channel: ") and port != q
+        assert control_request(port, {"cmd": "robots"})["result"][0]["port"] == q + 1
+    finally:
+        blocker.close()
+        proc.terminate()
+        out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 0 and "Traceback" not in err
+
+
+def test_cli_control_port_defaults_to_the_port_before_robot_1(tmp_path):
+    blocker, q = _port_pair()
+    blocker.close()                                    # q free again: the derived control port
+    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
+                             "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        lines = [proc.stdout.readline() for _ in range(2)]
+        assert lines[1].startswith(f"control channel: 127.0.0.1:{q} ")
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=10)
