@@ -9,6 +9,8 @@ documented = command FBs, then CBT_Connect; fast = CBT_Connect, command FBs, CBT
   (3) sustained blended commands, scans per command per FB instance      target: <= 2
       and per robot with 4 instances; library cost per scan with 7 idle / 7 busy FBs.
 Before issue 6 (documented order, Execute held): (1) 0, (2) 1, (3) 6.00 per instance, 1.50 with 4 instances.
+Then (issue 14) the Listen-node scripts per second of CBT_ReadActualPosition: 0 with the Ethernet Slave, at most
+one per Period without it (before: 190-250 per second, no Period input).
 """
 import statistics
 import sys
@@ -97,5 +99,31 @@ def main():
             r.close()
 
 
+def position_traffic(seconds=10.0):
+    """Listen-node scripts per second of one CBT_ReadActualPosition (Enable held, virtual time): with the robot's
+    Ethernet Slave (the data table stream) and without it (Listen node, rate-limited by Period)."""
+    print("CBT_ReadActualPosition traffic on the Listen node (issue 14), Enable held for "
+          f"{seconds:.0f} s of PLC time")
+    for label, svr, period_ms in (("Ethernet Slave, Period T#100ms", True, 100),
+                                  ("Listen node,    Period T#200ms", False, 200),
+                                  ("Listen node,    Period T#50ms ", False, 50)):
+        r = Rig(**({"svr_port": 0} if svr else {}))
+        try:
+            r.write("ReadPeriod", period_ms * 1_000_000)
+            r.write("ReadEnable", True)
+            r.until(lambda: r.read("rd.Valid"), 2)
+            before = len([e for e in r.events("frame_in") if e.get("header") == "TMSCT"])
+            start = r.plc.now_ns
+            r.until(lambda: False, seconds)
+            span = (r.plc.now_ns - start) / 1e9
+            scripts = len([e for e in r.events("frame_in") if e.get("header") == "TMSCT"]) - before
+            limit = 0 if svr else 1000 / period_ms
+            print(f"  {label}: {scripts / span:5.1f} scripts/s (limit {limit:4.1f}, "
+                  f"{mark(scripts / span, limit)}), Valid at the end: {r.read('rd.Valid')}")
+        finally:
+            r.close()
+
+
 if __name__ == "__main__":
     main()
+    position_traffic()
