@@ -23,6 +23,31 @@ from vplc.hmi.server import HmiServer, Mapping, MappingError  # noqa: E402
 SOURCES = [ROOT / "lib" / "CBT_Commands_Lib", ROOT / "examples"]
 
 
+def robot_event_line(event: dict) -> str | None:
+    """One console line for a robot-side event of the simulator's event log (what an operator at the robot
+    would notice), None for the rest (frames, scripts, motions)."""
+    kind, what = event["kind"], None
+    if kind == "state":
+        change = event.get("event")
+        if change == "robot_fault":
+            what = f"robot error: {event.get('reason') or 'no reason given'} - project stopped"
+        elif change == "stop_project":
+            what = "project stopped"
+        elif change == "start_project":
+            what = "project started"
+        elif change == "enter_node":
+            what = "flow entered the Listen node"
+        elif change == "leave_node":
+            what = f"flow left the Listen node ({event.get('path', 'Pass')} exit)"
+    elif kind == "stick":
+        what = f"stick button {event.get('button')} pressed through the Ethernet Slave"
+    elif kind == "stick_refused":
+        what = f"stick button {event.get('button')} refused: {event.get('reason')}"
+    if what is None:
+        return None
+    return f"[{event['t']:9.3f} s] robot {event['robot'] + 1}: {what}"
+
+
 class DemoError(Exception):
     """A problem the user can fix; str() is printed as it is."""
 
@@ -67,6 +92,7 @@ class Demo:
         self.stop_event = threading.Event()
         self.sim = self.plc = self.hmi = self.plc_thread = None
         self.fault: str | None = None
+        self._seen: dict[int, int] = {}          # robot index -> events already looked at (absolute count)
 
     def start(self) -> None:
         check_port_free(self.host, self.robot_port, "robot simulator", "--robot-port")
@@ -97,6 +123,8 @@ class Demo:
             self.sim.start_background()
         except OSError as exc:
             raise DemoError(f"error: robot simulator: {exc.strerror}") from None
+        with self.plc.lock:
+            self.plc.write("Connect_SvrPort", self.sim.robots[0].svr_port)
         self.hmi = HmiServer(self.plc, mapping, host=self.host, port=self.hmi_port)
         try:
             self.hmi.start()
@@ -128,8 +156,22 @@ class Demo:
             "   (also robot address, base, tool, outputs)",
             "The keys are new at every start; keep them to the people who may move the robot.",
             "The Program (Ladder) page shows Commands_Example's rungs live.",
+            "Robot-side events (robot error, project stopped, Listen node left) are printed below as they happen.",
             "Press Ctrl-C to stop.",
         ])
+
+    def robot_events(self) -> list[str]:
+        """Console lines of the robot-side events logged since the last call."""
+        lines = []
+        with self.sim.lock:
+            for robot in self.sim.robots:
+                seen = self._seen.get(robot.index, 0)
+                for event in robot.events[max(0, seen - robot.events_dropped):]:
+                    line = robot_event_line(event)
+                    if line:
+                        lines.append(line)
+                self._seen[robot.index] = robot.events_dropped + len(robot.events)
+        return lines
 
     def stop(self) -> None:
         self.stop_event.set()
@@ -151,7 +193,8 @@ def main(argv=None) -> int:
         demo.start()
         print(demo.banner(), flush=True)
         while not demo.stop_event.wait(0.5):
-            pass
+            for line in demo.robot_events():
+                print(line, flush=True)
     except DemoError as exc:
         print(exc, file=sys.stderr)
         return 2

@@ -93,3 +93,31 @@ def test_demo_runs_everything_and_stops_cleanly_on_ctrl_c():
             demo.wait(timeout=10)
     assert demo.returncode == 0, err
     assert "Demo stopped" in out and "Traceback" not in err
+
+
+def test_robot_side_events_print_one_console_line_each():
+    """The demo prints one line per robot-side event: a robot error, the project stopped and started, the flow
+    leaving and entering the Listen node, a stick button pressed through the Ethernet Slave."""
+    from sim.server import SimServer
+    sys.path.insert(0, str(ROOT / "examples"))
+    from run_demo import robot_event_line
+
+    sim = SimServer(port=0, robots=1, svr_port=0)
+    sim.start()
+    try:
+        robot = sim.robots[0]
+        start = len(robot.events)
+        robot.leave_listen_node()
+        robot.enter_listen_node()
+        robot.session.fire("robot_fault", reason="Line: target pose is out of reach")
+        robot.start_project()
+        robot.svr_source.write({"Stick_Stop": 1})
+        lines = [line for line in map(robot_event_line, robot.events[start:]) if line]
+    finally:
+        sim.close()
+    texts = [line.split(": ", 1)[1] for line in lines]
+    assert texts == ["flow left the Listen node (Pass exit)", "flow entered the Listen node",
+                     "robot error: Line: target pose is out of reach - project stopped", "project started",
+                     "flow entered the Listen node", "stick button Stop pressed through the Ethernet Slave",
+                     "project stopped"]
+    assert all(line.startswith("[") and "] robot 1: " in line for line in lines)
