@@ -301,7 +301,7 @@ function showStatus() {
 
 /* ---------- polling ---------- */
 function startPolling(names) {
-  names = [...new Set(names.filter((n) => MAP.variables[n]))];
+  names = [...new Set([...names, ...alarmVariables()].filter((n) => MAP.variables[n]))];
   const pillPlc = document.getElementById("pill-plc"), pillRobot = document.getElementById("pill-robot");
   async function tick() {
     try {
@@ -324,6 +324,7 @@ function startPolling(names) {
     pillRobot.textContent = connected ? "Robot connected" : "Robot not connected";
     pillRobot.className = "pill " + (connected ? "on" : "off");
     showStatus();
+    checkAlarms();
     for (const f of live.listeners) f();
     const timer = setTimeout(next, POLL_MS);
     live.kick = () => { clearTimeout(timer); next(); };   // poll at once after a command was sent
@@ -382,6 +383,7 @@ function frame(title, isMain) {
       <h1>${title}</h1><span class="pill ${ACCESS.role === "monitor" ? "off" : "on"}" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span></header>
     <main id="main"></main><div id="message">${ACCESS.role === "monitor" ?
       "Monitor mode (read only): open the operator address printed at start-up to operate." : "Ready."}</div></div>`;
+  alarmBanner(document.querySelector(".panel"));
   return document.getElementById("main");
 }
 
@@ -397,6 +399,7 @@ function mainPage() {
       <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>
     </div><div class="robotview" id="robotview"></div>`;
   robotView(document.getElementById("robotview"));
+  robotTile(document.getElementById("robotview"));
   document.querySelector("header h1").insertAdjacentHTML("afterend",
     '<a class="menu" id="nav-program" href="program.html">Program (Ladder)</a>');
   startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", "Robot_InListenNode", "Robot_QueueDepth",
@@ -408,7 +411,7 @@ async function executeCommand(execVar, values, what) {
   try {
     await api("/api/execute", { execute: execVar, values });
     if (live.kick) live.kick();
-    message(`${what}: command sent to the PLC.`, "ok");
+    message(`${what}: sent, waiting for the function block's answer …`);
     return true;
   } catch (e) { message(`${what}: ${e.message}`, "error"); return false; }
 }
@@ -422,7 +425,9 @@ function releaseWhenFinished(group, what) {
     if (!finished && Date.now() < deadline) { setTimeout(check, POLL_MS); return; }
     try {
       await api("/api/write", { values: { [`${group}_Execute`]: false } });
-      if (finished) message(`${what}: done, Execute reset (the robot accepts motions again).`, "ok");
+      if (finished && v[`${group}_Error`] === true)
+        message(`${what}: Error ${idText(v[`${group}_ErrorID`])} – ${v[`${group}_ErrorDescrip`] || ""}; Execute reset.`, "error");
+      else if (finished) message(`${what}: done, Execute reset.`, "ok");
       else message(`${what}: no answer within 10 s; Execute reset.`, "error");
     } catch (e) { message(`${what}: cannot reset Execute: ${e.message}`, "error"); }
   };
@@ -468,6 +473,7 @@ async function fbPage(key) {
     if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
     executeCommand(`${group}_Execute`, result.values, page.title).then((sent) => {
       if (sent && page.release) releaseWhenFinished(group, page.title);
+      else if (sent) watchResult(group, page.title);
     });
   };
   buttons.append(exec);
@@ -649,6 +655,7 @@ async function boot() {
   try {
     MAP = await api("/api/mapping");
     ACCESS.role = (await api("/api/session")).role;
+    await loadAlarms();
   } catch (e) {
     frame("CBT HMI", true);
     message("Cannot load the variable table: " + e.message, "error");

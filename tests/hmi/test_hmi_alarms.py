@@ -1,0 +1,64 @@
+"""The HMI's alarm banner and history and its Robot tile (issue 14) in headless Chromium, against the examples on
+the virtual PLC in real time and the simulator with its Ethernet Slave: a robot error raises the alarms (robot
+code and text, CBT_Connect's 16#4006), Acknowledge clears the banner, Play on the Robot tile restarts the
+project through CBT_ProjectControl and the message line reports the FB's answer."""
+import pytest
+from selenium.webdriver.common.by import By
+
+from test_hmi_end_to_end import System
+
+
+@pytest.fixture(scope="module")
+def system():
+    stack = System()
+    with stack.plc.lock:
+        stack.plc.write("Connect_Execute", True)
+    stack.wait(lambda: stack.read("Connect_Connected") and stack.read("RobotStatus_Valid"), "connected", 15)
+    yield stack
+    stack.close()
+
+
+def text(browser, element_id):
+    return browser.driver.find_element(By.ID, element_id).text
+
+
+def banner(browser):
+    element = browser.driver.find_element(By.ID, "alarm-banner")
+    return element.text if element.is_displayed() else ""
+
+
+def test_robot_error_raises_alarms_acknowledge_clears_the_banner_and_play_restarts(system):
+    browser = system.open("index")
+    browser.wait_for(lambda d: text(browser, "robot-project").startswith("running"), "the project running")
+    assert text(browser, "robot-error") == "none" and banner(browser) == ""
+    with system.sim.lock:
+        system.robot.session.fire("robot_fault", reason="Line: target pose is out of reach")
+    browser.wait_for(lambda d: "out of reach" in text(browser, "robot-error"), "the robot error on the tile")
+    assert text(browser, "robot-project") == "stopped"
+    browser.wait_for(lambda d: "16#4006" in browser.driver.find_element(By.ID, "alarm-history").text,
+                     "CBT_Connect's robot error alarm")
+    history = browser.driver.find_element(By.ID, "alarm-history").text
+    assert "Robot code 16#00010001: Line: target pose is out of reach" in history
+    assert banner(browser) != ""
+    browser.click("btn-alarm-ack-all")
+    browser.wait_for(lambda d: banner(browser) == "", "the banner to clear")
+    browser.click("btn-project-play")
+    browser.wait_for(lambda d: "Project Play: done" in browser.message(), "Play's answer on the message line")
+    browser.wait_for(lambda d: text(browser, "robot-project").startswith("running"), "the project running again")
+    system.wait(lambda: system.read("Connect_Connected"), "the automatic reconnect", 15)
+    browser.wait_for(lambda d: text(browser, "robot-link") == "Listen node connected", "the link on the tile")
+    browser.wait_for(lambda d: "gone" in browser.driver.find_element(By.ID, "alarm-history").text, "alarms gone")
+    browser.screenshot("e2e_robot_tile")
+
+
+def test_a_refused_project_command_is_reported_as_an_error_not_as_sent(system):
+    browser = system.open("index")
+    browser.wait_for(lambda d: text(browser, "robot-project").startswith("running"), "the project running")
+    with system.sim.lock:
+        system.robot.svr_source.model.estop = True
+    browser.wait_for(lambda d: text(browser, "robot-safety").startswith("E-STOP"), "the E-stop on the tile")
+    browser.click("btn-project-play")
+    browser.wait_for(lambda d: "Error 16#400A" in browser.message(), "the refusal on the message line")
+    assert "error" in browser.driver.find_element(By.ID, "message").get_attribute("class")
+    with system.sim.lock:
+        system.robot.svr_source.model.estop = False
