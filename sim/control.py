@@ -23,7 +23,6 @@ that lets more than CONTROL_OUTBOX_MAX bytes of answers pile up is closed.
 """
 from __future__ import annotations
 
-import errno
 import json
 import math
 import re
@@ -31,7 +30,7 @@ import selectors
 import socket
 
 from .limits import (ACCEPT_BACKOFF_S, CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX,
-                     CONTROL_EVENTS_MAX, CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX)
+                     CONTROL_EVENTS_MAX, CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, OUT_OF_DESCRIPTORS)
 from .session import TransitionError
 
 _FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission"}
@@ -98,7 +97,7 @@ class ControlChannel:
         except (BlockingIOError, InterruptedError):
             return
         except OSError as exc:
-            if exc.errno in (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM):
+            if exc.errno in OUT_OF_DESCRIPTORS:
                 self._pause_accepting(exc)
             return
         if len(self.clients) >= CONTROL_CLIENTS_MAX:

@@ -15,6 +15,7 @@ import selectors
 import socket
 
 from . import codec
+from .limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
 from .svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
 from .svr_source import RobotDataSource
 
@@ -72,6 +73,10 @@ class EthernetSlave:
     def poll(self, now):
         """Stream the data tables that are due and send what is waiting (called by SimServer.poll)."""
         for robot in self.server.robots:
+            paused = getattr(robot, "svr_accept_paused_until", None)
+            if paused is not None and now >= paused:
+                robot.svr_accept_paused_until = None
+                self.server.selector.register(robot.svr_listener, selectors.EVENT_READ, ("svr_listen", None, robot))
             if robot.svr.clients:
                 robot.svr.advance(now)
                 self._flush(robot)
@@ -83,7 +88,13 @@ class EthernetSlave:
             except (BlockingIOError, InterruptedError):
                 return
             except OSError as exc:
-                robot._log("svr_accept_error", reason=exc.strerror)
+                if exc.errno in OUT_OF_DESCRIPTORS:
+                    # the listener stays readable: watching it now would spin; try again after a pause
+                    self.server.selector.unregister(robot.svr_listener)
+                    robot.svr_accept_paused_until = self.server._now + ACCEPT_BACKOFF_S
+                    robot._log("svr_accept_paused", reason=exc.strerror, seconds=ACCEPT_BACKOFF_S)
+                else:
+                    robot._log("svr_accept_error", reason=exc.strerror)
                 return
             if len(robot.svr_conns) >= MAX_CLIENTS:
                 robot._log("svr_rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")

@@ -8,6 +8,7 @@ give their values).
 """
 from __future__ import annotations
 
+import errno
 import sys
 
 # ---- script values ------------------------------------------------------------------------------
@@ -43,6 +44,7 @@ CONTROL_CLIENTS_MAX = 16
 # ---- robot servers (per robot unless noted) -----------------------------------------------------
 EVENT_BYTES_MAX = 20 << 20                  # event log kept in memory, all robots together
 ACCEPT_BACKOFF_S = 0.1                      # out of descriptors: stop accepting for this long
+OUT_OF_DESCRIPTORS = (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM)   # accept() errors that pause it
 SERVE_ITEMS = 8                             # items of one client's input processed in one turn ...
 SERVE_SCAN = 256                            # ... and decoded (bad packets not answered count here only)
 CPERR_BURST = 16                            # CPERR answers to bad packets a client gets at once ...

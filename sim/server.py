@@ -16,7 +16,6 @@ Limits (per robot unless noted):
 """
 from __future__ import annotations
 
-import errno
 import gc
 import math
 import selectors
@@ -30,7 +29,8 @@ from .ethernet_slave import EthernetSlave
 from .eventlog import EventLog, text as _text
 from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
 from .faults import FaultState, check_params as check_fault_params
-from .limits import ACCEPT_BACKOFF_S, CPERR_BURST, EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX
+from .limits import (ACCEPT_BACKOFF_S, CPERR_BURST, EVENT_BYTES_MAX, OUT_OF_DESCRIPTORS, OUTBOX_TOTAL_MAX,
+                     PENDING_BYTES_MAX)
 from .profiles import Profile
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
@@ -41,7 +41,6 @@ RECV_SIZE = 65536
 RBUF_READ_BELOW = codec.MAX_DATA + 64     # a receive buffer this full holds a complete item: process it first
 EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all), and at
                             # most limits.EVENT_BYTES_MAX bytes (sim/eventlog.py)
-_OUT_OF_DESCRIPTORS = (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM)
 GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
 
@@ -411,7 +410,7 @@ class SimServer(FairInput):
             except (BlockingIOError, InterruptedError):
                 return
             except OSError as exc:
-                if exc.errno in _OUT_OF_DESCRIPTORS:
+                if exc.errno in OUT_OF_DESCRIPTORS:
                     # the listener stays readable: watching it now would spin; try again after a pause
                     self.selector.unregister(robot.listener)
                     robot.accept_paused_until = self._now + ACCEPT_BACKOFF_S

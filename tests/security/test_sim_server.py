@@ -222,3 +222,32 @@ def test_buffered_scripts_are_bounded_in_bytes_not_only_in_count():
         assert len(pending) < 20
     finally:
         h.close()
+
+
+def test_out_of_descriptors_pauses_the_ethernet_slave_listener_too():
+    """Probe: EMFILE on the Ethernet Slave port (old: an svr_accept_error on every turn of the loop)."""
+    h = Harness(svr_port=0)
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    held = []
+    try:
+        clients = [socket.create_connection(("127.0.0.1", h.robot.svr_port), timeout=5) for _ in range(2)]
+        highest = max(int(fd) for fd in os.listdir("/proc/self/fd"))
+        resource.setrlimit(resource.RLIMIT_NOFILE, (highest + 1, hard))
+        held = _fill_descriptors()
+        for _ in range(200):
+            h.srv.poll(h.t)
+        kinds = [e["kind"] for e in h.robot.events]
+        assert kinds.count("svr_accept_paused") == 1 and "svr_accept_error" not in kinds
+        for fd in held:
+            os.close(fd)
+        held = []
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+        h.run(ACCEPT_BACKOFF_S + 0.01)
+        assert len(h.robot.svr_conns) == 2              # accepting resumed after the back-off
+        for sock in clients:
+            sock.close()
+    finally:
+        for fd in held:
+            os.close(fd)
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+        h.srv.close()
