@@ -3,15 +3,14 @@ from __future__ import annotations
 
 import pathlib
 import sys
-import threading
 
 import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
-from fake_plc import FakePlc, command_program  # noqa: E402
+from fake_plc import FakePlc, command_program, scanning, serving  # noqa: E402
 from hmi_http import Client  # noqa: E402
-from vplc.hmi.server import HmiServer, Mapping  # noqa: E402
+from vplc.hmi.server import Mapping  # noqa: E402
 
 
 @pytest.fixture
@@ -21,26 +20,14 @@ def mapping():
 
 @pytest.fixture
 def fake_plc(mapping):
-    plc = FakePlc(mapping, command_program)
-    stop = threading.Event()
-
-    def scanning():
-        while not stop.wait(0.001):
-            plc.scan()
-
-    thread = threading.Thread(target=scanning, daemon=True)
-    thread.start()
-    yield plc
-    stop.set()
-    thread.join(timeout=5)
+    with scanning(FakePlc(mapping, command_program)) as plc:
+        yield plc
 
 
 @pytest.fixture
 def server(fake_plc, mapping):
-    srv = HmiServer(fake_plc, mapping, port=0)
-    srv.start()
-    yield srv
-    srv.stop()
+    with serving(fake_plc, mapping) as srv:
+        yield srv
 
 
 @pytest.fixture

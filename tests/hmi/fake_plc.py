@@ -5,6 +5,7 @@ built from hmi/mapping.json; scan() advances the clock and runs an optional prog
 """
 from __future__ import annotations
 
+import contextlib
 import re
 import threading
 
@@ -115,3 +116,33 @@ def command_program(plc: FakePlc) -> None:
             if group == "Connect":
                 plc.vars["Connect_Connected"] = False
         state[group] = execute
+
+
+@contextlib.contextmanager
+def scanning(plc: FakePlc, period_s: float = 0.001):
+    """The fake PLC scanning in a thread (wall clock) while the block runs."""
+    stop = threading.Event()
+
+    def loop():
+        while not stop.wait(period_s):
+            plc.scan()
+
+    thread = threading.Thread(target=loop, daemon=True)
+    thread.start()
+    try:
+        yield plc
+    finally:
+        stop.set()
+        thread.join(timeout=5)
+
+
+@contextlib.contextmanager
+def serving(plc, mapping):
+    """An HMI server for ``plc`` on an ephemeral loopback port while the block runs."""
+    from vplc.hmi.server import HmiServer
+    server = HmiServer(plc, mapping, port=0)
+    server.start()
+    try:
+        yield server
+    finally:
+        server.stop()

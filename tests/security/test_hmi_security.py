@@ -18,7 +18,7 @@ import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "hmi"))
 
-from fake_plc import FakePlc, command_program  # noqa: E402
+from fake_plc import FakePlc, command_program, scanning, serving  # noqa: E402
 from hmi_http import Client  # noqa: E402
 from vplc.hmi import server as hmi_server  # noqa: E402
 from vplc.hmi.server import HmiServer, Mapping  # noqa: E402
@@ -33,26 +33,14 @@ def mapping():
 
 @pytest.fixture
 def plc(mapping):
-    plc = FakePlc(mapping, command_program)
-    stop = threading.Event()
-
-    def scanning():
-        while not stop.wait(0.001):
-            plc.scan()
-
-    thread = threading.Thread(target=scanning, daemon=True)
-    thread.start()
-    yield plc
-    stop.set()
-    thread.join(timeout=5)
+    with scanning(FakePlc(mapping, command_program)) as scanned:
+        yield scanned
 
 
 @pytest.fixture
 def hmi(plc, mapping):
-    server = HmiServer(plc, mapping, port=0)
-    server.start()
-    yield server
-    server.stop()
+    with serving(plc, mapping) as server:
+        yield server
 
 
 def raw_request(port: int, method: str, path: str, body: bytes = b"", headers: dict | None = None):
@@ -312,38 +300,33 @@ def test_many_simultaneous_pollers_are_all_answered(hmi):
 def test_execute_on_a_stopped_plc_writes_nothing(mapping):
     """/api/execute answered 503 after it had already written the values; a 503 now means nothing changed."""
     plc = FakePlc(mapping, command_program)            # never scanned
-    server = HmiServer(plc, mapping, port=0)
-    server.start()
-    try:
+    with serving(plc, mapping) as server:
         status, answer = Client(f"http://127.0.0.1:{server.port}", server.access.keys["operator"]).json(
             "/api/execute", MOVE)
-    finally:
-        server.stop()
     assert status == 503 and "nothing was written" in answer["error"]
     assert plc.read("MoveAbs_Param.TargetPosition.Z") == 0.0 and plc.read("MoveAbs_Execute") is False
 
 
-def test_execute_when_the_plc_stops_midway_restores_every_value(mapping, monkeypatch):
+@pytest.mark.parametrize("stops_before", ["the Execute FALSE cycle", "the Execute TRUE cycle"])
+def test_execute_when_the_plc_stops_midway_restores_every_value(mapping, monkeypatch, stops_before):
+    """The PLC scans when the request arrives, then stops before it has seen Execute TRUE: every value
+    written goes back, so the 503 is the truth."""
     plc = FakePlc(mapping, command_program)
-    server = HmiServer(plc, mapping, port=0)
-    calls = []
-    real_wait = HmiServer._await_task_cycles
+    waits = []
+    fail_at = 2 if stops_before == "the Execute FALSE cycle" else 3
 
-    def wait_then_stop(self, what):
-        calls.append(what)
-        if len(calls) == 1:
-            plc.scan()                                  # the PLC still scans before the write ...
-            return real_wait(self, what)
-        raise hmi_server.RequestError(f"the PLC is not scanning: {what}", 503)   # ... and stops after it
+    def scanning_until_it_stops(self, what):
+        waits.append(plc.read("MoveAbs_Execute"))
+        if len(waits) == fail_at:
+            raise hmi_server.RequestError(f"the PLC is not scanning: {what}", 503)
+        plc.scan()                                      # one task cycle passes
 
-    monkeypatch.setattr(HmiServer, "_await_task_cycles", wait_then_stop)
-    server.start()
-    try:
+    monkeypatch.setattr(HmiServer, "_await_task_cycles", scanning_until_it_stops)
+    with serving(plc, mapping) as server:
         status, _ = Client(f"http://127.0.0.1:{server.port}", server.access.keys["operator"]).json(
             "/api/execute", MOVE)
-    finally:
-        server.stop()
-    assert status == 503
+    assert status == 503 and len(waits) == fail_at
+    assert waits[-1] is (fail_at == 3)                   # the values really were written before the stop
     assert plc.read("MoveAbs_Param.TargetPosition.Z") == 0.0 and plc.read("MoveAbs_Execute") is False
 
 
