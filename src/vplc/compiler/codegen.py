@@ -13,7 +13,7 @@ import re
 from ..frontend import ast as A
 from ..frontend import types as T
 from .codegen_expr import ExprGen, attr, cut, is_scalar
-from .inline import constant_bounds, inlinable, kept_inputs, loop_range, unguarded
+from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop_range, unguarded
 from ..runtime.program import GEN_FILE, PouClass, Program
 
 CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)
@@ -139,6 +139,29 @@ class CodeGen(ExprGen):
             self.emit(f"o.{a} = {self.field_copy(f'v.{a}', f.type)}")
         self.emit("return o")
         self.ind -= 1
+        # the assigner: a structure value copied into an existing structure (assignment, FB input)
+        self.emit(f"def A{name[1:]}(o, v):")
+        self.ind += 1
+        if not t.fields:
+            self.emit("pass")
+        for f in t.fields.values():
+            a = attr(f.name)
+            self.emit(self.field_assign(f"o.{a}", f"v.{a}", f.type))
+        self.ind -= 1
+
+    def assign_code(self, dst: str, src: str, t) -> str:
+        """Statement copying the structure or array value ``src`` into the existing ``dst`` of type ``t``."""
+        u = T.unalias(t)
+        entry = self.struct_names.get(id(u)) if isinstance(u, T.StructType) else None
+        return f"A{entry[1][1:]}({dst}, {src})" if entry is not None else f"_assign({dst}, {src})"
+
+    def field_assign(self, dst: str, src: str, t) -> str:
+        u = T.unalias(t)
+        if is_scalar(u):
+            return f"{dst} = {src}"
+        if isinstance(u, T.ArrayType) and not u.open and is_scalar(T.unalias(u.element)):
+            return f"{dst}[:] = {src}"
+        return self.assign_code(dst, src, u)
 
     def field_copy(self, code: str, t) -> str:
         u = T.unalias(t)
@@ -297,7 +320,7 @@ class CodeGen(ExprGen):
             return
         lv = self.lvalue(target)
         if isinstance(tt, (T.StructType, T.ArrayType)):
-            self.emit(f"_assign({lv}, {code})")
+            self.emit(self.assign_code(lv, code, tt))
             return
         if isinstance(tt, T.StringType):
             sb = T.base_of(st_ty) if st_ty is not None else None
@@ -414,7 +437,10 @@ class CodeGen(ExprGen):
         self.ind += 1
         self.emit(f"{var} = {v}")
         short = self.optimise and unguarded(st)
-        if not short:
+        unit = self.optimise and not short and (st.step is None or constant_step(st) in (1, -1))
+        if unit:              # counting by one: check the watchdog every 64 iterations, and when the loop ends
+            self.emit(f"if not {v} & 63 and _pc() > _DL[0]: _watchdog()")
+        elif not short:
             self.loop_guard()
         known = loop_range(st) if self.optimise else None
         if known is not None:
@@ -423,7 +449,7 @@ class CodeGen(ExprGen):
         if known is not None:
             del self.loop_index[id(st.var.sym)]
         self.ind -= 1
-        if short:                   # a short loop is checked once, when it ends
+        if short or unit:           # a short loop is checked once, when it ends
             self.at(st.span)
             self.loop_guard()
 
@@ -494,8 +520,12 @@ class CodeGen(ExprGen):
             p = ba.param
             a = attr(p.name)
             if p.direction == "in":
-                value = self.input_value(ba, p)
                 sym = kept.get(p.name.upper())
+                if self.optimise and isinstance(T.base_of(p.type), T.StructType) and not ba.from_element \
+                        and ba.expr.conv is None:       # into the instance's own structure, no new object
+                    self.emit(self.assign_code(f"{inst}.{a}", self.expr_raw(ba.expr), p.type))
+                    continue
+                value = self.input_value(ba, p)
                 if sym is None:
                     self.emit(f"{inst}.{a} = {value}")
                 elif _LITERAL.fullmatch(value):

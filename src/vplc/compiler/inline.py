@@ -180,6 +180,11 @@ def constant_bounds(st: A.For):
     return start, end, step
 
 
+def constant_step(st: A.For):
+    """The literal step of a FOR loop (1 when omitted), or None."""
+    return 1 if st.step is None else _int_literal(st.step)
+
+
 def unguarded(st: A.For) -> bool:
     """A FOR loop that needs no watchdog check per iteration, only one when it ends: constant bounds, at most
     MAX_UNGUARDED iterations and no loop inside its body (the innermost loops of a nest keep their checks)."""

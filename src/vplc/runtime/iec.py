@@ -163,6 +163,23 @@ class ArrView:
         return (b[o + k] for k in range(self.n))
 
 
+def bytes_of(arr, n: int) -> bytes:
+    """The first ``n`` elements of a byte array (a list, or a view starting at an element) as bytes."""
+    items = arr.base[arr.off:arr.off + n] if isinstance(arr, ArrView) else arr[:n]
+    try:
+        return bytes(items)
+    except ValueError:                      # elements of a wider integer type: their low bytes, as Sysmac sends
+        return bytes(x & 0xFF for x in items)
+
+
+def store_bytes(arr, data) -> None:
+    """Write ``data`` into the first elements of a byte array (a list, or a view starting at an element)."""
+    if isinstance(arr, ArrView):
+        arr.base[arr.off:arr.off + len(data)] = data
+    else:
+        arr[:len(data)] = data
+
+
 def copy_value(v):
     """Deep copy of a value (structs and arrays are copied; scalars are immutable)."""
     t = type(v)

@@ -7,6 +7,7 @@ arrives as a (container, key) reference, an array as a list or an array view.
 """
 from __future__ import annotations
 
+from . import iec
 from . import sockets as S
 from .sysmac_fns import FUNCTIONS
 from .testing import FUNCTIONS as TEST_FUNCTIONS
@@ -110,7 +111,7 @@ class SktTCPSend(_SocketFB):
         if c is not None and not self.i__err and (c.eof or c.error):
             self.i__err = S.ERR_CLOSED
         if not self.i__err:
-            c.tx += bytes(self.SendDat[k] & 0xFF for k in range(self.Size))
+            c.tx += iec.bytes_of(self.SendDat, self.Size)
             # the controller's socket service transmits in the background as soon as the send is started;
             # only Done waits for the next call (what the OS does not take now goes out when polled)
             try:
@@ -154,8 +155,7 @@ class SktTCPRcv(_SocketFB):
         c.pump()
         if c.rx:
             n = min(len(c.rx), self.Size)
-            for k in range(n):
-                self.RcvDat[k] = c.rx[k]
+            iec.store_bytes(self.RcvDat, c.rx[:n])
             del c.rx[:n]
             self.RcvSize = n
             return 0

@@ -7,6 +7,7 @@ from __future__ import annotations
 import struct
 
 from ..frontend import types as T
+from . import iec
 from .faults import RuntimeFaultError
 
 LOW_HIGH, HIGH_LOW = 0, 1
@@ -44,8 +45,7 @@ def ToAryByte(rt, In, In_t, Order, AryOut) -> int:
         data = _order(data, Order)
     if len(data) > len(AryOut):
         raise RuntimeFaultError(f"ToAryByte: {len(data)} bytes do not fit in the {len(AryOut)}-byte array")
-    for i, x in enumerate(data):
-        AryOut[i] = x
+    iec.store_bytes(AryOut, data)
     return len(data)
 
 
@@ -76,15 +76,14 @@ def StringToAry(rt, In, AryOut) -> int:
     data = In.encode("latin-1", "replace")
     if len(data) > len(AryOut):
         raise RuntimeFaultError(f"StringToAry: {len(data)} characters do not fit in the {len(AryOut)}-byte array")
-    for i, x in enumerate(data):
-        AryOut[i] = x
+    iec.store_bytes(AryOut, data)
     return len(data)
 
 
 def AryToString(rt, In, Size) -> str:
     if Size > len(In):
         raise RuntimeFaultError(f"AryToString: Size {Size} exceeds the {len(In)} bytes of the array")
-    data = bytes(In[i] & 0xFF for i in range(Size))
+    data = iec.bytes_of(In, Size)
     return data.split(b"\0", 1)[0].decode("latin-1")[:1985]
 
 
