@@ -20,7 +20,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "src"), str(ROOT), str(ROOT / "tests" / "lib")]
 
-from rig import Rig, move_abs  # noqa: E402
+from rig import ST, Rig, move_abs  # noqa: E402
 from latency import ORDERS, execute_to_socket, reply_to_done, scan, sustained  # noqa: E402
 
 
@@ -76,7 +76,39 @@ def cost(r, n=400):
     return statistics.median(times), statistics.median(stmts)
 
 
+# issue 15: the original design's seven FBs measured in the same way (µs per scan, ST statements per scan)
+ORIGINAL = {"connect": (16.3, 39), "connect+move": (27.3, 52), "7 idle": (78.9, 111), "7, one busy": (83.3, 125)}
+
+
+def versus_original():
+    """Issue 15, target 1: statements and µs per scan in the states the original design was measured in."""
+    bench = Path(__file__).resolve().parent / "st"
+    rows = []
+    for key, program in (("connect", bench / "Main_Connect.st"), ("connect+move", ST / "Main_Basic.st")):
+        r = Rig(program=str(program), load_args=dict(count_statements=True))
+        try:
+            rows.append((key, *cost(r)))
+        finally:
+            r.close()
+    r = Rig(program="Main_Bench.st", load_args=dict(count_statements=True))
+    try:
+        rows.append(("7 idle", *cost(r)))
+        r.set_struct("MParam[1]", move_abs(Speed=5, TargetPosition=dict(X=60.0, Y=0, Z=90, RX=0, RY=90, RZ=0)))
+        r.write("MExec[1]", True)
+        scan(r)
+        rows.append(("7, one busy", *cost(r)))
+    finally:
+        r.close()
+    print("Library cost per scan against the original design (issue 15; same virtual PLC, simulator, 1 ms task)")
+    print(f"  {'state (1 robot)':<34}{'original':>18}{'ours':>18}  target: statements <= original")
+    for key, us, st in rows:
+        o_us, o_st = ORIGINAL[key]
+        mark = "ok " if st <= o_st else "-- "
+        print(f"  {key:<34}{o_us:7.1f} us {o_st:4d} st   {us:7.1f} us {mark}{st:4.0f} st")
+
+
 def main():
+    versus_original()
     latency_table()
     for order, program in ORDERS.items():
         r = Rig(program=program, load_args=dict(count_statements=True))
