@@ -81,23 +81,23 @@ class Robot(EventLog):
     # ---- control ------------------------------------------------------------------------------
     def enter_listen_node(self):
         with self._server.lock:
-            self.session.fire("enter_node", source="control")
+            self.session.enter_node()
 
     def leave_listen_node(self):
         with self._server.lock:
-            self.session.fire("leave_node", path="Pass", source="control")
+            self.session.leave_node()
 
     def stop_project(self):
         with self._server.lock:
-            self.session.fire("stop_project", source="control")
+            self.session.stop_project()
             self._server._close_robot_sockets(self)
 
     def start_project(self, enter_node=None):
         with self._server.lock:
-            self.session.fire("start_project", source="control")
+            self.session.start_project(enter_node=False)
             self._server._listen(self)
             if self._server.auto_enter if enter_node is None else enter_node:
-                self.session.fire("enter_node", source="control")
+                self.session.enter_node()
 
     def inject(self, fault: str, **params):
         """Arm a fault (see docs/simulator.md, 'Fault injection'); raises ValueError when unknown or when a
@@ -105,10 +105,9 @@ class Robot(EventLog):
         checked = check_fault_params(fault, params)
         with self._server.lock:
             if fault == "reply_error":
-                self.session.faults["reply_error"] = min(self.session.faults["reply_error"] + checked["count"],
-                                                         10 ** 6)
+                self.session.add_reply_errors(checked["count"])
             elif fault == "leave_node":
-                self.session.fire("leave_node", path=checked["path"], source="fault")
+                self.session.leave_node(path=checked["path"], source="fault")
             elif fault == "stop_project":
                 self.stop_project()
             elif fault == "refuse_connections":
@@ -126,7 +125,7 @@ class Robot(EventLog):
             held = self.faults
             self.faults = FaultState()
             self.faults.adopt(held)          # frames already held back still leave at their time
-            self.session.faults["reply_error"] = 0
+            self.session.clear_reply_errors()
             self._server._apply_refuse(self)
             self._log("fault", fault="cleared", params={})
 
@@ -508,7 +507,7 @@ class SimServer(FairInput):
             if close:
                 self._drop(robot, conn, "fault: close_mid_frame")
             elif conn.eof and not conn.wbuf and not robot.faults.holding(conn_id) and \
-                    not _has_work_for(robot.session, conn_id):
+                    not robot.session.has_work_for(conn_id):
                 self._drop(robot, conn, "peer closed its side")
         if only is not None:
             return
@@ -555,12 +554,6 @@ def _send(sock, data) -> int:
         return sock.send(data)
     except (BlockingIOError, InterruptedError):
         return 0
-
-
-def _has_work_for(session, conn_id):
-    if session.running is not None and session.running.packet.conn == conn_id:
-        return True
-    return any(p.conn == conn_id for p in session.pending)
 
 
 _HEADERS = {b"TMSCT": "TMSCT", b"TMSTA": "TMSTA", b"CPERR": "CPERR"}

@@ -1,8 +1,9 @@
 """Listen Node session of one robot: a sans-I/O state machine (bytes and time in, frames out).
 
-The server calls ``connect``/``handle``/``disconnect``/``advance(now)``; replies and pushes are
-collected per connection in ``clients[conn].outbox`` (one bytes object per frame, so each goes out in one
-send). The node state follows an explicit transition table; the scripts of all clients are run
+A server calls ``connect``/``receive_data(conn, bytes)``/``disconnect``/``advance(now)`` and takes
+``data_to_send(conn)`` (one bytes object per frame, so each goes out in one send); the control channel
+uses the control methods (``enter_node``, ``stop_project`` ...). ``handle`` takes one decoded item for a
+server that decodes itself (the simulator's server does, to share its input fairly between clients). The node state follows an explicit transition table; the scripts of all clients are run
 strictly in arrival order, one at a time.
 """
 from __future__ import annotations
@@ -59,6 +60,7 @@ class Running:
 class Client:
     peer: str
     outbox: list = field(default_factory=list)
+    rbuf: bytearray = field(default_factory=bytearray)      # an incomplete frame (receive_data)
 
 
 class TransitionError(Exception):
@@ -360,7 +362,67 @@ class ListenSession:
         if self.state == EXITING and self.robot.idle and self.running is None:
             self.fire("drain_done")
 
-    # ---- control ------------------------------------------------------------------------------
+    # ---- sans-I/O byte interface (h11 pattern): bytes in, bytes out; nobody else touches the state -------
+    def receive_data(self, conn: int, data: bytes) -> int:
+        """Bytes received from connection ``conn``: every complete item in them (and in what an earlier call
+        left incomplete) is handled at once; returns the number of items handled. A partial frame waits in
+        the session's buffer of that connection for the next call."""
+        client = self.clients.get(conn)
+        if client is None:
+            return 0
+        client.rbuf += data
+        handled = 0
+        while client.rbuf:
+            item, used = codec.decode(client.rbuf)
+            if not used:
+                break
+            del client.rbuf[:used]
+            self.handle(conn, item)
+            handled += 1
+        return handled
+
+    def data_to_send(self, conn: int) -> list[bytes]:
+        """The frames for connection ``conn`` produced so far (one bytes object per frame, so each can go out
+        in one send); the session forgets them."""
+        client = self.clients.get(conn)
+        if client is None or not client.outbox:
+            return []
+        frames, client.outbox = client.outbox, []
+        return frames
+
+    def has_work_for(self, conn: int) -> bool:
+        """True while a script of ``conn`` runs or waits (its replies are still to come)."""
+        if self.running is not None and self.running.packet.conn == conn:
+            return True
+        return any(p.conn == conn for p in self.pending)
+
+    @property
+    def buffered(self) -> int:
+        """Scripts received and not answered yet (running or waiting)."""
+        return len(self.pending) + (1 if self.running else 0)
+
+    # ---- control (the control channel, fault injection) ---------------------------------------------
+    def enter_node(self, source="control"):
+        self.fire("enter_node", source=source)
+
+    def leave_node(self, path="Pass", source="control"):
+        self.fire("leave_node", path=path, source=source)
+
+    def stop_project(self, source="control"):
+        self.fire("stop_project", source=source)
+
+    def start_project(self, enter_node=True, source="control"):
+        self.fire("start_project", source=source)
+        if enter_node:
+            self.fire("enter_node", source=source)
+
+    def add_reply_errors(self, count: int):
+        """The next ``count`` scripts are answered ERROR;1 without running (fault injection)."""
+        self.faults["reply_error"] = min(self.faults["reply_error"] + count, 10 ** 6)
+
+    def clear_reply_errors(self):
+        self.faults["reply_error"] = 0
+
     def snapshot(self) -> dict:
         data = self.robot.state()
         data.update(in_listen_node=self.state in (IN_NODE, EXITING), node_state=self.state,

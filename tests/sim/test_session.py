@@ -390,3 +390,34 @@ def test_listen_packet_builds_the_manual_frames(node, call, frame):
 
 def test_listen_packet_with_an_unknown_header_is_a_runtime_error(node):
     assert node.send(1, sct("1", 'string p = ListenPacket("TMXYZ", "1,x")')) == [sct("1", "ERROR;1").decode()]
+
+
+def test_receive_data_takes_bytes_whole_split_and_glued_and_data_to_send_hands_out_each_frame_once():
+    n = S()
+    n.s.connect(1, "127.0.0.1")
+    n.s.data_to_send(1)
+    raw = sct("A", "int a = 1") + sct("B", "int b = 2") + sta("00")
+    assert n.s.receive_data(1, raw[:7]) == 0 and n.s.data_to_send(1) == []
+    assert n.s.receive_data(1, raw[7:40]) == 1
+    assert n.s.receive_data(1, raw[40:]) == 2
+    frames = n.s.data_to_send(1)
+    assert [f.decode() for f in frames] == [codec.encode("TMSCT", "A,OK").decode(), codec.encode("TMSCT", "B,OK").decode(),
+                                           codec.encode("TMSTA", "00,true,Listen1").decode()]
+    assert n.s.data_to_send(1) == [] and n.s.receive_data(9, raw) == 0          # unknown connection: ignored
+
+
+def test_control_methods_drive_the_node_without_touching_its_state():
+    n = S()
+    n.s.connect(1, "127.0.0.1")
+    n.s.leave_node(path="Fail")
+    assert n.s.state == IDLE and n.s.exit_path == "Fail"
+    n.s.stop_project()
+    n.s.start_project(enter_node=True)
+    assert n.s.state == IN_NODE
+    n.s.add_reply_errors(1)
+    assert n.s.receive_data(1, sct("A", "int a = 1")) == 1
+    assert n.s.data_to_send(1)[-1] == codec.encode("TMSCT", "A,ERROR;1")
+    n.s.add_reply_errors(3)
+    n.s.clear_reply_errors()
+    n.s.receive_data(1, sct("B", "int b = 1"))
+    assert n.s.data_to_send(1) == [codec.encode("TMSCT", "B,OK")] and n.s.buffered == 0
