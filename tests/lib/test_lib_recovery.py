@@ -125,3 +125,27 @@ def test_commands_waiting_at_a_loss_end_with_outcome_unknown(rig):
     assert rig.until(lambda: not any(rig.read(f"movers[{k}].Busy") for k in (1, 2, 3)), 2)
     assert [rig.read(f"movers[{k}].ErrorID") for k in (1, 2, 3)] == [0x200B] * 3
     assert rig.read("Cobot.LastErrorID") == 0x2008
+
+
+def test_a_damaged_status_reply_is_not_a_lost_link(rig):
+    """One TMSTA 00 reply with a wrong checksum is dropped and counted; the next supervision query answers, so
+    the link stays up (it used to end in 16#2006 and a reconnect)."""
+    rig.scans(600)
+    rig.robot.inject("corrupt_checksum", count=1)
+    assert not rig.until(lambda: rig.read("conn.Error") or not rig.read("Cobot.Connected"), 3)
+    assert rig.read("Cobot.BadFrames") == 1 and rig.read("conn.RetryCount") == 0
+    assert rig.events("disconnect") == [] and len(rig.events("connect")) == 1
+
+
+def test_a_motion_whose_ok_reply_is_lost_completes_by_its_queue_tag(rig):
+    """The reply to a non-blended motion is damaged and dropped: its own queue tag reached proves the script was
+    accepted, so the motion ends Done when it arrives (not 16#3001 after the 5 s reply timeout)."""
+    rig.set_struct("MParam[1]", move_abs(Speed=20, TargetPosition=dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=30)))
+    sent = rig.read("Cobot.FramesOut")
+    rig.write("MExec[1]", True)
+    assert rig.until(lambda: rig.read("Cobot.FramesOut") > sent, 1)
+    rig.robot.inject("corrupt_checksum", count=1)                  # the next frame out: the OK of the motion
+    start = rig.plc.now_ns
+    assert rig.until(lambda: rig.read("movers[1].Done") or rig.read("movers[1].Error"), 8)
+    assert rig.read("movers[1].Done") and rig.read("Cobot.BadFrames") == 1
+    assert rig.plc.now_ns - start < 2 * SEC and len(rig.events("motion_start")) == 1
