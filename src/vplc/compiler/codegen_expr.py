@@ -365,6 +365,8 @@ class ExprGen:
     def aggregate_arg(self, ba) -> str:
         if ba.from_element:
             ref = self.ref(ba.expr)
+            if getattr(self, "optimise", False) and ref.endswith(", 0)"):
+                return ref[1:-len(", 0)")]          # from the first element: the array itself, no view
             return f"_View(*{ref})"
         pt, at = T.unalias(ba.param.type), T.unalias(ba.expr.ty)
         if isinstance(pt, T.ArrayType) and pt.open and isinstance(at, T.ArrayType) and not at.open \
