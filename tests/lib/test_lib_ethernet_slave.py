@@ -87,7 +87,7 @@ def test_robot_error_is_told_apart_and_project_control_restarts_the_project(svr)
     svr.set_struct("MoveParam", move_abs(MovementCommand=0, DataFormat=2, TargetPosition=UNREACHABLE))
     svr.write("MoveExec", True)
     assert svr.until(lambda: svr.read("mover.Error"), 3)
-    assert svr.read("mover.ErrorID") == 0x200B
+    assert svr.read("mover.ErrorID") == 0x4006                      # stopped by the robot error
     assert svr.until(lambda: svr.read("conn.ErrorID") == 0x4006, 2), hex(svr.read("conn.ErrorID"))
     assert svr.read("conn.Error") and svr.read("conn.ErrorDescrip").startswith("Robot error stopped the project")
     svr.scans(1)                                                  # CBT_RobotStatus runs before CBT_Connect
