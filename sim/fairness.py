@@ -55,7 +55,7 @@ class FairInput:
                 self._drop(robot, conn, "fault: close_after")
                 return
             handled += 1
-            if handled >= SERVE_ITEMS or len(robot.session.pending) >= MAX_PENDING:
+            if handled >= SERVE_ITEMS or robot.session.waiting_scripts >= MAX_PENDING:
                 self._backlog[key] = (robot, conn)
                 conn.greedy = True
                 break
@@ -66,11 +66,11 @@ class FairInput:
     def _buffer_full(self, robot, fraction=1.0) -> bool:
         """The robot's buffered scripts reach MAX_PENDING or its share of PENDING_BYTES_MAX (times
         ``fraction``). Checked once a turn: one turn may add SERVE_ITEMS frames more."""
-        pending = robot.session.pending
-        if len(pending) >= MAX_PENDING * fraction:
+        waiting = robot.session.waiting_scripts
+        if waiting >= MAX_PENDING * fraction:
             return True
         limit = self.pending_bytes_limit * fraction
-        return len(pending) * codec.MAX_DATA >= limit and sum(len(p.script) for p in pending) >= limit
+        return waiting * codec.MAX_DATA >= limit and robot.session.waiting_script_bytes() >= limit
 
     def _cperr_tokens(self, conn) -> float:
         """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""

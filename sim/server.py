@@ -298,7 +298,7 @@ class SimServer(FairInput):
                     robot.accept_paused_until = None
                     self.selector.register(robot.listener, selectors.EVENT_READ, ("listen", robot, None))
                 self._advance(robot)
-                if any(client.outbox for client in session.clients.values()) and not robot.faults.active:
+                if session.has_output() and not robot.faults.active:
                     self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
                 self._breathe()
             if self.svr is not None:
@@ -332,7 +332,7 @@ class SimServer(FairInput):
     def _set_reading(self, robot, reading: bool):
         """Back-pressure: stop reading this robot's clients while its script buffer is full."""
         robot.reading_paused = not reading
-        robot._log("reading_resumed" if reading else "reading_paused", buffered=len(robot.session.pending))
+        robot._log("reading_resumed" if reading else "reading_paused", buffered=robot.session.waiting_scripts)
         for conn in robot.conns.values():
             if reading and conn.rbuf:
                 self._backlog[(robot.index, conn.id)] = (robot, conn)    # input read before the pause
@@ -386,9 +386,7 @@ class SimServer(FairInput):
             robot.session.advance(self._now)
         except Exception as exc:          # noqa: BLE001 - safety net, see docstring
             robot._log("internal_error", conn=None, error=f"{type(exc).__name__}: {exc}")
-            robot.session.robot.stop_and_clear()
-            if robot.session.state != STOPPED:
-                robot.session.fire("robot_fault", reason=f"internal error of the simulator ({type(exc).__name__})")
+            robot.session.internal_error(f"internal error of the simulator ({type(exc).__name__})")
 
     def _start_touched(self):
         """Advance the robots that received scripts with dt = 0, so a motion queued now starts now."""
@@ -464,17 +462,14 @@ class SimServer(FairInput):
         now = self._now
         faulty = robot.faults.active
         waiting = 0
-        clients = robot.session.clients
-        if only is None:
-            items = list(clients.items())
-        else:
-            items = [(only.id, clients[only.id])] if only.id in clients else []
-        for conn_id, client in items:
-            conn = robot.conns.get(conn_id)
-            if conn is None:
+        session = robot.session
+        conns = list(robot.conns.values()) if only is None else [only]
+        for conn in conns:
+            conn_id = conn.id
+            if not session.is_connected(conn_id):
                 continue
-            if client.outbox:
-                frames, client.outbox = client.outbox, []
+            frames = session.data_to_send(conn_id)
+            if frames:
                 for frame in frames:
                     header, _, rest = frame[1:].partition(b",")
                     robot._log("frame_out", conn=conn_id, raw=_text(frame), header=_header_text(header),
@@ -511,7 +506,7 @@ class SimServer(FairInput):
                 self._drop(robot, conn, "peer closed its side")
         if only is not None:
             return
-        for conn in [c for c in robot.conns.values() if c.id not in robot.session.clients]:
+        for conn in [c for c in robot.conns.values() if not robot.session.is_connected(c.id)]:
             self._drop(robot, conn, "session ended")
         while waiting > OUTBOX_TOTAL_MAX:             # e.g. a large ListenSend to many clients that do not read
             laziest = max(robot.conns.values(), key=lambda c: len(c.wbuf))

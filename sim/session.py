@@ -401,6 +401,21 @@ class ListenSession:
         """Scripts received and not answered yet (running or waiting)."""
         return len(self.pending) + (1 if self.running else 0)
 
+    @property
+    def waiting_scripts(self) -> int:
+        """Scripts received and not started yet."""
+        return len(self.pending)
+
+    def waiting_script_bytes(self) -> int:
+        return sum(len(p.script) for p in self.pending)
+
+    def has_output(self) -> bool:
+        """True when a frame for some client is waiting in data_to_send."""
+        return any(client.outbox for client in self.clients.values())
+
+    def is_connected(self, conn: int) -> bool:
+        return conn in self.clients
+
     # ---- control (the control channel, fault injection) ---------------------------------------------
     def enter_node(self, source="control"):
         self.fire("enter_node", source=source)
@@ -415,6 +430,12 @@ class ListenSession:
         self.fire("start_project", source=source)
         if enter_node:
             self.fire("enter_node", source=source)
+
+    def internal_error(self, reason: str):
+        """The simulator failed while advancing: a robot error of this robot (arm stops, project stops)."""
+        self.robot.stop_and_clear()
+        if self.state != STOPPED:
+            self.fire("robot_fault", reason=reason)
 
     def add_reply_errors(self, count: int):
         """The next ``count`` scripts are answered ERROR;1 without running (fault injection)."""
