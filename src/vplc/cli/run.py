@@ -1,9 +1,12 @@
 """``python -m vplc run PATHS... [--task Main@1ms] [--virtual-time] [--cycles N | --duration T] [--stats]
-[--trace VAR,... --trace-out FILE.vcd|FILE.svg]``: run ST programs on the virtual controller.
+[--watch VAR,...] [--set VAR=VALUE@TIME]... [--scenario FILE] [--trace VAR,... --trace-out FILE.vcd|FILE.svg
+[--trace-window FROM..TO]]``: run ST programs on the virtual controller.
 
-Real time (default) scans at the task period on the wall clock until Ctrl-C, --cycles or --duration;
---virtual-time scans as fast as possible with the clock advancing one period per scan (deterministic).
-Exit 0 on a clean stop, 1 on a major fault, 2 on usage or load errors.
+Real time (default) scans at the task period on the wall clock until Ctrl-C, --cycles, --duration or the end of
+the scenario; --virtual-time scans as fast as possible with the clock advancing one period per scan
+(deterministic). Exit 0 when the run ended as asked and every expectation held; 1 with a one-line reason on a
+major fault (watchdog included), a failed expectation or an operator stop before the scenario was decided;
+2 on usage or load errors.
 """
 from __future__ import annotations
 
@@ -12,6 +15,7 @@ import sys
 import threading
 import time
 
+from . import scenario as scn
 from ..runtime.values import parse_duration
 
 
@@ -28,8 +32,18 @@ def register(subparsers) -> None:
     g.add_argument("--cycles", type=int, metavar="N", help="stop after N scans")
     g.add_argument("--duration", metavar="T", help="stop after this (controller) time, e.g. 5s or 250ms")
     p.add_argument("--stats", action="store_true", help="print scan time, lateness, overruns and statements per scan")
+    p.add_argument("--watch", metavar="VAR,...",
+                   help="print every change of these variables with its time, and their values at the end")
+    p.add_argument("--set", action="append", default=[], metavar="VAR=VALUE@TIME",
+                   help="write a variable when the run reaches TIME (default 0s), e.g. Main.Start=TRUE@2s "
+                        "(repeatable)")
+    p.add_argument("--scenario", metavar="FILE",
+                   help="timed writes and expectations (`at 2s set Main.Start TRUE`, `expect Main.Placed = 24 "
+                        "within 60s`); the run ends when every expectation is decided")
     p.add_argument("--trace", metavar="VAR,...", help="variables to record every scan")
     p.add_argument("--trace-out", metavar="FILE", help="trace file: .vcd (GTKWave) or .svg (timing diagram)")
+    p.add_argument("--trace-window", metavar="FROM..TO",
+                   help="SVG: draw only this part of the run, e.g. 2s..2.5s (the VCD keeps everything)")
     p.add_argument("--spin-us", type=int, default=300, metavar="US",
                    help="real time: busy-wait this long before each scan for lower jitter (default 300)")
     p.add_argument("--watchdog", default="500ms", metavar="T", help="major fault when one scan runs longer (default 500ms)")
@@ -51,7 +65,7 @@ def run_cmd(args) -> int:
     from ..api import LoadError, PlcFault, load_plc, parse_task
     from ..runtime.stats import ScanStats
     from ..runtime.values import PathError
-    from ..trace import Recorder, write_trace
+    from ..trace import Recorder, parse_window, write_trace
     if bool(args.trace) != bool(args.trace_out):
         return _err("--trace and --trace-out go together")
     if args.trace_out and not args.trace_out.lower().endswith((".vcd", ".svg")):
@@ -60,6 +74,14 @@ def run_cmd(args) -> int:
         folder = os.path.dirname(os.path.abspath(args.trace_out))
         if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
             return _err(f"--trace-out {args.trace_out!r}: the folder {folder} does not exist or is not writable")
+    window = None
+    if args.trace_window:
+        if not (args.trace_out or "").lower().endswith(".svg"):
+            return _err("--trace-window applies to an .svg --trace-out")
+        try:
+            window = parse_window(args.trace_window)
+        except ValueError as exc:
+            return _err(str(exc))
     if args.cycles is not None and not 0 <= args.cycles <= MAX_CYCLES:
         return _err(f"--cycles must be 0 .. {MAX_CYCLES:,}")
     duration = parse_duration(args.duration) if args.duration else None
@@ -71,6 +93,12 @@ def run_cmd(args) -> int:
     if not 0 <= args.spin_us <= MAX_SPIN_US:
         return _err(f"--spin-us must be 0 .. {MAX_SPIN_US:,} microseconds")
     try:
+        scenario = scn.load(args.scenario) if args.scenario else scn.Scenario()
+        for text in args.set:
+            scn.add_set_option(text, scenario)
+    except scn.ScenarioError as exc:
+        return _err(str(exc))
+    try:
         if args.task is not None:
             parse_task(args.task)
         plc = load_plc(args.paths, task=args.task or "Main@1ms", programs=args.program, watchdog_ms=wd / 1e6,
@@ -81,72 +109,199 @@ def run_cmd(args) -> int:
     if args.task is not None and plc.project.configurations:
         print(f"vplc run: note: --task {args.task} is not used: the sources define their own CONFIGURATION",
               file=sys.stderr)
-    rec = None
-    if args.trace:
-        try:
-            rec = Recorder(plc, [p.strip() for p in args.trace.split(",") if p.strip()])
-        except (PathError, ValueError) as exc:
-            return _err(str(exc))
+    rec = watch = None
+    try:
+        scn.resolve(plc, scenario)
+        if args.trace:
+            rec = Recorder(plc, _paths(args.trace))
+        if args.watch:
+            watch = Watch(plc, _paths(args.watch))
+    except scn.ScenarioError as exc:
+        plc.close()
+        return _err(str(exc))
+    except (PathError, ValueError) as exc:
+        plc.close()
+        return _err(str(exc))
+    runner = scn.Runner(plc, scenario)
     stats = ScanStats() if args.stats else None
-    status = 0
+    print(start_line(plc, args, scenario, duration), flush=True)
+    reason = None
+    hooks = Hooks(plc, runner, rec, watch, args.cycles, duration)
     try:
         if args.virtual_time:
-            _run_virtual(plc, args.cycles, duration, rec, stats)
+            _run_virtual(plc, hooks, stats)
         else:
-            _run_realtime(plc, args.cycles, duration, rec, stats, args.spin_us * 1000)
+            _run_realtime(plc, hooks, stats, args.spin_us * 1000)
     except PlcFault as exc:
         print(f"vplc run: controller stopped: {exc}", file=sys.stderr)
-        status = 1
+        reason = f"major fault at {scn.seconds(plc.now_ns)}: {str(exc).splitlines()[0]}"
     except KeyboardInterrupt:
         print("vplc run: stopped by the operator", file=sys.stderr)
+        if not scenario.empty and runner.failure is None and runner.end_check(plc.now_ns):
+            reason = f"stopped by the operator at {scn.seconds(plc.now_ns)} before the scenario was decided"
     finally:
         plc.close()
+    if reason is None:
+        reason = runner.end_check(hooks.last_ns)
+    if watch is not None:
+        print(watch.final(hooks.last_ns))
     if stats is not None:
         print(stats.summary())
     if rec is not None:
         try:
-            write_trace(rec, args.trace_out)
+            write_trace(rec, args.trace_out, window)
         except OSError as exc:
             print(f"vplc run: cannot write the trace to {args.trace_out}: {exc.strerror}", file=sys.stderr)
             return 1
         print(f"trace written to {args.trace_out}")
-    return status
+    held = sum(1 for e in scenario.expects if e.state == "held")
+    if reason is not None:
+        print(f"vplc run: FAILED: {reason}", file=sys.stderr)
+        return 1
+    summary = f"{hooks.scans} scan(s), {scn.seconds(hooks.last_ns)} of controller time"
+    if scenario.expects:
+        summary += f"; {held} of {len(scenario.expects)} expectation(s) held"
+    print(f"vplc run: OK: {summary}")
+    return 0
 
 
-def _run_virtual(plc, cycles, duration, rec, stats) -> None:
+def _paths(text: str) -> list[str]:
+    return [p.strip() for p in text.split(",") if p.strip()]
+
+
+def start_line(plc, args, scenario, duration) -> str:
+    tasks = "; ".join(f"task {t.name} every {_period(t.period_ns)}: "
+                      f"{', '.join(inst.i__path for inst, _ in t.programs)}" for t in plc.engine.tasks)
+    clock = "virtual time" if args.virtual_time else "real time"
+    if args.cycles is not None:
+        until = f"{args.cycles} scan(s)"
+    elif duration is not None:
+        until = scn.seconds(duration)
+    elif scenario.stop_ns is not None or scenario.expects:
+        until = "the scenario is decided"
+    else:
+        until = "Ctrl-C" if not args.virtual_time else "Ctrl-C (virtual time never ends by itself)"
+    sockets = socket_use(plc)
+    socks = (f"may open {sockets} (at most {plc.engine.sockets.limit})" if sockets else "opens no sockets")
+    return f"vplc run: {tasks}; {clock} until {until}; {socks}"
+
+
+def _period(ns: int) -> str:
+    for unit, scale in (("s", 10**9), ("ms", 10**6), ("us", 10**3)):
+        if ns >= scale:
+            return f"{ns / scale:g} {unit}"
+    return f"{ns} ns"
+
+
+_SOCKET_KINDS = {"SKTTCPCONNECT": "TCP client connections", "SKTTCPACCEPT": "TCP server connections",
+                 "SKTUDPCREATE": "UDP sockets"}
+
+
+def socket_use(plc) -> str:
+    """Which kinds of socket the loaded program can open (the Skt* instruction instances it declares)."""
+    from ..frontend import ast as A
+    kinds = []
+    for unit in plc.project.units:
+        if getattr(unit, "in_prelude", False):
+            continue
+        for item in unit.items:
+            for node in A.walk(item):
+                if isinstance(node, A.NamedTypeRef):
+                    kind = _SOCKET_KINDS.get(node.name.name.upper())
+                    if kind and kind not in kinds:
+                        kinds.append(kind)
+    return " and ".join(kinds)
+
+
+class Watch:
+    """Prints each change of the watched variables as `time  VAR = value`, and a table at the end."""
+
+    def __init__(self, plc, paths: list[str]) -> None:
+        self.plc, self.paths = plc, paths
+        self.is_time = {p: plc.var_type(p).upper() in ("TIME", "LTIME") for p in paths}   # PathError first
+        self.values: dict[str, object] = {}
+        self.width = max(len(p) for p in paths)
+
+    def sample(self, t_ns: int) -> None:
+        for p in self.paths:
+            v = self.plc.read(p)
+            if p not in self.values or self.values[p] != v:
+                self.values[p] = v
+                print(f"{t_ns / 1e9:10.3f} s  {p:<{self.width}} = {self.show(p, v)}", flush=True)
+
+    def final(self, t_ns: int) -> str:
+        lines = [f"final values at {scn.seconds(t_ns)}:"]
+        for p in self.paths:
+            lines.append(f"  {p:<{self.width}} = {self.show(p, self.plc.read(p))}")
+        return "\n".join(lines)
+
+    def show(self, path: str, v) -> str:
+        if self.is_time[path] and isinstance(v, int):
+            return "T#" + _period(v).replace(" ", "") if v > 0 else "T#0s"
+        return str(v) if isinstance(v, (dict, list)) else scn.fmt(v)
+
+
+class Hooks:
+    """What happens around every scan: scenario writes before it; watch, trace and expectations after it."""
+
+    def __init__(self, plc, runner, rec, watch, cycles, duration) -> None:
+        self.plc, self.runner, self.rec, self.watch = plc, runner, rec, watch
+        self.cycles, self.duration = cycles, duration
+        self.scans = 0
+        self.last_ns = 0
+
+    def before(self, t_ns: int) -> bool:
+        """False when the run must end before this scan."""
+        if (self.cycles is not None and self.scans >= self.cycles) or \
+                (self.duration is not None and t_ns >= self.duration):
+            return False
+        if self.scans and self.runner.finished(self.last_ns):
+            return False
+        self.runner.before_scan(t_ns)
+        return True
+
+    def after(self, t_ns: int) -> None:
+        self.scans += 1
+        self.last_ns = t_ns
+        if self.rec is not None:
+            self.rec.sample(t_ns)
+        if self.watch is not None:
+            self.watch.sample(t_ns)
+        self.runner.after_scan(t_ns)
+
+
+def _run_virtual(plc, hooks, stats) -> None:
     period = plc.period_ns
-    n, t = 0, 0
-    while (cycles is None or n < cycles) and (duration is None or t < duration):
+    t = 0
+    while hooks.before(t):
         c0 = plc.statements_executed
         s0 = time.perf_counter_ns()
         plc.scan(t)
         if stats is not None:
             stats.record(0, time.perf_counter_ns() - s0, plc.statements_executed - c0)
-        if rec is not None:
-            rec.sample(t)
-        n += 1
+        hooks.after(t)
         t += period
 
 
-def _run_realtime(plc, cycles, duration, rec, stats, spin_ns) -> None:
+def _run_realtime(plc, hooks, stats, spin_ns) -> None:
     stop = threading.Event()
-    count = [0]
+    pending = []
 
     def on_scan(now_ns):
-        if rec is not None and count[0]:
-            rec.sample(plc.now_ns)
-        count[0] += 1
-        if (cycles is not None and count[0] > cycles) or (duration is not None and now_ns >= duration):
+        if pending:                        # the previous scan is complete: judge it
+            hooks.after(pending.pop())
+        if not hooks.before(now_ns):
             stop.set()
             raise _Stop()
+        pending.append(now_ns)
 
     try:
         plc.run_realtime(stop, on_scan=on_scan, stats=stats, spin_ns=spin_ns)
     except _Stop:
         pass
     finally:
-        if rec is not None and count[0] > 1:
-            rec.sample(plc.now_ns)                # values after the last scan
+        if pending:                        # values after the last scan
+            hooks.after(pending.pop())
 
 
 class _Stop(Exception):

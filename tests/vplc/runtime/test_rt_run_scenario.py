@@ -1,0 +1,113 @@
+"""`vplc run` for commissioning: start line, --watch, --set, scenario files and the exit status."""
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+ENV = {**os.environ, "PYTHONPATH": os.path.join(ROOT, "src")}
+
+PROG = """PROGRAM Main
+VAR Start : BOOL; Count : INT; Level : REAL; Mode : STRING[10] := 'auto'; Wait : TIME := T#20ms; t : TON; END_VAR
+t(IN := Start, PT := Wait);
+IF t.Q AND Count < 5 THEN Count := Count + 1; END_IF;
+Level := INT_TO_REAL(Count) * 1.5;
+END_PROGRAM
+"""
+
+
+def vplc(*args):
+    return subprocess.run([sys.executable, "-m", "vplc", *args], capture_output=True, text=True, env=ENV, timeout=60)
+
+
+def run(tmp_path, *args, scenario=None):
+    src = tmp_path / "m.st"
+    src.write_text(PROG)
+    extra = []
+    if scenario is not None:
+        (tmp_path / "s.scn").write_text(scenario)
+        extra = ["--scenario", str(tmp_path / "s.scn")]
+    return vplc("run", str(src), "--virtual-time", *extra, *args)
+
+
+def test_start_line_names_task_period_clock_end_and_sockets(tmp_path):
+    r = run(tmp_path, "--cycles", "3")
+    assert r.returncode == 0, r.stderr
+    first = r.stdout.splitlines()[0]
+    assert first == ("vplc run: task Main every 1 ms: Main; virtual time until 3 scan(s); opens no sockets")
+    assert r.stdout.splitlines()[-1] == "vplc run: OK: 3 scan(s), 0.002 s of controller time"
+
+
+def test_watch_prints_each_change_with_its_time_and_the_final_values(tmp_path):
+    r = run(tmp_path, "--duration", "40ms", "--watch", "Main.Start,Main.Count", "--set", "Main.Start=TRUE@10ms")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert "     0.000 s  Main.Start = FALSE" in lines
+    assert "     0.010 s  Main.Start = TRUE" in lines           # the write is seen by the scan at 10 ms
+    assert "     0.030 s  Main.Count = 1" in lines              # TON of 20 ms from 10 ms
+    assert lines[lines.index("final values at 0.039 s:") + 1:][:2] == ["  Main.Start = TRUE", "  Main.Count = 5"]
+
+
+def test_scenario_that_holds_ends_by_itself_with_exit_0(tmp_path):
+    r = run(tmp_path, scenario="# start, then five counts\n"
+                               "at 10ms set Main.Start TRUE   # push button\n"
+                               "at 5ms expect Main.Count = 0\n"
+                               "expect Main.Count = 5 within 1s\n"
+                               "expect Main.Level >= 7.5 within 1s\n"
+                               "expect Main.Mode = 'auto' always\n")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[-1] == ("vplc run: OK: 35 scan(s), 0.034 s of controller time; "
+                                         "4 of 4 expectation(s) held")
+
+
+def test_failed_expectation_exits_1_with_one_line_reason(tmp_path):
+    r = run(tmp_path, scenario="at 0s set Main.Wait T#500ms\nat 0s set Main.Start TRUE\n"
+                               "expect Main.Count = 5 within 100ms\n")
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines() == [
+        "vplc run: FAILED: expectation failed at 0.100 s: expect Main.Count = 5 within 100ms (" +
+        str(tmp_path / "s.scn") + ":3); Main.Count is 0"]
+
+
+def test_always_expectation_fails_at_the_first_scan_it_does_not_hold(tmp_path):
+    r = run(tmp_path, "--set", "Main.Start=1@2ms", scenario="expect Main.Count < 3 always\nat 1s stop\n")
+    assert r.returncode == 1
+    assert "expectation failed at 0.024 s: expect Main.Count < 3 always" in r.stderr
+
+
+def test_run_ended_before_the_scenario_was_decided_is_a_failure(tmp_path):
+    r = run(tmp_path, "--cycles", "10", scenario="at 0s set Main.Start TRUE\nexpect Main.Count = 5 within 1s\n")
+    assert r.returncode == 1
+    assert "expectation not decided: the run ended at 0.009 s before `expect Main.Count = 5 within 1s`" in r.stderr
+
+
+def test_a_fault_is_a_one_line_reason_after_the_details(tmp_path):
+    src = tmp_path / "m.st"
+    src.write_text("PROGRAM Main\nVAR a, b : INT; END_VAR\na := 10 / b;\nEND_PROGRAM\n")
+    r = vplc("run", str(src), "--virtual-time", "--set", "Main.b=0@0s", "--duration", "1s")
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert r.stderr.strip().splitlines()[-1].startswith("vplc run: FAILED: major fault at 0.000 s: ")
+
+
+def test_scenario_mistakes_are_usage_errors_naming_file_and_line(tmp_path):
+    cases = {"at 2 set Main.Start TRUE\n": ":1: time `2` is not a time like 2s",
+             "\nat 1s set Main.Nope TRUE\n": ":2: `Nope` is not a variable of Main",
+             "at 1s set Main.Count TRUE\n": ":1: `TRUE` is not a value for Main.Count (INT)",
+             "at 1s set Main.Mode auto\n": ":1: `auto`: write a text for Main.Mode (STRING[10]) in quotes",
+             "expect Main.Start > TRUE within 1s\n": ":1: `>` compares numbers; Main.Start is a BOOL",
+             "set Main.Start TRUE\n": ":1: `set` needs a time: `at 0s set Main.Start TRUE`",
+             "press Main.Start\n": ":1: cannot read `press Main.Start`"}
+    for text, message in cases.items():
+        r = run(tmp_path, scenario=text)
+        assert r.returncode == 2, text
+        assert message in r.stderr, (text, r.stderr)
+        assert "Traceback" not in r.stderr
+
+
+def test_set_option_takes_st_literals(tmp_path):
+    r = run(tmp_path, "--cycles", "2", "--watch", "Main.Count,Main.Wait,Main.Mode",
+            "--set", "Main.Count=16#3", "--set", "Main.Wait=T#1s", "--set", "Main.Mode='hand'")
+    assert r.returncode == 0, r.stderr
+    assert "  Main.Count = 3" in r.stdout and "  Main.Wait  = T#1s" in r.stdout
+    assert "  Main.Mode  = hand" in r.stdout
+    bad = run(tmp_path, "--cycles", "1", "--set", "Main.Count")
+    assert bad.returncode == 2 and "--set 'Main.Count' is not of the form VAR=VALUE@TIME" in bad.stderr
