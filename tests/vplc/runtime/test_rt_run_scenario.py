@@ -111,3 +111,14 @@ def test_set_option_takes_st_literals(tmp_path):
     assert "  Main.Mode  = hand" in r.stdout
     bad = run(tmp_path, "--cycles", "1", "--set", "Main.Count")
     assert bad.returncode == 2 and "--set 'Main.Count' is not of the form VAR=VALUE@TIME" in bad.stderr
+
+
+def test_trace_window_goes_with_an_svg_trace(tmp_path):
+    svg = tmp_path / "t.svg"
+    r = run(tmp_path, "--duration", "50ms", "--trace", "Main.Count,Main.Level", "--trace-out", str(svg),
+            "--trace-window", "10ms..40ms", "--set", "Main.Start=TRUE")
+    assert r.returncode == 0, r.stderr
+    assert ">10 ms<" in svg.read_text() and ">40 ms<" in svg.read_text()
+    r = run(tmp_path, "--cycles", "1", "--trace", "Main.Count", "--trace-out", str(tmp_path / "t.vcd"),
+            "--trace-window", "0s..1s")
+    assert r.returncode == 2 and "--trace-window applies to an .svg --trace-out" in r.stderr
