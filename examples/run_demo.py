@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import os
 import pathlib
 import signal
 import socket
@@ -53,16 +54,47 @@ class DemoError(Exception):
 
 
 def check_port_free(host: str, port: int, what: str, option: str) -> None:
+    """Fail early, before the programs are compiled, when a port is really taken. The probe binds the way the
+    servers do (SO_REUSEADDR): connections of a demo just stopped, still in TIME_WAIT, do not count."""
     probe = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
     try:
         probe.bind((host, port))
+        probe.listen(1)
     except OSError as exc:
         if exc.errno == errno.EADDRINUSE:
-            raise DemoError(f"error: port {port} on {host} ({what}) is already in use - is another demo or "
-                            f"simulator running? Stop it, or choose another port with {option} PORT.") from None
+            raise DemoError(f"error: port {port} on {host} ({what}) is already in use by {port_holder(port)}. "
+                            f"Stop it, or choose another port with {option} PORT.") from None
         raise DemoError(f"error: cannot use {host}:{port} for the {what}: {exc.strerror}") from None
     finally:
         probe.close()
+
+
+def port_holder(port: int) -> str:
+    """``process 1234 (python3 sim/tmflow_listener.py)`` listening on ``port``, found through /proc (Linux);
+    a neutral phrase where the process cannot be seen (another user's, or no /proc)."""
+    inodes = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            with open(table, encoding="ascii") as f:
+                rows = f.read().splitlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            fields = row.split()
+            if len(fields) > 9 and fields[3] == "0A" and int(fields[1].rsplit(":", 1)[1], 16) == port:
+                inodes.add(f"socket:[{fields[9]}]")          # state 0A = LISTEN
+    proc = pathlib.Path("/proc")
+    for pid_dir in (proc.iterdir() if inodes and proc.is_dir() else ()):
+        if not pid_dir.name.isdigit():
+            continue
+        try:
+            if any(os.readlink(fd) in inodes for fd in (pid_dir / "fd").iterdir()):
+                cmd = (pid_dir / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace").strip()
+                return f"process {pid_dir.name} ({cmd[:80]})"
+        except OSError:
+            continue
+    return "another program"
 
 
 def tcp_port(text: str) -> int:

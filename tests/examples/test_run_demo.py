@@ -56,43 +56,73 @@ def test_port_outside_the_tcp_range_is_refused():
     assert result.returncode == 2 and "70000 is not a TCP port (1..65535)" in result.stderr
 
 
-def test_demo_runs_everything_and_stops_cleanly_on_ctrl_c():
-    import json
+def start_demo(robot_port: int, hmi_port: int, svr_port: int):
+    """The demo as `make demo` starts it; returns (process, banner text, queue of further stdout lines)."""
     import queue
-    import signal
     import threading
-    import urllib.request
-    robot_port, hmi_port = free_port(), free_port()
     demo = subprocess.Popen([sys.executable, str(DEMO), "--robot-port", str(robot_port), "--hmi-port",
-                             str(hmi_port), "--svr-port", str(free_port())], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+                             str(hmi_port), "--svr-port", str(svr_port)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=ROOT)
     lines: queue.Queue = queue.Queue()
-    reader = threading.Thread(target=lambda: [lines.put(line) for line in demo.stdout], daemon=True)
-    reader.start()
+    errors: list[str] = []                  # drained all the time: a full stderr pipe would block the demo
+    threading.Thread(target=lambda: [lines.put(line) for line in demo.stdout], daemon=True).start()
+    threading.Thread(target=lambda: errors.extend(demo.stderr), daemon=True).start()
+    demo.errors = errors
+    banner, waited = [], 0
+    while not banner or not banner[-1].startswith("Press Ctrl-C"):
+        try:
+            banner.append(lines.get(timeout=1).strip())
+        except queue.Empty:
+            waited += 1
+            if demo.poll() is not None or waited >= 60:
+                demo.kill()
+                raise AssertionError(f"no complete banner from the demo: {banner} {''.join(errors)}") from None
+    return demo, "\n".join(banner), lines
+
+
+def stop_demo(demo, lines) -> tuple[str, str]:
+    import signal
+    demo.send_signal(signal.SIGINT)
     try:
-        banner = []
-        while not banner or not banner[-1].startswith("Press Ctrl-C"):
-            try:
-                banner.append(lines.get(timeout=60).strip())
-            except queue.Empty:
-                raise AssertionError(f"no complete banner from the demo within 60 s: {banner}") from None
-        text = "\n".join(banner)
-        assert f"1 robot on 127.0.0.1:{robot_port}" in text and "1 ms task" in text
-        assert f"http://127.0.0.1:{hmi_port}/" in text
-        with urllib.request.urlopen(f"http://127.0.0.1:{hmi_port}/api/read?names=PnP_Segment", timeout=5) as r:
-            assert json.loads(r.read())["ok"] is True
-        with socket.create_connection(("127.0.0.1", robot_port), timeout=5):
-            pass
-        demo.send_signal(signal.SIGINT)
-        demo.wait(timeout=30)
-        reader.join(timeout=5)
-        err = demo.stderr.read()
-        out = "".join(lines.queue)
-    finally:
-        if demo.poll() is None:
-            demo.kill()
-            demo.wait(timeout=10)
-    assert demo.returncode == 0, err
-    assert "Demo stopped" in out and "Traceback" not in err
+        demo.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        demo.kill()
+        demo.wait(timeout=10)
+        raise AssertionError("the demo did not stop within 60 s of Ctrl-C; it printed: "
+                             f"{''.join(lines.queue)} {''.join(demo.errors)}") from None
+    return "".join(lines.queue), "".join(demo.errors)
+
+
+def test_demo_runs_everything_stops_cleanly_on_ctrl_c_and_starts_again_at_once():
+    import json
+    import urllib.request
+    ports = []
+    while len(ports) < 3:
+        port = free_port()
+        if port not in ports:
+            ports.append(port)
+    robot_port, hmi_port, svr_port = ports
+    for attempt in range(2):          # the second start follows at once: the first one's connections in TIME_WAIT
+        demo, text, lines = start_demo(robot_port, hmi_port, svr_port)
+        try:
+            assert f"1 robot on 127.0.0.1:{robot_port}" in text and "1 ms task" in text
+            assert f"http://127.0.0.1:{hmi_port}/" in text
+            url = f"http://127.0.0.1:{hmi_port}/api/read?names=PnP_Segment"
+            with urllib.request.urlopen(url, timeout=5) as r:
+                assert json.loads(r.read())["ok"] is True
+            with socket.create_connection(("127.0.0.1", robot_port), timeout=5):
+                pass
+        finally:
+            out, err = stop_demo(demo, lines)
+        assert demo.returncode == 0, (attempt, demo.returncode, out, err)
+        assert "Demo stopped" in out and "Traceback" not in err
+
+
+def test_taken_port_names_the_process_that_holds_it(busy_port):
+    import os
+    result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(busy_port), "--svr-port", str(free_port()))
+    assert result.returncode == 2
+    assert f"is already in use by process {os.getpid()} (" in result.stderr
 
 
 def test_robot_side_events_print_one_console_line_each():

@@ -217,3 +217,20 @@ def test_date_and_time_is_shown_as_an_iec_literal(client, fake_plc):
     fake_plc.vars["Connect_LastConnTime"] = 1_795_383_758_000_000_000
     status, answer = client.json("/api/read?names=Connect_LastConnTime,Connect_LastLostTime")
     assert answer["values"] == {"Connect_LastConnTime": "DT#2026-11-22-21:42:38", "Connect_LastLostTime": "—"}
+
+
+@pytest.mark.parametrize("gone", [BrokenPipeError(32, "Broken pipe"), ConnectionResetError(104, "reset")])
+def test_a_client_leaving_mid_request_is_one_debug_line_not_a_traceback(server, capsys, caplog, gone):
+    caplog.set_level("DEBUG", logger="vplc")
+    try:
+        raise gone
+    except OSError:
+        server._httpd.handle_error(None, ("127.0.0.1", 50123))
+    assert capsys.readouterr().err == ""
+    assert [r.getMessage() for r in caplog.records] == [
+        f"HMI client 127.0.0.1:50123 left before the answer was sent ({type(gone).__name__})"]
+
+
+def test_the_server_binds_with_address_reuse_so_a_restart_works_at_once(server):
+    import socket
+    assert server._httpd.socket.getsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR)

@@ -24,10 +24,11 @@ from __future__ import annotations
 import datetime
 import ipaddress
 import json
+import logging
 import math
 import mimetypes
 import pathlib
-import logging
+import sys
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -290,6 +291,11 @@ class _PooledHTTPServer(HTTPServer):
             self._slots.release()
 
     def handle_error(self, request, client_address):
+        exc = sys.exc_info()[1]
+        if isinstance(exc, (BrokenPipeError, ConnectionResetError, ConnectionAbortedError)):
+            log.debug("HMI client %s:%s left before the answer was sent (%s)", *client_address[:2],
+                      type(exc).__name__)       # a browser leaving a page mid-request: normal, one line
+            return
         log.debug("HMI connection from %s ended abnormally", client_address[0], exc_info=True)
 
     def server_close(self):
