@@ -1,76 +1,117 @@
-"""Regenerates the timing diagrams of docs/library/*.md from real runs (virtual PLC + simulator).
+"""Regenerates the timing diagrams of docs/library/*.md from real runs (virtual PLC + simulator): one diagram per
+FB page, drawn from that page's own "## Example" program, plus the blended and error cases of CBT_MoveAbsolute.
 
-    PYTHONPATH=src:. python docs/library/make_traces.py
+    PYTHONPATH=src:. python3 docs/library/make_traces.py
 """
+import re
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(HERE.parents[1] / "src"), str(HERE.parents[1]), str(HERE.parents[1] / "tests" / "lib")]
 
-from rig import Rig, move_abs  # noqa: E402
+from rig import LIB, SEC, Rig, move_abs  # noqa: E402
+from sim.server import SimServer  # noqa: E402
+from test_lib_doc_examples import STEPS, example_of  # noqa: E402
+from vplc.api import PathError, load_plc  # noqa: E402
 from vplc.trace.recorder import Recorder, write_trace  # noqa: E402
 
 OUT = HERE / "traces"
-PINS = ("Execute", "Busy", "Active", "Done", "CommandAborted", "Error")
+PINS = ("Busy", "Active", "Connected", "Valid", "Done", "CommandAborted", "Error", "ErrorID")
+EXTRA = {"CBT_Connect": ["Cobot.InListenNode", "RobotReady"], "CBT_Stop": ["Cobot.Stopping"],
+         "CBT_ReadActualPosition": ["TcpZ"]}
+FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"]}      # the FB's Enable
+HOLD_S = 0.02                   # Execute stays TRUE this long after Done, then falls: both Done cases show
 
 
-def record(rig, paths, steps, name):
-    rec = Recorder(rig.plc, ["Main." + p for p in paths])
+def slug(page: str) -> str:
+    """CBT_MoveRelative -> move_relative (the file name of its diagram)."""
+    return re.sub(r"(?<=[a-z])(?=[A-Z])", "_", page.removeprefix("CBT_")).lower()
+
+
+def trace_name(page: str) -> str:
+    return f"{slug(page)}.svg"
+
+
+def page_trace(page: str, out: Path) -> None:
+    """Run the page's example as the library tests do and record its trigger inputs and the FB's pins."""
+    code, _ = example_of(page)
+    program = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
+    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True)
+    srv.start()
+    source = out / f".{page}_example.st"
+    try:
+        source.write_text(code.replace("'192.168.1.10'", "'127.0.0.1'")
+                          .replace("IPPort := 5890", f"IPPort := {srv.ports[0]}"), encoding="utf-8")
+        plc = load_plc([str(LIB), str(source)], task="Main@1ms")
+        read = lambda name: plc.read(f"{program}.{name}")   # noqa: E731
+        pump = lambda now_ns: srv.poll(now_ns / 1e9)        # noqa: E731
+        steps = STEPS[page]
+        if page not in ("CBT_Connect", "CBT_ReadActualPosition"):
+            assert plc.run_until(lambda: read("fbConnect.Connected"), 5 * SEC, on_scan=pump)
+        paths = list(FIRST.get(page, []))
+        for trigger, done in steps:
+            fb = done.rpartition(".")[0] or "fbConnect"
+            paths += [trigger] if trigger else []
+            for pin in PINS:
+                try:
+                    read(f"{fb}.{pin}")
+                    paths.append(f"{fb}.{pin}")
+                except PathError:
+                    pass
+        paths += EXTRA.get(page, [])
+        paths = list(dict.fromkeys(paths))
+        rec = Recorder(plc, [f"{program}.{p}" for p in paths], labels=paths)
+        sample = lambda: rec.sample() and False             # noqa: E731
+        plc.run_until(sample, int(0.005 * SEC), on_scan=pump)
+        for trigger, done in steps:
+            fb = done.rpartition(".")[0] or "fbConnect"
+            if trigger:
+                plc.write(f"{program}.{trigger}", True)
+            plc.run_until(lambda: sample() or read(done) or read(f"{fb}.Error"), 20 * SEC, on_scan=pump)
+            plc.run_until(sample, int(HOLD_S * SEC), on_scan=pump)
+            if trigger:
+                plc.write(f"{program}.{trigger}", False)
+            plc.run_until(sample, int(HOLD_S * SEC), on_scan=pump)
+        write_trace(rec, str(out / trace_name(page)))
+        plc.close()
+    finally:
+        source.unlink(missing_ok=True)
+        srv.close()
+
+
+def record(rig, paths, steps, path: Path):
+    rec = Recorder(rig.plc, ["Main." + p for p in paths], labels=paths)
     rig.until(lambda: rec.sample() and False, 0.005)
     for action, seconds in steps:
         if action:
             action()
         rig.until(lambda: rec.sample() and False, seconds)
-    write_trace(rec, str(OUT / name))
+    write_trace(rec, str(path))
 
 
-def fb_paths(fb, exec_var, active=True):
-    return [exec_var] + [f"{fb}.{p}" for p in PINS[1:] if active or p != "Active"] + [f"{fb}.ErrorID"]
-
-
-def main():
-    OUT.mkdir(exist_ok=True)
-    r = Rig(connect=False)
-    record(r, ["ConnExec", "conn.Busy", "conn.Connected", "conn.Error", "Cobot.InListenNode", "Cobot.QueueDepth"],
-           [(lambda: r.write("ConnExec", True), 0.05), (lambda: r.write("ConnExec", False), 0.02)], "connect.svg")
-    r.close()
-
+def move_absolute_cases(out: Path) -> None:
+    """The two cases the example does not show: blended (Done on acceptance) and a parameter error."""
+    paths = ["MoveExec", "mover.Busy", "mover.Active", "mover.Done", "mover.CommandAborted", "mover.Error",
+             "mover.ErrorID"]
     r = Rig()
-    r.set_struct("MoveParam", move_abs(TargetPosition=dict(X=10, Y=0, Z=90, RX=0, RY=90, RZ=0)))
-    record(r, fb_paths("mover", "MoveExec"),
-           [(lambda: r.write("MoveExec", True), 0.05), (lambda: r.write("MoveExec", False), 0.3)],
-           "move_absolute_non_blended.svg")
     r.set_struct("MoveParam", move_abs(BlendingEnable=True, BlendingValue=50))
-    record(r, fb_paths("mover", "MoveExec"),
-           [(lambda: r.write("MoveExec", True), 0.02), (lambda: r.write("MoveExec", False), 0.01)],
-           "move_absolute_blended.svg")
+    record(r, paths, [(lambda: r.write("MoveExec", True), 0.02), (lambda: r.write("MoveExec", False), 0.01)],
+           out / "move_absolute_blended.svg")
     r.set_struct("MoveParam", move_abs(Speed=0))
-    record(r, fb_paths("mover", "MoveExec"),
-           [(lambda: r.write("MoveExec", True), 0.01), (lambda: r.write("MoveExec", False), 0.01)],
-           "move_absolute_error.svg")
+    record(r, paths, [(lambda: r.write("MoveExec", True), 0.01), (lambda: r.write("MoveExec", False), 0.01)],
+           out / "move_absolute_error.svg")
     r.close()
 
-    r = Rig()
-    r.set_struct("MParam[1]", move_abs(Speed=20, TargetPosition=dict(X=40, Y=0, Z=90, RX=0, RY=90, RZ=0)))
-    r.set_struct("StopParam", dict(Mode=1))
-    record(r, ["MExec[1]", "movers[1].Busy", "movers[1].Active", "movers[1].CommandAborted",
-               "StopExec", "stop.Busy", "stop.Done", "Cobot.Stopping"],
-           [(lambda: r.write("MExec[1]", True), 0.1), (lambda: r.write("StopExec", True), 0.03),
-            (lambda: (r.write("StopExec", False), r.write("MExec[1]", False)), 0.02)], "stop.svg")
-    r.set_struct("MParam[2]", move_abs(Speed=20, TargetPosition=dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=0)))
-    record(r, ["MExec[2]", "movers[2].Busy", "movers[2].Active", "movers[2].Done", "PrgExec", "prg.Done",
-               "PrgParam.Command"],
-           [(lambda: r.write("MExec[2]", True), 0.1),
-            (lambda: (r.write("PrgParam.Command", 0), r.write("PrgExec", True)), 0.3),
-            (lambda: r.write("PrgExec", False), 0.01),
-            (lambda: (r.write("PrgParam.Command", 1), r.write("PrgExec", True)), 0.6)], "program_control.svg")
-    record(r, ["ReadEnable", "rd.Busy", "rd.Valid", "rd.Error", "rd.Position.TCP.X"],
-           [(lambda: r.write("ReadEnable", True), 0.03), (lambda: r.write("ReadEnable", False), 0.01)],
-           "read_actual_position.svg")
-    r.close()
-    print("traces written to", OUT)
+
+def main(out: Path = OUT) -> None:
+    """Write every diagram into ``out`` (the drift test writes them into a temporary folder and compares)."""
+    out.mkdir(exist_ok=True)
+    for page in sorted(STEPS):
+        page_trace(page, out)
+    move_absolute_cases(out)
 
 
 if __name__ == "__main__":
     main()
+    print("traces written to", OUT)

@@ -5,9 +5,10 @@ from ..frontend import types as T
 
 
 class Recorder:
-    def __init__(self, plc, paths: list[str]) -> None:
+    def __init__(self, plc, paths: list[str], labels: list[str] | None = None) -> None:
         self.plc = plc
         self.paths = paths
+        self.labels = labels or paths            # row names of the SVG diagram
         self.kinds = []
         for p in paths:
             t = T.base_of(plc._resolver._locate(p)[2])           # raises PathError for a bad path

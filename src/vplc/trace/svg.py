@@ -31,7 +31,19 @@ def time_label(t_ns: float, step_ns: float) -> str:
     step = step_ns / scale
     whole = step >= 10 or (step >= 1 and abs(step - round(step)) < 1e-9)
     decimals = 0 if whole else 1 if step >= 1 else 2 if step >= 0.1 else 3
-    return f"{t_ns / scale:.{decimals}f} {unit}"
+    value = t_ns / scale
+    return f"{0.0 if abs(value) < 0.5 * 10 ** -decimals else value:.{decimals}f} {unit}"
+
+
+def nice_step(span_ns: float, most: int = 8) -> float:
+    """Grid step of 1, 2 or 5 times a power of ten giving at most ``most`` intervals over the span."""
+    step = 1.0
+    while span_ns / step > most:
+        for factor in (2, 2.5, 2):            # 1 -> 2 -> 5 -> 10
+            step *= factor
+            if span_ns / step <= most:
+                break
+    return step
 
 
 def clip(changes, t0: int, t1: int) -> list[tuple[int, object]]:
@@ -129,7 +141,8 @@ def render_svg(rec, window: tuple[int, int] | None = None) -> str:
            f'<path d="M0,4 L4,0" stroke="{BLUE}" stroke-width="0.8"/></pattern></defs>',
            f'<rect width="{WIDTH}" height="{h}" fill="white"/>']
     top = 10
-    for i, (p, (kind, _bits)) in enumerate(zip(rec.paths, rec.kinds)):
+    labels = getattr(rec, "labels", None) or rec.paths
+    for i, (p, (kind, _bits)) in enumerate(zip(labels, rec.kinds)):
         rh = heights[i]
         base, hi = top + rh - 8, top + rh - 8 - (HIGH if kind != "real" else rh - 14)
         label_y = base - 4 if kind != "real" else (hi + base) / 2 + 4
@@ -145,10 +158,14 @@ def render_svg(rec, window: tuple[int, int] | None = None) -> str:
                 out += _bus_row(ch, x, t1, hi, base)
         top += rh
     axis = top + 14
-    for k in range(6):
-        t = t0 + span * k / 5
+    step = nice_step(span)
+    k = -(-t0 // step)                          # first grid line at or after the start of the window
+    while k * step <= t1:
+        t = k * step
+        out.insert(3, f'<line x1="{x(t):.1f}" y1="10" x2="{x(t):.1f}" y2="{top}" stroke="#eee"/>')
         out.append(f'<text x="{x(t):.1f}" y="{axis}" font-size="10" text-anchor="middle">'
-                   f'{escape(time_label(t, span / 5))}</text>')
+                   f'{escape(time_label(t, step))}</text>')
+        k += 1
     out.append("</svg>")
     return "\n".join(out) + "\n"
 
