@@ -1,6 +1,6 @@
 """Front-end benchmark: check time of lib/ + examples/, of generated files up to 50,000 lines, and the slope.
 
-Run: python bench/bench_frontend.py   (prints figures; no pass/fail thresholds)
+Run: python3 bench/bench_frontend.py   (prints figures; no pass/fail thresholds)
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """HMI benchmarks: button-to-status round trip over loopback, and what serving the HMI adds to the PLC scan.
 
-    python bench/bench_hmi.py
+    python3 bench/bench_hmi.py
 
 1. Round trip: POST /api/execute ChangeBase_Execute (what the Execute button sends), then poll /api/read
    like the page does until ChangeBase_Done is TRUE. PLC (examples + library) in real time, simulator in a

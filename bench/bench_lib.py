@@ -1,6 +1,6 @@
 """Benchmarks of the CBT_Commands_Lib function blocks on the virtual PLC (1 ms task) against the simulator.
 
-    PYTHONPATH=src:. python bench/bench_lib.py
+    PYTHONPATH=src:. python3 bench/bench_lib.py
 
 Figures (issue 6), each printed with its target, in two call orders (docs/library/design.md, "Latency"):
 documented = command FBs, then CBT_Connect; fast = CBT_Connect, command FBs, CBT_Connect (same instance).

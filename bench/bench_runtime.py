@@ -1,6 +1,6 @@
 """Runtime benchmarks (issue 4): per-scan cost, virtual scans/s, real-time lateness, compile time, memory.
 
-Run alone: ``python bench/bench_runtime.py`` (prints human-readable figures, exits 0).
+Run alone: ``python3 bench/bench_runtime.py`` (prints human-readable figures, exits 0).
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """`make demo`: robot simulator + virtual PLC running the examples in real time + web HMI, stopped by Ctrl-C.
 
-    python examples/run_demo.py [--host 127.0.0.1] [--robot-port 5890] [--svr-port 5891] [--hmi-port 8080]
+    python3 examples/run_demo.py [--host 127.0.0.1] [--robot-port 5890] [--svr-port 5891] [--hmi-port 8080]
 """
 from __future__ import annotations
 

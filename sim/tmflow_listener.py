@@ -1,6 +1,6 @@
 """Command line of the TMflow Listen Node simulator.
 
-    python sim/tmflow_listener.py [--host 127.0.0.1] [--port 5890] [--robots N]
+    python3 sim/tmflow_listener.py [--host 127.0.0.1] [--port 5890] [--robots N]
                                   [--realtime | --speedup K] [--log FILE.jsonl]
                                   [--no-auto-enter] [--send-message Listen1]
                                   [--control-port 5889 | --no-control] [--control-host 127.0.0.1]

@@ -1,7 +1,7 @@
 """Generates every ErrorID text of the project from the one ErrorID table, errors.tsv (one fact, one home).
 
-    python docs/library/make_error_tables.py           # rewrite the generated files
-    python docs/library/make_error_tables.py --check   # exit 1 and name the files that are out of date
+    python3 docs/library/make_error_tables.py           # rewrite the generated files
+    python3 docs/library/make_error_tables.py --check   # exit 1 and name the files that are out of date
 
 errors.tsv has one row per ErrorID: id (16#XXXX), raised_by, text (the ErrorDescrip, <= 79 characters), cause,
 remedy. Generated from it:
@@ -152,7 +152,7 @@ def main(argv: list[str]) -> int:
                 path.write_text(text, encoding="utf-8")
     if check and stale:
         print("Out of date with docs/library/errors.tsv: " + ", ".join(stale)
-              + " (run python docs/library/make_error_tables.py)")
+              + " (run python3 docs/library/make_error_tables.py)")
         return 1
     return 0
 

@@ -1,4 +1,4 @@
-"""``python -m vplc``: see vplc.cli.main."""
+"""``python3 -m vplc``: see vplc.cli.main."""
 import sys
 
 from .cli.main import main

@@ -1,1 +1,1 @@
-"""Command line: ``python -m vplc`` (main: registry and ``check``; run; test)."""
+"""Command line: ``python3 -m vplc`` (main: registry and ``check``; run; test)."""

@@ -1,4 +1,4 @@
-"""Command line: ``python -m vplc <command> ...``.
+"""Command line: ``python3 -m vplc <command> ...``.
 
 Subcommands live in a registry: this module registers ``check``; the back end's modules
 ``vplc.cli.run`` and ``vplc.cli.test`` register ``run`` and ``test``, the package ``vplc.export`` registers

@@ -1,4 +1,4 @@
-"""``python -m vplc run PATHS... [--task Main@1ms] [--virtual-time] [--cycles N | --duration T] [--stats]
+"""``python3 -m vplc run PATHS... [--task Main@1ms] [--virtual-time] [--cycles N | --duration T] [--stats]
 [--watch VAR,...] [--set VAR=VALUE@TIME]... [--scenario FILE] [--trace VAR,... --trace-out FILE.vcd|FILE.svg
 [--trace-window FROM..TO]]``: run ST programs on the virtual controller.
 

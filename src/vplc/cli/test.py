@@ -1,4 +1,4 @@
-"""``python -m vplc test PATHS... [--junit FILE]``: run TcUnit-style ST test suites on virtual time.
+"""``python3 -m vplc test PATHS... [--junit FILE]``: run TcUnit-style ST test suites on virtual time.
 
 A test suite is any FUNCTION_BLOCK (outside the prelude) whose body calls TEST('name'). All suites are
 instantiated in one generated runner program and called once per 1 ms scan until every test called

@@ -1,4 +1,4 @@
-"""``python -m vplc export PATH... --format iec61131-10|paste -o OUT [--flat]``: hand the library to
+"""``python3 -m vplc export PATH... --format iec61131-10|paste -o OUT [--flat]``: hand the library to
 Sysmac Studio.
 
 * ``iec61131-10`` writes one IEC 61131-10 Ed.1 XML file for Tools > IEC 61131-10 XML > Import
