@@ -65,7 +65,7 @@ def run_cmd(args) -> int:
     from ..api import LoadError, PlcFault, load_plc, parse_task
     from ..runtime.stats import ScanStats
     from ..runtime.values import PathError
-    from ..trace import Recorder, parse_window, write_trace
+    from ..trace import Recorder, write_trace
     if bool(args.trace) != bool(args.trace_out):
         return _err("--trace and --trace-out go together")
     if args.trace_out and not args.trace_out.lower().endswith((".vcd", ".svg")):
@@ -163,6 +163,18 @@ def run_cmd(args) -> int:
         summary += f"; {held} of {len(scenario.expects)} expectation(s) held"
     print(f"vplc run: OK: {summary}")
     return 0
+
+
+def parse_window(text: str) -> tuple[int, int]:
+    """``"2s..2.5s"`` -> (FROM, TO) in ns; ``"..3s"`` starts at 0; ValueError with the reason otherwise."""
+    start, sep, end = text.partition("..")
+    t0 = parse_duration(start) if start.strip() else 0
+    t1 = parse_duration(end) if end.strip() else None
+    if not sep or t0 is None or t1 is None:
+        raise ValueError(f"--trace-window {text!r} is not of the form FROM..TO, e.g. 2s..2.5s")
+    if t1 <= t0:
+        raise ValueError(f"--trace-window {text!r}: TO must be later than FROM")
+    return t0, t1
 
 
 def _paths(text: str) -> list[str]:

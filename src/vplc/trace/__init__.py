@@ -1,4 +1,4 @@
 """Signal traces of a running PLC: record variables every scan, write VCD (GTKWave) or an SVG timing diagram."""
-from .recorder import Recorder, parse_window, write_trace
+from .recorder import Recorder, write_trace
 
-__all__ = ["Recorder", "parse_window", "write_trace"]
+__all__ = ["Recorder", "write_trace"]

@@ -35,19 +35,6 @@ class Recorder:
         self.end_ns = now
 
 
-def parse_window(text: str) -> tuple[int, int]:
-    """``"2s..2.5s"`` -> (FROM, TO) in ns; ``"..3s"`` starts at 0; ValueError with the reason otherwise."""
-    from ..runtime.values import parse_duration
-    start, sep, end = text.partition("..")
-    t0 = parse_duration(start) if start.strip() else 0
-    t1 = parse_duration(end) if end.strip() else None
-    if not sep or t0 is None or t1 is None:
-        raise ValueError(f"--trace-window {text!r} is not of the form FROM..TO, e.g. 2s..2.5s")
-    if t1 <= t0:
-        raise ValueError(f"--trace-window {text!r}: TO must be later than FROM")
-    return t0, t1
-
-
 def write_trace(rec: Recorder, filename: str, window: tuple[int, int] | None = None) -> None:
     """Write ``rec`` as VCD (``.vcd``) or SVG (``.svg``, only ``window`` if given), chosen by the extension."""
     from .svg import write_svg

@@ -4,7 +4,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from vplc.trace import parse_window
+from vplc.cli.run import parse_window
 from vplc.trace.svg import LABEL_W, MIN_PULSE, render_svg
 
 MS = 1_000_000
