@@ -173,7 +173,7 @@ function drawRobotTile() {
 }
 
 /* ---------- the FB's answer on the message line ---------- */
-function watchResult(group, what) {
+function watchResult(group, what, doneText) {      // doneText: what Done means for this command
   const firstPoll = live.polls + 2, deadline = Date.now() + 30000;
   const check = () => {
     const v = live.values;
@@ -187,7 +187,7 @@ function watchResult(group, what) {
         return;
       }
       if (v[`${group}_Done`] === true || (group === "Connect" && v.Connect_Connected === true)) {
-        message(`${what}: done.`, "ok");
+        message(doneText ? `${what}: Done – ${doneText}` : `${what}: done.`, "ok");
         return;
       }
     }

@@ -4,7 +4,6 @@
 "use strict";
 
 const POLL_MS = 50;            // 20 updates per second (issue: >= 10)
-const TRAIL_POINTS = 400;
 
 const LABELS = {
   TargetPosition: "Target Position (mm, °)", ArcPoint: "Arc Point (mm, °)", EndPoint: "End Point (mm, °)",
@@ -38,22 +37,28 @@ const PAGES = {
     presets: { "Preset Values": { Connect_AddressIP: "127.0.0.1", Connect_Dest_PortIP: 5890, Connect_Time_Out: 10 } },
     status: ["Connected", "Busy", "Error", "ErrorID", "ErrorDescrip", "LastConnTime", "LastLostTime", "Reconnecting",
       "RetryCount"] },
-  changebase: { title: "Change Base", group: "ChangeBase", param: "ChangeBase_Param", legend: "Base Settings",
+  changebase: { title: "Change Base",
+    done: () => "the robot accepted the base; it applies to the motions queued after it.", group: "ChangeBase", param: "ChangeBase_Param", legend: "Base Settings",
     presets: { "Set Default Robot Base": { Transformation: T(0, 0, 0, 0, 0, 0), ExitNode: false } } },
-  changetcp: { title: "Change TCP", group: "ChangeTCP", param: "ChangeTCP_Param", legend: "Tool Settings",
+  changetcp: { title: "Change TCP", view: false,
+    done: () => "the robot accepted the tool; it applies to the motions queued after it.", group: "ChangeTCP", param: "ChangeTCP_Param", legend: "Tool Settings",
     presets: { "Set Null Tool Offset": { TCPOffset: T(0, 0, 0, 0, 0, 0), Weight: 0,
       MomentOfInertia: { Ixx: 0, Iyy: 0, Izz: 0 }, MassCenter: T(0, 0, 0, 0, 0, 0), ExitNode: false } } },
-  moverel: { title: "Move Relative", group: "MoveRel", param: "MoveRel_Param",
+  moverel: { title: "Move Relative",
+    done: (c) => (c.BlendingEnable === "TRUE" ? "the robot accepted the motion (blended: the next one may follow)." : "the robot arrived at the target."), group: "MoveRel", param: "MoveRel_Param",
     presets: { "Preset Values": { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 20,
       TargetPosition: T(0, 0, 0, 0, 0, 0) } } },
-  moveabs: { title: "Move Absolute", group: "MoveAbs", param: "MoveAbs_Param",
+  moveabs: { title: "Move Absolute",
+    done: (c) => (c.BlendingEnable === "TRUE" ? "the robot accepted the motion (blended: the next one may follow)." : "the robot arrived at the target."), group: "MoveAbs", param: "MoveAbs_Param",
     presets: { "Preset Values": { ...MOTION, TargetPosition: { ...HOME },
       RobotPose: { Pose1: 0, Pose2: 0, Pose3: 0 } } } },
-  movecircle: { title: "Move Circle", group: "MoveCircle", param: "MoveCircle_Param",
+  movecircle: { title: "Move Circle",
+    done: (c) => (c.BlendingEnable === "TRUE" ? "the robot accepted the motion (blended: the next one may follow)." : "the robot arrived at the target."), group: "MoveCircle", param: "MoveCircle_Param",
     presets: { "Preset Values": { DataFormat: 0, ArcPoint: T(450, 50, 400), EndPoint: T(400, 100, 400),
       Speed: 30, AccelTime: 200, BlendingEnable: false, BlendingValue: 0, ArcAngle: 0,
       PrecisePositioning: false, ExitNode: false } } },
-  setoutput: { title: "Digital Output", group: "SetOutput", param: "SetOutput_Param", legend: "Output Settings",
+  setoutput: { title: "Digital Output",
+    done: (c) => (c.WaitUntilSet === "TRUE" && c.Immediate !== "TRUE" ? "the robot switched the output." : "the robot accepted the command."), group: "SetOutput", param: "SetOutput_Param", legend: "Output Settings",
     presets: { "Close Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: true, Immediate: false,
       WaitUntilSet: true, ExitNode: false },
       "Open Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: false, Immediate: false,
@@ -66,7 +71,7 @@ const DEFAULT_STATUS = ["Busy", "Done", "CommandAborted", "Error", "ErrorID", "E
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
 let MAP = null;
-const live = { values: {}, online: false, trail: [], listeners: [], kick: null, polls: 0 };
+const live = { values: {}, online: false, listeners: [], kick: null, polls: 0 };
 
 /* ---------- server access ---------- */
 /* The access key comes in the address printed at start-up (…/#key=…): kept for this browser tab only and
@@ -117,21 +122,22 @@ function leafSpec(path) {
   for (const part of rest.split(".").filter(Boolean)) {
     const def = typeDef(spec.type);
     if (!def || !def.fields || !def.fields[part]) return null;
-    spec = def.fields[part];
+    const inner = def.fields[part];        // a structure member's range holds for its members (TargetPosition.X)
+    spec = spec.min !== undefined && inner.min === undefined ?
+      { ...inner, min: spec.min, max: spec.max, ranges: spec.ranges } : inner;
   }
   return spec;
-}
-
-function rangeText(spec) {
-  if (spec.min === undefined) return spec.unit || "";
-  return `${spec.min}..${spec.max}${spec.unit ? " " + spec.unit : ""}`;
 }
 
 /* returns [value, null] or [null, error text] */
 function checkValue(path, spec, raw, context) {
   const def = typeDef(spec.type);
   const name = LABELS[path.split(".").pop()] || path.split(".").pop();
-  if (def && def.enum) return [Number(raw), null];
+  if (def && def.enum) {
+    const text = Object.keys(def.enum).find((k) => def.enum[k] === Number(raw));
+    const refused = context && refusedCombination(spec, text, context, name);
+    return refused ? [null, refused] : [Number(raw), null];
+  }
   if (spec.type === "BOOL") return [Boolean(raw), null];
   if (spec.type.startsWith("STRING")) {
     if (spec.pattern === "ipv4" && !/^(25[0-5]|2[0-4]\d|1?\d?\d)(\.(25[0-5]|2[0-4]\d|1?\d?\d)){3}$/.test(raw))
@@ -144,12 +150,10 @@ function checkValue(path, spec, raw, context) {
   if (text === "" || !(isReal ? /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/ : /^[-+]?\d+$/).test(text))
     return [null, `${name}: enter ${isReal ? "a number" : "a whole number"}`];
   const value = Number(text);
-  let max = spec.max;
-  const fmt = context && context.DataFormat;          // e.g. "CAR_Abs": 2nd letter speed, 3rd blending unit
-  if (fmt && path.endsWith(".Speed") && fmt[1] === "P") max = Math.min(max, 100);
-  if (fmt && path.endsWith(".BlendingValue") && fmt[2] === "P") max = Math.min(max, 100);
-  if ((spec.min !== undefined && value < spec.min) || (max !== undefined && value > max))
-    return [null, `${name}: ${value} is out of range ${spec.min}..${max}${spec.unit ? " " + spec.unit : ""}`];
+  const r = applicableRange(spec, context || {});      // the library's range for the selected format
+  if (r && (value < r.min || value > r.max))
+    return [null, `${name}: ${value} is out of range ${r.min}..${r.max}${r.unit ? " " + r.unit : ""}` +
+      (r.error ? ` (the FB would refuse it with ${r.error})` : "")];
   return [value, null];
 }
 
@@ -167,6 +171,7 @@ function makeField(path, spec, label) {
   } else if (def && def.enum) {
     input = document.createElement("select");
     for (const [k, v] of Object.entries(def.enum)) input.add(new Option(k, v));
+    if (Math.max(...Object.keys(def.enum).map((k) => k.length)) > 10) box.classList.add("span2");   // StopDiscardAll
   } else {
     input = document.createElement("input");
     input.type = "text";
@@ -184,38 +189,56 @@ function makeField(path, spec, label) {
   lab.textContent = label;
   if (spec.type === "BOOL") { box.append(input, lab); return box; }
   box.append(lab, input);
-  const hint = rangeText(spec);
-  if (hint) { const h = document.createElement("span"); h.className = "hint"; h.textContent = hint; box.append(h); }
+  const h = document.createElement("span");          // filled by refreshLimits: follows the selected format
+  h.className = "hint";
+  h.textContent = spec.ranges || spec.allowed ? "" : rangeHint(spec, {});
+  box.append(h);
   return box;
 }
 
 /* builds fieldsets for a struct variable (or array element) rooted at `path` */
 function buildStruct(container, path, typeName, legendText) {
   const def = typeDef(typeName);
-  const scalars = [];
+  const scalars = [], checks = [];
   for (const [field, spec] of Object.entries(def.fields)) {
     const fdef = typeDef(spec.type);
-    if (fdef && fdef.fields) {
+    if (fdef && fdef.fields) {                  // a pose: one row of six, the range once in the legend
       const fs = document.createElement("fieldset");
-      fs.innerHTML = `<legend>${LABELS[field] || field}</legend>`;
+      fs.className = "pose";
+      fs.dataset.member = field;
+      const range = spec.min === undefined ? "" :
+        ` <span class="range">${spec.min === -spec.max ? "±" + spec.max : spec.min + ".." + spec.max}</span>`;
+      fs.innerHTML = `<legend>${LABELS[field] || field}${range}</legend>`;
       const grid = document.createElement("div");
       grid.className = "grid six";
-      for (const [sub, subSpec] of Object.entries(fdef.fields))
-        grid.append(makeField(`${path}.${field}.${sub}`, subSpec, sub));
+      for (const [sub, subSpec] of Object.entries(fdef.fields)) {
+        const box = makeField(`${path}.${field}.${sub}`, leafSpec(`${path}.${field}.${sub}`) || subSpec, sub);
+        box.querySelector(".hint").remove();
+        grid.append(box);
+      }
       fs.append(grid);
       container.append(fs);
-    } else {
-      scalars.push([field, spec]);
-    }
+    } else if (spec.type === "BOOL") checks.push([field, spec]);
+    else scalars.push([field, spec]);
   }
-  if (scalars.length) {
-    const fs = document.createElement("fieldset");
-    fs.innerHTML = `<legend>${legendText}</legend>`;
-    const grid = document.createElement("div");
-    grid.className = "grid wide";
-    for (const [field, spec] of scalars) grid.append(makeField(`${path}.${field}`, spec, LABELS[field] || field));
-    fs.append(grid);
-    container.prepend(fs);
+  const fs = document.createElement("fieldset");
+  fs.innerHTML = `<legend>${legendText}</legend>`;
+  const grid = document.createElement("div");
+  grid.className = "grid wide";
+  for (const [field, spec] of scalars) grid.append(makeField(`${path}.${field}`, spec, LABELS[field] || field));
+  const row = document.createElement("div");
+  row.className = "checks";
+  for (const [field, spec] of checks) row.append(makeField(`${path}.${field}`, spec, LABELS[field] || field));
+  if (scalars.length) fs.append(grid);
+  if (checks.length) fs.append(row);
+  container.prepend(fs);
+  const pose = container.querySelector('fieldset[data-member="RobotPose"]');
+  const poseOn = container.querySelector(`[data-path="${path}.RobotPoseEnable"]`);
+  if (pose && poseOn) {                          // shown only when it is sent (PTP CPP with Enable Robot Pose)
+    const show = () => { pose.hidden = !poseOn.checked; };
+    poseOn.addEventListener("change", show);
+    container.addEventListener("fill", show);
+    show();
   }
 }
 
@@ -242,14 +265,13 @@ function pick(obj, rel) {
 /* fill every input under `prefix` from a nested value object */
 function fillFrom(root, prefix, valueObj) {
   for (const el of inputsUnder(root, prefix)) setInput(el, pick(valueObj, el.dataset.path.slice(prefix.length)));
+  root.dispatchEvent(new Event("fill"));
 }
 
 /* collect + check the inputs under `prefix`; returns {values} or {error} */
 function collect(root, prefix) {
   const els = inputsUnder(root, prefix);
-  const context = {};
-  for (const el of els)
-    if (el.dataset.path.endsWith(".DataFormat")) context.DataFormat = el.options[el.selectedIndex].text;
+  const context = formContext(root, prefix);
   const values = {};
   let first = null;
   for (const el of els) {
@@ -288,6 +310,7 @@ function statusTable(title, rows) {
 function showStatus() {
   for (const cell of document.querySelectorAll("[data-status]")) {
     const v = live.values[cell.dataset.status];
+    if (cell.classList.contains("lamp")) { cell.dataset.value = String(v === true); continue; }
     const led = cell.querySelector(".led");
     if (led) { led.classList.toggle("on", v === true); cell.dataset.value = String(v === true); continue; }
     let text = v === undefined || v === null ? "" : String(v);
@@ -309,14 +332,6 @@ function startPolling(names) {
       Object.assign(live.values, data.values);
       live.polls += 1;
       live.online = true;
-      const p = live.values.ReadPos_Position && live.values.ReadPos_Position.TCP;
-      if (live.values.ReadPos_Valid && p) {
-        const last = live.trail[live.trail.length - 1];
-        if (!last || Math.abs(last.X - p.X) + Math.abs(last.Y - p.Y) + Math.abs(last.Z - p.Z) > 0.2) {
-          live.trail.push({ X: p.X, Y: p.Y, Z: p.Z });
-          if (live.trail.length > TRAIL_POINTS) live.trail.shift();
-        }
-      }
     } catch (e) { live.online = false; }
     pillPlc.textContent = live.online ? "PLC online" : "PLC offline";
     pillPlc.className = "pill " + (live.online ? "on" : "off");
@@ -331,48 +346,6 @@ function startPolling(names) {
   }
   function next() { live.kick = null; tick(); }
   tick();
-}
-
-/* ---------- live robot view (top X-Y and side X-Z) ---------- */
-function drawView(canvas, h, v, title) {
-  const rect = canvas.getBoundingClientRect();
-  canvas.width = Math.max(50, rect.width); canvas.height = Math.max(50, rect.height);
-  const ctx = canvas.getContext("2d"), W = canvas.width, H = canvas.height;
-  ctx.clearRect(0, 0, W, H);
-  const pts = live.trail;
-  let lo = { h: -100, v: -100 }, hi = { h: 600, v: 600 };
-  for (const p of pts) { lo = { h: Math.min(lo.h, p[h]), v: Math.min(lo.v, p[v]) }; hi = { h: Math.max(hi.h, p[h]), v: Math.max(hi.v, p[v]) }; }
-  const scale = Math.min((W - 30) / (hi.h - lo.h), (H - 24) / (hi.v - lo.v));
-  const X = (x) => 22 + (x - lo.h) * scale, Y = (y) => H - 14 - (y - lo.v) * scale;
-  ctx.strokeStyle = "#c9d1d9"; ctx.lineWidth = 1;
-  ctx.beginPath(); ctx.moveTo(X(0), 0); ctx.lineTo(X(0), H); ctx.moveTo(0, Y(0)); ctx.lineTo(W, Y(0)); ctx.stroke();
-  ctx.fillStyle = "#44505c"; ctx.font = "11px sans-serif";
-  ctx.fillText(`${title}  (${h} → , ${v} ↑, mm)`, 4, 12);
-  if (!pts.length) { ctx.fillText("no position yet: connect the robot", 4, 28); return; }
-  ctx.strokeStyle = "#2e9b4f"; ctx.lineWidth = 2; ctx.beginPath();
-  pts.forEach((p, i) => (i ? ctx.lineTo(X(p[h]), Y(p[v])) : ctx.moveTo(X(p[h]), Y(p[v]))));
-  ctx.stroke();
-  const last = pts[pts.length - 1];
-  ctx.fillStyle = "#e07b00"; ctx.beginPath(); ctx.arc(X(last[h]), Y(last[v]), 5, 0, 7); ctx.fill();
-}
-
-function robotView(container) {
-  container.innerHTML = `<h2>Live robot view: TCP path from CBT_ReadActualPosition</h2>
-    <div class="views"><canvas id="view-top"></canvas><canvas id="view-side"></canvas></div>
-    <div class="pos" id="tcp-pos">X — Y — Z —</div>
-    <div class="robot-status">
-      <span>In Listen node <span data-status="Robot_InListenNode"><span class="led"></span></span></span>
-      <span>Stopping <span data-status="Robot_Stopping"><span class="led busy"></span></span></span>
-      <span>Queue <b data-status="Robot_QueueDepth"></b></span>
-      <span>Last ErrorID <b data-status="Robot_LastErrorID"></b></span></div>`;
-  live.listeners.push(() => {
-    drawView(document.getElementById("view-top"), "X", "Y", "Top view");
-    drawView(document.getElementById("view-side"), "X", "Z", "Side view");
-    const p = live.values.ReadPos_Position && live.values.ReadPos_Position.TCP;
-    document.getElementById("tcp-pos").textContent = live.values.ReadPos_Valid && p ?
-      `X ${p.X.toFixed(1)}  Y ${p.Y.toFixed(1)}  Z ${p.Z.toFixed(1)}  RX ${p.RX.toFixed(1)}  RY ${p.RY.toFixed(1)}  RZ ${p.RZ.toFixed(1)}` :
-      "position not valid (robot not connected)";
-  });
 }
 
 /* ---------- page frame ---------- */
@@ -397,13 +370,33 @@ function mainPage() {
       <a href="moverel.html" id="nav-moverel">Move Relative</a><a href="moveabs.html" id="nav-moveabs">Move Absolute</a>
       <a href="movecircle.html" id="nav-movecircle">Move Circle</a><a href="pnp.html" id="nav-pnp">PnP Sequence</a>
       <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>
-    </div><div class="robotview" id="robotview"></div>`;
+    </div><div class="viewcol"><div id="robotview"></div>${robotStatusStrip()}</div>`;
   robotView(document.getElementById("robotview"));
   robotTile(document.getElementById("robotview"));
   document.querySelector("header h1").insertAdjacentHTML("afterend",
     '<a class="menu" id="nav-program" href="program.html">Program (Ladder)</a>');
-  startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", "Robot_InListenNode", "Robot_QueueDepth",
-    "Robot_Stopping", "Robot_LastErrorID"]);
+  startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", ...ROBOT_STATUS]);
+}
+
+/* the robot's state on every page: In Listen node, Paused, Stopping, queue depth, last ErrorID */
+const ROBOT_STATUS = ["Robot_InListenNode", "Robot_Paused", "Robot_Stopping", "Robot_QueueDepth", "Robot_LastErrorID"];
+function robotStatusStrip() {
+  return `<div class="robot-status">
+    <span>In Listen node <span data-status="Robot_InListenNode"><span class="led"></span></span></span>
+    <span>Paused <span data-status="Robot_Paused"><span class="led busy"></span></span></span>
+    <span>Stopping <span data-status="Robot_Stopping"><span class="led bad"></span></span></span>
+    <span>Queue <b data-status="Robot_QueueDepth"></b></span>
+    <span>Last ErrorID <b data-status="Robot_LastErrorID"></b></span></div>`;
+}
+
+/* Active / Paused / Stopping lamps of a command page (Busy where the FB has no Active output) */
+function indicators(active) {
+  const div = document.createElement("div");
+  div.className = "indicators";
+  div.innerHTML = `<span data-status="${active}" class="lamp active">${active.endsWith("Active") ? "Active" : "Busy"}</span>
+    <span data-status="Robot_Paused" class="lamp paused">Paused</span>
+    <span data-status="Robot_Stopping" class="lamp stopping">Stopping</span>`;
+  return [div, [active, "Robot_Paused", "Robot_Stopping"]];
 }
 
 async function executeCommand(execVar, values, what) {
@@ -460,6 +453,7 @@ async function fbPage(key) {
     b.onclick = () => {
       if (page.param) fillFrom(params, page.param, page.presets[name]);
       else for (const [v, val] of Object.entries(page.presets[name])) setInput(params.querySelector(`[data-path="${v}"]`), val);
+      refreshLimits(params, page.param || "");
       message(`${name}: fields filled, press ${page.execLabel || "Execute"} to send.`);
     };
     buttons.append(b);
@@ -473,7 +467,7 @@ async function fbPage(key) {
     if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
     executeCommand(`${group}_Execute`, result.values, page.title).then((sent) => {
       if (sent && page.release) releaseWhenFinished(group, page.title);
-      else if (sent) watchResult(group, page.title);
+      else if (sent) watchResult(group, page.title, page.done && page.done(formContext(params, page.param)));
     });
   };
   buttons.append(exec);
@@ -487,162 +481,41 @@ async function fbPage(key) {
     buttons.append(off);
   }
   const statusNames = page.status || DEFAULT_STATUS;
-  side.append(buttons, statusTable("Command Status", statusNames.map((s) => [s, `${group}_${s}`])));
-  main.append(params, side);
+  const [lamps, lampNames] = indicators(MAP.variables[`${group}_Active`] ? `${group}_Active` : `${group}_Busy`);
+  side.append(buttons, ...(key === "connect" ? [] : [lamps]),
+    statusTable("Command Status", statusNames.map((s) => [s, `${group}_${s}`])));
+  const left = document.createElement("div");
+  left.className = "left";
+  left.append(params);
+  let redraw;
+  if (key === "connect") {
+    const box = document.createElement("div");
+    box.className = "area connectinfo";
+    box.innerHTML = `<h2>Robot</h2>${robotStatusStrip()}<p>The PLC connects to the robot's Listen node (TMflow, port 5890)
+      and checks it every 500 ms; a silent link is reported 1.0 to 1.5 s later (16#2006).</p>`;
+    left.append(box);
+  }
+  if (page.view !== false) {                 // Change TCP needs its whole panel for the tool data
+    const view = document.createElement("div");
+    view.id = "robotview";
+    left.append(view);
+    redraw = robotView(view, () => motionPreview(key, params, page.param));
+  } else {
+    params.classList.add("full");
+    redraw = () => {};
+  }
+  main.append(left, side);
   const toRead = page.param ? [page.param] : page.inputs;
   try {
     const data = await readVars(toRead);
     if (page.param) fillFrom(params, page.param, data.values[page.param]);
     else for (const v of page.inputs) setInput(params.querySelector(`[data-path="${v}"]`), data.values[v]);
   } catch (e) { message("Cannot read the current parameters: " + e.message, "error"); }
-  startPolling([...statusNames.map((s) => `${group}_${s}`), "Connect_Connected"]);
-}
-
-function buildPnP() {
-  const main = frame("PnP Sequence", false);
-  main.innerHTML = `<div class="pnpdraw"><svg id="pnp-svg" viewBox="0 0 520 330" preserveAspectRatio="xMidYMid meet"></svg>
-      <div class="pos" id="pnp-note">Side view (X/Y → , Z ↑). Orange: segment in progress. Green: live TCP.</div></div>
-    <div class="side"><div class="buttons">
-      <button class="wide" id="btn-preset">Preset Values</button>
-      <button class="primary" id="btn-execute">Execute</button><button class="danger" id="btn-stop">Stop</button>
-      <button class="warn" id="btn-pause">Pause</button><button id="btn-resume">Resume</button></div>
-    <div id="pnp-status"></div></div>
-    <dialog id="seg-dialog"><header><h1 id="seg-title">Segment</h1></header><div class="body" id="seg-body"></div>
-      <div class="actions"><button id="seg-cancel">Cancel</button><button class="primary" id="seg-apply">Apply</button></div></dialog>`;
-  const statusBox = document.getElementById("pnp-status");
-  statusBox.append(statusTable("Cycle Status", [["Execute", "PnP_Example_Execute"], ["Segment", "PnP_Segment"],
-    ["Waiting", "PnP_Waiting"], ["Gripper closed", "PnP_GripperClosed"], ["Cycles", "PnP_CycleCount"],
-    ["Busy", "PnP_MoveBusy"], ["Error", "PnP_MoveError"], ["ErrorID", "PnP_MoveErrorID"], ["ErrorDescrip", "PnP_MoveErrorDescrip"],
-    ["CmdID_Ack", "PnP_Move_CmdID_Ack"]]));
-  statusBox.append(statusTable("Program Control", [["Busy", "ProgramControl_Busy"], ["Done", "ProgramControl_Done"],
-    ["Error", "ProgramControl_Error"], ["ErrorDescrip", "ProgramControl_ErrorDescrip"]]));
-  statusBox.style.cssText = "display:flex;flex-direction:column;gap:4px;flex:1;min-height:0";
-  return main;
-}
-
-let pnpParams = null;
-
-let pnpGeometry = null;
-
-/* static part: the six segments and their Edit buttons, rebuilt only when the parameters change so a tap
-   on an Edit button never lands on an element that a status update has just replaced */
-function drawPnP() {
-  const svg = document.getElementById("pnp-svg");
-  if (!pnpParams) return;
-  const pts = pnpParams.map((p) => p.TargetPosition);
-  const alongY = Math.abs(pts[3].Y - pts[0].Y) >= Math.abs(pts[3].X - pts[0].X);
-  const horiz = (p) => (alongY ? p.Y : p.X);
-  let h0 = Math.min(...pts.map(horiz)), h1 = Math.max(...pts.map(horiz));
-  let v0 = Math.min(...pts.map((p) => p.Z)), v1 = Math.max(...pts.map((p) => p.Z));
-  if (h1 - h0 < 50) { h0 -= 50; h1 += 50; }
-  if (v1 - v0 < 50) { v0 -= 25; v1 += 25; }
-  const s = Math.min(300 / (h1 - h0), 200 / (v1 - v0));
-  const X = (p) => 110 + (horiz(p) - h0) * s + (300 - (h1 - h0) * s) / 2;
-  const Y = (p) => 290 - (p.Z - v0) * s;
-  pnpGeometry = { X, Y };
-  let out = `<defs><marker id="arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="6" markerHeight="6" orient="auto-start-reverse">
-    <path d="M0,0 L10,5 L0,10 z" fill="#2368a8"/></marker>
-    <clipPath id="pnp-clip"><rect x="0" y="0" width="520" height="300"/></clipPath></defs>`;
-  for (let i = 0; i < 6; i++) {
-    const a = pts[(i + 5) % 6], b = pts[i];
-    const [x1, y1, x2, y2] = [X(a), Y(a), X(b), Y(b)];
-    let mx = (x1 + x2) / 2, my = (y1 + y2) / 2, d;
-    const vertical = Math.abs(x1 - x2) < 8;
-    const shift = vertical ? (i === 1 || i === 4 ? -5 : 5) : 0;   // down and up side by side, not on top
-    if (vertical) d = `M${x1 + shift},${y1} L${x2 + shift},${y2}`;
-    else if (i === 0) {            // return travel: drawn as an arc above the approach so the two do not overlap
-      const cy = Math.min(y1, y2) - 70;
-      d = `M${x1},${y1} Q${mx},${cy} ${x2},${y2}`; my = (y1 + y2) / 4 + cy / 2;
-    } else d = `M${x1},${y1} L${x2},${y2}`;
-    if (vertical) mx += i === 1 || i === 4 ? -46 : 46;
-    else my += 16;
-    out += `<path class="seg" id="seg-${i}" d="${d}"/>`;
-    out += `<g class="edit" id="edit-${i}" data-seg="${i}"><rect x="${mx - 40}" y="${my - 11}" width="80" height="22"/>
-      <text x="${mx}" y="${my + 4}" text-anchor="middle">${i + 1} Edit</text></g>`;
-  }
-  pts.forEach((p) => { out += `<circle class="pt" cx="${X(p)}" cy="${Y(p)}" r="4"/>`; });
-  out += `<polyline class="trail" id="pnp-trail" points="" clip-path="url(#pnp-clip)"/>
-    <circle class="tcp" id="pnp-tcp" r="6" cx="-20" cy="-20"/>`;
-  out += `<text x="10" y="318" font-size="11" fill="#44505c">1 ${PNP_SEGMENTS[0]} · 2 ${PNP_SEGMENTS[1]} · 3 ${PNP_SEGMENTS[2]} · 4 ${PNP_SEGMENTS[3]} · 5 ${PNP_SEGMENTS[4]} · 6 ${PNP_SEGMENTS[5]}</text>`;
-  svg.innerHTML = out;
-  for (const g of svg.querySelectorAll(".edit")) g.onclick = () => openSegment(Number(g.dataset.seg));
-  updatePnP();
-}
-
-/* dynamic part: segment in progress and live TCP trail, updated in place at every poll */
-function updatePnP() {
-  if (!pnpGeometry) return;
-  const { X, Y } = pnpGeometry;
-  const active = live.values.PnP_Example_Execute || live.values.PnP_MoveBusy ? live.values.PnP_Segment : -1;
-  for (let i = 0; i < 6; i++) document.getElementById(`seg-${i}`).classList.toggle("active", i === active);
-  document.getElementById("pnp-trail").setAttribute("points", live.trail.map((p) => `${X(p)},${Y(p)}`).join(" "));
-  const last = live.trail[live.trail.length - 1];
-  if (last) {
-    const dot = document.getElementById("pnp-tcp");
-    dot.setAttribute("cx", X(last)); dot.setAttribute("cy", Y(last));
-  }
-}
-
-function openSegment(i) {
-  const dialog = document.getElementById("seg-dialog"), body = document.getElementById("seg-body");
-  const root = `PnP_MoveParameters[${i}]`;
-  body.innerHTML = "";
-  buildStruct(body, root, MAP.variables.PnP_MoveParameters.type, "Motion Settings");
-  fillFrom(body, root, pnpParams[i]);
-  document.getElementById("seg-title").textContent = `Segment ${i + 1}: ${PNP_SEGMENTS[i]} – CBT_MoveAbsolute parameters`;
-  document.getElementById("seg-cancel").onclick = () => dialog.close();
-  document.getElementById("seg-apply").onclick = async () => {
-    const result = collect(body, root);
-    if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
-    try {
-      await api("/api/write", { values: result.values });
-      await loadPnP();
-      dialog.close();
-      message(`Segment ${i + 1} updated in the PLC.`, "ok");
-    } catch (e) { message(`Segment ${i + 1}: ${e.message}`, "error"); }
-  };
-  dialog.showModal();
-}
-
-async function loadPnP() {
-  const data = await readVars(["PnP_MoveParameters"]);
-  pnpParams = data.values.PnP_MoveParameters;
-  drawPnP();
-}
-
-async function pnpPage() {
-  buildPnP();
-  const flatPreset = {};
-  PNP_PRESET.forEach((seg, i) => {
-    const walk = (obj, prefix) => {
-      for (const [k, v] of Object.entries(obj)) {
-        if (v !== null && typeof v === "object") walk(v, `${prefix}.${k}`);
-        else if (leafSpec(`${prefix}.${k}`)) flatPreset[`${prefix}.${k}`] = v;
-      }
-    };
-    walk(seg, `PnP_MoveParameters[${i}]`);
-  });
-  document.getElementById("btn-preset").onclick = async () => {
-    try { await api("/api/write", { values: flatPreset }); await loadPnP(); message("Preset PnP cycle written to the PLC.", "ok"); }
-    catch (e) { message("Preset Values: " + e.message, "error"); }
-  };
-  const setRun = async (on) => {
-    try {
-      await api("/api/write", { values: { PnP_Example_Execute: on } });
-      message(on ? "PnP cycle started: it repeats while Execute stays on." : "PnP stop requested: the cycle ends after the current move.", "ok");
-    } catch (e) { message("PnP: " + e.message, "error"); }
-  };
-  document.getElementById("btn-execute").onclick = () => setRun(true);
-  document.getElementById("btn-stop").onclick = () => setRun(false);
-  const control = (cmd, what) => executeCommand("ProgramControl_Execute", { "ProgramControl_Param.Command": cmd }, what);
-  document.getElementById("btn-pause").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Pause, "Pause");
-  document.getElementById("btn-resume").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Resume, "Resume");
-  live.listeners.push(updatePnP);
-  try { await loadPnP(); } catch (e) { message("Cannot read the PnP parameters: " + e.message, "error"); }
-  startPolling(["PnP_Example_Execute", "PnP_Segment", "PnP_Waiting", "PnP_GripperClosed", "PnP_CycleCount", "PnP_MoveBusy",
-    "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",
-    "ProgramControl_Busy", "ProgramControl_Done", "ProgramControl_Error", "ProgramControl_ErrorDescrip",
-    "Connect_Connected", "ReadPos_Valid", "ReadPos_Position"]);
+  watchLimits(params, page.param || "");
+  params.addEventListener("input", redraw);        // the target preview follows the typing
+  params.addEventListener("change", redraw);
+  startPolling([...statusNames.map((s) => `${group}_${s}`), ...lampNames, "Connect_Connected", "ReadPos_Valid",
+    "ReadPos_Position", ...ROBOT_STATUS]);
 }
 
 async function boot() {

@@ -134,8 +134,8 @@ def execute_and_wait_done(system, browser, group: str) -> None:
 
 def test_main_page_shows_the_live_tcp_position(connected):
     browser = connected.open("index")
-    browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text.startswith("X "), "the TCP position")
-    x = float(browser.driver.find_element(By.ID, "tcp-pos").text.split()[1])
+    browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text.startswith("TCP X "), "the TCP position")
+    x = float(browser.driver.find_element(By.ID, "tcp-pos").text.split()[2])
     assert abs(x - connected.robot_state()["tcp"][0]) < 1.0
     browser.wait_status("Robot_InListenNode", "true")                     # the robot status strip
     assert browser.status("Robot_Stopping") == "false" and browser.status("Robot_LastErrorID").startswith("16#")

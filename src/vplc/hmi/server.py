@@ -37,9 +37,12 @@ from http.server import BaseHTTPRequestHandler, HTTPServer
 from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
+from .ranges import RangeTableError, apply_ranges, load_ranges
+from .trail import Trail
 
 HMI_DIR = pathlib.Path(__file__).resolve().parents[3] / "hmi"
 DEFAULT_MAPPING = HMI_DIR / "mapping.json"
+DEFAULT_RANGES = HMI_DIR / "ranges.json"
 MAX_BODY = 16 * 1024
 MAX_NAMES = 400
 SCAN_WAIT_S = 1.0
@@ -134,6 +137,12 @@ class Mapping:
             raise MappingError(f"{path}: cannot read the HMI variable table ({exc.strerror})") from None
         except json.JSONDecodeError as exc:
             raise MappingError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
+        ranges_file = path.with_name(DEFAULT_RANGES.name)
+        if ranges_file.exists():                # the limits come from the library's range table
+            try:
+                apply_ranges(document, load_ranges(ranges_file), str(ranges_file))
+            except RangeTableError as exc:
+                raise MappingError(str(exc)) from None
         return cls(document, str(path))
 
     def _expand(self, path: str, spec: dict, access: str, role: str, types: dict) -> None:
@@ -156,6 +165,8 @@ class Mapping:
             self.leaves[path] = Leaf(path, spec, access, role, enum=dict(definition["enum"]))
         else:
             for field, field_spec in definition["fields"].items():
+                if "min" in spec and "min" not in field_spec:      # e.g. TargetPosition's range on X..RZ
+                    field_spec = {**field_spec, "min": spec["min"], "max": spec["max"]}
                 self._expand(f"{path}.{field}", field_spec, access, role, types)
 
     def is_readable(self, name: str) -> bool:
@@ -319,6 +330,8 @@ class HmiServer:
         self.requests = 0
         self._execute_lock = threading.Lock()
         self.program = None            # ProgramMonitor, built at the Program page's first request
+        spec = self.mapping.document.get("trail")
+        self.trail = Trail(plc, spec["valid"], spec["position"]) if spec else None
 
     @property
     def port(self) -> int:
@@ -340,8 +353,12 @@ class HmiServer:
         self._thread = threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.1},
                                         name="hmi-http", daemon=True)
         self._thread.start()
+        if self.trail is not None:
+            self.trail.start()
 
     def stop(self) -> None:
+        if self.trail is not None:
+            self.trail.stop()
         if self._httpd:
             self._httpd.shutdown()
             self._httpd.server_close()
@@ -515,6 +532,11 @@ class _Handler(BaseHTTPRequestHandler):
                 self._json(HTTPStatus.OK, self.hmi.read(names))
             elif url.path in ("/api/program", "/api/program/state"):
                 self._program(url)
+            elif url.path == "/api/trail" and self.hmi.trail is not None:
+                since = parse_qs(url.query).get("since", ["0"])[0]
+                if not since.isdigit():
+                    raise RequestError("since must be a point number: /api/trail?since=0")
+                self._json(HTTPStatus.OK, self.hmi.trail.since(int(since)))
             elif url.path.startswith("/api/"):
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
             else:

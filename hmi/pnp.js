@@ -1,0 +1,177 @@
+/* CBT HMI: the PnP Sequence page. The six CBT_MoveAbsolute segments of PnP_Example drawn in side view over the
+   whole panel, at one scale with a scale bar and the base height marked; each segment carries its name on the
+   path (tap it to edit the segment), the one in progress is orange, and the TCP trail comes from the server. */
+"use strict";
+
+let pnpParams = null;
+let pnpGeometry = null;
+
+function buildPnP() {
+  const main = frame("PnP Sequence", false);
+  main.innerHTML = `<div class="pnpdraw"><svg id="pnp-svg"></svg>
+      <div class="pos" id="pnp-note">Side view. Tap a segment's name to edit it. Orange: segment in progress; green: TCP trail.</div></div>
+    <div class="side"><div class="buttons">
+      <button class="wide" id="btn-preset">Preset Values</button>
+      <button class="primary" id="btn-execute">Execute</button><button class="danger" id="btn-stop">Stop</button>
+      <button class="warn" id="btn-pause">Pause</button><button id="btn-resume">Resume</button></div>
+    <div id="pnp-status"></div></div>
+    <dialog id="seg-dialog"><header><h1 id="seg-title">Segment</h1></header><div class="body" id="seg-body"></div>
+      <div class="actions"><button id="seg-cancel">Cancel</button><button class="primary" id="seg-apply">Apply</button></div></dialog>`;
+  const statusBox = document.getElementById("pnp-status");
+  const [lamps] = indicators("PnP_MoveActive");
+  statusBox.append(lamps);
+  statusBox.append(statusTable("Cycle Status", [["Execute", "PnP_Example_Execute"], ["Segment", "PnP_Segment"],
+    ["Waiting", "PnP_Waiting"], ["Gripper closed", "PnP_GripperClosed"], ["Cycles", "PnP_CycleCount"],
+    ["Busy", "PnP_MoveBusy"], ["Error", "PnP_MoveError"], ["ErrorID", "PnP_MoveErrorID"], ["ErrorDescrip", "PnP_MoveErrorDescrip"],
+    ["Pause/Resume", "ProgramControl_Done"], ["P/R Error", "ProgramControl_Error"]]));
+  statusBox.style.cssText = "display:flex;flex-direction:column;gap:4px;flex:1;min-height:0";
+  return main;
+}
+
+/* static part, rebuilt only when the parameters or the panel size change, so a tap on a label never lands on
+   an element that a status update has just replaced */
+function drawPnP() {
+  const svg = document.getElementById("pnp-svg");
+  if (!pnpParams) return;
+  const box = svg.getBoundingClientRect();
+  const W = Math.max(200, Math.round(box.width)), H = Math.max(150, Math.round(box.height));
+  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+  const pts = pnpParams.map((p) => p.TargetPosition);
+  const alongY = Math.abs(pts[3].Y - pts[0].Y) >= Math.abs(pts[3].X - pts[0].X);
+  const axis = alongY ? "Y" : "X";
+  const horiz = (p) => (alongY ? p.Y : p.X);
+  let h0 = Math.min(...pts.map(horiz)), h1 = Math.max(...pts.map(horiz));
+  let v0 = Math.min(...pts.map((p) => p.Z)), v1 = Math.max(...pts.map((p) => p.Z));
+  const [mx0, my0] = [150, 60];                         // room for the labels beside and above the path
+  const s = Math.min((W - 2 * mx0) / Math.max(h1 - h0, 50), (H - 2 * my0 - 20) / Math.max(v1 - v0, 50));
+  const X = (p) => W / 2 + (horiz(p) - (h0 + h1) / 2) * s;
+  const Y = (p) => (H - 20) / 2 + my0 / 2 - (p.Z - (v0 + v1) / 2) * s;
+  pnpGeometry = { X, Y, horiz };
+  let out = `<defs><marker id="arrow" viewBox="0 0 10 10" refX="8" refY="5" markerWidth="4" markerHeight="4" orient="auto-start-reverse">
+    <path d="M0,0 L10,5 L0,10 z" fill="#2368a8"/></marker></defs>`;
+  const step = niceStep(Math.max(h1 - h0, v1 - v0, 100));           // grid in mm, as in the robot view
+  for (let g = Math.ceil((h0 - W / s) / step) * step; g <= h1 + W / s; g += step) {
+    const x = X(alongY ? { Y: g } : { X: g });
+    if (x >= 0 && x <= W) out += `<line class="gridline" x1="${x}" y1="0" x2="${x}" y2="${H - 20}"/>`;
+  }
+  for (let g = Math.ceil((v0 - H / s) / step) * step; g <= v1 + H / s; g += step) {
+    const y = Y({ Z: g });
+    if (y >= 0 && y <= H - 20) out += `<line class="gridline" x1="0" y1="${y}" x2="${W}" y2="${y}"/>`;
+  }
+  const labels = [];
+  for (let i = 0; i < 6; i++) {
+    const a = pts[(i + 5) % 6], b = pts[i];
+    const [x1, y1, x2, y2] = [X(a), Y(a), X(b), Y(b)];
+    let lx = (x1 + x2) / 2, ly = (y1 + y2) / 2, d;
+    const vertical = Math.abs(x1 - x2) < 8;
+    const down = y2 > y1;
+    const shift = vertical ? (down ? -6 : 6) : 0;     // down and up side by side, not on top of each other
+    if (vertical) {               // both labels of a column on its outer side, the down one higher
+      d = `M${x1 + shift},${y1} L${x2 + shift},${y2}`;
+      const top = Math.min(y1, y2), bottom = Math.max(y1, y2);
+      lx = x1 < W / 2 ? x1 - 78 : x1 + 78;
+      ly = top + (down ? 0.28 : 0.78) * (bottom - top);
+    }
+    else if (i === 0) {            // return travel: an arc above the approach so the two do not overlap
+      const cy = Math.min(y1, y2) - 60;
+      d = `M${x1},${y1} Q${lx},${cy} ${x2},${y2}`; ly = (y1 + y2) / 4 + cy / 2 - 14;
+    } else { d = `M${x1},${y1} L${x2},${y2}`; ly += 18; }
+    out += `<path class="seg" id="seg-${i}" d="${d}"/>`;
+    labels.push(`<g class="edit" id="edit-${i}" data-seg="${i}"><rect x="${lx - 62}" y="${ly - 12}" width="124" height="24"/>
+      <text x="${lx}" y="${ly + 4}" text-anchor="middle">${i + 1} ${PNP_SEGMENTS[i]} ✎</text></g>`);
+  }
+  pts.forEach((p) => { out += `<circle class="pt" cx="${X(p)}" cy="${Y(p)}" r="3.5"/>`; });
+  out += `<polyline class="trail" id="pnp-trail" points=""/><circle class="tcp" id="pnp-tcp" r="5" cx="-20" cy="-20"/>`;
+  out += labels.join("");
+  const bar = step, bx = W - 12 - bar * s, by = H - 6;              // scale bar and axes, bottom
+  out += `<path class="scale" d="M${bx},${by - 5} V${by} H${W - 12} V${by - 5}"/>
+    <text class="axis" x="${W - 12}" y="${by - 8}" text-anchor="end">${bar} mm</text>
+    <text class="axis" x="6" y="${by}">${axis} → (mm, base frame) · Z ↑ · grid ${step} mm</text>`;
+  svg.innerHTML = out;
+  for (const g of svg.querySelectorAll(".edit")) g.onclick = () => openSegment(Number(g.dataset.seg));
+  updatePnP();
+}
+
+/* dynamic part: segment in progress and the TCP trail, updated in place at every poll */
+function updatePnP() {
+  if (!pnpGeometry) return;
+  const { X, Y } = pnpGeometry;
+  const active = live.values.PnP_Example_Execute || live.values.PnP_MoveBusy ? live.values.PnP_Segment : -1;
+  for (let i = 0; i < 6; i++) {
+    document.getElementById(`seg-${i}`).classList.toggle("active", i === active);
+    document.getElementById(`edit-${i}`).classList.toggle("active", i === active);
+  }
+  const pts = VIEW.trail.map(([x, y, z]) => ({ X: x, Y: y, Z: z }));
+  document.getElementById("pnp-trail").setAttribute("points", pts.map((p) => `${X(p)},${Y(p)}`).join(" "));
+  const tcp = live.values.ReadPos_Valid && live.values.ReadPos_Position ? live.values.ReadPos_Position.TCP : null;
+  if (tcp) {
+    const dot = document.getElementById("pnp-tcp");
+    dot.setAttribute("cx", X(tcp)); dot.setAttribute("cy", Y(tcp));
+  }
+}
+
+function openSegment(i) {
+  const dialog = document.getElementById("seg-dialog"), body = document.getElementById("seg-body");
+  const root = `PnP_MoveParameters[${i}]`;
+  body.innerHTML = "";
+  buildStruct(body, root, MAP.variables.PnP_MoveParameters.type, "Motion Settings");
+  fillFrom(body, root, pnpParams[i]);
+  watchLimits(body, root);
+  document.getElementById("seg-title").textContent = `Segment ${i + 1}: ${PNP_SEGMENTS[i]} – CBT_MoveAbsolute parameters`;
+  document.getElementById("seg-cancel").onclick = () => dialog.close();
+  document.getElementById("seg-apply").onclick = async () => {
+    const result = collect(body, root);
+    if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
+    try {
+      await api("/api/write", { values: result.values });
+      await loadPnP();
+      dialog.close();
+      message(`Segment ${i + 1} updated in the PLC.`, "ok");
+    } catch (e) { message(`Segment ${i + 1}: ${e.message}`, "error"); }
+  };
+  dialog.showModal();
+}
+
+async function loadPnP() {
+  const data = await readVars(["PnP_MoveParameters"]);
+  pnpParams = data.values.PnP_MoveParameters;
+  drawPnP();
+}
+
+async function pnpPage() {
+  buildPnP();
+  const flatPreset = {};
+  PNP_PRESET.forEach((seg, i) => {
+    const walk = (obj, prefix) => {
+      for (const [k, v] of Object.entries(obj)) {
+        if (v !== null && typeof v === "object") walk(v, `${prefix}.${k}`);
+        else if (leafSpec(`${prefix}.${k}`)) flatPreset[`${prefix}.${k}`] = v;
+      }
+    };
+    walk(seg, `PnP_MoveParameters[${i}]`);
+  });
+  document.getElementById("btn-preset").onclick = async () => {
+    try { await api("/api/write", { values: flatPreset }); await loadPnP(); message("Preset PnP cycle written to the PLC.", "ok"); }
+    catch (e) { message("Preset Values: " + e.message, "error"); }
+  };
+  const setRun = async (on) => {
+    try {
+      await api("/api/write", { values: { PnP_Example_Execute: on } });
+      message(on ? "PnP cycle started: it repeats while Execute stays on." : "PnP stop requested: the cycle ends after the current move.", "ok");
+    } catch (e) { message("PnP: " + e.message, "error"); }
+  };
+  document.getElementById("btn-execute").onclick = () => setRun(true);
+  document.getElementById("btn-stop").onclick = () => setRun(false);
+  const control = (cmd, what) => executeCommand("ProgramControl_Execute", { "ProgramControl_Param.Command": cmd }, what)
+    .then((sent) => sent && watchResult("ProgramControl", what, what === "Pause" ? "the robot holds its path." : "the robot continues."));
+  document.getElementById("btn-pause").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Pause, "Pause");
+  document.getElementById("btn-resume").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Resume, "Resume");
+  live.listeners.push(updatePnP, fetchTrail);
+  window.addEventListener("resize", drawPnP);
+  try { await loadPnP(); } catch (e) { message("Cannot read the PnP parameters: " + e.message, "error"); }
+  startPolling(["PnP_Example_Execute", "PnP_Segment", "PnP_Waiting", "PnP_GripperClosed", "PnP_CycleCount", "PnP_MoveBusy",
+    "PnP_MoveActive", "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",
+    "ProgramControl_Busy", "ProgramControl_Done", "ProgramControl_Error", "ProgramControl_ErrorID",
+    "ProgramControl_CommandAborted", "ProgramControl_ErrorDescrip", "Connect_Connected", "ReadPos_Valid",
+    "ReadPos_Position", ...ROBOT_STATUS]);
+}

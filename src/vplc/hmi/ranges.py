@@ -1,0 +1,54 @@
+"""Parameter ranges of the HMI taken from the library's one range table (hmi/ranges.json, generated from
+docs/library/ranges.tsv by docs/library/make_types.py), never typed into the variable table a second time.
+
+For every structure member (or FB input) in the table, the variable table's spec gets:
+  min / max   the widest range over all conditions: what the server accepts for a single write
+  ranges      the conditional ranges ({"when": {"DataFormat": [...]}, "min", "max", "unit", "error"}): the page
+              applies the one that matches the selected data format, blending, module ...
+  allowed     the data formats a motion command takes ({"when": {"MovementCommand": ["PTP"]}, "allowed": [...]})
+A structure-typed member (TargetPosition, MomentOfInertia) passes min / max on to its members.
+"""
+from __future__ import annotations
+
+import json
+import pathlib
+
+
+class RangeTableError(ValueError):
+    """hmi/ranges.json is unreadable or names something the variable table does not have."""
+
+
+def load_ranges(path: pathlib.Path) -> dict:
+    try:
+        table = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise RangeTableError(f"{path}: cannot read the range table ({exc.strerror})") from None
+    except json.JSONDecodeError as exc:
+        raise RangeTableError(f"{path}:{exc.lineno}: invalid JSON: {exc.msg}") from None
+    return {k: v for k, v in table.items() if not k.startswith("_")}
+
+
+def apply_ranges(document: dict, table: dict, source: str = "ranges") -> dict:
+    """Write the table's ranges into the variable table ``document`` (in place; returned for chaining)."""
+    types = document.get("types", {})
+    inputs = {spec["input"]: spec for spec in document.get("variables", {}).values() if "input" in spec}
+    for owner, members in table.items():
+        for member, entries in members.items():
+            if owner in types:
+                spec = types[owner].get("fields", {}).get(member)
+            else:
+                spec = inputs.get(f"{owner}.{member}")
+            if spec is None:
+                raise RangeTableError(f"{source}: {owner}.{member} is not in the HMI variable table")
+            numeric = [e for e in entries if "min" in e]
+            allowed = [e for e in entries if "allowed" in e]
+            if numeric:
+                spec["min"] = min(e["min"] for e in numeric)
+                spec["max"] = max(e["max"] for e in numeric)
+                spec["ranges"] = numeric
+                units = [e["unit"] for e in numeric if e["unit"] not in ("", "—")]
+                if units and spec["type"] not in types:
+                    spec["unit"] = " or ".join(dict.fromkeys(units))
+            if allowed:
+                spec["allowed"] = allowed
+    return document
