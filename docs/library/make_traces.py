@@ -19,8 +19,10 @@ from vplc.trace.recorder import Recorder, write_trace  # noqa: E402
 OUT = HERE / "traces"
 PINS = ("Busy", "Active", "Connected", "Valid", "Done", "CommandAborted", "Error", "ErrorID")
 EXTRA = {"CBT_Connect": ["Cobot.InListenNode", "RobotReady"], "CBT_Stop": ["Cobot.Stopping"],
-         "CBT_ReadActualPosition": ["TcpZ"]}
-FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"]}      # the FB's Enable
+         "CBT_ReadActualPosition": ["TcpZ"],
+         "CBT_RobotStatus": ["fbStatus.Status.ProjectRunning", "fbStatus.Status.Position.TCP.Z", "RobotFault"],
+         "CBT_ProjectControl": ["Cobot.Status.ProjectRunning"]}
+FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"], "CBT_RobotStatus": ["fbConnect.Connected"]}      # the FB's Enable
 HOLD_S = 0.02                   # Execute stays TRUE this long after Done, then falls: both Done cases show
 
 
@@ -37,17 +39,18 @@ def page_trace(page: str, out: Path) -> None:
     """Run the page's example as the library tests do and record its trigger inputs and the FB's pins."""
     code, _ = example_of(page)
     program = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
-    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True)
+    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0)
     srv.start()
     source = out / f".{page}_example.st"
     try:
         source.write_text(code.replace("'192.168.1.10'", "'127.0.0.1'")
-                          .replace("IPPort := 5890", f"IPPort := {srv.ports[0]}"), encoding="utf-8")
+                          .replace("IPPort := 5890", f"IPPort := {srv.ports[0]}")
+                          .replace("SvrPort := 5891", f"SvrPort := {srv.robots[0].svr_port}"), encoding="utf-8")
         plc = load_plc([str(LIB), str(source)], task="Main@1ms")
         read = lambda name: plc.read(f"{program}.{name}")   # noqa: E731
         pump = lambda now_ns: srv.poll(now_ns / 1e9)        # noqa: E731
         steps = STEPS[page]
-        if page not in ("CBT_Connect", "CBT_ReadActualPosition"):
+        if page not in ("CBT_Connect", "CBT_ReadActualPosition", "CBT_RobotStatus"):   # these show the connect
             assert plc.run_until(lambda: read("fbConnect.Connected"), 5 * SEC, on_scan=pump)
         paths = list(FIRST.get(page, []))
         for trigger, done in steps:

@@ -29,8 +29,8 @@ HMI_FILE = ROOT / "hmi" / "ranges.json"
 COLUMNS = ["struct", "member", "when", "min", "max", "unit", "error"]
 
 _COMMENT = re.compile(r"\(\*(.*?)\*\)", re.S)
-_MEMBER = re.compile(r"^\s*(\w+)\s*:\s*([^;:=]+?)\s*(?::=\s*([^;]+))?;\s*(?:\(\*(.*?)\*\))?\s*$")
-_ENUM_VALUE = re.compile(r"^\s*(\w+)\s*(?::=\s*(\d+))?\s*,?\s*(?:\(\*(.*?)\*\))?\s*$")
+_MEMBER = re.compile(r"(\w+)[ \t]*:[ \t]*([^;:=]+?)\s*(?::=\s*([^;]+))?;[ \t]*(?:\(\*(.*?)\*\))?", re.S)
+_ENUM_VALUE = re.compile(r"(\w+)[ \t]*(?::=[ \t]*(\d+))?[ \t]*,?[ \t]*(?:\(\*(.*?)\*\))?", re.S)
 
 
 class SourceError(Exception):
@@ -79,22 +79,23 @@ def read_type(path: Path) -> DataType:
         raise SourceError(f"{path}: expected one TYPE with a STRUCT or an enumeration")
     dt = DataType(m.group(1), "struct" if m.group(2) == "STRUCT" else "enum", header)
     body = m.group(3)
-    if dt.kind == "struct":
-        for line in body.splitlines():
-            if not line.strip() or line.strip().startswith("(*"):
-                continue
-            mm = _MEMBER.match(line)
-            if mm is None:
-                raise SourceError(f"{path}: cannot read the member line {line.strip()!r}")
+    item = _MEMBER if dt.kind == "struct" else _ENUM_VALUE
+    pos, number = 0, 0
+    while True:                                  # declarations, each with the comment after it (one or more lines)
+        blank = re.compile(r"\s*").match(body, pos)
+        pos = blank.end()
+        if pos >= len(body):
+            break
+        if body.startswith("(*", pos):           # a comment on its own: a section title, not a member
+            pos = body.index("*)", pos) + 2
+            continue
+        mm = item.match(body, pos)
+        if mm is None:
+            raise SourceError(f"{path}: cannot read {body[pos:].splitlines()[0].strip()!r}")
+        pos = mm.end()
+        if dt.kind == "struct":
             dt.members.append(Member(mm.group(1), _clean(mm.group(2)), _clean(mm.group(4) or ""), mm.group(3)))
-    else:
-        number = 0
-        for line in body.splitlines():
-            if not line.strip():
-                continue
-            mm = _ENUM_VALUE.match(line)
-            if mm is None:
-                raise SourceError(f"{path}: cannot read the enumeration value {line.strip()!r}")
+        else:
             number = int(mm.group(2)) if mm.group(2) else number
             dt.members.append(Member(mm.group(1), str(number), _clean(mm.group(3) or "")))
             number += 1
