@@ -409,13 +409,19 @@ async function executeCommand(execVar, values, what) {
   } catch (e) { message(`${what}: ${e.message}`, "error"); return false; }
 }
 
-/* Push-button commands (CBT_Stop): reset Execute once Done or Error shows, within 10 s. */
+/* Push-button commands (CBT_Stop): reset Execute once Done or Error shows (within 10 s), after holding it
+   HOLD_DONE_MS so the operator sees Done on the page before the FB clears it. */
+const HOLD_DONE_MS = 1500;
 function releaseWhenFinished(group, what) {
   const deadline = Date.now() + 10000, firstPoll = live.polls + 2;   // values read after the command was sent
   const check = async () => {
     const v = live.values;
     const finished = live.polls >= firstPoll && (v[`${group}_Done`] === true || v[`${group}_Error`] === true);
     if (!finished && Date.now() < deadline) { setTimeout(check, POLL_MS); return; }
+    if (finished && v[`${group}_Done`] === true) {
+      message(`${what}: Done – the robot stopped and its queue is cleared; releasing the robot …`, "ok");
+      await new Promise((resume) => setTimeout(resume, HOLD_DONE_MS));
+    }
     try {
       await api("/api/write", { values: { [`${group}_Execute`]: false } });
       if (finished && v[`${group}_Error`] === true)

@@ -32,7 +32,7 @@ function rangeHint(spec, context) {
   if (r) return `${r.min === -r.max ? "±" + r.max : r.min + ".." + r.max}${r.unit ? " " + r.unit : ""}`;
   if (spec.ranges) {
     const off = Object.keys(spec.ranges[0].when).find((k) => context[k] === "FALSE");
-    return off ? `not used (${off.replace(/Enable$/, "").toLowerCase()} off)` : "";
+    return off ? `${off.replace(/Enable$/, "").toLowerCase()} off: not checked` : "";
   }
   return spec.unit || "";
 }

@@ -53,11 +53,12 @@ function drawProjection(canvas, h, v, title, tcp) {
   if (pv && pv.frame) pts.push([pv.frame.X, pv.frame.Y, pv.frame.Z]);
   let [h0, h1, v0, v1] = [Infinity, -Infinity, Infinity, -Infinity];
   for (const p of pts) { h0 = Math.min(h0, p[hi]); h1 = Math.max(h1, p[hi]); v0 = Math.min(v0, p[vi]); v1 = Math.max(v1, p[vi]); }
-  const pad = 60, minSpan = 600;
+  const pad = 20, minSpan = 600;
   const grow = (lo, hiV) => { const m = (lo + hiV) / 2, s = Math.max(hiV - lo, minSpan) / 2 + pad; return [m - s, m + s]; };
   [h0, h1] = grow(h0, h1); [v0, v1] = grow(v0, v1);
-  const scale = Math.min((W - 16) / (h1 - h0), (H - 30) / (v1 - v0));
-  const ox = 8 + ((W - 16) - (h1 - h0) * scale) / 2, oy = 18 + ((H - 30) - (v1 - v0) * scale) / 2;
+  const M = 30;                                             // px kept free at each side for labels and arrows
+  const scale = Math.min((W - 2 * M) / (h1 - h0), (H - 2 * M) / (v1 - v0));
+  const ox = M + ((W - 2 * M) - (h1 - h0) * scale) / 2, oy = M + ((H - 2 * M) - (v1 - v0) * scale) / 2;
   const X = (p) => ox + (p[hi] - h0) * scale, Y = (p) => oy + (v1 - p[vi]) * scale;
   ctx.fillStyle = "#f6f8fa"; ctx.fillRect(0, 0, W, H);
   const step = niceStep(Math.max(h1 - h0, v1 - v0));       // grid
@@ -82,7 +83,7 @@ function drawProjection(canvas, h, v, title, tcp) {
     [0, 1, 2].forEach((i) => arrow([pose.X, pose.Y, pose.Z], column(m, i), len, AXIS_COLORS[i], labels ? labels[i] : ""));
   };
   frame({ X: 0, Y: 0, Z: 0, RX: 0, RY: 0, RZ: 0 }, 26, ["X", "Y", "Z"]);
-  ctx.fillStyle = "#24425f"; ctx.fillText("Base", X([0, 0, 0]) - 28, Y([0, 0, 0]) + 12);
+  ctx.fillStyle = "#24425f"; ctx.fillText("Base", X([0, 0, 0]) + 4, Y([0, 0, 0]) + 12);
   if (VIEW.trail.length > 1) {
     ctx.strokeStyle = "#34a853"; ctx.lineWidth = 1.5; ctx.beginPath();
     VIEW.trail.forEach((p, i) => (i ? ctx.lineTo(X(p), Y(p)) : ctx.moveTo(X(p), Y(p))));
@@ -95,7 +96,9 @@ function drawProjection(canvas, h, v, title, tcp) {
     ctx.stroke(); ctx.setLineDash([]);
     const t = pv.path[pv.path.length - 1];
     ctx.strokeStyle = "#7a3db8"; ctx.beginPath(); ctx.arc(X(t), Y(t), 6, 0, 2 * Math.PI); ctx.stroke();
-    ctx.fillStyle = "#7a3db8"; ctx.fillText("target", X(t) + 8, Y(t) - 6);
+    ctx.fillStyle = "#7a3db8";
+    const right = X(t) > W - 60;                               // keep the label inside the view
+    ctx.textAlign = right ? "right" : "left"; ctx.fillText("target", X(t) + (right ? -8 : 8), Y(t) - 6); ctx.textAlign = "left";
     if (pv.target) frame(pv.target, 16);
   }
   if (tcp) {

@@ -223,6 +223,8 @@ def test_stop_page_stops_a_running_move_and_aborts_it(connected):
     browser.click("btn-preset")                                  # Stop Immediately
     since = connected.event_count()
     execute_and_wait_done(connected, browser, "Stop")
+    browser.wait_for(lambda d: "Done – the robot stopped" in browser.message(), "Done on the message line")
+    assert browser.status("Stop_Done") == "true"                 # held long enough to be seen
     assert [e["command"] for e in connected.events("priority", since)] == ["StopAndClearBuffer(0)"]
     browser.wait_for(lambda d: "Execute reset" in browser.message(), "the push button to release")
     assert connected.read("Stop_Execute") is False and connected.read("Cobot.Stopping") is False
@@ -308,3 +310,16 @@ def test_connection_loss_shows_on_the_connect_page(connected):
         connected.robot.clear_faults()                          # back: CBT_Connect reconnects by itself
     browser.wait_status("Connect_Connected", "true")
     browser.wait_status("Connect_Reconnecting", "false")
+
+
+def test_message_line_shows_the_fb_error_of_a_motion_the_robot_refuses(connected):
+    """An unreachable target passes the page's range check (±100000 mm) but not the robot: the message line shows
+    the FB's Error, ErrorID and ErrorDescrip."""
+    browser = connected.open("moveabs")
+    browser.click("btn-preset")
+    browser.type_into("MoveAbs_Param.TargetPosition.X", "5000")
+    browser.click("btn-execute")
+    browser.wait_for(lambda d: "Move Absolute: Error 16#" in browser.message(), "the FB's error on the message line")
+    error_id = connected.read("MoveAbs_ErrorID")
+    assert f"Error 16#{error_id:04X} – {connected.read('MoveAbs_ErrorDescrip')}" in browser.message()
+    browser.screenshot("e2e_moveabs_robot_error")

@@ -70,7 +70,7 @@ def test_speed_and_blending_hints_follow_the_data_format(page):
     select(b, "MoveAbs_Param.MovementCommand", "Line")
     select(b, "MoveAbs_Param.DataFormat", "CPP_Abs")
     assert hint(b, "MoveAbs_Param.Speed") == "1..100 %"
-    assert hint(b, "MoveAbs_Param.BlendingValue") == "not used (blending off)"
+    assert hint(b, "MoveAbs_Param.BlendingValue") == "blending off: not checked"
     b.field("MoveAbs_Param.BlendingEnable").click()
     assert hint(b, "MoveAbs_Param.BlendingValue") == "0..100 %"
     select(b, "MoveAbs_Param.DataFormat", "CAR_Abs")
