@@ -1,7 +1,7 @@
 """Ladder benchmarks (issue 16): per-scan cost of the LD example against its ST twin, and the time to load a
 1,000-rung ladder program.
 
-Run alone: ``python bench/bench_ladder.py`` (prints human-readable figures, exits 0).
+Run alone: ``python3 bench/bench_ladder.py`` (prints human-readable figures, exits 0).
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""``python -m vplc draw FILE... --pou NAME -o rung.svg``: draw a ladder POU as SVG (docs/toolchain/ladder.md).
+"""``python3 -m vplc draw FILE... --pou NAME -o rung.svg``: draw a ladder POU as SVG (docs/toolchain/ladder.md).
 
 The sources are loaded and checked first (a ladder with errors is not drawn). Exit codes: 0 written,
 1 errors in the sources, 2 usage error (one line on stderr).
