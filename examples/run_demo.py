@@ -223,6 +223,9 @@ def main(argv=None) -> int:
     signal.signal(signal.SIGTERM, lambda *_: demo.stop_event.set())
     try:
         demo.start()
+        # From here Ctrl-C only sets the stop event: a KeyboardInterrupt raised inside Event.wait can leave its
+        # lock held, and the shutdown would then wait on it for ever
+        signal.signal(signal.SIGINT, lambda *_: demo.stop_event.set())
         print(demo.banner(), flush=True)
         while not demo.stop_event.wait(0.5):
             for line in demo.robot_events():
