@@ -498,7 +498,8 @@ async function fbPage(key) {
     const box = document.createElement("div");
     box.className = "area connectinfo";
     box.innerHTML = `<h2>Robot</h2>${robotStatusStrip()}<p>The PLC connects to the robot's Listen node (TMflow, port 5890)
-      and checks it every 500 ms; a silent link is reported 1.0 to 1.5 s later (16#2006).</p>`;
+      and checks it every 500 ms; a silent link is reported 1.0 to 1.5 s later (16#2006), then it reconnects by
+      itself while Connect is on (Reconnecting, RetryCount).</p>`;
     left.append(box);
   }
   if (page.view !== false) {                 // Change TCP needs its whole panel for the tool data
