@@ -47,7 +47,7 @@ function drawPnP() {
   const X = (p) => W / 2 + (horiz(p) - (h0 + h1) / 2) * s;
   const Y = (p) => (H - 20) / 2 + my0 / 2 - (p.Z - (v0 + v1) / 2) * s;
   pnpGeometry = { X, Y, horiz };
-  let out = `<defs><marker id="arrow" viewBox="0 0 10 10" refX="8" refY="5" markerWidth="4" markerHeight="4" orient="auto-start-reverse">
+  let out = `<defs><marker id="arrow" viewBox="0 0 10 10" refX="8" refY="5" markerUnits="userSpaceOnUse" markerWidth="10" markerHeight="10" orient="auto-start-reverse">
     <path d="M0,0 L10,5 L0,10 z" fill="#2368a8"/></marker></defs>`;
   const step = niceStep(Math.max(h1 - h0, v1 - v0, 100));           // grid in mm, as in the robot view
   for (let g = Math.ceil((h0 - W / s) / step) * step; g <= h1 + W / s; g += step) {
