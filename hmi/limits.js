@@ -32,7 +32,7 @@ function rangeHint(spec, context) {
   if (r) return `${r.min === -r.max ? "±" + r.max : r.min + ".." + r.max}${r.unit ? " " + r.unit : ""}`;
   if (spec.ranges) {
     const off = Object.keys(spec.ranges[0].when).find((k) => context[k] === "FALSE");
-    return off ? `${off.replace(/Enable$/, "").toLowerCase()} off: not checked` : "";
+    return off ? `${off.replace(/Enable$/, "").toLowerCase()} off` : "";      // the FB does not check it
   }
   return spec.unit || "";
 }
@@ -61,7 +61,7 @@ function refreshLimits(root, prefix) {
       el.classList.toggle("invalid", Boolean(bad));
       el.title = bad || "";
       const rule = spec.allowed.find((r) => holds(r.when, context));
-      if (hint) hint.textContent = bad ? `not with ${Object.values(rule.when)[0]} (${rule.error})` : "";
+      if (hint) hint.textContent = bad ? `not for ${Object.values(rule.when)[0]}` : "";     // ErrorID in the title
     }
   }
 }

@@ -70,7 +70,7 @@ def test_speed_and_blending_hints_follow_the_data_format(page):
     select(b, "MoveAbs_Param.MovementCommand", "Line")
     select(b, "MoveAbs_Param.DataFormat", "CPP_Abs")
     assert hint(b, "MoveAbs_Param.Speed") == "1..100 %"
-    assert hint(b, "MoveAbs_Param.BlendingValue") == "blending off: not checked"
+    assert hint(b, "MoveAbs_Param.BlendingValue") == "blending off"
     b.field("MoveAbs_Param.BlendingEnable").click()
     assert hint(b, "MoveAbs_Param.BlendingValue") == "0..100 %"
     select(b, "MoveAbs_Param.DataFormat", "CAR_Abs")
@@ -118,7 +118,8 @@ def test_format_the_fb_refuses_for_the_motion_command_is_refused_on_the_page(pag
     select(b, "MoveRel_Param.MovementCommand", command)
     select(b, "MoveRel_Param.DataFormat", fmt)
     assert "invalid" in b.field("MoveRel_Param.DataFormat").get_attribute("class")
-    assert hint(b, "MoveRel_Param.DataFormat") == f"not with {command} ({code})"
+    assert hint(b, "MoveRel_Param.DataFormat") == f"not for {command}"
+    assert code in b.field("MoveRel_Param.DataFormat").get_attribute("title")
     b.type_into("MoveRel_Param.Speed", "10")
     b.click("btn-execute")
     b.wait_for(lambda d: "cannot be used" in b.message(), "the refusal")
