@@ -1,6 +1,6 @@
 """Scale (issue 15, target 2): 1, 8 and 32 robots from one program, each streaming blended motions.
 
-    PYTHONPATH=src:. python bench/bench_scale.py
+    PYTHONPATH=src:. python3 bench/bench_scale.py
 
 The library (lib/CBT_Commands_Lib) and bench/st/Main_Stream.st on the virtual PLC, 1 ms task on virtual time,
 against the simulator's robots over loopback; the simulator is polled between scans and is not timed. Figures:
