@@ -135,3 +135,14 @@ def test_get_string_of_a_pose_prints_32_bit_floats():
 def test_a_pvt_mode_outside_0_and_1_is_a_run_time_error_as_in_the_manual():
     node = node_of("2.24")
     assert reply(node, "PVTEnter(2)") == ok("ERROR;1")                  # §13.17: 0 joint, 1 Cartesian only
+
+
+def test_the_docs_profile_table_names_every_function_format_and_attribute_of_the_table():
+    from pathlib import Path
+    text = (Path(__file__).resolve().parents[2] / "docs" / "simulator.md").read_text(encoding="utf-8")
+    section = text[text.index("### Version profiles"):text.index("### Third-party clients")]
+    missing = [name for name in tmscript.FUNCTIONS if f"`{name}" not in section and f" {name}" not in section]
+    missing += [fmt for table in tmscript.FORMATS.values() for fmt, versions in table.items()
+                if versions == tmscript.NEW and fmt not in section]
+    missing += [attr for attr in tmscript.ROBOT if attr not in section]
+    assert missing == []
