@@ -12,7 +12,7 @@ sys.path[:0] = [str(HERE.parents[1] / "src"), str(HERE.parents[1]), str(HERE.par
 
 from rig import LIB, SEC, Rig, move_abs  # noqa: E402
 from sim.server import SimServer  # noqa: E402
-from test_lib_doc_examples import STEPS, example_of  # noqa: E402
+from test_lib_doc_examples import STEPS, example_of, on_simulator  # noqa: E402
 from vplc.api import PathError, load_plc  # noqa: E402
 from vplc.trace.recorder import Recorder, write_trace  # noqa: E402
 
@@ -43,9 +43,7 @@ def page_trace(page: str, out: Path) -> None:
     srv.start()
     source = out / f".{page}_example.st"
     try:
-        source.write_text(code.replace("'192.168.1.10'", "'127.0.0.1'")
-                          .replace("IPPort := 5890", f"IPPort := {srv.ports[0]}")
-                          .replace("SvrPort := 5891", f"SvrPort := {srv.robots[0].svr_port}"), encoding="utf-8")
+        source.write_text(on_simulator(code, srv), encoding="utf-8")
         plc = load_plc([str(LIB), str(source)], task="Main@1ms")
         read = lambda name: plc.read(f"{program}.{name}")   # noqa: E731
         pump = lambda now_ns: srv.poll(now_ns / 1e9)        # noqa: E731

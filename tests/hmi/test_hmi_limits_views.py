@@ -5,15 +5,14 @@ from __future__ import annotations
 
 import json
 import math
-import threading
 
 import pytest
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
 from browser import ROOT, Browser
-from fake_plc import FakePlc, command_program
-from vplc.hmi.server import HmiServer, Mapping
+from fake_plc import FakePlc, command_program, scanning, serving
+from vplc.hmi.server import Mapping
 
 TCP = {"X": 400.0, "Y": 0.0, "Z": 400.0, "RX": 180.0, "RY": 0.0, "RZ": 90.0}
 
@@ -21,23 +20,12 @@ TCP = {"X": 400.0, "Y": 0.0, "Z": 400.0, "RX": 180.0, "RY": 0.0, "RZ": 90.0}
 @pytest.fixture(scope="module")
 def stack():
     mapping = Mapping.load()
-    plc = FakePlc(mapping, command_program)
-    stop = threading.Event()
-
-    def scanning():
-        while not stop.wait(0.001):
-            plc.scan()
-
-    thread = threading.Thread(target=scanning, daemon=True)
-    thread.start()
-    server = HmiServer(plc, mapping, port=0)
-    server.start()
-    browser = Browser()
-    yield plc, server, browser
-    browser.close()
-    server.stop()
-    stop.set()
-    thread.join(timeout=5)
+    with scanning(FakePlc(mapping, command_program)) as plc, serving(plc, mapping) as server:
+        browser = Browser()
+        try:
+            yield plc, server, browser
+        finally:
+            browser.close()
 
 
 @pytest.fixture

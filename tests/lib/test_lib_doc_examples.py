@@ -45,6 +45,12 @@ def test_every_fb_page_has_a_runnable_example():
     assert pages == set(STEPS), "a page was added or removed: give its example steps in STEPS"
 
 
+def on_simulator(code: str, srv) -> str:
+    """The example as the page shows it, pointed at the simulator's robot and Ethernet Slave on loopback."""
+    return (code.replace("'192.168.1.10'", "'127.0.0.1'").replace("IPPort := 5890", f"IPPort := {srv.ports[0]}")
+            .replace("SvrPort := 5891", f"SvrPort := {srv.robots[0].svr_port}"))
+
+
 @pytest.mark.parametrize("page", sorted(STEPS))
 def test_page_example_runs_against_the_simulator(page, tmp_path):
     code, promised = example_of(page)
@@ -53,9 +59,7 @@ def test_page_example_runs_against_the_simulator(page, tmp_path):
     srv.start()
     try:
         source = tmp_path / f"{page}_example.st"
-        source.write_text(code.replace("'192.168.1.10'", "'127.0.0.1'")
-                          .replace("IPPort := 5890", f"IPPort := {srv.ports[0]}")
-                          .replace("SvrPort := 5891", f"SvrPort := {srv.robots[0].svr_port}"), encoding="utf-8")
+        source.write_text(on_simulator(code, srv), encoding="utf-8")
         plc = load_plc([str(LIB), str(source)], task="Main@1ms")
         read = lambda name: plc.read(f"{program}.{name}")  # noqa: E731
         pump = lambda now_ns: srv.poll(now_ns / 1e9)  # noqa: E731
