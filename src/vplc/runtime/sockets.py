@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import ipaddress
+import select
 import socket
 
 ERR_PARAM = 0x0400            # input value out of range (port 0, Size larger than the array, ...)
@@ -32,6 +33,11 @@ CLOSED, LISTEN, SYN_SENT, SYN_RECEIVED, ESTABLISHED, CLOSE_WAIT = 0, 1, 2, 3, 4,
 class _Conn:
     def __init__(self, sock: socket.socket) -> None:
         self.sock = sock
+        # asking the OS whether anything arrived is cheaper than a receive that fails with "would block"
+        # (most scans); select.poll is not on every platform: there a receive asks
+        self.poller = select.poll() if hasattr(select, "poll") else None
+        if self.poller is not None:
+            self.poller.register(sock, select.POLLIN)
         self.rx = bytearray()
         self.eof = False
         self.error = 0
@@ -42,7 +48,7 @@ class _Conn:
         """Move whatever the OS has received into ``rx``; note end of stream and resets."""
         if not self.connected or self.eof:
             return
-        while True:
+        while self.poller is None or self.poller.poll(0):
             try:
                 data = self.sock.recv(65536)
             except (BlockingIOError, InterruptedError):
