@@ -59,7 +59,7 @@ class EthernetSlave:
             sock.bind((self.server.host, port))
         except OSError as exc:
             sock.close()
-            raise OSError(exc.errno, f"cannot open the Ethernet Slave of robot {robot.index} on "
+            raise OSError(exc.errno, f"cannot open the Ethernet Slave of robot {robot.index + 1} on "
                                      f"{self.server.host}:{port}: {exc.strerror}") from None
         sock.listen(16)
         sock.setblocking(False)

@@ -206,7 +206,7 @@ class SimServer(FairInput):
             sock.bind((self.host, robot.port))
         except OSError as exc:
             sock.close()
-            raise OSError(exc.errno, f"cannot listen on {self.host}:{robot.port} for robot {robot.index}: "
+            raise OSError(exc.errno, f"cannot listen on {self.host}:{robot.port} for robot {robot.index + 1}: "
                                      f"{exc.strerror}") from None
         sock.listen(128)
         sock.setblocking(False)

@@ -105,7 +105,14 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
     svr_port = None if args.no_svr else args.port + args.robots if args.svr_port is None and args.port else \
         (args.svr_port or 0)
     if svr_port is not None and not (0 <= svr_port and (not svr_port or svr_port + args.robots - 1 <= 65535)):
-        problems.append(f"--svr-port {svr_port} with {args.robots} robot(s) leaves the port range 1..65535")
+        if args.svr_port is not None:
+            problems.append(f"--svr-port {svr_port} with {args.robots} robot(s) leaves the port range 1..65535")
+        else:
+            problems.append(f"the Ethernet Slave ports would follow the Listen node ports at {svr_port}, outside "
+                            f"1..65535: choose --svr-port PORT or --no-svr")
+    elif svr_port and args.port and svr_port < args.port + args.robots and args.port < svr_port + args.robots:
+        problems.append(f"--svr-port {svr_port} overlaps the Listen node ports {args.port}.."
+                        f"{args.port + args.robots - 1}: choose another --svr-port")
     if not (math.isfinite(args.svr_period) and 0 <= args.svr_period <= 3600):
         problems.append(f"--svr-period must be 0 (off) .. 3600 s (got {args.svr_period:g})")
     svr_items = [name.strip() for name in args.svr_items.split(",") if name.strip()]

@@ -32,8 +32,10 @@ def parse_task(task: str) -> tuple[str, int]:
     if not m:
         raise LoadError(f"error: task `{task}` is not of the form Name@period (e.g. Main@1ms)")
     period = parse_duration(m.group(2))
-    if period is None or period <= 0:
+    if period is None:
         raise LoadError(f"error: task period `{m.group(2)}` is not a duration like 1ms, 500us or 0.01s")
+    if period <= 0:
+        raise LoadError(f"error: task period `{m.group(2)}` must be greater than zero")
     return m.group(1), period
 
 
@@ -153,6 +155,8 @@ class Plc:
     def _setup_tasks(self, task, programs) -> None:
         configs = self.project.configurations
         if configs:
+            wanted = {p.upper() for p in programs or ()}      # --program: instance or PROGRAM type names
+            found: set[str] = set()
             for cfg in configs:
                 for res in cfg.resources:
                     by_name = {}
@@ -165,12 +169,19 @@ class Plc:
                         by_name[td.name.upper()] = t
                         self.engine.tasks.append(t)
                     for pi in res.programs:
+                        if programs and not {pi.name.upper(), pi.program.text().upper()} & wanted:
+                            continue
+                        found.update({pi.name.upper(), pi.program.text().upper()} & wanted)
                         t = by_name.get((pi.task or "").upper())
                         if t is None:
                             if not self.engine.tasks:
                                 self.engine.tasks.append(Task("Default", 10_000_000, 0))
                             t = self.engine.tasks[0]
                         t.programs.append(self._instance(pi.name, self._program(pi.program.text())))
+            missing = [p for p in programs or () if p.upper() not in found]
+            if missing:
+                raise LoadError(f"error: the CONFIGURATION runs no PROGRAM named `{missing[0]}` (give a program "
+                                f"instance or PROGRAM type that one of its tasks runs)")
         else:
             t = Task(*parse_task(task), 0)
             pts = [self._program(p) for p in programs] if programs else list(self.project.programs)

@@ -344,3 +344,26 @@ def test_a_write_the_plc_refuses_halfway_leaves_no_partial_change(hmi, plc, monk
                                                            "MoveAbs_Param.Speed": 20}})
     assert status == 400 and "nothing was written" in answer["error"]
     assert plc.read("MoveAbs_Param.TargetPosition.X") == 0.0
+
+
+def test_a_taken_port_is_an_oserror_not_a_traceback(hmi, plc, mapping):
+    """The pool was created after the base class bound the socket: a refused bind raised AttributeError."""
+    second = HmiServer(plc, mapping, port=hmi.port)
+    with pytest.raises(OSError):
+        second.start()
+
+
+@pytest.mark.parametrize("path, expected", [
+    ("PnP_MoveParameters", "is a structure or array: write its elements one by one, e.g. 'PnP_MoveParameters[0]."),
+    ("PnP_MoveParameters[9].Speed", "the index is outside PnP_MoveParameters[0..5]"),
+    ("Secret_Recipe", "is not in the HMI variable table"),
+])
+def test_writes_that_name_no_single_value_say_why(hmi, path, expected):
+    client = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["engineer"])
+    status, answer = client.json("/api/write", {"values": {path: 1}})
+    assert status == 403 and expected in answer["error"]
+
+
+def test_get_on_a_write_endpoint_is_405(hmi):
+    status, payload, _ = raw_request(hmi.port, "GET", "/api/write")
+    assert status == 405 and b"takes POST" in payload

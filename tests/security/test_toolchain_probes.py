@@ -5,7 +5,10 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 from vplc.api import load_plc
+from vplc.runtime.values import PathError
 
 LONG = "9" * 5000                                     # Python's int() refuses more than 4,300 digits
 
@@ -88,3 +91,31 @@ def test_absurd_run_and_test_limits_are_refused_with_their_range(tmp_path):
         assert code == 2 and expected in out and "Traceback" not in out, (flags, out)
     code, out = vplc("test", src, "--timeout", "1000000d")
     assert code == 2 and "from 1ns to 1d of virtual time" in out
+
+
+def test_a_duration_without_a_unit_is_refused(tmp_path):
+    """`--duration 5` ran 5 ms (a silent default unit); a duration now needs its unit."""
+    src = write(tmp_path, "p.st", "PROGRAM P\nVAR x : DINT; END_VAR\nx := x + 1;\nEND_PROGRAM\n")
+    code, out = vplc("run", src, "--virtual-time", "--duration", "5")
+    assert code == 2 and "like 5s or 250ms" in out
+    code, out = vplc("run", src, "--virtual-time", "--cycles", "1", "--task", "Main@0ms")
+    assert code == 2 and "must be greater than zero" in out
+
+
+def test_program_selection_applies_to_a_configuration_too(tmp_path):
+    """`--program Nope` was ignored when the sources had a CONFIGURATION (exit 0, everything ran)."""
+    src = write(tmp_path, "cfg.st", "PROGRAM A\nVAR n : DINT; END_VAR\nn := n + 1;\nEND_PROGRAM\n"
+                                    "PROGRAM B\nVAR n : DINT; END_VAR\nn := n + 1;\nEND_PROGRAM\n"
+                                    "CONFIGURATION C\nRESOURCE R ON PLC\nTASK T(INTERVAL := T#1ms, PRIORITY := 1);\n"
+                                    "PROGRAM IA WITH T : A;\nPROGRAM IB WITH T : B;\nEND_RESOURCE\nEND_CONFIGURATION\n")
+    code, out = vplc("run", src, "--virtual-time", "--cycles", "1", "--program", "Nope")
+    assert code == 2 and "runs no PROGRAM named `Nope`" in out
+    plc = load_plc([src], programs=["B"])
+    try:
+        plc.scan(0)
+        with plc.lock:
+            assert plc.read("IB.n") == 1
+        with pytest.raises(PathError):                     # IA is not instantiated: it does not run
+            plc.read("IA.n")
+    finally:
+        plc.close()

@@ -169,6 +169,21 @@ class Mapping:
                     field_spec = {**field_spec, "min": spec["min"], "max": spec["max"]}
                 self._expand(f"{path}.{field}", field_spec, access, role, types)
 
+    def why_not_a_leaf(self, path) -> str:
+        """Why ``path`` cannot be written as one value: a whole structure/array, an index out of its range,
+        or a name that is not in the table."""
+        if not isinstance(path, str):
+            return f"{json.dumps(path)} is not a variable name"
+        if path in self.roots or self.is_readable(path):
+            example = next(leaf for leaf in self.leaves if leaf.startswith(path))
+            return f"'{path}' is a structure or array: write its elements one by one, e.g. '{example}'"
+        root = path.split(".")[0].split("[")[0]
+        spec = self.roots.get(root)
+        if spec is not None and "array" in spec and path[len(root):].startswith("["):
+            low, high = spec["array"]
+            return f"'{path}': the index is outside {root}[{low}..{high}]"
+        return f"'{path}' is not in the HMI variable table"
+
     def is_readable(self, name: str) -> bool:
         """A mapped variable, a leaf inside one, or an inner struct/array element of one."""
         if name in self.roots or name in self.leaves:
@@ -276,9 +291,10 @@ class _PooledHTTPServer(HTTPServer):
     allow_reuse_address = True
 
     def __init__(self, address, handler):
-        super().__init__(address, handler)
+        # the pool exists before the base class binds: a refused bind calls server_close(), which shuts it down
         self._pool = ThreadPoolExecutor(WORKERS, thread_name_prefix="hmi-http")
         self._slots = threading.BoundedSemaphore(WORKERS + WAITING)
+        super().__init__(address, handler)
 
     def process_request(self, request, client_address):
         if not self._slots.acquire(blocking=False):
@@ -339,7 +355,9 @@ class HmiServer:
 
     @property
     def url(self) -> str:
-        return f"http://{self.host}:{self.port}/"
+        """The address to open on this machine (a server bound to every interface is reached on loopback)."""
+        host = {"0.0.0.0": "127.0.0.1", "::": "[::1]", "": "127.0.0.1"}.get(self.host, self.host)
+        return f"http://{host}:{self.port}/"
 
     def page_url(self, page: str = "index", role: str = "operator") -> str:
         """The address of a page that carries the access key of ``role`` (in the fragment: never sent on)."""
@@ -395,7 +413,7 @@ class HmiServer:
     def _writable(self, path, role: str) -> Leaf:
         leaf = self.mapping.leaves.get(path) if isinstance(path, str) else None
         if leaf is None:
-            raise RequestError(f"'{path}' is not in the HMI variable table", HTTPStatus.FORBIDDEN)
+            raise RequestError(self.mapping.why_not_a_leaf(path), HTTPStatus.FORBIDDEN)
         if leaf.access != "rw":
             raise RequestError(f"'{path}' is read-only for the HMI", HTTPStatus.FORBIDDEN)
         if not role_at_least(role, leaf.role):
@@ -537,6 +555,8 @@ class _Handler(BaseHTTPRequestHandler):
                 if not since.isdigit():
                     raise RequestError("since must be a point number: /api/trail?since=0")
                 self._json(HTTPStatus.OK, self.hmi.trail.since(int(since)))
+            elif url.path in ("/api/write", "/api/execute"):
+                raise RequestError(f"{url.path} takes POST with a JSON body", HTTPStatus.METHOD_NOT_ALLOWED)
             elif url.path.startswith("/api/"):
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
             else:

@@ -13,20 +13,20 @@ class PathError(ValueError):
     """Unknown variable path, wrong index or a value that does not fit the variable."""
 
 
-_DUR = re.compile(r"^\s*(-?\d+(?:\.\d+)?)\s*(ns|us|µs|ms|s|m|h)?\s*$", re.IGNORECASE)
+_DUR = re.compile(r"^\s*(-?\d+(?:\.\d+)?)\s*(ns|us|µs|ms|s|m|h)\s*$", re.IGNORECASE)   # the unit is required
 _UNIT = {"ns": 1, "us": 1_000, "µs": 1_000, "ms": 1_000_000, "s": 1_000_000_000, "m": 60_000_000_000,
          "h": 3_600_000_000_000}
 
 
 def parse_duration(text: str) -> int | None:
-    """'1ms', '500us', '2s', 'T#10ms' -> nanoseconds (None when not a duration)."""
+    """'1ms', '500us', '2s', 'T#10ms' -> nanoseconds (None when not a duration; '5' alone is not one: 5 what?)."""
     t = text.strip()
     if t.upper().startswith("T#"):
         t = t[2:]
     m = _DUR.match(t)
     if not m:
         return None
-    return int(float(m.group(1)) * _UNIT[(m.group(2) or "ms").lower()])
+    return int(float(m.group(1)) * _UNIT[m.group(2).lower()])
 
 
 _SEG = re.compile(r"([A-Za-z_]\w*)((?:\[[^\]]*\])*)")

@@ -55,7 +55,7 @@ def test_run_refuses_a_malformed_task_option_cleanly(tmp_path):
     r = vplc("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main")
     assert r.returncode == 2 and "task `Main` is not of the form Name@period" in r.stderr
     r = vplc("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main@0ms")
-    assert r.returncode == 2 and "task period `0ms` is not a duration" in r.stderr
+    assert r.returncode == 2 and "task period `0ms` must be greater than zero" in r.stderr
     assert "Traceback" not in r.stderr and "internal" not in r.stderr
 
 
