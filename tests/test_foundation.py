@@ -58,3 +58,14 @@ def test_stdlib_guard_detects_a_third_party_import(tmp_path):
     sample = tmp_path / "sample.py"
     sample.write_text("import os\nfrom selenium import webdriver\nfrom . import sibling\n", encoding="utf-8")
     assert _imported_top_level_modules(sample) == {"os", "selenium"}
+
+
+def test_the_vplc_launcher_runs_the_toolchain_from_the_checkout():
+    """Docs say `./vplc check ...`: the launcher needs no install and no PYTHONPATH."""
+    import os
+    import subprocess
+    root = pathlib.Path(__file__).resolve().parents[1]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    done = subprocess.run([str(root / "vplc"), "check", "lib/CBT_Commands_Lib"], cwd=root, env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and "0 error(s)" in done.stdout, done.stdout + done.stderr

@@ -27,7 +27,8 @@ def register_check(subparsers) -> None:
         "check", help="parse and check Structured Text files",
         description="Check ST files (or folders, searched recursively for *.st) and print every diagnostic as "
                     "path:line:col: severity[CODE]: message. Exit 0 without errors, 1 with errors.")
-    p.add_argument("paths", nargs="+", metavar="PATH", help="ST file or folder")
+    p.add_argument("paths", nargs="+", metavar="PATH",
+                   help="ST (.st) or PLCopen / IEC 61131-10 (.xml) file, or a folder searched recursively for both")
     p.add_argument("--format", choices=("text", "json"), default="text", help="output format (default: text)")
     p.add_argument("--portable", action="store_true",
                    help="also warn on constructs outside IEC 61131-3 2nd edition (vendor instructions and types, "

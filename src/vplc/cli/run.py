@@ -22,7 +22,8 @@ from ..runtime.values import parse_duration
 def register(subparsers) -> None:
     p = subparsers.add_parser("run", help="run ST programs on the virtual PLC",
                               description="Load, compile and run ST programs cyclically like an NJ/NX controller.")
-    p.add_argument("paths", nargs="+", metavar="PATH", help="ST file or folder (recursive *.st)")
+    p.add_argument("paths", nargs="+", metavar="PATH",
+                   help="ST (.st) or PLCopen / IEC 61131-10 (.xml) file, or a folder searched recursively for both")
     p.add_argument("--task",
                    help="task NAME@PERIOD running every PROGRAM when the sources have no CONFIGURATION "
                         "(default Main@1ms)")

@@ -25,7 +25,8 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("test", help="run ST unit-test suites (TcUnit style)",
                               description="Run every test-suite FB (a FUNCTION_BLOCK calling TEST('name')) found in "
                                           "PATHS on virtual time and report the results.")
-    p.add_argument("paths", nargs="+", metavar="PATH", help="ST file or folder (recursive *.st)")
+    p.add_argument("paths", nargs="+", metavar="PATH",
+                   help="ST (.st) or PLCopen / IEC 61131-10 (.xml) file, or a folder searched recursively for both")
     p.add_argument("--junit", metavar="FILE", help="also write the results as JUnit XML")
     p.add_argument("--timeout", default="10s", help="virtual time allowed for all tests to finish (default 10s)")
     p.add_argument("-v", "--verbose", action="store_true", help="list passing tests too")
