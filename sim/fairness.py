@@ -1,19 +1,20 @@
 """Fair processing of the robots' client input (mixed into ``server.SimServer``).
 
-One turn processes at most SERVE_ITEMS items of one client's input (and decodes at most SERVE_SCAN);
-what is left waits in the client's receive buffer (``_backlog``), which is not read further meanwhile,
-while the other clients get their turn, round robin. A client whose last read filled the receive size
-or who has input left over is "greedy": ``SimServer._serve`` serves it after the others. Bad packets are
-answered with CPERR at most CPERR_BURST at once, then CPERR_PER_S per second of robot clock per client;
-the others are counted (event ``cperr_suppressed``). Bounds: sim/limits.py.
+The server only schedules: which client's input is processed next and how much of it. One turn lets the
+robot's session (``ListenSession.process``) handle at most SERVE_ITEMS items of one client's input and
+decode at most SERVE_SCAN; what is left waits in that client's receive buffer in the session
+(``_backlog``), which is not read further meanwhile, while the other clients get their turn, round
+robin. A client whose last read filled the receive size or who has input left over is "greedy":
+``SimServer._serve`` serves it after the others. The session limits the CPERR answers to bad packets
+(CPERR_BURST, CPERR_PER_S per client). Bounds: sim/limits.py.
 """
 from __future__ import annotations
 
 import time
 
 from . import codec
-from .eventlog import text as _text
-from .limits import CPERR_BURST, CPERR_PER_S, SERVE_ITEMS, SERVE_SCAN
+from .limits import SERVE_ITEMS, SERVE_SCAN
+from .session import FRAME_LIMIT, INPUT_DONE
 
 MAX_PENDING = 1000          # buffered scripts per robot (TCP back-pressure beyond, see server.py)
 POLL_BUDGET_S = 0.004       # backlog turns of one poll stop after this long
@@ -23,42 +24,17 @@ IO_SLICE_S = 0.0003         # between two turns, the sockets are polled for new 
 class FairInput:
     def _process(self, robot, conn):
         """One turn of ``conn``'s input: at most SERVE_ITEMS items handled, SERVE_SCAN decoded. What is left
-        waits for the next turn (``_backlog``), after the other clients' turns."""
-        handled, key = 0, (robot.index, conn.id)
-        for _ in range(SERVE_SCAN):
-            if conn.rbuf[:2] == b"$$" and self._cperr_tokens(conn) < 1.0:
-                # a '$' followed by another '$' is always a bad packet (header missing, CPERR 01): a run of
-                # them that gets no answer anyway is skipped at once
-                run = len(conn.rbuf) - len(conn.rbuf.lstrip(b"$")) - 1
-                del conn.rbuf[:run]
-                conn.suppressed += run
-                continue
-            item, used = codec.decode(conn.rbuf)
-            if not used:
-                self._backlog.pop(key, None)
-                break
-            del conn.rbuf[:used]
-            if type(item) is codec.BadFrame and not self._may_answer_bad(conn):
-                conn.suppressed += 1
-                continue
-            if conn.suppressed:
-                robot._log("cperr_suppressed", conn=conn.id, count=conn.suppressed)
-                conn.suppressed = 0
-            if type(item) is codec.Frame:
-                conn.frames_in += 1
-                robot._log("frame_in", conn=conn.id, raw=_text(item.raw), header=item.header,
-                           data=_text(item.data))
-            robot.session.handle(conn.id, item)
-            if robot.faults.close_after is not None and conn.frames_in >= robot.faults.close_after:
-                robot.faults.close_after = None
-                self._flush(robot)
-                self._drop(robot, conn, "fault: close_after")
-                return
-            handled += 1
-            if handled >= SERVE_ITEMS or robot.session.waiting_scripts >= MAX_PENDING:
-                self._backlog[key] = (robot, conn)
-                conn.greedy = True
-                break
+        waits for the next turn (``_backlog``), after the other clients' turns. The fault ``close_after``
+        closes the connection right after the frame that reaches its count (its replies are sent first)."""
+        key = (robot.index, conn.id)
+        _, outcome = robot.session.process(conn.id, SERVE_ITEMS, SERVE_SCAN, max_waiting=MAX_PENDING,
+                                           frame_limit=robot.faults.close_after)
+        if outcome == INPUT_DONE:
+            self._backlog.pop(key, None)
+        elif outcome == FRAME_LIMIT:
+            robot.faults.close_after = None
+            self._flush(robot)
+            self._drop(robot, conn, "fault: close_after")
         else:
             self._backlog[key] = (robot, conn)
             conn.greedy = True
@@ -71,18 +47,6 @@ class FairInput:
             return True
         limit = self.pending_bytes_limit * fraction
         return waiting * codec.MAX_DATA >= limit and robot.session.waiting_script_bytes() >= limit
-
-    def _cperr_tokens(self, conn) -> float:
-        """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""
-        conn.cperr_tokens = min(CPERR_BURST, conn.cperr_tokens + (self._now - conn.cperr_at) * CPERR_PER_S)
-        conn.cperr_at = self._now
-        return conn.cperr_tokens
-
-    def _may_answer_bad(self, conn) -> bool:
-        if self._cperr_tokens(conn) < 1.0:
-            return False
-        conn.cperr_tokens -= 1.0
-        return True
 
     def _serve_backlog(self):
         """Turns for the clients with input left over, round robin, until none is left or POLL_BUDGET_S has

@@ -10,8 +10,8 @@ Limits (per robot unless noted):
   server stops reading from that robot's clients (TCP back-pressure) until the buffer is half empty
 * MAX_OUTBOX bytes waiting to be sent to one client, OUTBOX_TOTAL_MAX to all clients of a robot; a client
   that does not read (the one with most waiting, for the total) is dropped
-* fairness: each client's input is processed in bounded turns, floods after the others, CPERR answers
-  to bad packets limited per client (sim/fairness.py)
+* fairness: each client's input is processed in bounded turns, floods after the others (sim/fairness.py);
+  CPERR answers to bad packets limited per client (the session, sim/session.py)
 * the event log: bounded by count and bytes (sim/eventlog.py)
 """
 from __future__ import annotations
@@ -29,7 +29,7 @@ from .ethernet_slave import EthernetSlave
 from .eventlog import EventLog, text as _text
 from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
 from .faults import FaultState, check_params as check_fault_params
-from .limits import (ACCEPT_BACKOFF_S, CPERR_BURST, EVENT_BYTES_MAX, OUT_OF_DESCRIPTORS, OUTBOX_TOTAL_MAX,
+from .limits import (ACCEPT_BACKOFF_S, EVENT_BYTES_MAX, OUT_OF_DESCRIPTORS, OUTBOX_TOTAL_MAX,
                      PENDING_BYTES_MAX)
 from .profiles import Profile
 from .robot import RobotModel
@@ -46,18 +46,20 @@ GC_FORCE = 20_000           # ...and in any poll once this many are (a flood lea
 
 
 class _Conn:
-    __slots__ = ("sock", "id", "rbuf", "wbuf", "eof", "frames_in", "peer", "cperr_tokens", "cperr_at",
-                 "suppressed", "greedy")
+    """One client socket of a robot; what it received waits in the robot's session (``buffer_data``)."""
+    __slots__ = ("sock", "id", "wbuf", "eof", "peer", "greedy", "_session")
 
-    def __init__(self, sock, conn_id, peer, now):
+    def __init__(self, sock, conn_id, peer, session):
         self.sock, self.id, self.peer = sock, conn_id, peer
-        self.rbuf = bytearray()
         self.wbuf = bytearray()
         self.eof = False
-        self.frames_in = 0
-        self.cperr_tokens, self.cperr_at = float(CPERR_BURST), now     # CPERR answers to bad bytes (a bucket)
-        self.suppressed = 0                                              # bad packets not answered since
         self.greedy = False                     # its last read filled RECV_SIZE, or input is left over
+        self._session = session
+
+    @property
+    def suppressed(self) -> int:
+        """Bad packets of this client not answered (CPERR limit) and not logged yet; the session counts."""
+        return self._session.unanswered_bad(self.id)
 
 
 class Robot(EventLog):
@@ -334,7 +336,7 @@ class SimServer(FairInput):
         robot.reading_paused = not reading
         robot._log("reading_resumed" if reading else "reading_paused", buffered=robot.session.waiting_scripts)
         for conn in robot.conns.values():
-            if reading and conn.rbuf:
+            if reading and robot.session.input_bytes(conn.id):
                 self._backlog[(robot.index, conn.id)] = (robot, conn)    # input read before the pause
             if conn.eof:
                 continue
@@ -421,19 +423,21 @@ class SimServer(FairInput):
                 robot._log("rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")
                 sock.close()
                 continue
-            conn = _Conn(sock, self._next_conn, addr[0], self._now)
+            conn = _Conn(sock, self._next_conn, addr[0], robot.session)
             self._next_conn += 1
             robot.conns[conn.id] = conn
             robot.session.connect(conn.id, addr[0])
             self.selector.register(sock, selectors.EVENT_READ, ("conn", robot, conn))
 
     def _read(self, robot, conn):
+        """Read what ``conn`` sent into the robot's session and give it a turn (unless it waits in the
+        backlog). The server never decodes: the session owns the bytes (h11's model)."""
         if conn.id not in robot.conns or conn.eof:
             return
         if self._buffer_full(robot):
             self._set_reading(robot, False)
             return
-        if len(conn.rbuf) < RBUF_READ_BELOW:     # else: what is buffered is processed first (fairness)
+        if robot.session.input_bytes(conn.id) < RBUF_READ_BELOW:    # else: what is buffered goes first (fairness)
             try:
                 data = conn.sock.recv(RECV_SIZE)
             except (BlockingIOError, InterruptedError):
@@ -450,7 +454,7 @@ class SimServer(FairInput):
             if robot.faults.black_hole:
                 robot._log("black_hole", conn=conn.id, bytes=len(data))
                 return
-            conn.rbuf += data
+            robot.session.buffer_data(conn.id, data)
         if (robot.index, conn.id) not in self._backlog:     # else it waits for its turn in _serve_backlog
             self._process(robot, conn)
 
@@ -528,8 +532,6 @@ class SimServer(FairInput):
             pass
         robot.faults.forget(conn.id)
         self._backlog.pop((robot.index, conn.id), None)
-        if conn.suppressed:
-            robot._log("cperr_suppressed", conn=conn.id, count=conn.suppressed)
         robot.session.disconnect(conn.id)
         robot._log("closed", conn=conn.id, reason=reason)
 

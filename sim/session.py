@@ -2,9 +2,11 @@
 
 A server calls ``connect``/``receive_data(conn, bytes)``/``disconnect``/``advance(now)`` and takes
 ``data_to_send(conn)`` (one bytes object per frame, so each goes out in one send); the control channel
-uses the control methods (``enter_node``, ``stop_project`` ...). ``handle`` takes one decoded item for a
-server that decodes itself (the simulator's server does, to share its input fairly between clients). The node state follows an explicit transition table; the scripts of all clients are run
-strictly in arrival order, one at a time.
+uses the control methods (``enter_node``, ``stop_project`` ...). A server that shares its input fairly
+between clients (sim/fairness.py) calls ``buffer_data`` and then ``process`` in bounded turns instead of
+``receive_data``; the session decodes, limits its CPERR answers to bad packets (CPERR_BURST, CPERR_PER_S
+in sim/limits.py) and logs ``frame_in`` either way. The node state follows an explicit transition table;
+the scripts of all clients are run strictly in arrival order, one at a time.
 """
 from __future__ import annotations
 
@@ -14,7 +16,9 @@ from dataclasses import dataclass, field
 
 from . import codec
 from .checker import check_script
+from .eventlog import text as _text
 from .interp import Context, ScriptRuntimeError, run_script
+from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN
 from .profiles import Profile
 from .robot import RobotModel
 from .script import split_lines
@@ -36,6 +40,11 @@ TRANSITIONS = {
     (IN_NODE, "robot_fault"): STOPPED,        # a failed motion is a robot error: the project stops
     (EXITING, "robot_fault"): STOPPED,
 }
+
+# outcome of one turn of a connection's input (``process``)
+INPUT_DONE = "done"                 # no complete item is left in the receive buffer
+INPUT_LEFT = "left"                 # a bound of the turn ended it: input may be left for the next turn
+FRAME_LIMIT = "frame_limit"         # the connection's received frames reached ``frame_limit``
 
 _PRIORITY = re.compile(r"^\s*(ScriptExit|StopAndClearBuffer)\s*\(\s*(\d)\s*\)\s*$")
 _PRIORITY_ARGS = {"ScriptExit": (0, 1), "StopAndClearBuffer": (0, 1, 2)}
@@ -59,8 +68,12 @@ class Running:
 @dataclass
 class Client:
     peer: str
+    cperr_at: float                     # robot clock of the last refill of ``cperr_tokens``
+    cperr_tokens: float = float(CPERR_BURST)        # CPERR answers to bad packets still allowed (a bucket)
+    suppressed: int = 0                 # bad packets not answered since the last ``cperr_suppressed`` event
+    frames_in: int = 0                  # well-formed frames received
     outbox: list = field(default_factory=list)
-    rbuf: bytearray = field(default_factory=bytearray)      # an incomplete frame (receive_data)
+    rbuf: bytearray = field(default_factory=bytearray)      # bytes received and not processed yet
 
 
 class TransitionError(Exception):
@@ -144,11 +157,14 @@ class ListenSession:
 
     # ---- connections --------------------------------------------------------------------------
     def connect(self, conn: int, peer="127.0.0.1"):
-        self.clients[conn] = Client(peer)
+        self.clients[conn] = Client(peer, self.now)
         self.log("connect", conn=conn, peer=peer)
 
     def disconnect(self, conn: int):
-        if self.clients.pop(conn, None) is not None:
+        client = self.clients.pop(conn, None)
+        if client is not None:
+            if client.suppressed:
+                self.log("cperr_suppressed", conn=conn, count=client.suppressed)
             self.log("disconnect", conn=conn)
 
     def send(self, conn, frame: bytes):
@@ -163,7 +179,8 @@ class ListenSession:
 
     # ---- input --------------------------------------------------------------------------------
     def handle(self, conn: int, item):
-        """Process one decoded item (codec.Frame / BadFrame / Garbage) from connection ``conn``."""
+        """Process one decoded item (codec.Frame / BadFrame / Garbage) from connection ``conn``, as it is
+        (no CPERR limit, no ``frame_in`` event: ``process`` adds those)."""
         self.last_packet = self.now
         if isinstance(item, codec.Garbage):
             self.log("garbage", conn=conn, bytes=len(item.raw))
@@ -365,21 +382,87 @@ class ListenSession:
     # ---- sans-I/O byte interface (h11 pattern): bytes in, bytes out; nobody else touches the state -------
     def receive_data(self, conn: int, data: bytes) -> int:
         """Bytes received from connection ``conn``: every complete item in them (and in what an earlier call
-        left incomplete) is handled at once; returns the number of items handled. A partial frame waits in
-        the session's buffer of that connection for the next call."""
+        left incomplete) is processed at once; returns the number of items handled (bad packets beyond the
+        CPERR limit are not). A partial frame waits in the session's buffer of that connection for the next
+        call."""
+        if conn not in self.clients:
+            return 0
+        self.buffer_data(conn, data)
+        total = 0
+        while True:
+            handled, outcome = self.process(conn, SERVE_SCAN, SERVE_SCAN)
+            total += handled
+            if outcome != INPUT_LEFT:
+                return total
+
+    def buffer_data(self, conn: int, data: bytes):
+        """Bytes received from connection ``conn``, kept for ``process`` (unknown connection: ignored)."""
+        client = self.clients.get(conn)
+        if client is not None:
+            client.rbuf += data
+
+    def input_bytes(self, conn: int) -> int:
+        """Bytes of connection ``conn`` received and not processed yet."""
+        client = self.clients.get(conn)
+        return 0 if client is None else len(client.rbuf)
+
+    def unanswered_bad(self, conn: int) -> int:
+        """Bad packets of connection ``conn`` not answered (CPERR limit) and not logged yet."""
+        client = self.clients.get(conn)
+        return 0 if client is None else client.suppressed
+
+    def process(self, conn: int, max_items: int, max_decoded: int, max_waiting: int | None = None,
+                frame_limit: int | None = None) -> tuple[int, str]:
+        """One turn of connection ``conn``'s buffered input: at most ``max_decoded`` items decoded and
+        ``max_items`` of them handled; the turn also ends once ``max_waiting`` scripts wait to start, or
+        right after the item that brings the connection's received frames to ``frame_limit``. Returns
+        (items handled, INPUT_DONE | INPUT_LEFT | FRAME_LIMIT). Bad packets are answered with CPERR at most
+        CPERR_BURST at once, then CPERR_PER_S per second of robot clock; the others are counted (event
+        ``cperr_suppressed`` before the next item handled, or at ``disconnect``)."""
         client = self.clients.get(conn)
         if client is None:
-            return 0
-        client.rbuf += data
-        handled = 0
-        while client.rbuf:
-            item, used = codec.decode(client.rbuf)
+            return 0, INPUT_DONE
+        rbuf, handled = client.rbuf, 0
+        for _ in range(max_decoded):
+            if rbuf[:2] == b"$$" and self._cperr_tokens(client) < 1.0:
+                # a '$' followed by another '$' is always a bad packet (header missing, CPERR 01): a run of
+                # them that gets no answer anyway is skipped at once
+                run = len(rbuf) - len(rbuf.lstrip(b"$")) - 1
+                del rbuf[:run]
+                client.suppressed += run
+                continue
+            item, used = codec.decode(rbuf)
             if not used:
-                break
-            del client.rbuf[:used]
+                return handled, INPUT_DONE
+            del rbuf[:used]
+            if type(item) is codec.BadFrame and not self._may_answer_bad(client):
+                client.suppressed += 1
+                continue
+            if client.suppressed:
+                self.log("cperr_suppressed", conn=conn, count=client.suppressed)
+                client.suppressed = 0
+            if type(item) is codec.Frame:
+                client.frames_in += 1
+                self.log("frame_in", conn=conn, raw=_text(item.raw), header=item.header, data=_text(item.data))
             self.handle(conn, item)
             handled += 1
-        return handled
+            if frame_limit is not None and client.frames_in >= frame_limit:
+                return handled, FRAME_LIMIT
+            if handled >= max_items or (max_waiting is not None and len(self.pending) >= max_waiting):
+                return handled, INPUT_LEFT
+        return handled, INPUT_LEFT
+
+    def _cperr_tokens(self, client) -> float:
+        """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""
+        client.cperr_tokens = min(CPERR_BURST, client.cperr_tokens + (self.now - client.cperr_at) * CPERR_PER_S)
+        client.cperr_at = self.now
+        return client.cperr_tokens
+
+    def _may_answer_bad(self, client) -> bool:
+        if self._cperr_tokens(client) < 1.0:
+            return False
+        client.cperr_tokens -= 1.0
+        return True
 
     def data_to_send(self, conn: int) -> list[bytes]:
         """The frames for connection ``conn`` produced so far (one bytes object per frame, so each can go out

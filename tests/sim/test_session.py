@@ -4,7 +4,9 @@ import struct
 import pytest
 
 from sim import codec
-from sim.session import EXITING, IDLE, IN_NODE, STOPPED, TRANSITIONS, ListenSession, TransitionError
+from sim.limits import CPERR_BURST, CPERR_PER_S
+from sim.session import (EXITING, FRAME_LIMIT, IDLE, IN_NODE, INPUT_DONE, INPUT_LEFT, STOPPED, TRANSITIONS,
+                         ListenSession, TransitionError)
 
 
 class S:
@@ -404,6 +406,52 @@ def test_receive_data_takes_bytes_whole_split_and_glued_and_data_to_send_hands_o
     assert [f.decode() for f in frames] == [codec.encode("TMSCT", "A,OK").decode(), codec.encode("TMSCT", "B,OK").decode(),
                                            codec.encode("TMSTA", "00,true,Listen1").decode()]
     assert n.s.data_to_send(1) == [] and n.s.receive_data(9, raw) == 0          # unknown connection: ignored
+
+
+def test_process_handles_buffered_input_in_bounded_turns_and_says_whether_input_is_left():
+    n = S()
+    n.connect(1)
+    n.out(1)
+    n.s.buffer_data(1, sta("00") * 3 + sta("00")[:5])
+    assert n.s.process(1, 2, 256) == (2, INPUT_LEFT) and len(n.out(1)) == 2
+    assert n.s.process(1, 2, 256) == (1, INPUT_DONE) and n.s.input_bytes(1) == 5      # the partial frame waits
+    n.s.buffer_data(1, sta("00")[5:] + sct("A", "int a = 1") * 3)
+    assert n.s.process(1, 8, 2) == (2, INPUT_LEFT)                                     # decode bound
+    assert n.s.process(1, 8, 256, frame_limit=6) == (1, FRAME_LIMIT)                 # 5 frames + this one
+    assert [k for k, _ in n.events].count("frame_in") == 6
+    assert n.s.process(9, 8, 256) == (0, INPUT_DONE) and n.s.input_bytes(9) == 0      # unknown connection
+
+
+def test_process_stops_a_turn_once_max_waiting_scripts_wait():
+    n = S()
+    n.connect(1)
+    n.s.buffer_data(1, sct("A", "Sleep(1000)") + sct("B", "int b = 1") * 4)
+    assert n.s.process(1, 8, 256, max_waiting=2) == (3, INPUT_LEFT) and n.s.waiting_scripts == 2
+
+
+def test_bad_packets_get_cperr_burst_answers_then_cperr_per_s_and_the_rest_are_counted():
+    n = S()
+    n.connect(1)
+    n.out(1)
+    bad = sta("00")[:-4] + b"00\r\n"                        # checksum mismatch: CPERR 02
+    assert n.s.receive_data(1, bad * (CPERR_BURST + 4)) == CPERR_BURST
+    assert n.out(1) == [codec.encode("CPERR", codec.CPERR_CHECKSUM).decode()] * CPERR_BURST
+    assert n.s.unanswered_bad(1) == 4 and not [e for e in n.events if e[0] == "cperr_suppressed"]
+    n.advance(2 / CPERR_PER_S)
+    assert n.s.receive_data(1, bad * 3) == 2 and n.s.unanswered_bad(1) == 1     # 2 answers refilled
+    assert n.s.receive_data(1, b"$" * 1000) == 0 and n.s.unanswered_bad(1) == 1 + 999     # one '$' waits
+    n.s.receive_data(1, sta("00"))
+    assert [f["count"] for k, f in n.events if k == "cperr_suppressed"] == [4, 1001]    # the waiting "$" too
+    assert n.events[-1][0] == "frame_in" and n.s.unanswered_bad(1) == 0
+
+
+def test_disconnect_logs_the_bad_packets_left_unanswered():
+    n = S()
+    n.connect(1)
+    n.s.receive_data(1, b"$" * (CPERR_BURST + 10))
+    n.s.disconnect(1)
+    assert [k for k, _ in n.events][-2:] == ["cperr_suppressed", "disconnect"]
+    assert n.events[-2][1]["count"] == 9 and n.s.unanswered_bad(1) == 0
 
 
 def test_control_methods_drive_the_node_without_touching_its_state():
