@@ -514,6 +514,14 @@ class ListenSession:
         if enter_node:
             self.fire("enter_node", source=source)
 
+    def robot_error(self, reason: str, source="control"):
+        """A robot error from outside the Listen node (the emergency stop): the project stops with it; when
+        it is stopped already, the error is latched only."""
+        if self.state != STOPPED:
+            self.fire("robot_fault", reason=reason, source=source)
+        else:
+            self.robot.latch_error(reason, self.now)
+
     def internal_error(self, reason: str):
         """The simulator failed while advancing: a robot error of this robot (arm stops, project stops)."""
         self.robot.stop_and_clear()

@@ -168,13 +168,11 @@ class RobotDataSource:
     # ---- operator actions (control channel, tests) --------------------------------------------
     def set_estop(self, pressed: bool):
         """Press (the project stops with a robot error) or release the emergency stop."""
-        model, session = self.model, self.robot.session
+        model = self.model
         model.estop = bool(pressed)
         self.log("estop", pressed=model.estop)
-        if model.estop and session.state != "project_stopped":
-            session.fire("robot_fault", reason="emergency stop pressed", source="estop")
-        elif model.estop:
-            model.latch_error("emergency stop pressed", session.now)
+        if model.estop:
+            self.robot.session.robot_error("emergency stop pressed", source="estop")
 
     def set_auto_mode(self, auto: bool):
         self.model.auto_mode = bool(auto)

@@ -469,3 +469,14 @@ def test_control_methods_drive_the_node_without_touching_its_state():
     n.s.clear_reply_errors()
     n.s.receive_data(1, sct("B", "int b = 1"))
     assert n.s.data_to_send(1) == [codec.encode("TMSCT", "B,OK")] and n.s.buffered == 0
+
+
+def test_robot_error_stops_a_running_project_and_is_only_latched_when_it_is_stopped():
+    n = S()
+    n.s.robot_error("emergency stop pressed", source="estop")
+    assert n.s.state == STOPPED and n.s.last_error == "emergency stop pressed"
+    assert ("state", {"event": "robot_fault", "previous": IN_NODE, "state": STOPPED,
+                      "reason": "emergency stop pressed", "source": "estop"}) in n.events
+    count = len(n.events)
+    n.s.robot_error("emergency stop pressed")
+    assert n.s.state == STOPPED and len(n.events) == count and n.s.robot.state()["robot_error"]["active"]
