@@ -29,8 +29,9 @@ import re
 import selectors
 import socket
 
-from .limits import (ACCEPT_BACKOFF_S, CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX,
-                     CONTROL_EVENTS_MAX, CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, OUT_OF_DESCRIPTORS)
+from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX,
+                     CONTROL_EVENTS_MAX, CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX)
+from .listener import Listener
 from .session import TransitionError
 
 _FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission"}
@@ -54,23 +55,13 @@ class _Client:
 class ControlChannel:
     def __init__(self, server, host="127.0.0.1", port=0):
         self.server = server
-        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((host, port))
-        except OSError as exc:
-            sock.close()
-            raise OSError(exc.errno, f"cannot open the control channel on {host}:{port}: {exc.strerror}") from None
-        sock.listen(16)
-        sock.setblocking(False)
-        self.sock = sock
-        self.host = host
-        self.port = sock.getsockname()[1]
-        self.clients: dict[socket.socket, _Client] = {}
-        self._accept_paused_until = None
         server._dispatch["control_listen"] = self._accept
         server._dispatch["control_conn"] = self._serve_client
-        server.selector.register(sock, selectors.EVENT_READ, ("control_listen", None, None))
+        self.listener = Listener(server.selector, host, port, ("control_listen", None, None),
+                                 "open the control channel on {where}")
+        self.host = host
+        self.port = self.listener.port
+        self.clients: dict[socket.socket, _Client] = {}
         self._commands = {
             "ping": lambda robot, req: "pong",
             "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.state,
@@ -92,14 +83,10 @@ class ControlChannel:
 
     # ---- sockets ------------------------------------------------------------------------------
     def _accept(self, _robot, _conn):
-        try:
-            sock, _addr = self.sock.accept()
-        except (BlockingIOError, InterruptedError):
+        accepted = self.listener.accept(self.server._now, self.server._log_server, prefix="control_")
+        if accepted is None:
             return
-        except OSError as exc:
-            if exc.errno in OUT_OF_DESCRIPTORS:
-                self._pause_accepting(exc)
-            return
+        sock, _addr = accepted
         if len(self.clients) >= CONTROL_CLIENTS_MAX:
             sock.close()
             return
@@ -107,17 +94,9 @@ class ControlChannel:
         self.clients[sock] = _Client(sock)
         self.server.selector.register(sock, selectors.EVENT_READ, ("control_conn", None, sock))
 
-    def _pause_accepting(self, exc):
-        """Out of descriptors: stop watching the listener for ACCEPT_BACKOFF_S (no busy loop), say it once."""
-        self.server.selector.unregister(self.sock)
-        self._accept_paused_until = self.server._now + ACCEPT_BACKOFF_S
-        self.server._log_server("control_accept_paused", reason=exc.strerror, seconds=ACCEPT_BACKOFF_S)
-
     def tick(self, now):
         """Called once a poll: resume accepting after a pause."""
-        if self._accept_paused_until is not None and now >= self._accept_paused_until:
-            self._accept_paused_until = None
-            self.server.selector.register(self.sock, selectors.EVENT_READ, ("control_listen", None, None))
+        self.listener.tick(now)
 
     def _serve_client(self, _robot, sock):
         client = self.clients.get(sock)
@@ -201,12 +180,7 @@ class ControlChannel:
     def close(self):
         for sock in list(self.clients):
             self._close(sock)
-        if self._accept_paused_until is None:
-            try:
-                self.server.selector.unregister(self.sock)
-            except (KeyError, ValueError):
-                pass
-        self.sock.close()
+        self.listener.close()
 
     # ---- requests -----------------------------------------------------------------------------
     def execute(self, line: bytes) -> dict:

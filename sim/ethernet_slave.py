@@ -15,7 +15,7 @@ import selectors
 import socket
 
 from . import codec
-from .limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
+from .listener import Listener
 from .svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
 from .svr_source import RobotDataSource
 
@@ -53,49 +53,28 @@ class EthernetSlave:
             raise
 
     def _listen(self, robot, port):
-        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((self.server.host, port))
-        except OSError as exc:
-            sock.close()
-            raise OSError(exc.errno, f"cannot open the Ethernet Slave of robot {robot.index + 1} on "
-                                     f"{self.server.host}:{port}: {exc.strerror}") from None
-        sock.listen(16)
-        sock.setblocking(False)
-        robot.svr_port = sock.getsockname()[1]
-        robot.svr_listener = sock
-        self.listeners.append(sock)
-        self.server.selector.register(sock, selectors.EVENT_READ, ("svr_listen", None, robot))
+        robot.svr_listener = Listener(self.server.selector, self.server.host, port, ("svr_listen", None, robot),
+                                      f"open the Ethernet Slave of robot {robot.index + 1} on {{where}}")
+        robot.svr_port = robot.svr_listener.port
+        self.listeners.append(robot.svr_listener)
         robot._log("svr_listening", host=self.server.host, port=robot.svr_port)
 
     # ---- per poll -----------------------------------------------------------------------------
     def poll(self, now):
         """Stream the data tables that are due and send what is waiting (called by SimServer.poll)."""
         for robot in self.server.robots:
-            paused = getattr(robot, "svr_accept_paused_until", None)
-            if paused is not None and now >= paused:
-                robot.svr_accept_paused_until = None
-                self.server.selector.register(robot.svr_listener, selectors.EVENT_READ, ("svr_listen", None, robot))
+            if getattr(robot, "svr_listener", None) is not None:
+                robot.svr_listener.tick(now)
             if robot.svr.clients:
                 robot.svr.advance(now)
                 self._flush(robot)
 
     def _accept(self, _none, robot):
         for _ in range(16):
-            try:
-                sock, addr = robot.svr_listener.accept()
-            except (BlockingIOError, InterruptedError):
+            accepted = robot.svr_listener.accept(self.server._now, robot._log, prefix="svr_")
+            if accepted is None:
                 return
-            except OSError as exc:
-                if exc.errno in OUT_OF_DESCRIPTORS:
-                    # the listener stays readable: watching it now would spin; try again after a pause
-                    self.server.selector.unregister(robot.svr_listener)
-                    robot.svr_accept_paused_until = self.server._now + ACCEPT_BACKOFF_S
-                    robot._log("svr_accept_paused", reason=exc.strerror, seconds=ACCEPT_BACKOFF_S)
-                else:
-                    robot._log("svr_accept_error", reason=exc.strerror)
-                return
+            sock, addr = accepted
             if len(robot.svr_conns) >= MAX_CLIENTS:
                 robot._log("svr_rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")
                 sock.close()
@@ -193,12 +172,8 @@ class EthernetSlave:
         for robot in self.server.robots:
             for conn in list(getattr(robot, "svr_conns", {}).values()):
                 self._drop(robot, conn, "simulator closed")
-        for sock in self.listeners:
-            try:
-                self.server.selector.unregister(sock)
-            except (KeyError, ValueError):
-                pass
-            sock.close()
+        for listener in self.listeners:
+            listener.close()
         self.listeners = []
 
 

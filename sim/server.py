@@ -26,11 +26,11 @@ import time
 from . import codec
 from .control import ControlChannel
 from .ethernet_slave import EthernetSlave
+from .listener import Listener
 from .eventlog import EventLog, text as _text
 from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
 from .faults import FaultState, check_params as check_fault_params
-from .limits import (ACCEPT_BACKOFF_S, EVENT_BYTES_MAX, OUT_OF_DESCRIPTORS, OUTBOX_TOTAL_MAX,
-                     PENDING_BYTES_MAX)
+from .limits import EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX
 from .profiles import Profile
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
@@ -76,7 +76,6 @@ class Robot(EventLog):
                                      auto_enter=auto_enter, data_timeout=timeouts[0], connection_timeout=timeouts[1],
                                      profile=profile)
         self.listener = None
-        self.accept_paused_until = None          # out of descriptors: the listener is not watched until then
         self.conns: dict[int, _Conn] = {}
         self.reading_paused = False
 
@@ -202,25 +201,12 @@ class SimServer(FairInput):
     def _listen(self, robot):
         if robot.listener is not None or robot.faults.refuse:
             return
-        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((self.host, robot.port))
-        except OSError as exc:
-            sock.close()
-            raise OSError(exc.errno, f"cannot listen on {self.host}:{robot.port} for robot {robot.index + 1}: "
-                                     f"{exc.strerror}") from None
-        sock.listen(128)
-        sock.setblocking(False)
-        robot.port = sock.getsockname()[1]
-        robot.listener = sock
-        self.selector.register(sock, selectors.EVENT_READ, ("listen", robot, None))
+        robot.listener = Listener(self.selector, self.host, robot.port, ("listen", robot, None),
+                                  f"listen on {{where}} for robot {robot.index + 1}", backlog=128)
+        robot.port = robot.listener.port
         robot._log("listening", host=self.host, port=robot.port)
 
     def _close_listener(self, robot):
-        if robot.accept_paused_until is None:
-            self.selector.unregister(robot.listener)
-        robot.accept_paused_until = None
         robot.listener.close()
         robot.listener = None
 
@@ -296,9 +282,8 @@ class SimServer(FairInput):
             self._poll_end = self._slice_start + POLL_BUDGET_S
             for robot in self.robots:
                 session = robot.session
-                if robot.accept_paused_until is not None and self._now >= robot.accept_paused_until:
-                    robot.accept_paused_until = None
-                    self.selector.register(robot.listener, selectors.EVENT_READ, ("listen", robot, None))
+                if robot.listener is not None:
+                    robot.listener.tick(self._now)
                 self._advance(robot)
                 if session.has_output() and not robot.faults.active:
                     self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
@@ -404,19 +389,10 @@ class SimServer(FairInput):
 
     def _accept(self, robot, _conn):
         for _ in range(64):
-            try:
-                sock, addr = robot.listener.accept()
-            except (BlockingIOError, InterruptedError):
+            accepted = robot.listener.accept(self._now, robot._log)
+            if accepted is None:
                 return
-            except OSError as exc:
-                if exc.errno in OUT_OF_DESCRIPTORS:
-                    # the listener stays readable: watching it now would spin; try again after a pause
-                    self.selector.unregister(robot.listener)
-                    robot.accept_paused_until = self._now + ACCEPT_BACKOFF_S
-                    robot._log("accept_paused", reason=exc.strerror, seconds=ACCEPT_BACKOFF_S)
-                else:
-                    robot._log("accept_error", reason=exc.strerror)
-                return
+            sock, addr = accepted
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             if len(robot.conns) >= MAX_CLIENTS:

@@ -86,8 +86,8 @@ def test_a_client_that_never_reads_its_answers_is_closed_and_never_stalls_the_ot
 def test_control_channel_binds_loopback_even_when_the_robots_listen_elsewhere():
     srv = SimServer(host="127.0.0.2", port=0, control_port=0).start()
     try:
-        assert srv.robots[0].listener.getsockname()[0] == "127.0.0.2"
-        assert srv.control.sock.getsockname()[0] == "127.0.0.1"
+        assert srv.robots[0].listener.sock.getsockname()[0] == "127.0.0.2"
+        assert srv.control.listener.sock.getsockname()[0] == "127.0.0.1"
     finally:
         srv.close()
 

@@ -1,0 +1,65 @@
+"""A listening TCP socket of the simulator, watched by the server's selector (Listen node, Ethernet Slave and
+control channel ports share it).
+
+Out of file descriptors, ``accept()`` fails while the listener stays readable: watching it then would spin the
+loop at 100 % CPU and log an error on every turn. The listener stops being watched for ACCEPT_BACKOFF_S instead,
+says so once, and ``tick(now)`` watches it again; pending connections wait in the kernel's backlog meanwhile.
+"""
+from __future__ import annotations
+
+import selectors
+import socket
+
+from .limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
+
+
+class Listener:
+    def __init__(self, selector, host: str, port: int, key, what: str, backlog: int = 16):
+        """Bind and listen; ``key`` is the selector data of the listener, ``what`` is the OSError's text when the port
+        cannot be opened, ``{where}`` standing for host:port (e.g. "listen on {where} for robot 1")."""
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            sock.bind((host, port))
+        except OSError as exc:
+            sock.close()
+            raise OSError(exc.errno, f"cannot {what.format(where=f'{host}:{port}')}: {exc.strerror}") from None
+        sock.listen(backlog)
+        sock.setblocking(False)
+        self.sock = sock
+        self.port = sock.getsockname()[1]
+        self._selector = selector
+        self._key = key
+        self.paused_until: float | None = None
+        selector.register(sock, selectors.EVENT_READ, key)
+
+    def accept(self, now: float, log, prefix: str = ""):
+        """One pending connection as ``(sock, addr)``, or None: none waiting, or an error that ``log`` was told
+        (``<prefix>accept_paused`` once per pause when out of descriptors, ``<prefix>accept_error`` otherwise)."""
+        try:
+            return self.sock.accept()
+        except (BlockingIOError, InterruptedError):
+            return None
+        except OSError as exc:
+            if exc.errno in OUT_OF_DESCRIPTORS:
+                self._selector.unregister(self.sock)
+                self.paused_until = now + ACCEPT_BACKOFF_S
+                log(f"{prefix}accept_paused", reason=exc.strerror, seconds=ACCEPT_BACKOFF_S)
+            else:
+                log(f"{prefix}accept_error", reason=exc.strerror)
+            return None
+
+    def tick(self, now: float) -> None:
+        """Watch the listener again once a pause is over (called once a poll)."""
+        if self.paused_until is not None and now >= self.paused_until:
+            self.paused_until = None
+            self._selector.register(self.sock, selectors.EVENT_READ, self._key)
+
+    def close(self) -> None:
+        if self.paused_until is None:
+            try:
+                self._selector.unregister(self.sock)
+            except (KeyError, ValueError):
+                pass
+        self.paused_until = None
+        self.sock.close()
