@@ -15,7 +15,8 @@ def register(subparsers) -> None:
         description="Check the sources, then draw the ladder body of one POU as an SVG file: rails, contacts, "
                     "coils, blocks with pin names, variable names and rung comments. Exit 0 written, 1 errors "
                     "in the sources, 2 usage error.")
-    p.add_argument("paths", nargs="+", metavar="PATH", help="XML file with the ladder, plus the .st files or folders it uses")
+    p.add_argument("paths", nargs="+", metavar="PATH",
+                   help="XML file with the ladder, plus the .st files or folders it uses")
     p.add_argument("--pou", required=True, metavar="NAME", help="the POU to draw")
     p.add_argument("-o", "--output", required=True, metavar="FILE.svg", help="SVG file to write")
     p.set_defaults(handler=run_draw)
@@ -30,6 +31,8 @@ def run_draw(args) -> int:
     if missing:
         return _usage(f"file or folder `{missing[0]}` does not exist")
     parent = os.path.dirname(os.path.abspath(args.output))
+    if not args.output.lower().endswith(".svg"):
+        return _usage(f"`{args.output}`: the drawing is SVG, give a file name ending in .svg")
     if os.path.isdir(args.output) or not os.path.isdir(parent):
         return _usage(f"cannot write `{args.output}`: give a file name in an existing folder")
     proj = load_project(args.paths)

@@ -60,7 +60,8 @@ def test_usage_errors_are_one_line_with_exit_2(tmp_path, capsys):
     cases = [(["nope.xml", "--pou", "Main", "-o", tmp_path / "x.svg"], "does not exist"),
              ([LIB, ROOT / "examples", "--pou", "Nope", "-o", tmp_path / "x.svg"], "no POU named `Nope`"),
              ([LIB, ROOT / "examples", "--pou", "PnP_Example", "-o", tmp_path / "x.svg"], "written in Structured Text"),
-             ([LIB, ROOT / "examples", "--pou", "Commands_Example", "-o", tmp_path / "no" / "x.svg"], "cannot write")]
+             ([LIB, ROOT / "examples", "--pou", "Commands_Example", "-o", tmp_path / "no" / "x.svg"], "cannot write"),
+             ([LIB, ROOT / "examples", "--pou", "Commands_Example", "-o", tmp_path / "x.png"], "ending in .svg")]
     for args, expected in cases:
         code, _, err = draw(capsys, *args)
         assert code == 2 and expected in err and err.count("\n") == 1, err
