@@ -23,7 +23,8 @@ for entry in (ROOT / "src", ROOT):
     sys.path.insert(0, str(entry))
 
 from sim.server import SimServer  # noqa: E402
-from vplc.hmi.server import HmiServer, Mapping  # noqa: E402
+from vplc.hmi.mapping import Mapping  # noqa: E402
+from vplc.hmi.server import HmiServer  # noqa: E402
 
 try:
     from vplc.api import load_plc

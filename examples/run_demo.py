@@ -19,7 +19,8 @@ for entry in (ROOT / "src", ROOT):
         sys.path.insert(0, str(entry))
 
 from sim.server import SimServer  # noqa: E402
-from vplc.hmi.server import HmiServer, Mapping, MappingError  # noqa: E402
+from vplc.hmi.mapping import Mapping, MappingError  # noqa: E402
+from vplc.hmi.server import HmiServer  # noqa: E402
 
 SOURCES = [ROOT / "lib" / "CBT_Commands_Lib", ROOT / "examples"]
 

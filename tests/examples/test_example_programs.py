@@ -9,7 +9,7 @@ import pytest
 
 from sim.server import SimServer
 from vplc.api import load_plc
-from vplc.hmi.server import Mapping
+from vplc.hmi.mapping import Mapping
 from vplc.project import load_project
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -10,7 +10,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 from fake_plc import FakePlc, command_program, scanning, serving  # noqa: E402
 from hmi_http import Client  # noqa: E402
-from vplc.hmi.server import Mapping  # noqa: E402
+from vplc.hmi.mapping import Mapping  # noqa: E402
 
 
 @pytest.fixture

@@ -9,7 +9,7 @@ import contextlib
 import re
 import threading
 
-from vplc.hmi.server import INT_RANGES, Mapping
+from vplc.hmi.mapping import INT_RANGES, Mapping
 
 _STEP = re.compile(r"\.?([A-Za-z_]\w*)|\[(\d+)\]")
 

@@ -15,7 +15,8 @@ from selenium.webdriver.common.by import By
 from browser import Browser
 from sim.server import SimServer
 from vplc.api import load_plc
-from vplc.hmi.server import HmiServer, Mapping
+from vplc.hmi.mapping import Mapping
+from vplc.hmi.server import HmiServer
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]

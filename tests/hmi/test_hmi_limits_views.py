@@ -12,7 +12,7 @@ from selenium.webdriver.support.ui import Select
 
 from browser import ROOT, Browser
 from fake_plc import FakePlc, command_program, scanning, serving
-from vplc.hmi.server import Mapping
+from vplc.hmi.mapping import Mapping
 
 TCP = {"X": 400.0, "Y": 0.0, "Z": 400.0, "RX": 180.0, "RY": 0.0, "RZ": 90.0}
 

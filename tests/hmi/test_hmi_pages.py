@@ -9,7 +9,8 @@ from selenium.webdriver.support.ui import Select
 
 from browser import Browser
 from fake_plc import FakePlc, command_program
-from vplc.hmi.server import HmiServer, Mapping
+from vplc.hmi.mapping import Mapping
+from vplc.hmi.server import HmiServer
 
 PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "setoutput", "stop", "pnp"]
 

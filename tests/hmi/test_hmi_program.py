@@ -12,7 +12,8 @@ from browser import Browser, chromium_paths
 from hmi_http import Client
 from sim.server import SimServer
 from vplc.api import load_plc
-from vplc.hmi.server import HmiServer, Mapping
+from vplc.hmi.mapping import Mapping
+from vplc.hmi.server import HmiServer
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]

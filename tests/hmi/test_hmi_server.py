@@ -7,7 +7,8 @@ import pytest
 
 from fake_plc import FakePlc
 from hmi_http import Client
-from vplc.hmi.server import MAX_BODY, HmiServer, Mapping, MappingError
+from vplc.hmi.mapping import Mapping, MappingError
+from vplc.hmi.server import MAX_BODY, HmiServer
 
 
 def test_main_page_and_script_are_served_with_text_types(client):

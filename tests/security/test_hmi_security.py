@@ -21,7 +21,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "hmi"))
 from fake_plc import FakePlc, command_program, scanning, serving  # noqa: E402
 from hmi_http import Client  # noqa: E402
 from vplc.hmi import server as hmi_server  # noqa: E402
-from vplc.hmi.server import HmiServer, Mapping  # noqa: E402
+from vplc.hmi.mapping import Mapping  # noqa: E402
+from vplc.hmi.server import HmiServer  # noqa: E402
 
 MOVE = {"execute": "MoveAbs_Execute", "values": {"MoveAbs_Param.TargetPosition.Z": 300.0}}
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from http import HTTPStatus
 
 from ..ladder.svg import svg_document
-from .server import format_dt
+from .mapping import format_dt
 from ..runtime.values import PathError
 
 
