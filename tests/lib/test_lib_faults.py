@@ -35,12 +35,31 @@ def test_stream_faults_still_complete_every_command_once(rig, fault, params):
     assert rig.read("Cobot.BadFrames") == 0, detail
 
 
-def test_corrupt_checksum_reply_is_dropped_and_ends_in_reply_timeout(rig):
+def test_blended_motion_whose_ok_is_damaged_ends_outcome_unknown_at_the_status_query_not_after_5_s(rig):
+    """TMscript 2.24 §15.8: the Listen node works through its packets in order, so the answer to the status
+    query asked at once after the damaged frame proves the OK was in it: 16#3005 (outcome unknown), not a
+    16#3001 reply timeout 5 s later. The motion ran once and nothing is sent again."""
     go(rig, 1, blend=True)
-    rig.robot.inject("corrupt_checksum", count=1)
+    rig.robot.inject("corrupt_checksum", count=1, match=",OK")
+    start = rig.plc.now_ns
     assert rig.until(lambda: settled(rig, 1), 7)
-    assert rig.read("movers[1].Error") and rig.read("movers[1].ErrorID") == 0x3001
-    assert rig.read("Cobot.BadFrames") >= 1 and rig.read("Cobot.Connected")
+    assert rig.read("movers[1].Error") and rig.read("movers[1].ErrorID") == 0x3005
+    assert rig.plc.now_ns - start < 200_000_000                   # the next status answer, not ReplyTimeout
+    assert rig.read("Cobot.BadFrames") == 1 and rig.read("Cobot.Connected")
+    rig.until(lambda: False, 2)
+    assert len(executed_lines(rig)) == 1 and len(rig.scripts_in()) == 1
+
+
+def test_non_blended_motion_whose_ok_is_damaged_ends_done_by_its_tag_even_after_the_reply_timeout(rig):
+    """The same loss for a motion with a queue tag: found by the status query, it waits for its tag like an
+    accepted motion, so a motion longer than ReplyTimeout (5 s) ends Done when it is finished, not 16#3001."""
+    rig.set_struct("MParam[1]", move_abs(Speed=5, TargetPosition=dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=170)))
+    rig.write("MExec[1]", True)
+    rig.robot.inject("corrupt_checksum", count=1, match=",OK")
+    start = rig.plc.now_ns
+    assert rig.until(lambda: settled(rig, 1), 30)
+    assert rig.read("movers[1].Done"), rig.read("movers[1].ErrorDescrip")
+    assert rig.plc.now_ns - start > 5_000_000_000 and rig.read("Cobot.BadFrames") == 1
     assert len(executed_lines(rig)) == 1
 
 
