@@ -62,3 +62,27 @@ def test_portable_warning_points_at_file_line_col_with_a_fix(tmp_path):
     proj = check_text(tmp_path, CASES[1][1], "kw.st", portable=True)
     text = proj.render_diagnostics()
     assert "kw.st:1:" in text and "warning[ST2005]" in text and "rename it" in text
+
+
+def test_st2004_and_st2008_messages_come_out_whole_in_text_and_json(tmp_path):
+    """Two quoted names in one message: the prose between them is not a quote and is never shortened."""
+    import json
+    from vplc.frontend.diagnostics import to_json
+    proj = check_text(tmp_path, "TYPE eColor : (Red := 0, Green := 1); END_TYPE\n"
+                      "PROGRAM P VAR c : eColor; b : BOOL; END_VAR b := c > Red; END_PROGRAM", portable=True)
+    messages = {(d.code, d.message) for d in proj.diagnostics}
+    assert ("ST2004", "enumeration value `Red` has an explicit number, which is IEC 61131-3 3rd edition only; "
+            "write `Red` without `:= ...`; the values are already in number order from 0") in messages
+    assert ("ST2008", "`>` on values of the enumeration eColor: IEC 61131-3 enumerations have no order; "
+            "compare with `=` / `<>` for each state") in messages
+    rendered = proj.render_diagnostics()
+    assert "…" not in rendered
+    assert {d["message"] for d in json.loads(to_json(proj.diagnostics))["diagnostics"]} == {m for _, m in messages}
+
+
+def test_a_long_quoted_name_is_shown_by_its_ends_and_the_prose_stays_whole(tmp_path):
+    name = "Very" + "Long" * 30 + "Name"
+    proj = check_text(tmp_path, f"PROGRAM P VAR x : INT; END_VAR x := {name}; END_PROGRAM")
+    (diag,) = [d for d in proj.diagnostics if d.code == "ST1001"]
+    assert diag.message == (f"`{name[:28]}…{name[-28:]}` is not declared; declare it in a VAR section or check "
+                            "the spelling")
