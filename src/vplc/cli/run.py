@@ -250,7 +250,7 @@ class Watch:
 
     def show(self, path: str, v) -> str:
         if self.is_time[path] and isinstance(v, int):
-            return "T#" + _period(v).replace(" ", "") if v > 0 else "T#0s"
+            return "T#" + ("-" if v < 0 else "") + _period(abs(v)).replace(" ", "") if v else "T#0s"
         return str(v) if isinstance(v, (dict, list)) else scn.fmt(v)
 
 

@@ -122,3 +122,14 @@ def test_trace_window_goes_with_an_svg_trace(tmp_path):
     r = run(tmp_path, "--cycles", "1", "--trace", "Main.Count", "--trace-out", str(tmp_path / "t.vcd"),
             "--trace-window", "0s..1s")
     assert r.returncode == 2 and "--trace-window applies to an .svg --trace-out" in r.stderr
+
+
+def test_watch_shows_a_negative_time_with_its_sign(tmp_path):
+    """TIME is signed (IEC 61131-3 duration literal `T#-5ms`); --watch must not show -5 ms as zero."""
+    src = tmp_path / "late.st"
+    src.write_text("PROGRAM Main\nVAR Wait : TIME := T#20ms; Late : TIME; Zero : TIME; END_VAR\n"
+                   "Late := Wait - T#25ms;\nEND_PROGRAM\n")
+    r = vplc("run", str(src), "--virtual-time", "--cycles", "2", "--watch", "Main.Late,Main.Zero")
+    assert r.returncode == 0, r.stderr
+    assert "     0.000 s  Main.Late = T#-5ms" in r.stdout.splitlines()
+    assert "  Main.Late = T#-5ms" in r.stdout.splitlines() and "  Main.Zero = T#0s" in r.stdout.splitlines()
