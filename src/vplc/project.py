@@ -55,6 +55,7 @@ class Project:
         self.configurations: list[A.Configuration] = []
         self.programs: list[T.PouType] = []
         self.diagnostics: list[Diagnostic] = []
+        self.files: list[str] = []        # the user's files: those passed, and those found in the folders passed
         self._tables: Tables | None = None
 
     @property
@@ -169,6 +170,7 @@ def _load(paths, dialect: str, include_prelude: bool, portable: bool) -> Project
         if include_prelude and os.path.isdir(PRELUDE_DIR) else []
     prelude_abs = {os.path.abspath(f) for f in prelude_files}
     user_files = [f for f in user_files if os.path.abspath(f) not in prelude_abs]
+    proj.files = user_files
     for path in prelude_files + user_files:
         if is_xml(path):
             for src, namespace in read_xml(path, diags):

@@ -50,8 +50,7 @@ def run_check(args) -> int:
     else:
         for d in diags:
             print(d.render())
-        files = sum(1 for u in proj.units if not getattr(u, "in_prelude", False))
-        print(f"{files} file(s) checked: {errors} error(s), {warnings} warning(s)")
+        print(f"{len(proj.files)} file(s) checked: {errors} error(s), {warnings} warning(s)")
     if errors or (args.warnings_as_errors and warnings):
         return 1
     return 0

@@ -227,3 +227,31 @@ def test_damaged_files_give_diagnostics_never_a_traceback(tmp_path):
         path.write_text(text, encoding="utf-8")
         for d in load_project([str(path)]).diagnostics:
             assert "internal error" not in d.render()
+
+
+def test_check_summary_counts_an_xml_file_with_an_error_as_one_file(tmp_path, capsys):
+    """The summary counts the files passed or found, not the units read from them (a rung that cannot be read
+    gives none, an export with a library gives one per namespace)."""
+    from vplc.cli.main import main
+    path = program(tmp_path, V, [rail(1), contact(2, "A", 77), coil(3, "Q", 2)])
+    assert main(["check", str(path)]) == 1
+    assert capsys.readouterr().out.splitlines()[-1].startswith("1 file(s) checked: 1 error(s), ")
+
+
+@pytest.mark.parametrize("fmt", ["iec61131-10", "plcopen"])
+def test_check_summary_counts_one_exported_project_file_as_one_file(tmp_path, capsys, fmt):
+    from vplc.cli.main import main
+    src = tmp_path / "src"
+    (src / "Demo_Lib").mkdir(parents=True)
+    (src / "Demo_Lib" / "Both.st").write_text("FUNCTION Both : BOOL\nVAR_INPUT a, b : BOOL; END_VAR\nBoth := a AND b;\n"
+                                              "END_FUNCTION\n", encoding="utf-8")
+    (src / "Globals.st").write_text("VAR_GLOBAL\n    Start : BOOL;\n    Lamp : BOOL;\nEND_VAR\n", encoding="utf-8")
+    program(src, {}, [rail(1), invar(2, "Start"), invar(3, "TRUE", y=10), block(4, "Both", {"a": 2, "b": 3}, ["Both"]),
+                      outvar(5, "Lamp", (4, "Both"))])
+    assert main(["check", str(src)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "3 file(s) checked: 0 error(s), 0 warning(s)"
+    out = tmp_path / "project.xml"
+    assert main(["export", str(src), "--format", fmt, "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["check", str(out)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "1 file(s) checked: 0 error(s), 0 warning(s)"
