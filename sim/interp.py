@@ -13,7 +13,9 @@ Immediate statements run when reached; motions, queue tags, base/TCP/load change
 are appended to the robot FIFO.
 
 Values are bounded as on the robot (sim/limits.py; each bound is a run-time ``ERROR;line``):
-int arithmetic wraps at 32 bits and byte arithmetic at 8 bits [MAN 2.24 §2.2]; a float variable refuses
+int arithmetic wraps at 32 bits and byte arithmetic at 8 bits [MAN 2.24 §2.2]; a value outside int
+converted to int (a variable, an IO point, any int parameter of any function) is an error [§2.2], so no
+Sleep or WaitQueueTag timeout exceeds INT_MAX ms; a float variable refuses
 a value beyond ±3.4028235E+38, infinity or NaN [MAN 2.24 §2.5]; arrays hold at most 2048 elements
 [MAN 2.24 §2.3]; strings at most STRING_MAX characters; a project at most VARIABLES_MAX variables using
 VARIABLE_BYTES_MAX bytes; one script at most STEPS_MAX steps of work. A script's intermediate values
@@ -85,6 +87,7 @@ def run_script(lines, ctx: Context):
                 current = yield from _eval(stmt.target, ctx, line)
                 yield from _store(stmt.target, _arith("+" if stmt.op == "++" else "-", current, 1, ctx), ctx, line)
             elif isinstance(stmt.expr, ast.Call) and stmt.expr.name == "ScriptExit":
+                yield from _arguments(stmt.expr, ctx, line)      # checked like any call's, then the exit
                 return "exit"
             else:
                 yield from _eval(stmt.expr, ctx, line)
@@ -147,11 +150,31 @@ def _check_constant(type_name, node):
 
 
 def _to_int(value) -> int:
+    """A value converted to int, as an int variable or an int parameter takes it: a float is truncated; a
+    value outside the int range is an error [MAN 2.24 §2.2]: results of int arithmetic wrap before they
+    get here, so an int outside the range is the constant 2147483648, a float constant by §2.2."""
     if isinstance(value, float):
         if not math.isfinite(value) or not INT_MIN <= value < INT_MAX + 1:
             raise ScriptRuntimeError(f"value {value:g} does not fit int ({INT_MIN}..{INT_MAX})")
         return int(value)
-    return _wrap_int(int(value))
+    value = int(value)
+    if not INT_MIN <= value <= INT_MAX:
+        raise ScriptRuntimeError(f"value {value} does not fit int ({INT_MIN}..{INT_MAX})")
+    return value
+
+
+def _int_arguments(name, args, positions):
+    """The arguments of a call with its int (and int[]) parameters converted by the rule of _to_int, for
+    every function in one place: Sleep(1e30) or WaitQueueTag(1, 2147483648) is an error of its line, not a
+    wait of 10^27 s. ``positions``: sim.tmscript.INT_ARGUMENTS."""
+    args = list(args)
+    for position, is_array in positions:
+        try:
+            value = args[position]
+            args[position] = [_to_int(v) for v in value] if is_array else _to_int(value)
+        except ScriptRuntimeError as exc:
+            raise ScriptRuntimeError(f"{name} argument {position + 1}: {exc}") from None
+    return args
 
 
 def _to_float(value) -> float:
@@ -241,7 +264,7 @@ def _store(target, value, ctx, line):
         return
     if _is_io(target):
         key, member = yield from _io_key(target, ctx, line)
-        level = int(value) if table.IO_POINTS[member][0] == "int" else float(value)
+        level = _to_int(value) if table.IO_POINTS[member][0] == "int" else _to_float(value)
         if member.startswith("Instant"):
             point = key.replace("Instant", "")
             ctx.robot.io[point] = level
@@ -252,7 +275,7 @@ def _store(target, value, ctx, line):
             ctx.robot.enqueue_setting("io", (key, level))
         return
     if isinstance(target, ast.Member):          # Robot[0].CameraLight / InstantCameraLight
-        ctx.robot.io["CameraLight"] = int(value)
+        ctx.robot.io["CameraLight"] = _to_int(value)
         return
     name = target.obj.id
     array = ctx.vars[name]
@@ -278,6 +301,7 @@ def _store(target, value, ctx, line):
 
 _LITERALS = frozenset({ast.Num, ast.Str, ast.Bool})
 _QUEUED = frozenset(name for name in table.FUNCTIONS if table.queued(name))
+_INT_ARGUMENTS = table.INT_ARGUMENTS
 
 
 def _eval(node, ctx, line):
@@ -312,12 +336,7 @@ def _eval(node, ctx, line):
             return _COMPARE[node.op](left, right)
         return _arith(node.op, left, right, ctx)
     if isinstance(node, ast.Call):
-        args = []
-        for arg in node.args:
-            if type(arg) in _LITERALS:             # no generator for a literal (motion lines are all literals)
-                args.append(arg.value)
-            else:
-                args.append((yield from _eval(arg, ctx, line)))
+        args = yield from _arguments(node, ctx, line)
         return (yield from _call(node, args, ctx, line))
     if _is_io(node):
         key, _member = yield from _io_key(node, ctx, line)
@@ -389,11 +408,23 @@ def _motion(name, args, line):
     else:
         speed, accel, blend, disable = rest[:4]
         if len(rest) > 4:
-            config = tuple(int(v) for v in (rest[4] if isinstance(rest[4], list) else rest[4:7]))
+            config = tuple(rest[4] if isinstance(rest[4], list) else rest[4:7])
             if len(config) != 3 or config[0] not in (0, 1) or config[1] not in (2, 3) or config[2] not in (4, 5):
                 raise ScriptRuntimeError(f"arm configuration {list(config)} is not {{0|1, 2|3, 4|5}}")
     return MotionRequest(name, fmt, tuple(float(v) for v in target), speed, accel, blend, not disable,
                          config=config, line=line.text)
+
+
+def _arguments(node, ctx, line):
+    """The argument values of a call, its int parameters converted (_int_arguments)."""
+    args = []
+    for arg in node.args:
+        if type(arg) in _LITERALS:                 # no generator for a literal (motion lines are all literals)
+            args.append(arg.value)
+        else:
+            args.append((yield from _eval(arg, ctx, line)))
+    positions = _INT_ARGUMENTS.get((node.name, len(args)))
+    return _int_arguments(node.name, args, positions) if positions else args
 
 
 def _call(node, args, ctx, line):
@@ -422,7 +453,7 @@ def _call(node, args, ctx, line):
         robot.enqueue_setting("load", float(args[0]))
         return True
     if name == "PVTEnter":
-        mode = int(args[0]) if args else 0
+        mode = args[0] if args else 0
         if mode not in (0, 1):
             raise ScriptRuntimeError(f"PVT mode {mode} is not 0 (joint) or 1 (Cartesian)")
         robot.enqueue_setting("pvt", mode)
@@ -448,17 +479,17 @@ def _call(node, args, ctx, line):
         (robot.pause if name == "PVTPause" else robot.resume)()
         return True
     if name == "QueueTag":
-        tag = int(args[0])
+        tag = args[0]
         if not 1 <= tag <= 15:
             raise ScriptRuntimeError(f"queue tag {tag} is outside 1..15")
         robot.enqueue_tag(tag)
-        if len(args) > 1 and int(args[1]) == 1:
+        if len(args) > 1 and args[1] == 1:
             yield ("tag", tag, None)
         return True
     if name == "WaitQueueTag":
         return (yield from _wait_queue_tag(args, robot))
     if name == "CheckQueueTag":                 # TMscript 2.24 §13.3: WaitQueueTag(tag, 0), one check
-        return robot.tag_result(int(args[0]))
+        return robot.tag_result(args[0])
     if name == "Sleep":
         if args[0] > 0:
             yield ("delay", None, args[0] / 1000.0)
@@ -497,7 +528,7 @@ def _wait_queue_tag(args, robot):
     if not args:
         yield ("idle", None, None)
         return None
-    tag = int(args[0])
+    tag = args[0]
     timeout = args[1] if len(args) > 1 else -1
     if tag < 0 or tag > 15:
         return -1

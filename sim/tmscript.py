@@ -94,6 +94,24 @@ def overloads(name: str, version: str):
     return found or None
 
 
+def int_parameter_kinds() -> dict[tuple[str, int], set]:
+    """(function, argument count) -> the set of its overloads' int parameters, each a tuple of
+    (position, is int[]). One element per key: overloads of one arity agree on which parameters are int
+    (tests/sim/test_tmscript_profiles.py checks it)."""
+    kinds: dict[tuple[str, int], set] = {}
+    for name, (_queued, entries) in FUNCTIONS.items():
+        for params, _ret, _versions in entries:
+            kinds.setdefault((name, len(params)), set()).add(
+                tuple((i, p == IA) for i, p in enumerate(params) if p in (I, IA)))
+    return kinds
+
+
+# (function, argument count) -> ((position, is int[]), ...): the interpreter converts int arguments by arity
+# alone, whichever overload the checker matched
+INT_ARGUMENTS: dict[tuple[str, int], tuple[tuple[int, bool], ...]] = {
+    key: min(kinds) for key, kinds in int_parameter_kinds().items() if any(kinds)}
+
+
 def formats(name: str, version: str):
     table = FORMATS.get(name)
     return None if table is None else tuple(f for f, versions in table.items() if version in versions)

@@ -156,6 +156,40 @@ def test_sleep_delays_the_rest_of_the_script(node):
     assert node.send(1, sct("C", "Sleep()")) == [reply("C", "ERROR;1")]
 
 
+@pytest.mark.parametrize("argument", ["1e30", "2147483648"])
+def test_sleep_beyond_int_is_an_error_of_its_line_and_the_robot_serves_the_next_script(node, argument):
+    """Sleep(int): a value that does not fit int is ERROR;1 (docs/simulator.md "Limits"); it once waited
+    10^27 s and the robot answered no script after it."""
+    assert node.send(1, sct("A", f"Sleep({argument})")) == [reply("A", "ERROR;1")]
+    assert node.send(1, sct("B", "Sleep(100)\r\nint after_sleep = 1")) == []
+    node.advance(0.11)
+    assert node.out(1) == [reply("B", "OK")] and node.s.variables["after_sleep"] == 1
+
+
+@pytest.mark.parametrize("wait", ["Sleep(2147483647)", "WaitQueueTag(0, 2147483647)"])
+def test_the_longest_legal_wait_keeps_status_queries_answered_and_priority_stop_1_ends_it(node, wait):
+    """A 24.8-day wait (INT_MAX ms) is legal TMscript; like on the robot, TMSTA is answered meanwhile,
+    StopAndClearBuffer(0) stops the arm and lets the script continue, StopAndClearBuffer(1) ends it
+    (TMflow manual, Listen node priority commands) and the next buffered packet runs."""
+    assert node.send(1, sct("A", wait) + sct("B", "int after_wait = 1")) == []
+    node.advance(3600, dt=10)
+    assert node.send(1, sta("00")) == [codec.encode("TMSTA", "00,true,Listen1").decode()]
+    assert node.send(1, sct("S0", "StopAndClearBuffer(0)")) == [reply("S0", "OK")]
+    node.advance(1)
+    assert node.out(1) == []                                     # the script still waits
+    assert node.send(1, sct("S1", "StopAndClearBuffer(1)")) == [reply("A", "OK"), reply("S1", "OK"),
+                                                                 reply("B", "OK")]
+    assert node.s.variables["after_wait"] == 1
+
+
+@pytest.mark.parametrize("command", ["ScriptExit(0)", "ScriptExit(1)", "StopAndClearBuffer(2)"])
+def test_the_longest_sleep_ends_with_every_priority_command_that_ends_a_script(node, command):
+    assert node.send(1, sct("A", "Sleep(2147483647)")) == []
+    node.advance(60, dt=1)
+    assert node.send(1, sct("P", command))[:2] == [reply("A", "OK"), reply("P", "OK")]
+    assert node.s.running is None
+
+
 def test_manual_13_18_to_13_21_pvt_exit_pause_resume_outside_pvt_mode_are_rejected_false_without_effect(node):
     def answer(call):
         name = f"b{next(_names)}"

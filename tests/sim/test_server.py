@@ -212,6 +212,27 @@ def test_many_robots_on_consecutive_ports_are_independent():
         srv.close()
 
 
+def test_control_channel_answers_during_the_longest_sleep_and_ends_it_by_leaving_the_node():
+    """Sleep(2147483647) (24.8 days, legal TMscript) never makes the simulator unresponsive: the control
+    channel answers while the script sleeps, and leaving the node ends the script with OK (as the robot's
+    flow leaving the Listen node does)."""
+    srv = SimServer(port=0, control_port=0).start_background()
+    try:
+        port = srv.control.port
+        with socket.create_connection(("127.0.0.1", srv.ports[0]), timeout=5) as robot:
+            robot.sendall(sct("A", "Sleep(2147483647)"))
+            assert srv.robots[0].wait_event("script_line", timeout=5) is not None
+            state = control_request(port, {"cmd": "state", "robot": 0})["result"]
+            assert state["buffered_scripts"] == 1 and state["in_listen_node"] is True
+            assert control_request(port, {"cmd": "leave_listen_node"})["ok"]
+            buffer = bytearray()
+            while b"\r\n" not in buffer:                          # blocking read, 5 s socket timeout
+                buffer += robot.recv(4096)
+            assert bytes(buffer).startswith(codec.encode("TMSCT", "A,OK"))
+    finally:
+        srv.close()
+
+
 def test_control_channel_commands():
     srv = SimServer(port=0, control_port=0).start()
     port = srv.control.port

@@ -146,3 +146,39 @@ def test_the_docs_profile_table_names_every_function_format_and_attribute_of_the
                 if versions == tmscript.NEW and fmt not in section]
     missing += [attr for attr in tmscript.ROBOT if attr not in section]
     assert missing == []
+
+
+def test_overloads_of_one_arity_agree_on_their_int_parameters():
+    """The interpreter converts int arguments by arity (sim.tmscript.INT_ARGUMENTS): that needs one set of
+    int positions per arity of every function."""
+    assert all(len(kinds) == 1 for kinds in tmscript.int_parameter_kinds().values())
+
+
+def _call_with(name, params, position, bad):
+    """A call of ``name`` with valid arguments of types ``params``, ``bad`` at ``position``."""
+    fmt = [f for f in (tmscript.formats(name, tmscript.V224) or ("RobotBase",)) if f.startswith("C")] or ["CAP"]
+    valid = {"string": f'"{fmt[0]}"', "float": "0", "float[]": "{417,0,300,180,0,90}", "int": "1",
+             "int[]": "{0,2,4}", "bool": "false", "any": '"x"'}
+    args = [valid[p] for p in params]
+    args[position] = "{0,2,%s}" % bad if params[position] == "int[]" else bad
+    return f"{name}({','.join(args)})"
+
+
+INT_CASES = [(name, params, position) for name, (_queued, entries) in sorted(tmscript.FUNCTIONS.items())
+             for params, _ret, versions in entries if tmscript.V224 in versions
+             for position, kind in enumerate(params) if kind in ("int", "int[]")]
+
+
+@pytest.mark.parametrize("bad", ["1e30", "2147483648", "-1e30"])
+@pytest.mark.parametrize("name,params,position", INT_CASES)
+def test_manual_2_2_a_value_outside_int_in_any_int_parameter_is_an_error_of_its_line(name, params, position, bad):
+    """docs/simulator.md "Limits": a float outside int converted to int is ERROR;n - for variables and, in one
+    place (sim.interp._arguments), for every int parameter of every function: Sleep(1e30) once waited 10^27 s
+    and the robot served no script after it. A decimal constant beyond int is a float constant [MAN 2.24 §2.2]."""
+    node = node_of("2.24")
+    script = _call_with(name, params, position, bad)
+    assert reply(node, script) == ok("ERROR;1"), script
+    reason = [f for kind, f in node.events if kind == "runtime_error"][-1]["reason"]
+    assert f"{name} argument {position + 1}: value" in reason and "does not fit int" in reason, reason
+    assert reply(node, "Sleep(0)") == ok("OK")                 # the robot keeps serving scripts
+
