@@ -2,16 +2,17 @@
 
 A script is accepted only when every line passes: known function, a matching overload (arity and
 value types), a data-format string valid for that function, declared variables, no redeclaration,
-writable targets. Lines that pass but lose information (float into an int parameter, unquoted IO
-module name) are *warnings* (``OK;lines``). Argument *values* (speed 500 %, tag 99 ...) are not
-checked here: like on the robot they fail at run time.
+writable targets, no call without a value (``void``: Sleep, WaitQueueTag()) inside an expression. Lines
+that pass but lose information (float into an int parameter, unquoted IO module name) are *warnings*
+(``OK;lines``). Argument *values* (speed 500 %, tag 99, Sleep(1e30) ...) are not checked here: like on
+the robot they fail at run time.
 """
 from __future__ import annotations
 
 from . import script as ast
 from . import tmscript as table
 
-F, I, S, B, FA, IA, ANY = "float", "int", "string", "bool", "float[]", "int[]", "any"
+F, I, S, B, FA, IA, ANY, VOID = "float", "int", "string", "bool", "float[]", "int[]", "any", "void"
 
 
 class CheckError(Exception):
@@ -87,7 +88,7 @@ class _LineChecker:
         if isinstance(stmt, ast.ExprStmt):
             if not isinstance(stmt.expr, ast.Call):
                 raise CheckError("a statement must be a function call, a declaration or an assignment")
-            self.expr(stmt.expr)
+            self.call(stmt.expr)                 # the one place a call without a value may stand
             return
         raise CheckError("unsupported statement")
 
@@ -196,7 +197,11 @@ class _LineChecker:
                 raise CheckError("array elements must all be numbers")
             return FA if F in kinds else IA
         if isinstance(node, ast.Call):
-            return self.call(node)
+            kind = self.call(node)
+            if kind == VOID:                     # [MAN 2.24 §13.2 syntax 3] "void WaitQueueTag()": no return
+                raise CheckError(f"{node.name}() returns no value: it cannot be used in an expression, "
+                                 f"an argument or an assignment")
+            return kind
         if isinstance(node, ast.Unary):
             kind = self.expr(node.operand)
             if node.op == "!":

@@ -182,3 +182,23 @@ def test_manual_2_2_a_value_outside_int_in_any_int_parameter_is_an_error_of_its_
     assert f"{name} argument {position + 1}: value" in reason and "does not fit int" in reason, reason
     assert reply(node, "Sleep(0)") == ok("OK")                 # the robot keeps serving scripts
 
+
+@pytest.mark.parametrize("script", ["ListenSend(90, GetString(WaitQueueTag()))", "int k = WaitQueueTag()",
+                                    "bool b = !WaitQueueTag()", "int k = 1 + Sleep(1)",
+                                    'string s = "t" + GetString(Sleep(0))', "int[] a = {1, Sleep(1)}",
+                                    "int k = 0\r\nk = WaitQueueTag()", "QueueTag(Sleep(1))"])
+def test_manual_13_2_syntax_3_a_void_result_in_an_expression_is_an_error_and_nothing_runs(script):
+    """WaitQueueTag() (TMscript 2.24 §13.2 syntax 3) and Sleep() return void: used as a value - an argument,
+    an operand, an initial or assigned value - the line is refused (ERROR;line) and no Python None reaches
+    the wire ($TMSTA,7,90,None once)."""
+    node = node_of("2.24")
+    status = reply(node, script)
+    assert status == ok("ERROR;" + str(script.count("\r\n") + 1)), status
+    reason = [f for kind, f in node.events if kind == "script_error"][-1]["reason"]
+    assert "returns no value" in reason, reason
+    assert node.out(1) == [] and not any(kind == "script_line" for kind, _ in node.events)
+
+
+def test_a_void_call_as_a_statement_of_its_own_runs():
+    node = node_of("2.24")
+    assert reply(node, "WaitQueueTag()\r\nSleep(0)") == ok("OK")
