@@ -14,16 +14,20 @@ from .limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
 
 
 class Listener:
-    def __init__(self, selector, host: str, port: int, key, what: str, backlog: int = 16):
+    def __init__(self, selector, host: str, port: int, key, what: str, backlog: int = 16,
+                 held: socket.socket | None = None):
         """Bind and listen; ``key`` is the selector data of the listener, ``what`` is the OSError's text when the port
-        cannot be opened, ``{where}`` standing for host:port (e.g. "listen on {where} for robot 1")."""
-        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((host, port))
-        except OSError as exc:
-            sock.close()
-            raise OSError(exc.errno, f"cannot {what.format(where=f'{host}:{port}')}: {exc.strerror}") from None
+        cannot be opened, ``{where}`` standing for host:port (e.g. "listen on {where} for robot 1"). ``held``: a
+        socket already bound to the port by ``close(hold_port=True)``, which starts listening instead."""
+        sock = held
+        if sock is None:
+            sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                sock.bind((host, port))
+            except OSError as exc:
+                sock.close()
+                raise OSError(exc.errno, f"cannot {what.format(where=f'{host}:{port}')}: {exc.strerror}") from None
         sock.listen(backlog)
         sock.setblocking(False)
         self.sock = sock
@@ -55,11 +59,25 @@ class Listener:
             self.paused_until = None
             self._selector.register(self.sock, selectors.EVENT_READ, self._key)
 
-    def close(self) -> None:
+    def close(self, hold_port: bool = False) -> socket.socket | None:
+        """Stop listening. ``hold_port``: keep the port bound by a socket that does not listen, returned for a later
+        ``Listener(..., held=...)``: connection attempts are refused as by a closed port, but no other program can
+        take the port meanwhile (a robot whose project stopped comes back on the same port). None when not held."""
         if self.paused_until is None:
             try:
                 self._selector.unregister(self.sock)
             except (KeyError, ValueError):
                 pass
         self.paused_until = None
+        host = self.sock.getsockname()[0]
         self.sock.close()
+        if not hold_port:
+            return None
+        hold = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        hold.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            hold.bind((host, self.port))
+        except OSError:
+            hold.close()
+            return None
+        return hold

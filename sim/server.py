@@ -76,6 +76,7 @@ class Robot(EventLog):
                                      auto_enter=auto_enter, data_timeout=timeouts[0], connection_timeout=timeouts[1],
                                      profile=profile)
         self.listener = None
+        self.port_hold = None                  # the Listen-node port, bound but not listening while it is closed
         self.conns: dict[int, _Conn] = {}
         self.reading_paused = False
 
@@ -201,13 +202,15 @@ class SimServer(FairInput):
     def _listen(self, robot):
         if robot.listener is not None or robot.faults.refuse:
             return
+        held, robot.port_hold = robot.port_hold, None
         robot.listener = Listener(self.selector, self.host, robot.port, ("listen", robot, None),
-                                  f"listen on {{where}} for robot {robot.index + 1}", backlog=128)
+                                  f"listen on {{where}} for robot {robot.index + 1}", backlog=128, held=held)
         robot.port = robot.listener.port
         robot._log("listening", host=self.host, port=robot.port)
 
-    def _close_listener(self, robot):
-        robot.listener.close()
+    def _close_listener(self, robot, hold_port: bool = True):
+        """The port stays held (refusing connections) while the robot's server is down, so it comes back on it."""
+        robot.port_hold = robot.listener.close(hold_port=hold_port)
         robot.listener = None
 
     def _log_server(self, kind, **fields):
@@ -231,6 +234,9 @@ class SimServer(FairInput):
         with self.lock:
             for robot in self.robots:
                 self._close_robot_sockets(robot, "simulator closed")
+                if robot.port_hold is not None:
+                    robot.port_hold.close()
+                    robot.port_hold = None
             if self.control is not None:
                 self.control.close()
                 self.control = None

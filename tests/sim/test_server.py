@@ -172,6 +172,24 @@ def test_fault_refuse_connections_keeps_existing_clients(harness):
     assert harness.request(harness.connect(), sta("00")) == [("TMSTA", "00,true,Listen1")]
 
 
+def test_a_closed_listen_node_port_stays_held_so_the_robot_comes_back_on_it(harness):
+    """While refusing (and while the project is stopped) the port is bound by a socket that does not listen:
+    connects are refused as by a closed port, but no other program can take the port meanwhile."""
+    port = harness.srv.ports[0]
+    harness.robot.inject("refuse_connections")
+    other = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        with pytest.raises(OSError):
+            other.bind(("127.0.0.1", port))
+    finally:
+        other.close()
+    with pytest.raises(OSError):
+        socket.create_connection(("127.0.0.1", port), timeout=1).close()
+    harness.robot.inject("refuse_connections", enabled=False)
+    assert harness.srv.ports[0] == port
+    assert harness.request(harness.connect(), sta("00")) == [("TMSTA", "00,true,Listen1")]
+
+
 def test_fault_leave_node_and_stop_project(harness):
     peer = harness.connect()
     harness.robot.inject("leave_node")
