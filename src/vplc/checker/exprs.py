@@ -266,6 +266,7 @@ class ExprChecker:
         if not (T.is_num(t) or T.is_time(t)) or (e.op == "-" and T.base_of(t).kind == "uint"):
             self.ctx.diags.error("ST1102", f"unary `{e.op}` needs a signed number or TIME, not {t.name}", e.span)
             return T.ERROR
+        e.sysmac_ty = e.operand.sysmac_ty
         return T.base_of(t)
 
     @staticmethod
@@ -334,20 +335,28 @@ class ExprChecker:
 
     def numeric_common(self, e, a: T.Type, b: T.Type) -> T.Type | None:
         """Common type of two operands. Sysmac (W501 6-106): the operand of highest rank, unsigned at equal
-        rank. Where Sysmac would take an integer above a REAL operand (DINT, LINT rank above REAL), vplc keeps
-        the floating-point type and warns (ST1108): the controller drops the fraction there."""
+        rank. Where Sysmac's rank table puts an integer above a floating-point operand (DINT above REAL, LINT
+        above LREAL), Sysmac computes the expression in that integer; vplc computes it in LREAL, keeps Sysmac's
+        type in ``e.sysmac_ty`` (so `d := r * d` is accepted as on the controller, see coerce) and warns
+        (ST1108) where the floating-point operand meets the integer."""
         c = T.common_type(a, b)
         if self.ctx.dialect != "sysmac" or not (T.is_num(a) and T.is_num(b)):
             return c
-        s = T.sysmac_common(a, b)
+        sa = T.base_of(getattr(e.left, "sysmac_ty", None) or a)
+        sb = T.base_of(getattr(e.right, "sysmac_ty", None) or b)
+        s = T.sysmac_common(sa, sb)
         if s is None:
             return c
         if T.is_int(s) and (T.is_real(a) or T.is_real(b)):
-            self.ctx.diags.warning("ST1108", f"Sysmac types this {T.base_of(a).name}/{T.base_of(b).name} expression "
-                                   f"as {s.name} (W501 6-106: {s.name} ranks above REAL) and drops the fraction; "
-                                   f"vplc computes it as {c.name if c else 'LREAL'}: convert explicitly so both agree",
-                                   e.span)
-            return c
+            e.sysmac_ty = s
+            real = next((t for t in (sa, sb) if T.is_real(t)), None)
+            if real is not None:                     # an inner expression already warned otherwise
+                self.ctx.diags.warning(
+                    "ST1108", f"Sysmac types this {sa.name} {e.op} {sb.name} expression as {s.name} (W501 6-106: "
+                    f"{s.name} ranks above {real.name}) and computes it in {s.name}; vplc computes it in LREAL "
+                    f"(stored into an integer, the result is rounded to nearest): convert explicitly so both agree",
+                    e.span)
+            return T.LREAL
         return s
 
     def arithmetic(self, e, lt, rt):
@@ -417,6 +426,11 @@ class ExprChecker:
         if isinstance(T.unalias(want), T.PouType) or isinstance(T.unalias(have), T.PouType):
             self.ctx.diags.error("ST1101", f"{what}: function block instances cannot be assigned or copied",
                                  value.span)
+            return
+        sysmac = getattr(value, "sysmac_ty", None)
+        if sysmac is not None and isinstance(T.base_of(want), T.ElementaryType) and T.is_int(want) \
+                and T.sysmac_assignable(sysmac, want):
+            value.conv = T.base_of(want)            # W501 6-106/6-107: Sysmac's integer expression fits here
             return
         if not compatible(have, want) and not (self.ctx.dialect == "sysmac" and T.sysmac_assignable(have, want)):
             hint = ""

@@ -157,6 +157,8 @@ class ExprGen:
             return f"_f32({code})" if d.bits == 32 else f"float({code})"
         if isinstance(s, T.ElementaryType) and s.kind == "bool" and d.kind != "bool":
             return f"int({code})"
+        if isinstance(s, T.ElementaryType) and s.kind == "real" and d.kind in ("int", "uint"):
+            return iec.wrap_expr(f"_round({code})", d.bits, d.kind == "int")   # an LREAL Sysmac types as integer
         return _sign_cast(code, s, d)
 
     def store_conv(self, code: str, e, t) -> str:

@@ -7,7 +7,8 @@ Checker annotations (set by :mod:`vplc.checker`, ``None`` before checking), docu
 docs/toolchain/frontend_api.md:
 
 * every :class:`Expr` gets ``ty`` (its resolved :mod:`vplc.frontend.types` type) and ``conv`` (the type it is
-  implicitly widened to by its context, or ``None``);
+  implicitly widened to by its context, or ``None``); ``sysmac_ty`` is Sysmac's integer type of an expression
+  vplc computes in LREAL (W501 6-106), or ``None``;
 * :class:`Name` gets ``sym`` (a :mod:`vplc.checker.symbols` symbol);
 * :class:`Call` gets ``binding`` (a :class:`vplc.checker.symbols.CallBinding`).
 """
@@ -123,6 +124,7 @@ class Expr(Node):
     span: Span = _ann()
     ty: Any = _ann()     # resolved type (vplc.frontend.types.Type), set by the checker
     conv: Any = _ann()   # implicit conversion target type, or None
+    sysmac_ty: Any = _ann()   # Sysmac's type of an expression vplc computes in LREAL (W501 6-106), or None
 
 
 @dataclass(eq=True)

@@ -38,3 +38,46 @@ def test_narrowing_stays_a_build_error_as_on_the_controller(tmp_path):
     path = tmp_path / "m.st"
     path.write_text("PROGRAM Main\nVAR D : DINT; I : INT; END_VAR\nI := D;\nEND_PROGRAM\n")
     assert load_project([str(path)]).has_errors
+
+
+def _warnings(tmp_path, decls, body):
+    path = tmp_path / "m.st"
+    path.write_text(f"PROGRAM Main\nVAR {decls} END_VAR\n{body}\nEND_PROGRAM\n")
+    proj = load_project([str(path)])
+    return proj, [d.message for d in proj.diagnostics if d.code == "ST1108"]
+
+
+def test_real_times_dint_into_a_dint_builds_as_on_sysmac_w501_6_106(tmp_path):
+    """W501 6-106 rank table: DINT (rank 4) ranks above REAL (rank 3), so `d := r * d` is a DINT expression that
+    Sysmac Studio builds. vplc accepts it with the ST1108 warning naming both types, and rounds the LREAL result."""
+    proj, warns = _warnings(tmp_path, "R : REAL := 2.5; D : DINT := 3;", "D := R * D;")
+    assert not proj.has_errors, proj.render_diagnostics()
+    assert warns == ["Sysmac types this REAL * DINT expression as DINT (W501 6-106: DINT ranks above REAL) and "
+                     "computes it in DINT; vplc computes it in LREAL (stored into an integer, the result is rounded "
+                     "to nearest): convert explicitly so both agree"]
+    plc = run1(tmp_path, "D := R * D;", "R : REAL := 2.5; D : DINT := 3;")
+    assert plc.read("Main.D") == 8                                  # 7.5 rounded half to even
+
+
+def test_lreal_times_lint_into_a_lint_builds_and_the_warning_names_lreal_w501_6_106(tmp_path):
+    """W501 6-106: LINT (rank 6) ranks above LREAL (rank 5): the message names LREAL, not REAL."""
+    proj, warns = _warnings(tmp_path, "LR : LREAL := 1.5; LI : LINT := 3;", "LI := LR * LI;")
+    assert not proj.has_errors, proj.render_diagnostics()
+    assert len(warns) == 1 and "LREAL * LINT expression as LINT (W501 6-106: LINT ranks above LREAL)" in warns[0]
+    plc = run1(tmp_path, "LI := LR * LI;", "LR : LREAL := 1.5; LI : LINT := 3;")
+    assert plc.read("Main.LI") == 4                                 # 4.5 rounded half to even
+
+
+def test_sysmac_integer_type_carries_through_a_larger_expression_w501_6_106(tmp_path):
+    """(R * D) is DINT on Sysmac, so (R * D) + D and -(R * D) are DINT too; one warning, at the REAL operand."""
+    proj, warns = _warnings(tmp_path, "R : REAL := 0.5; D : DINT := 3; E : DINT;", "E := -(R * D) + D;")
+    assert not proj.has_errors and len(warns) == 1, proj.render_diagnostics()
+    plc = run1(tmp_path, "E := -(R * D) + D;", "R : REAL := 0.5; D : DINT := 3; E : DINT;")
+    assert plc.read("Main.E") == 2                                  # -1.5 + 3 = 1.5 -> 2
+
+
+def test_real_times_int_stays_real_and_narrowing_it_is_still_an_error_w501_6_107(tmp_path):
+    """REAL (rank 3) ranks above INT (rank 2): the expression is REAL, and REAL -> DINT has no arrow in 6-107."""
+    proj, warns = _warnings(tmp_path, "R : REAL; I : INT; D : DINT;", "D := R * I;")
+    assert proj.has_errors and not warns
+    assert "cannot use a value of type REAL where DINT is expected" in proj.render_diagnostics()
