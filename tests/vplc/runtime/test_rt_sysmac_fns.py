@@ -130,3 +130,34 @@ def test_system_defined_variables_are_read_only_and_vendor(tmp_path):
     assert ("ST1301", "`P_On` is a Sysmac system-defined variable and is read-only; use a variable of your own") \
         in messages
     assert any(code == "ST2001" and "`P_1s` is an Omron Sysmac system-defined variable" in m for code, m in messages)
+
+
+def test_every_prelude_entry_has_a_row_in_the_manual_table():
+    """docs/toolchain/runtime_sysmac.md section 4: each instruction, type and system-defined variable the virtual
+    controller provides (prelude/sysmac_*.st, prelude/iec_fbs.st) is named in the first column of the table."""
+    import pathlib
+    import re
+
+    from vplc.frontend import ast as A
+    from vplc.frontend.diagnostics import DiagnosticBag
+    from vplc.frontend.parser import parse
+    from vplc.frontend.source import SourceFile
+
+    root = pathlib.Path(__file__).resolve().parents[3]
+    prelude = root / "src" / "vplc" / "prelude"
+    names = set()
+    for path in sorted(prelude.glob("sysmac_*.st")) + [prelude / "iec_fbs.st"]:
+        unit = parse(SourceFile(str(path), path.read_text(encoding="utf-8")), DiagnosticBag())
+        for item in unit.items:
+            if isinstance(item, A.Pou):
+                names.add(item.name)
+            elif isinstance(item, A.TypeBlock):
+                names |= {d.name for d in item.decls}
+            elif isinstance(item, A.GlobalVarList):
+                names |= {v.name for section in item.sections for v in section.vars}
+    assert {"TON", "SktTCPRcv", "_sSOCKET", "P_1min", "VPLC_ScanTime"} <= names
+    doc = (root / "docs" / "toolchain" / "runtime_sysmac.md").read_text(encoding="utf-8")
+    section = doc[doc.index("## 4."):]
+    first_cells = [line.split("|")[1] for line in section.splitlines() if line.startswith("| ")]
+    listed = {n for cell in first_cells for n in re.findall(r"[A-Za-z_][A-Za-z_0-9]*", cell)}
+    assert sorted(names - listed) == []
