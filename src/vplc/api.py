@@ -217,6 +217,12 @@ class Plc:
         return tuple(task.cycles for task in self.engine.tasks)
 
     @property
+    def instruction_errors(self) -> tuple[int, list[str]]:
+        """(count, the latest 100 messages) of instructions that ended in error without stopping the controller
+        (ENO FALSE on an NJ/NX, e.g. LrealToFormatString with DecPlace > MinLen: Out is not changed)."""
+        return self.engine.instruction_error_count, list(self.engine.instruction_errors)
+
+    @property
     def statements_executed(self) -> int:
         return self.engine.stmt_counter[0]
 

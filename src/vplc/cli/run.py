@@ -144,6 +144,12 @@ def run_cmd(args) -> int:
         plc.close()
     if reason is None:
         reason = runner.end_check(hooks.last_ns)
+    count, latest = plc.instruction_errors
+    if count:
+        print(f"vplc run: {count} instruction error(s) (ENO FALSE on the controller: the program went on, the "
+              "instruction's output kept its value):", file=sys.stderr)
+        for message in dict.fromkeys(latest):
+            print(f"  {message}", file=sys.stderr)
     if watch is not None:
         print(watch.final(hooks.last_ns))
     if stats is not None:

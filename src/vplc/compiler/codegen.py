@@ -15,6 +15,7 @@ from ..frontend import types as T
 from .codegen_expr import ExprGen, attr, cut, is_scalar
 from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop_range, unguarded
 from ..runtime.program import GEN_FILE, PouClass, Program
+from ..runtime.sysmac_fns import KEEPS_OUT_ON_ERROR
 
 CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)
 
@@ -309,7 +310,18 @@ class CodeGen(ExprGen):
         self.emit("return")
 
     def st_Assign(self, st: A.Assign) -> None:
-        self.store(st.target, self.expr(st.value), st.value)
+        v = st.value
+        pt = v.binding.pou if isinstance(v, A.Call) and v.binding is not None and v.binding.kind != "builtin" else None
+        tt = T.base_of(st.target.ty) if st.target.ty is not None else None
+        if pt is not None and pt.native and pt.name in KEEPS_OUT_ON_ERROR and isinstance(tt, T.StringType):
+            # W502 2-269: on an error the instruction's Out, the variable assigned here, does not change
+            self.emit(f"_k = {self.call_expr(v)}")            # whole, unconverted: a longer text is an error too
+            self.emit(f"if _stores_out(_k, {tt.capacity}, {pt.name!r}):")
+            self.ind += 1
+            self.store(st.target, "_k", v)
+            self.ind -= 1
+            return
+        self.store(st.target, self.expr(v), v)
 
     def store(self, target: A.Expr, code: str, value: A.Expr | None, src_type=None) -> None:
         tt = T.base_of(target.ty) if target.ty is not None else None

@@ -6,8 +6,10 @@ the real-time drivers (``run_until`` / ``run_realtime`` in vplc.api) call the sa
 """
 from __future__ import annotations
 
+import collections
 import gc
 import math
+import sys
 import time
 import traceback
 import weakref
@@ -69,6 +71,31 @@ class Engine:
         self.now_cell = module.namespace["_NOW"]          # what VPLC_ScanTime() returns in generated code
         self.system_vars = None           # (globals dict, first-run attrs, [(attr, period ns)]): see bind_system_vars
         self.system_vars_next = 0         # scan time at which a clock pulse changes next
+        self.instruction_errors: collections.deque[str] = collections.deque(maxlen=100)   # the latest, located
+        self.instruction_error_count = 0
+
+    def instruction_error(self, message: str) -> None:
+        """An instruction ended in error where the controller goes on (ENO FALSE, Out unchanged, e.g. W502 2-269):
+        recorded with its ST location (``file:line: instruction error in Main.x: message``), never a fault."""
+        self.instruction_error_count += 1
+        frames = []
+        frame = sys._getframe(1)
+        while frame is not None:
+            frames.append((frame, frame.f_lineno))
+            frame = frame.f_back
+        loc, inst = self.st_location(reversed(frames))
+        where = f"{loc[0]}:{loc[1]}" if loc and loc[0] else "<unknown location>"
+        self.instruction_errors.append(f"{where}: instruction error in {inst or '<unknown instance>'}: {message}")
+
+    def st_location(self, frames) -> tuple[tuple | None, str | None]:
+        """((file, line), instance path) of the innermost generated-code frame of ``frames`` (outermost first)."""
+        loc, inst = None, None
+        for frame, lineno in frames:
+            if frame.f_code.co_filename == GEN_FILE:
+                loc = self.module.linemap.get(lineno, loc)
+                s = frame.f_locals.get("s")
+                inst = getattr(s, "i__path", inst) if s is not None else inst
+        return loc, inst
 
     def bind_system_vars(self, globals_obj) -> None:
         """Let the scan update the Sysmac system-defined variables of prelude/sysmac_sysvars.st that the
@@ -152,12 +179,7 @@ class Engine:
         self.scan_count += 1
 
     def make_fault(self, exc: BaseException) -> PlcFault:
-        loc, inst = None, None
-        for frame, lineno in traceback.walk_tb(exc.__traceback__):
-            if frame.f_code.co_filename == GEN_FILE:
-                loc = self.module.linemap.get(lineno, loc)
-                s = frame.f_locals.get("s")
-                inst = getattr(s, "i__path", inst) if s is not None else inst
+        loc, inst = self.st_location(traceback.walk_tb(exc.__traceback__))
         if isinstance(exc, WatchdogError):
             kind, what = "watchdog", f"watchdog: scan exceeded {self.watchdog_ns / 1e6:g} ms ({exc})"
         elif isinstance(exc, RuntimeFaultError):

@@ -14,7 +14,7 @@ import time
 from dataclasses import dataclass, field
 from types import CodeType
 
-from . import iec, natives, stdlib
+from . import iec, natives, stdlib, sysmac_fns
 from .faults import GEN_FILE, RuntimeFaultError, WatchdogError
 
 __all__ = ["GEN_FILE", "HELPERS", "Image", "PouClass", "Program"]
@@ -110,3 +110,4 @@ class Image:
             ns["N_" + name] = functools.partial(cls, rt)
         for name, fn in natives.NATIVE_FUNCTIONS.items():
             ns["NF_" + name] = functools.partial(fn, rt)
+        ns["_stores_out"] = functools.partial(sysmac_fns.stores_out, rt)

@@ -87,22 +87,44 @@ def AryToString(rt, In, Size) -> str:
     return data.split(b"\0", 1)[0].decode("latin-1")[:1985]
 
 
-def _format(x: float, Exponent: bool, Sign: bool, MinLen: int, DecPlace: int) -> str:
-    """W502 2-269: DecPlace greater than MinLen is an error (the controller leaves Out unchanged and sets ENO
-    FALSE; vplc functions have no ENO, so the result is the empty string); the fraction is rounded half to
-    even (1.5 -> 2, 2.5 -> 2), which Python's formatting of the binary value does."""
+class _Unchanged(str):
+    """The result of an instruction that ended in error where W502 says Out does not change (ENO FALSE)."""
+
+
+UNCHANGED = _Unchanged("")       # an assignment of the call keeps its destination; inside an expression it is ''
+KEEPS_OUT_ON_ERROR = frozenset({"RealToFormatString", "LrealToFormatString"})
+
+
+def _format(rt, name: str, x: float, Exponent: bool, Sign: bool, MinLen: int, DecPlace: int) -> str:
+    """W502 2-269: the fraction is rounded half to even (1.5 -> 2, 2.5 -> 2), which Python's formatting of the
+    binary value does. DecPlace greater than MinLen is an error: ENO FALSE and Out does not change, so the
+    instruction error is recorded and the assignment keeps its destination (UNCHANGED)."""
     if DecPlace > MinLen:
-        return ""
+        rt.instruction_error(f"{name}: DecPlace {DecPlace} is greater than MinLen {MinLen} (W502 2-269); "
+                             "Out is not changed")
+        return UNCHANGED
     text = f"{x:{'+' if Sign else ''}.{int(DecPlace)}{'e' if Exponent else 'f'}}"
     return text.rjust(int(MinLen))
 
 
 def RealToFormatString(rt, In, Exponent, Sign, MinLen, DecPlace) -> str:
-    return _format(In, Exponent, Sign, MinLen, DecPlace)
+    return _format(rt, "RealToFormatString", In, Exponent, Sign, MinLen, DecPlace)
 
 
 def LrealToFormatString(rt, In, Exponent, Sign, MinLen, DecPlace) -> str:
-    return _format(In, Exponent, Sign, MinLen, DecPlace)
+    return _format(rt, "LrealToFormatString", In, Exponent, Sign, MinLen, DecPlace)
+
+
+def stores_out(rt, value: str, capacity: int, name: str) -> bool:
+    """May the result of instruction ``name`` go into the STRING variable connected to Out? Not after an error,
+    nor when the text is longer than the variable (W502 2-269: that too is an error and Out does not change)."""
+    if value is UNCHANGED:
+        return False
+    if len(value) > capacity:
+        rt.instruction_error(f"{name}: the result has {len(value)} characters, more than the {capacity} the "
+                             f"variable connected to Out holds (W502 2-269); Out is not changed")
+        return False
+    return True
 
 
 def GetTime(rt) -> int:

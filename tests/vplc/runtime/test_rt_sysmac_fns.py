@@ -64,9 +64,33 @@ def test_real_to_format_string_rounds_half_to_even_as_w502_2_269_shows(tmp_path)
     assert [plc.read(f"Main.{v}") for v in "abcd"] == ["1", "2", "2", "2"]
 
 
-def test_real_to_format_string_with_dec_place_above_min_len_is_the_error_case_of_w502_2_269(tmp_path):
-    plc = run1(tmp_path, "a := RealToFormatString(In := 1.25, MinLen := 1, DecPlace := 2);", "a : STRING[10];")
-    assert plc.read("Main.a") == ""
+def test_real_to_format_string_with_dec_place_above_min_len_keeps_out_as_w502_2_269_says(tmp_path):
+    """W502 2-269: DecPlace greater than MinLen is an error, ENO FALSE and Out does not change: the assigned
+    variable keeps its value, the controller goes on, and the error is recorded with its ST line."""
+    plc = run1(tmp_path, """a := RealToFormatString(In := 1.25, MinLen := 1, DecPlace := 2);
+        b := LrealToFormatString(In := lr, DecPlace := 3);
+        c := LrealToFormatString(In := lr, MinLen := 6, DecPlace := 3);
+        n := n + 1;""", "a : STRING[10] := 'before'; b : STRING[10] := 'kept'; c : STRING[10]; lr : LREAL := 2.5;"
+               " n : INT;")
+    assert plc.read("Main.a") == "before" and plc.read("Main.b") == "kept" and plc.read("Main.c") == " 2.500"
+    assert plc.read("Main.n") == 1
+    count, messages = plc.instruction_errors
+    assert count == 2
+    assert messages[0].endswith("main.st:5: instruction error in Main: RealToFormatString: DecPlace 2 is greater than "
+                                "MinLen 1 (W502 2-269); Out is not changed")
+    assert "LrealToFormatString: DecPlace 3 is greater than MinLen 1" in messages[1]
+
+
+def test_format_string_longer_than_the_variable_on_out_keeps_it_as_w502_2_269_says(tmp_path):
+    """W502 2-269: a result with more bytes than the variable connected to Out is an error; Out does not change.
+    Inside a larger expression the call has no Out variable of its own: it gives ''."""
+    plc = run1(tmp_path, """s := LrealToFormatString(In := 3.14159, MinLen := 8, DecPlace := 3);
+        t := CONCAT('x=', LrealToFormatString(In := 3.14159, DecPlace := 3));""",
+               "s : STRING[5] := 'old'; t : STRING[10];")
+    assert plc.read("Main.s") == "old" and plc.read("Main.t") == "x="
+    count, messages = plc.instruction_errors
+    assert count == 2 and "the result has 8 characters, more than the 4 the variable connected to Out holds" \
+        in messages[0]
 
 
 def test_time_instructions(tmp_path):
