@@ -230,10 +230,77 @@ def test_a_page_of_another_origin_cannot_move_the_robot_in_chromium(hmi, plc, at
 
 # --- server hygiene ---------------------------------------------------------------------------------------------
 
-def test_a_5000_digit_number_in_a_body_is_a_clean_400(hmi, plc):
-    body = b'{"values": {"MoveAbs_Param.Speed": ' + b"9" * 5000 + b"}}"
+@pytest.mark.parametrize("number", [b"9" * 5000, b"-" + b"9" * 5000, b"0." + b"0" * 5000 + b"1",
+                                    b"1" * 41 + b"e2"])
+def test_a_5000_digit_number_in_a_body_is_a_clean_400_in_the_hmi_own_words(hmi, plc, number):
+    """It answered with Python's own text ("Exceeds the limit (4300 digits) for integer string conversion ...
+    use sys.set_int_max_str_digits()"); now the HMI says what is wrong, and no Python integer is built."""
+    body = b'{"values": {"MoveAbs_Param.Speed": ' + number + b"}}"
     status, answer = Client(f"http://127.0.0.1:{hmi.port}", hmi.access.keys["operator"]).json("/api/write", raw=body)
-    assert status == 400 and "out of range" in answer["error"]
+    assert status == 400
+    assert answer["error"] == f"a number in the request has more than {hmi_server.MAX_DIGITS} digits"
+    assert plc.writes == []
+
+
+def test_a_point_number_of_5000_digits_in_the_trail_address_is_a_clean_400(hmi):
+    status, payload, _ = raw_request(hmi.port, "GET", "/api/trail?since=" + "9" * 5000)
+    assert status == 400 and json.loads(payload)["error"] == "since must be a point number: /api/trail?since=0"
+
+
+def post_with_content_length(hmi, declared: str, body: bytes = b""):
+    """POST /api/write with the operator key and a Content-Length header as given; (status, answer)."""
+    connection = http.client.HTTPConnection("127.0.0.1", hmi.port, timeout=5)
+    connection.putrequest("POST", "/api/write")
+    connection.putheader("Content-Type", "application/json")
+    connection.putheader("X-HMI-Key", hmi.access.keys["operator"])
+    connection.putheader("Content-Length", declared)
+    connection.endheaders(body or None)
+    response = connection.getresponse()
+    answer = json.loads(response.read())
+    connection.close()
+    return response.status, answer
+
+
+@pytest.mark.parametrize("declared", ["-5", "abc", "1.5", "+5", "1_0", "\u00b2"])
+def test_a_content_length_that_is_no_whole_number_is_a_clean_400(hmi, plc, declared):
+    """-5 answered 413 "request body of -5 bytes exceeds the limit", abc 411 "needs a Content-Length"."""
+    status, answer = post_with_content_length(hmi, declared)
+    assert (status, answer) == (400, {"ok": False, "error": "Content-Length must be a whole number of bytes"})
+    assert plc.writes == []
+
+
+def test_a_content_length_of_5000_digits_is_413_without_python_text(hmi):
+    status, answer = post_with_content_length(hmi, "9" * 5000)
+    assert status == 413 and answer["error"] == (f"request body of 999999999999... bytes exceeds the limit of "
+                                                 f"{hmi_server.MAX_BODY} bytes")
+
+
+def test_a_body_shorter_than_its_content_length_gets_408_when_the_connection_times_out(hmi, plc, monkeypatch):
+    """Content-Length 100 with 4 bytes sent got no answer at all: the connection closed silently after the
+    idle timeout. Now the timeout answers 408 with a JSON error, then closes (a 0.3 s timeout here)."""
+    monkeypatch.setattr(hmi_server._Handler, "timeout", 0.3)
+    with socket.create_connection(("127.0.0.1", hmi.port), timeout=5) as sock:
+        sock.sendall(b"POST /api/write HTTP/1.1\r\nHost: 127.0.0.1:" + str(hmi.port).encode() +
+                     b"\r\nContent-Type: application/json\r\nX-HMI-Key: " + hmi.access.keys["operator"].encode() +
+                     b"\r\nContent-Length: 100\r\n\r\n{\"va")
+        answer = read_until_closed(sock)                         # the server answers, then closes
+    head, _, body = answer.partition(b"\r\n\r\n")
+    assert head.split(b"\r\n")[0].split(b" ")[1] == b"408"
+    assert json.loads(body) == {"ok": False, "error": "the request body did not arrive: Content-Length announced "
+                                                      "100 bytes, fewer came within 0.3 s"}
+    assert plc.writes == []
+
+
+def test_a_body_cut_short_by_the_client_closing_its_side_is_a_clean_400(hmi, plc):
+    with socket.create_connection(("127.0.0.1", hmi.port), timeout=5) as sock:
+        sock.sendall(b"POST /api/write HTTP/1.1\r\nHost: 127.0.0.1:" + str(hmi.port).encode() +
+                     b"\r\nContent-Type: application/json\r\nX-HMI-Key: " + hmi.access.keys["operator"].encode() +
+                     b"\r\nContent-Length: 100\r\n\r\n{\"va")
+        sock.shutdown(socket.SHUT_WR)
+        answer = read_until_closed(sock)
+    head, _, body = answer.partition(b"\r\n\r\n")
+    assert head.split(b"\r\n")[0].split(b" ")[1] == b"400"
+    assert json.loads(body)["error"] == "the request body ended after 4 of the 100 bytes that Content-Length announced"
 
 
 def test_a_deeply_nested_body_is_a_clean_400(hmi):

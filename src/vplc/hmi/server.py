@@ -16,8 +16,9 @@ API (all answers are JSON objects with "ok"):
                                             validate, write the values and Execute := FALSE, wait for one
                                             PLC scan, then Execute := TRUE (a clean rising edge per press)
 
-The server is a bounded pool of worker threads: a connection idle for CONNECTION_TIMEOUT_S is closed, and
-beyond WORKERS + WAITING connections a new one is answered 503 at once.
+The server is a bounded pool of worker threads: a connection idle for CONNECTION_TIMEOUT_S is closed (one
+whose announced body has not arrived by then is answered 408 first), and beyond WORKERS + WAITING
+connections a new one is answered 503 at once.
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ import json
 import logging
 import mimetypes
 import pathlib
+import re
 import sys
 import threading
 import time
@@ -38,6 +40,7 @@ from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, 
 from .trail import Trail
 
 MAX_BODY = 16 * 1024
+MAX_DIGITS = 40                    # digits of one number in a request body (a LINT has 19, an LREAL 17)
 MAX_NAMES = 400
 SCAN_WAIT_S = 1.0
 CONNECTION_TIMEOUT_S = 10.0        # a client that sends nothing for this long is disconnected
@@ -46,6 +49,29 @@ WAITING = 48                       # connections queued for a worker before new 
 LISTEN_BACKLOG = 128
 
 log = logging.getLogger("vplc.hmi")
+
+_POINT_NUMBER = re.compile(r"[0-9]{1,18}")       # /api/trail?since=N: ASCII digits, within an int64
+
+
+def _number_digits(text: str) -> str:
+    """A JSON number as the decoder found it, refused beyond MAX_DIGITS digits (before Python converts it:
+    a 5,000-digit integer once answered with Python's own limit text)."""
+    mantissa = text.partition("e")[0].partition("E")[0]
+    if sum(c.isdigit() for c in mantissa) > MAX_DIGITS:
+        raise RequestError(f"a number in the request has more than {MAX_DIGITS} digits")
+    return text
+
+
+def _json_body(raw: bytes):
+    """The decoded request body; RequestError saying what is wrong with it."""
+    try:
+        return json.loads(raw.decode("utf-8"), parse_int=lambda t: int(_number_digits(t)),
+                          parse_float=lambda t: float(_number_digits(t)))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise RequestError(f"the request body is not valid JSON ({exc})") from None
+    except RecursionError:
+        raise RequestError("the request body is nested too deeply") from None
+
 
 class _PooledHTTPServer(HTTPServer):
     """HTTPServer whose connections are served by a bounded pool of threads (not a thread per connection)."""
@@ -315,7 +341,7 @@ class _Handler(BaseHTTPRequestHandler):
                 self._program(url)
             elif url.path == "/api/trail" and self.hmi.trail is not None:
                 since = parse_qs(url.query).get("since", ["0"])[0]
-                if not since.isdigit():
+                if not _POINT_NUMBER.fullmatch(since):
                     raise RequestError("since must be a point number: /api/trail?since=0")
                 self._json(HTTPStatus.OK, self.hmi.trail.since(int(since)))
             elif url.path in ("/api/write", "/api/execute"):
@@ -372,26 +398,35 @@ class _Handler(BaseHTTPRequestHandler):
     do_OPTIONS = do_PUT = do_DELETE = do_PATCH = _refuse_method
 
     def _body(self) -> dict:
-        try:
-            length = int(self.headers.get("Content-Length", ""))
-        except ValueError:
-            raise RequestError("the request needs a Content-Length header", HTTPStatus.LENGTH_REQUIRED) from None
-        if length > MAX_BODY or length < 0:
-            self.close_connection = True
-            raise RequestError(f"request body of {length} bytes exceeds the limit of {MAX_BODY} bytes",
+        declared = self.headers.get("Content-Length")
+        if declared is None:
+            raise RequestError("the request needs a Content-Length header", HTTPStatus.LENGTH_REQUIRED)
+        digits = declared.strip()
+        if not (digits.isascii() and digits.isdigit()):         # "-5", "abc", "1.5", "+5", "1_0"
+            raise self._unread("Content-Length must be a whole number of bytes")
+        if len(digits) > 12 or int(digits) > MAX_BODY:
+            shown = digits if len(digits) <= 12 else digits[:12] + "..."
+            raise self._unread(f"request body of {shown} bytes exceeds the limit of {MAX_BODY} bytes",
                                HTTPStatus.REQUEST_ENTITY_TOO_LARGE)
-        raw = self.rfile.read(length)
+        length = int(digits)
         try:
-            body = json.loads(raw.decode("utf-8"))
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise RequestError(f"the request body is not valid JSON ({exc})") from None
-        except ValueError as exc:                       # e.g. a number of more than 4,300 digits
-            raise RequestError(f"the request body holds a value out of range ({exc})") from None
-        except RecursionError:
-            raise RequestError("the request body is nested too deeply") from None
+            raw = self.rfile.read(length)
+        except TimeoutError:
+            raise self._unread(f"the request body did not arrive: Content-Length announced {length} bytes, "
+                               f"fewer came within {self.timeout:g} s", HTTPStatus.REQUEST_TIMEOUT) from None
+        if len(raw) < length:
+            raise self._unread(f"the request body ended after {len(raw)} of the {length} bytes that "
+                               f"Content-Length announced")
+        body = _json_body(raw)
         if not isinstance(body, dict):
             raise RequestError("the request body must be a JSON object")
         return body
+
+    def _unread(self, message: str, status: HTTPStatus = HTTPStatus.BAD_REQUEST) -> RequestError:
+        """A refused body that was not read whole: the answer closes the connection (the bytes that follow
+        are not the next request)."""
+        self.close_connection = True
+        return RequestError(message, status)
 
     def _static(self, path: str) -> None:
         relative = "index.html" if path in ("", "/") else path.lstrip("/")
