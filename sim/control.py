@@ -191,8 +191,10 @@ class ControlChannel:
             command = self._commands.get(name)
             if command is None:
                 raise RequestError(f"unknown command {name!r}; known: {', '.join(self._commands)}")
-            index = _int_field(request, "robot", 0, 0, len(self.server.robots) - 1,
-                               f"robot {{}} does not exist (0..{len(self.server.robots) - 1})")
+            count = len(self.server.robots)
+            index = _int_field(request, "robot", 0, 0, count - 1,
+                               f"robot {{}} does not exist: this simulator has {count} "
+                               f"robot{'s' if count > 1 else ''}; {robot_numbering(count)} of the start-up lines")
             return {"ok": True, "result": command(self.server.robots[index], request)}
         except (ValueError, TypeError, TransitionError) as exc:
             return _error(str(exc))
@@ -288,6 +290,14 @@ def _bool_field(request, name, default) -> bool:
     if not isinstance(value, bool):
         raise RequestError(f"'{name}' must be true or false, got {_show(value)}")
     return value
+
+
+def robot_numbering(count: int) -> str:
+    """'"robot": 0 is robot 1' for ``count`` robots: the control channel counts them from 0, the start-up
+    lines (and the demo's log) from 1, as a PLC program does."""
+    if count == 1:
+        return '"robot": 0 is robot 1'
+    return f'"robot": 0 to {count - 1} are robots 1 to {count}'
 
 
 def _int_field(request, name, default, low, high, message) -> int:

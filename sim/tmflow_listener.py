@@ -25,6 +25,7 @@ import threading
 if __package__ in (None, ""):
     sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
+from sim.control import robot_numbering  # noqa: E402
 from sim.profiles import STOP_TAGS, VERSIONS, Profile  # noqa: E402
 from sim.server import SimServer  # noqa: E402
 from sim.svr_session import DEFAULT_STREAM  # noqa: E402
@@ -168,7 +169,8 @@ def main(argv=None) -> int:
         slave = f", Ethernet Slave on {args.host}:{robot.svr_port}" if server.svr is not None else ""
         print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node}){slave}", flush=True)
     if server.control is not None:
-        print(f"control channel: {args.control_host}:{server.control.port} (JSON lines)", flush=True)
+        print(f"control channel: {args.control_host}:{server.control.port} "
+              f"(JSON lines; {robot_numbering(len(server.robots))})", flush=True)
     if server.svr is not None:
         print(f"Ethernet Slave data table: every {args.svr_period:g} s, {args.svr_format}, "
               f"{len(server.robots[0].svr.stream_items)} items", flush=True)

@@ -267,7 +267,8 @@ def test_control_channel_commands():
         bad = control_request(port, {"cmd": "enter_listen_node"})
         assert bad["ok"] is False and "in node" in bad["error"]
         assert "unknown command" in control_request(port, {"cmd": "fly"})["error"]
-        assert "does not exist" in control_request(port, {"cmd": "state", "robot": 7})["error"]
+        assert control_request(port, {"cmd": "state", "robot": 1})["error"] == (
+            'robot 1 does not exist: this simulator has 1 robot; "robot": 0 is robot 1 of the start-up lines')
         assert control_request(port, {"cmd": "inject", "fault": "nope"})["ok"] is False
     finally:
         srv.close()
@@ -298,6 +299,14 @@ def test_cli_starts_prints_one_line_per_robot_and_stops_on_terminate(tmp_path):
         assert lines[2].startswith("control channel: ")
         port = int(lines[2].split(":")[2].split()[0])
         assert control_request(port, {"cmd": "robots"})["result"][1]["node_state"] == "in_node"
+        # the start-up lines count robots from 1 as a PLC program does, the control channel from 0: the
+        # control channel line and the error for a robot that does not exist say how they match
+        assert lines[2].rstrip().endswith('(JSON lines; "robot": 0 to 1 are robots 1 to 2)')
+        robot_2_port = int(lines[1].split("listening on 127.0.0.1:")[1].split()[0])
+        assert control_request(port, {"cmd": "state", "robot": 1})["result"]["port"] == robot_2_port
+        assert control_request(port, {"cmd": "state", "robot": 2})["error"] == (
+            'robot 2 does not exist: this simulator has 2 robots; "robot": 0 to 1 are robots 1 to 2 of the '
+            'start-up lines')
     finally:
         proc.terminate()
         out, err = proc.communicate(timeout=10)
