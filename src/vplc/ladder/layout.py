@@ -13,6 +13,12 @@ CELL_W = {"contact": 96, "coil": 86, "block": 200, "in_var": 130, "out_var": 130
           "jump": 110, "return": 100}
 ROW_H = 44
 PIN_LABEL_W = 136          # room for a variable name left of a block input / right of a block output
+LEFT_RAIL = 18             # x of the left power rail; the right one stands at RungLayout.width + RAIL_GAP or further
+RAIL_GAP = 10
+CHAR_W = 8.0               # width of one character of a 12 px name in DejaVu Sans, with a margin: mixed-case
+SMALL = 11 / 12            # identifiers measure 7.6 px in Chromium; pin names and values are drawn at 11 px,
+BOLD = 1.1                 # the block type in bold
+PAD = 6                    # clearance between a name and a rail, a box or another name
 
 
 @dataclass
@@ -24,6 +30,7 @@ class Placed:
     x: float = 0.0
     y: float = 0.0          # top of the element's first row, relative to the rung
     w: float = 0.0
+    label_x: float = 0.0    # centre of the name drawn above a contact or coil
 
 
 @dataclass
@@ -35,6 +42,24 @@ class RungLayout:
     attached: set[str] = field(default_factory=set)                          # variables drawn as pin labels
     height: float = ROW_H
     width: float = 0.0
+
+
+def text_width(text: str, scale: float = 1.0) -> float:
+    """Estimated width of ``text`` as the drawing writes it (12 px; ``scale`` SMALL or BOLD for the others)."""
+    return len(text) * CHAR_W * scale
+
+
+def cell_width(e: Element) -> float:
+    """Width of an element's own cell: the symbol, or a box wide enough for its texts."""
+    w = CELL_W.get(e.kind, 100)
+    if e.kind == "block":
+        ins, outs = pin_rows(e)
+        pins = max((text_width(a, SMALL) for a in ins), default=0) + max((text_width(b, SMALL) for b in outs),
+                                                                          default=0)
+        return max(w, text_width(e.type_name.split("\\")[-1], BOLD) + 16, text_width(e.instance) + 16, pins + 24)
+    if e.kind in ("in_var", "out_var", "inout_var", "jump"):
+        return max(w, text_width(e.var if e.kind != "jump" else ">> " + e.var) + 24)
+    return w
 
 
 def pin_rows(e: Element) -> tuple[list[str], list[str]]:
@@ -118,21 +143,73 @@ def layout_rung(rung: Rung, number: int) -> RungLayout:
     ncols = max((p.col for p in lay.placed.values()), default=-1) + 1
     widths = [0.0] * ncols
     for p in lay.placed.values():
-        w = CELL_W.get(p.element.kind, 100)
-        if p.element.kind == "block":
-            w += PIN_LABEL_W * 2
-        widths[p.col] = max(widths[p.col], w)
+        p.w = cell_width(p.element)
+        widths[p.col] = max(widths[p.col], p.w + (PIN_LABEL_W * 2 if p.element.kind == "block" else 0))
     xs = [44.0]
     for w in widths:
         xs.append(xs[-1] + w)
     for p in lay.placed.values():
-        w = CELL_W.get(p.element.kind, 100)
-        p.w = w
         p.x = xs[p.col] + (PIN_LABEL_W if p.element.kind == "block" else 0)
         p.y = p.row * ROW_H
     lay.width = xs[-1] + 10
     lay.height = (max((p.row + p.rows for p in lay.placed.values()), default=1)) * ROW_H
+    _fit_names(lay)
     return lay
+
+
+def _fit_names(lay: RungLayout) -> None:
+    """Give every name room between the rails, column by column. The name above a contact or coil is centred on
+    it; near the right rail it moves left (a coil's long name over the wire from the block before it), and where
+    the row leaves too little room the symbol itself moves right, under its name. The variables written next to
+    block pins keep to their row. Whatever moves right takes the columns after it and the right rail along."""
+    placed = sorted(lay.placed.values(), key=lambda p: (p.col, p.row))
+
+    def shift(col: int, dx: float) -> None:
+        for q in placed:
+            if q.col >= col:
+                q.x += dx
+                q.label_x += dx
+        lay.width += dx
+
+    def boxes(p: Placed, later: bool, rows: range):
+        """Blocks in columns before (after) ``p`` whose box reaches into ``rows``."""
+        return [q for q in placed if q.element.kind == "block" and (q.col > p.col if later else q.col < p.col)
+                and q.row <= rows.stop - 1 and rows.start <= q.row + q.rows - 1]
+
+    for p in placed:
+        e = p.element
+        if e.kind in ("contact", "coil"):
+            tw = text_width(e.var)
+            band = range(p.row, p.row + 1)
+            lo = max([LEFT_RAIL + PAD] + [q.x + q.w + PAD for q in boxes(p, False, band)]
+                     + [q.label_x + text_width(q.element.var) / 2 + PAD for q in placed
+                        if q.col < p.col and q.row == p.row and q.element.kind in ("contact", "coil")])
+            if p.x + p.w / 2 < lo + tw / 2:          # the symbol moves right, to stay under its name
+                shift(p.col, lo + tw / 2 - p.x - p.w / 2)
+            hi = min([lay.width + RAIL_GAP - PAD] + [q.x - PAD for q in boxes(p, True, band)])
+            if hi - lo < tw:
+                shift(p.col + 1, tw - (hi - lo))
+                hi = lo + tw
+            p.label_x = max(min(p.x + p.w / 2, hi - tw / 2), lo + tw / 2)
+        elif e.kind == "block":
+            ins, outs = pin_rows(e)
+            for i, name in enumerate(ins):
+                label = lay.pin_labels.get((e.id, name))
+                if label is not None:
+                    row = range(p.row + i, p.row + i + 1)
+                    lo = max([LEFT_RAIL + PAD] + [q.x + q.w + PAD for q in boxes(p, False, row)])
+                    room = p.x - 18 - lo
+                    if room < text_width(label):
+                        shift(p.col, text_width(label) - room)
+            for i, name in enumerate(outs):
+                label = lay.pin_labels.get((e.id, "out:" + name))
+                if label is not None:
+                    r = p.row + i
+                    hi = min([lay.width + RAIL_GAP - PAD] + [q.x - PAD for q in placed if q.col > p.col and (
+                        q.row <= r <= q.row + q.rows - 1)])
+                    need = p.x + p.w + 18 + text_width(label) - hi
+                    if need > 0:
+                        shift(p.col + 1, need)
 
 
 def layout(body: LadderBody) -> list[RungLayout]:

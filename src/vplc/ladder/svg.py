@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from xml.sax.saxutils import escape, quoteattr
 
-from .layout import ROW_H, RungLayout, layout, pin_rows
+from .layout import CHAR_W, LEFT_RAIL, ROW_H, RungLayout, layout, pin_rows, text_width
 from .model import LadderBody
 
 COMMENT_H = 26
@@ -62,13 +62,13 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
     x = 40
     if lay.rung.label:                                 # a jump target, written first as Sysmac shows labels
         out.append(_t(x, 15, lay.rung.label + ":", "type"))
-        x += 12 + 8 * len(lay.rung.label)
+        x += 12 + text_width(lay.rung.label, 1.1)
     if lay.rung.comment:
-        room = int((width - x - 20) / 6.4)            # characters that fit before the right edge
+        room = int((width - x - 20) / CHAR_W)         # characters that fit before the right edge
         text = lay.rung.comment.splitlines()[0]
         out.append(_t(x, 15, text if len(text) <= room else text[:room - 1].rstrip() + "…", "cmt"))
     oy = COMMENT_H
-    left, right = 18, width - 14
+    left, right = LEFT_RAIL, width - 14
     out.append(f'<path class="rail" d="M{left} {oy} V{oy + lay.height + 8:.0f}"/>')
     out.append(f'<path class="rail" d="M{right:.0f} {oy} V{oy + lay.height + 8:.0f}"/>')
     by_id = {e.id: e for e in lay.rung.elements}
@@ -106,7 +106,7 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
                     continue
                 did = c.ref if src is None or src.kind != "block" else f"{c.ref}:{c.pin}"
                 out.append(_line(start[0], start[1], x, ty, "wire", did))
-        out.append(_element(p, y, lay, left, right))
+        out.append(_element(p, y, lay))
     read = {c.ref for e in lay.rung.elements if e.kind != "right_rail" for pin in [*e.inputs, *e.inouts]
             for c in pin.conns}
     for p in lay.placed.values():                      # a coil's right side always reaches the right rail
@@ -117,13 +117,7 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
     return "".join(out)
 
 
-def _fit(cx: float, text: str, left: float, right: float) -> float:
-    """The centre of a name drawn above a symbol, moved so the name stays between the rails."""
-    half = 3.4 * len(text)
-    return min(max(cx, left + 4 + half), right - 4 - half)
-
-
-def _element(p, y: float, lay: RungLayout, left: float, right: float) -> str:
+def _element(p, y: float, lay: RungLayout) -> str:
     e = p.element
     x, w = p.x, p.w
     cy = y + MID
@@ -144,7 +138,7 @@ def _element(p, y: float, lay: RungLayout, left: float, right: float) -> str:
         mark = {"rising": "P", "falling": "N"}.get(e.edge, "") or {"set": "S", "reset": "R"}.get(e.storage, "")
         if mark:
             g.append(_t(cx, cy + 4, mark, "pin", "middle"))
-        g.append(_t(_fit(cx, e.var, left, right), cy - 18, e.var, "", "middle"))
+        g.append(_t(p.label_x, cy - 18, e.var, "", "middle"))      # placed by layout._fit_names
         if e.kind == "contact":                        # a coil's value is its colour
             g.append(_t(cx, cy + 26, "", "val", "middle", var=e.var))
     elif e.kind == "block":

@@ -82,3 +82,53 @@ def test_function_block_pins_carry_their_variables(tmp_path, capsys):
     assert draw(capsys, src, "--pou", "Main", "-o", out)[0] == 0
     (add,) = groups(out, "block")
     assert texts(add) == ["ADD", "IN1", "A", "IN2", "5", "OUT", "S"]
+
+
+def _text_extents(svg_path):
+    """(x0, x1, rail_left, rail_right, text) for every name drawn between the rails of a rung, its width estimated
+    as the drawer estimates it (layout.text_width: characters x CHAR_W, scaled for the 11 px and bold classes)."""
+    import re
+
+    from vplc.ladder.layout import BOLD, SMALL, text_width
+    root = ET.parse(svg_path).getroot()
+    out = []
+    for rung in groups(svg_path, "rung"):
+        rails = [p for p in rung.iter(f"{SVG}path") if p.get("class") == "rail"]
+        xs = sorted(float(re.match(r"M([\d.]+) ([\d.]+)", r.get("d")).group(1)) for r in rails)
+        top = float(re.match(r"M[\d.]+ ([\d.]+)", rails[0].get("d")).group(1))
+        for t in rung.iter(f"{SVG}text"):
+            if not t.text or float(t.get("y")) <= top:
+                continue                                   # the rung number and comment stand above the rails
+            cls = (t.get("class") or "").split()
+            scale = SMALL if {"pin", "val", "num"} & set(cls) else BOLD if "type" in cls else 1.0
+            w = text_width(t.text, scale)
+            x = float(t.get("x"))
+            x0 = {"start": x, "middle": x - w / 2, "end": x - w}[t.get("text-anchor") or "start"]
+            out.append((x0, x0 + w, xs[0], xs[-1], t.text))
+    assert root is not None and out
+    return out
+
+
+def test_no_name_of_the_example_crosses_a_power_rail(tmp_path, capsys):
+    """Coil names such as ChangeBase_CommandAborted used to run past the right rail."""
+    out = tmp_path / "commands.svg"
+    assert draw(capsys, LIB, ROOT / "examples", "--pou", "Commands_Example", "-o", out)[0] == 0
+    crossing = [(text, round(x0), round(x1), left, right) for x0, x1, left, right, text in _text_extents(out)
+                if x0 < left + 2 or x1 > right - 2]
+    assert crossing == []
+
+
+def test_long_names_widen_the_rung_instead_of_crossing_the_rails(tmp_path, capsys):
+    long_in, long_out = "Conveyor_Infeed_Photoeye_Blocked_Long", "Palletizer_Layer_Complete_Acknowledged"
+    src = program(tmp_path, {long_in: "BOOL", "B": "BOOL", long_out: "BOOL", "Q": "BOOL", "N": "INT",
+                             "Sum_Of_Everything_Counted_So_Far": "INT"},
+                  [rail(1), contact(2, long_in, 1), contact(3, "B", 2), coil(4, long_out, 3), coil(5, "Q", 3, y=40),
+                   invar(6, "N", y=80), invar(7, "1", y=100), block(8, "ADD", {"IN1": 6, "IN2": 7}, ["OUT"], y=80),
+                   outvar(9, "Sum_Of_Everything_Counted_So_Far", (8, "OUT"), y=80)])
+    out = tmp_path / "long.svg"
+    assert draw(capsys, src, "--pou", "Main", "-o", out)[0] == 0
+    extents = _text_extents(out)
+    assert {long_in, long_out, "Sum_Of_Everything_Counted_So_Far"} <= {t for *_, t in extents}
+    assert [t for x0, x1, left, right, t in extents if x0 < left + 2 or x1 > right - 2] == []
+    named = sorted((x0, x1) for x0, x1, _, _, t in extents if t in (long_in, "B", long_out))
+    assert all(a[1] <= b[0] for a, b in zip(named, named[1:])), "names above one row overlap"
