@@ -54,7 +54,11 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
     try:
         out = []
         for unit in reader(root):
-            out.append((unit_source(path, unit), unit.namespace))
+            src = unit_source(path, unit)
+            for exc in src.errors:                           # rungs that could not be translated, all of them
+                place = LadderSource(path, "", [(0, 1, exc.where)])
+                diags.error(exc.code, exc.message, Span(place, 0, 1))
+            out.append((src, unit.namespace))
         return out
     except FormatError as exc:
         place = LadderSource(path, "", [(0, 1, exc.where or "project")])

@@ -31,10 +31,11 @@ COMPARE = {"GT": ">", "GE": ">=", "EQ": "=", "LT": "<", "LE": "<=", "NE": "<>"} 
 class LadderSource(SourceFile):
     """The ST text generated from an XML file; ``where(offset)`` names the XML element behind it."""
 
-    __slots__ = ("regions", "statements", "checks", "ladders")
+    __slots__ = ("regions", "statements", "checks", "ladders", "errors")
 
-    def __init__(self, path: str, text: str, regions=(), statements=(), checks=(), ladders=()) -> None:
+    def __init__(self, path: str, text: str, regions=(), statements=(), checks=(), ladders=(), errors=()) -> None:
         super().__init__(path, text)
+        self.errors = errors            # FormatError of each rung that could not be translated (reported by load)
         self.regions = regions          # (start, end, label), any order
         self.statements = statements    # (start, end) of each generated statement
         self.checks = checks            # (start, end, label, operand): contact operands that must be BOOL
@@ -111,7 +112,7 @@ class Writer:
 
 def unit_source(path: str, unit: XmlUnit) -> LadderSource:
     w = Writer()
-    ladders = []
+    ladders, errors = [], []
     for t in unit.types:
         init = f" := {t.init}" if t.init is not None else ""
         w.put(f"TYPE\n{_comment(t.comment)}{t.name} : {t.spec}{init};\nEND_TYPE\n\n", f"data type {t.name}")
@@ -120,11 +121,11 @@ def unit_source(path: str, unit: XmlUnit) -> LadderSource:
             _section(w, section, "global variables")
         w.put("\n")
     for pou in unit.pous:
-        _pou(w, pou)
+        errors += _pou(w, pou)
         if pou.ladder is not None:
             pou.ladder.path = path
             ladders.append(pou.ladder)
-    return LadderSource(path, w.text(), w.regions, w.statements, w.checks, ladders)
+    return LadderSource(path, w.text(), w.regions, w.statements, w.checks, ladders, errors)
 
 
 def _comment(text: str) -> str:
@@ -142,7 +143,9 @@ def _section(w: Writer, s: SectionText, owner: str) -> None:
     w.put("END_VAR\n")
 
 
-def _pou(w: Writer, pou: PouText) -> None:
+def _pou(w: Writer, pou: PouText) -> list[FormatError]:
+    """Write one POU; returns the wiring errors of its rungs (each rung with one is left out of the ST text)."""
+    errors = []
     w.put(_comment(pou.comment))
     head = f"{pou.kind} {pou.name}" + (f" : {pou.return_type}" if pou.return_type else "")
     w.put(head + "\n", f"{pou.name}")
@@ -150,10 +153,13 @@ def _pou(w: Writer, pou: PouText) -> None:
         _section(w, s, pou.name)
     if pou.ladder is not None:
         names = {v.name.upper() for s in pou.sections for v in s.vars}
-        RungCompiler(w, pou, names).body(pou.ladder)
+        compiler = RungCompiler(w, pou, names)
+        compiler.body(pou.ladder)
+        errors = compiler.errors
     else:
         w.put((pou.st_body or "") + "\n", f"{pou.name}:ST body")
     w.put(f"END_{pou.kind}\n\n")
+    return errors
 
 
 def _error(where: str, message: str, code: str) -> FormatError:
@@ -172,6 +178,7 @@ class RungCompiler:
         self.prefix = prefix
         self.hidden: list[str] = []
         self.lines: list[tuple] = []          # (Txt | str, label | None, statement)
+        self.errors: list[FormatError] = []   # every rung's wiring errors, not only the first
 
     def new(self, kind: str) -> str:
         name = f"{self.prefix}{kind}{len(self.hidden) + 1}"
@@ -187,29 +194,30 @@ class RungCompiler:
         for n, rung in enumerate(ladder.rungs):
             if rung.label:
                 if rung.label.upper() in labels:
-                    raise _error(f"{self.pou}:rung {n + 1}", f"label `{rung.label}` is defined twice", "ST2106")
-                labels[rung.label.upper()] = n
+                    self.errors.append(_error(f"{self.pou}:rung {n + 1}", f"label `{rung.label}` is defined twice",
+                                              "ST2106"))
+                labels.setdefault(rung.label.upper(), n)
+        self.jump_flags: dict[int, str] = {}
         for n, rung in enumerate(ladder.rungs):
             for el in rung.elements:
                 if el.kind == "jump":
                     target = labels.get(el.var.upper())
                     where = f"{self.pou}:rung {n + 1}:jump {el.var}"
                     if target is None:
-                        raise _error(where, f"jump to label `{el.var}`, which no rung of {self.pou} has", "ST2106")
-                    if target <= n:
-                        raise _error(where, f"jump back to label `{el.var}` (rung {target + 1}); a jump may only "
-                                            "skip rungs below it, so a scan always ends", "ST2106")
-        self.jump_flags: dict[int, str] = {}
-        for n, rung in enumerate(ladder.rungs):
-            for el in rung.elements:
-                if el.kind == "jump":
-                    self.jump_flags[id(el)] = self.new("J")
+                        self.errors.append(_error(where, f"jump to label `{el.var}`, which no rung of {self.pou} "
+                                                         "has", "ST2106"))
+                    elif target <= n:
+                        self.errors.append(_error(where, f"jump back to label `{el.var}` (rung {target + 1}); a "
+                                                         "jump may only skip rungs below it, so a scan always ends",
+                                                  "ST2106"))
+                    else:
+                        self.jump_flags[id(el)] = self.new("J")
         for flag in self.jump_flags.values():
             self.emit(f"{flag} := FALSE;\n")
         flags_by_rung = {}
         for n, rung in enumerate(ladder.rungs):
             for el in rung.elements:
-                if el.kind == "jump":
+                if id(el) in self.jump_flags:
                     flag = self.jump_flags[id(el)]
                     target = labels[el.var.upper()]
                     for skipped in range(n + 1, target):
@@ -235,6 +243,9 @@ class RungCompiler:
 
     # ---- one rung ---------------------------------------------------------------------------
     def rung(self, rung: Rung, number: int, indent: str) -> None:
+        """Translate one rung. Its wiring errors are collected (every missing or wrong connection, and a loop
+        among the rest), not only the first; a rung with one is replaced by checks of its contacts' and coils'
+        operands, so an undeclared or non-BOOL variable in it is still reported."""
         self.where = f"{self.pou}:rung {number}"
         self.indent = indent
         self.by_id = {e.id: e for e in rung.elements}
@@ -243,42 +254,71 @@ class RungCompiler:
         consumers: dict[tuple[str, str | None], int] = {}
         deps: dict[str, set[str]] = {e.id: set() for e in rung.elements}
         users: dict[str, list[str]] = {e.id: [] for e in rung.elements}
+        problems: list[FormatError] = []
         for e in rung.elements:
             if e.kind in ("left_rail", "right_rail"):
                 continue
             for pin in [*e.inputs, *e.inouts]:
                 for c in pin.conns:
                     src = self.by_id.get(c.ref)
-                    if src is None:
-                        raise _error(f"{self.where}:{e.describe()}",
-                                     f"input `{pin.name or 'power'}` is connected to element {c.ref.lstrip('?')}, "
-                                     "which is not in this rung", "ST2103")
-                    if src.kind == "right_rail":
-                        raise _error(f"{self.where}:{e.describe()}", "a wire starts at the right power rail", "ST2103")
-                    key = (src.id, self._pin_name(src, c, e))
+                    try:
+                        if src is None:
+                            raise _error(f"{self.where}:{e.describe()}",
+                                         f"input `{pin.name or 'power'}` is connected to element "
+                                         f"{c.ref.lstrip('?')}, which is not in this rung", "ST2103")
+                        if src.kind == "right_rail":
+                            raise _error(f"{self.where}:{e.describe()}", "a wire starts at the right power rail",
+                                         "ST2103")
+                        key = (src.id, self._pin_name(src, c, e))
+                    except FormatError as exc:
+                        problems.append(exc)
+                        continue
                     consumers[key] = consumers.get(key, 0) + 1
                     if src.kind != "left_rail":
                         deps[e.id].add(src.id)
                         users[src.id].append(e.id)
         self.consumers = consumers
+        order, stuck = self._order(rung, deps, users)
+        if stuck:
+            problems.append(_error(self.where, "the rung is wired in a loop (" + ", ".join(stuck[:6])
+                                   + "); power must flow from the left rail to the right without coming back",
+                                   "ST2104"))
+        mark, hidden = len(self.lines), len(self.hidden)
+        bad_jump = any(e.kind == "jump" and id(e) not in self.jump_flags for e in rung.elements)   # reported above
+        if not problems and not bad_jump:
+            try:
+                for eid in order:
+                    self.element(self.by_id[eid])
+                return
+            except FormatError as exc:
+                problems.append(exc)
+                del self.lines[mark:], self.hidden[hidden:]
+        self.errors.extend(problems)
+        for e in rung.elements:
+            if e.kind in ("contact", "coil") and e.var:
+                lab = self.label(e)
+                var = Txt(e.var, [(0, len(e.var), f"check:{e.kind}:{lab}")]).marked(lab)
+                self.stmt("IF FALSE THEN " + self.new("C") + " := " + var + "; END_IF;", lab)
+
+    @staticmethod
+    def _order(rung: Rung, deps: dict, users: dict) -> tuple[list[str], list[str]]:
+        """Evaluation order of the elements (power flow, then top to bottom and left to right as drawn) and the
+        elements left over because they are wired in a loop."""
         index = {e.id: i for i, e in enumerate(rung.elements)}
         rank = {e.id: ((e.pos[1], e.pos[0]) if e.pos else (0.0, 0.0), index[e.id]) for e in rung.elements}
         waiting = {k: len(v) for k, v in deps.items()}
         ready = [(rank[k], k) for k, n in waiting.items() if n == 0]
         heapq.heapify(ready)
-        done = 0
+        order = []
         while ready:
             _, eid = heapq.heappop(ready)
-            done += 1
-            self.element(self.by_id[eid])
+            order.append(eid)
             for u in users[eid]:
                 waiting[u] -= 1
                 if waiting[u] == 0:
                     heapq.heappush(ready, (rank[u], u))
-        if done < len(rung.elements):
-            stuck = [self.by_id[k].describe() for k, n in waiting.items() if n > 0]
-            raise _error(self.where, "the rung is wired in a loop (" + ", ".join(stuck[:6])
-                         + "); power must flow from the left rail to the right without coming back", "ST2104")
+        by_id = {e.id: e for e in rung.elements}
+        return order, [by_id[k].describe() for k, n in waiting.items() if n > 0]
 
     def _pin_name(self, src: Element, c: Conn, user: Element) -> str | None:
         if src.kind != "block":

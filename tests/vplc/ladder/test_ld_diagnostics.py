@@ -255,3 +255,25 @@ def test_check_summary_counts_one_exported_project_file_as_one_file(tmp_path, ca
     capsys.readouterr()
     assert main(["check", str(out)]) == 0
     assert capsys.readouterr().out.splitlines()[-1] == "1 file(s) checked: 0 error(s), 0 warning(s)"
+
+
+def test_independent_wiring_problems_are_all_reported_with_the_st_rules_of_the_broken_rung(tmp_path):
+    """A missing connection no longer hides the rest: a second missing wire in the same rung, a loop in another
+    rung, an undeclared contact in the broken rung (its operands are still checked) and one in a good rung."""
+    body = [rail(1), contact(2, "A", 77), contact(3, "Nope", 2), coil(5, "Q", 3, 88),
+            rail(10, y=100), contact(11, "A", 10, 12, y=100), contact(12, "B", 11, y=100), coil(13, "Q", 12, y=100),
+            rail(20, y=200), contact(21, "Strat", 20, y=200), coil(22, "Q", 21, y=200)]
+    found = sorted((d.code, d.location().split("main.xml:", 1)[1], d.message.split(";")[0]) for d in
+                   diags(program(tmp_path, V, body)))
+    assert found == [
+        ("ST1001", "Main:rung 1:contact Nope", "`Nope` is not declared"),
+        ("ST1001", "Main:rung 3:contact Strat", "`Strat` is not declared"),
+        ("ST2103", "Main:rung 1:coil Q", "input `power` is connected to element 88, which is not in this rung"),
+        ("ST2103", "Main:rung 1:contact A", "input `power` is connected to element 77, which is not in this rung"),
+        ("ST2104", "Main:rung 2", "the rung is wired in a loop (contact A, contact B, coil Q)"),
+    ]
+
+
+def test_a_contact_on_an_integer_in_a_broken_rung_is_still_the_pin_type_error(tmp_path):
+    errors = diags(program(tmp_path, V, [rail(1), contact(2, "N", 77), coil(3, "Q", 2)]))
+    assert sorted(d.code for d in errors) == ["ST2103", "ST2105"]
