@@ -174,3 +174,16 @@ def test_printing_arrays_counts_against_the_work_of_a_script(robot):
     reply = run(robot, text)
     assert reply.startswith("ERROR;") and int(reply[6:]) <= prints + 1
     assert f"more than {STEPS_MAX} steps" in last_error(robot)["reason"]
+
+
+@pytest.mark.parametrize("text, reason", [
+    ('IO["ControlBox"].AO[0] = 1e39', "outside the float range"),
+    ('IO["ControlBox"].DO[0] = 1e30', "does not fit int"),
+    ("Robot[0].CameraLight = 2147483648", "does not fit int"),
+])
+def test_an_io_or_robot_write_beyond_its_type_is_an_error_of_its_line(robot, text, reason):
+    """IO and Robot[0] points take values as variables of their type do [MAN 2.24 §2.2, §2.5]; the write
+    converted 1e30 to a 31-digit Python integer before."""
+    assert run(robot, text) == "ERROR;1"
+    assert reason in last_error(robot)["reason"]
+    assert run(robot, "ChangeLoad(1)", "2") == "OK"
