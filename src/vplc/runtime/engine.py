@@ -46,6 +46,8 @@ def _gc_pause(phase: str, _info) -> None:
         for engine in list(_ENGINES):
             deadline = engine.deadline
             if deadline[0] != math.inf:
+                if engine.probation[0] == deadline[0]:
+                    engine.probation[0] += pause
                 deadline[0] += pause
 
 
@@ -66,6 +68,8 @@ class Engine:
         self.fault: PlcFault | None = None
         self.scan_count = 0
         self.deadline = module.namespace["_DL"]
+        self.probation = module.namespace["_WDP"]       # watchdog probation: [deadline it set, CPU time]
+        module.namespace["_WDS"][0] = self.watchdog_s
         _ENGINES.add(self)
         self.stmt_counter = module.namespace["_NST"]
         self.now_cell = module.namespace["_NOW"]          # what VPLC_ScanTime() returns in generated code

@@ -20,8 +20,21 @@ from .faults import GEN_FILE, RuntimeFaultError, WatchdogError
 __all__ = ["GEN_FILE", "HELPERS", "Image", "PouClass", "Program"]
 
 
-def watchdog() -> None:
-    raise WatchdogError("a loop did not finish")
+def make_watchdog(deadline: list, probation: list, limit_s: list):
+    """The check generated loops call once the scan's wall-clock deadline ``deadline[0]`` (start + ``limit_s[0]``)
+    has passed. Wall time alone would fault a scan whose thread the host did not run (a loaded machine, parallel
+    tests), so the first pass starts a probation instead: the deadline moves by ``limit_s[0]`` and the thread's CPU
+    time is noted (``probation`` = [the deadline set, CPU time]); the fault comes when the program has used
+    ``limit_s[0]`` of CPU time since. A scan that needs less CPU than the limit always finishes first; an endless
+    loop faults after at most twice the limit of its own CPU time. Nothing of this costs a normal scan anything."""
+    def watchdog() -> None:
+        cpu = time.thread_time()
+        if probation[0] == deadline[0] and cpu - probation[1] >= limit_s[0]:
+            raise WatchdogError("a loop did not finish")
+        if probation[0] != deadline[0]:               # first pass in this scan
+            probation[1] = cpu
+        deadline[0] = probation[0] = time.perf_counter() + limit_s[0] - (cpu - probation[1])
+    return watchdog
 
 
 def fault(message: str) -> None:
@@ -33,7 +46,7 @@ HELPERS = {
     "_f32": iec.f32, "_idiv": iec.idiv, "_imod": iec.imod, "_rdiv": iec.rdiv, "_expt": iec.expt,
     "_ix1": iec.ix1, "_ixn": iec.ixn, "_ixo": iec.ixo, "_View": iec.ArrView,
     "_assign": iec.assign_into, "_copy": iec.copy_value,
-    "_pc": time.perf_counter, "_watchdog": watchdog, "_fault": fault, "_new": object.__new__,
+    "_pc": time.perf_counter, "_fault": fault, "_new": object.__new__,
 }
 
 
@@ -63,7 +76,9 @@ class Program:
         ns = dict(stdlib.NAMESPACE)
         ns.update(HELPERS)
         ns.update(self.consts)
-        ns.update({"_DL": [math.inf], "_NST": [0], "_NOW": [0], "_PROGRAMS": {}})
+        ns.update({"_DL": [math.inf], "_WDP": [math.nan, 0.0], "_WDS": [0.5], "_NST": [0], "_NOW": [0],
+                   "_PROGRAMS": {}})
+        ns["_watchdog"] = make_watchdog(ns["_DL"], ns["_WDP"], ns["_WDS"])
         exec(self.code, ns)
         image = Image(self, ns)
         for key, info in self.pous.items():

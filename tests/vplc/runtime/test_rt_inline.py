@@ -42,9 +42,11 @@ def test_optimised_and_plain_code_give_the_same_variables_after_every_scan():
 
 
 def test_a_long_scan_with_only_short_loops_still_trips_the_watchdog(tmp_path):
-    """Short constant FOR loops are checked once when they end instead of in every iteration."""
+    """Short constant FOR loops are checked once when they end instead of in every iteration (the first check past
+    the limit starts the watchdog's probation, the next one faults)."""
     path = tmp_path / "main.st"
-    path.write_text("PROGRAM Main\nVAR i, n : INT; END_VAR\nFOR i := 1 TO 10 DO n := n + 1; END_FOR;\nEND_PROGRAM\n")
+    path.write_text("PROGRAM Main\nVAR i, n : INT; END_VAR\nFOR i := 1 TO 10 DO n := n + 1; END_FOR;\n"
+                    "FOR i := 1 TO 10 DO n := n + 1; END_FOR;\nEND_PROGRAM\n")
     plc = load_plc([str(path)], watchdog_ms=0.000001)
     try:
         plc.scan(0)
