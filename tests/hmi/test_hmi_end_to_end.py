@@ -37,7 +37,8 @@ class System:
             self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
             self.plc.write("Connect_SvrPort", self.robot.svr_port)
         self.stop_event = threading.Event()
-        self.plc_thread = threading.Thread(target=self.plc.run_realtime, args=(self.stop_event,), daemon=True)
+        self.plc_thread = threading.Thread(target=self.plc.run_realtime, args=(self.stop_event,),
+                                           kwargs={"spin_ns": 0}, daemon=True)
         self.plc_thread.start()
         self.hmi = HmiServer(self.plc, self.mapping, port=0)
         self.hmi.start()
@@ -252,15 +253,23 @@ def test_out_of_range_entry_shows_the_error_and_nothing_reaches_the_robot(connec
     browser.screenshot("e2e_moveabs_range_error")
 
 
+def edit_place_speed(system, browser, speed: int) -> None:
+    """Segment 5 (place) through its dialog on the PnP page, as the operator does; returns once the PLC has it."""
+    browser.driver.find_element(By.ID, "edit-4").click()
+    browser.wait_for(lambda d: d.find_element(By.ID, "seg-dialog").get_attribute("open") is not None, "the dialog")
+    browser.type_into("PnP_MoveParameters[4].Speed", str(speed))
+    browser.click("seg-apply")
+    browser.wait_for(lambda d: d.find_element(By.ID, "seg-dialog").get_attribute("open") is None
+                     and "Segment 5 updated" in browser.message(), "the segment update")
+    system.wait(lambda: system.read("PnP_MoveParameters")[4]["Speed"] == speed, "the new place speed in the PLC")
+
+
 def test_two_pnp_cycles_with_pause_and_resume(connected):
     browser = connected.open("pnp")
     browser.click("btn-preset")
     browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset")
-    browser.driver.find_element(By.ID, "edit-4").click()        # slow "place" move: a sure window to pause in
-    browser.wait_for(lambda d: d.find_element(By.ID, "seg-dialog").get_attribute("open") is not None, "the dialog")
-    browser.type_into("PnP_MoveParameters[4].Speed", "1")
-    browser.click("seg-apply")
-    browser.wait_for(lambda d: "Segment 5 updated" in browser.message(), "the segment update")
+    preset_speed = connected.read("PnP_MoveParameters")[4]["Speed"]
+    edit_place_speed(connected, browser, 1)                     # slow "place" move: a sure window to pause in
     targets = [[p["TargetPosition"][k] for k in ("X", "Y", "Z")] for p in connected.read("PnP_MoveParameters")]
     cycles = connected.read("PnP_CycleCount")
     since = connected.event_count()
@@ -274,7 +283,8 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
     assert connected.robot.wait_event("motion_end", timeout=1.0, since=len(connected.robot.events)) is None
     assert connected.read("PnP_Segment") == 4, "the sequence must wait while the robot is paused"
     assert connected.robot_state()["tcp"][2] > targets[4][2] + 1, "paused before reaching the place point"
-    browser.click("btn-resume")
+    edit_place_speed(connected, browser, preset_speed)           # the paused move keeps speed 1 (latched at its
+    browser.click("btn-resume")                                  # start); the next cycle places at the preset speed
     connected.wait(lambda: not connected.robot_state()["paused"], "the robot to resume")
     connected.wait(lambda: connected.read("PnP_CycleCount") >= cycles + 2, "two complete cycles", timeout=90)
     browser.wait_for(lambda d: int(browser.status("PnP_CycleCount") or 0) >= cycles + 2, "the cycle count")
