@@ -128,8 +128,16 @@ def commands(system, since: float) -> list[str]:
     return [t for t in script_texts(system, since) if not t.startswith("QueueTag(")]
 
 
+ANSWERS = (": Done", ": done", ": Error", ": aborted")     # the message line's words for the FB's answer
+
+
 def execute_and_wait_done(system, browser, group: str) -> None:
+    """Execute and wait for this command's answer: the click replaces the message line at once ("Sending …"),
+    and the page writes the answer only from values read after the command, so a Done still shown from the
+    previous command of the same page does not count."""
     browser.click("btn-execute")
+    browser.wait_for(lambda d: any(word in browser.message() for word in ANSWERS), f"the answer of {group}",
+                     timeout=MOVE_WAIT_S)
     browser.wait_status(f"{group}_Done", "true", timeout=MOVE_WAIT_S)
     assert browser.status(f"{group}_Error") == "false"
 
