@@ -23,7 +23,8 @@ const alarms = { list: [], active: {}, texts: {} };
 
 function alarmVariables() {
   return [...ALARM_SOURCES.flatMap((s) => s.slice(2)), "RobotStatus_Valid", "RobotStatus", "Connect_Reconnecting",
-    "Connect_Connected", "Project_Busy", "Project_Done"].filter((n) => MAP.variables[n]);
+    "Connect_RetryCount", "Robot_LastErrorID", "Connect_Connected", "Project_Busy", "Project_Done"]
+    .filter((n) => MAP.variables[n]);
 }
 
 function idText(id) { return "16#" + Number(id).toString(16).toUpperCase().padStart(4, "0"); }
@@ -40,11 +41,28 @@ async function loadAlarms() {
 
 function saveAlarms() { sessionStorage.setItem("cbt-alarms", JSON.stringify(alarms.list)); }
 
+/* One alarm for a whole outage: CBT_Connect shows Error only during its back-off waits (FALSE during each
+   attempt), so its own Error would raise and clear an alarm on every retry. While Connect_Reconnecting is TRUE
+   the connection alarm stays active under one key; its ErrorID is the latest reason seen (Connect_ErrorID of
+   the loss or of the last failed attempt, else the connection's Robot_LastErrorID), updated in place. */
+function reconnectingAlarm(v) {
+  const held = alarms.active["connect:reconnecting"];
+  const id = v.Connect_ErrorID || (held && held.id) || v.Robot_LastErrorID || 0;
+  const known = alarms.texts[idText(id)];
+  const reason = v.Connect_Error === true && v.Connect_ErrorID === id && v.Connect_ErrorDescrip ? v.Connect_ErrorDescrip
+    : held && held.id === id ? held.reason : known ? known.text : "";
+  const attempt = v.Connect_RetryCount ? ` (attempt ${v.Connect_RetryCount})` : "";
+  return { source: "Connection", id, reason,
+    text: `Connection lost, reconnecting${attempt}${reason ? " — " + reason : ""}` };
+}
+
 /* what is in alarm now: {key: {source, id | code, text}} */
 function currentAlarms() {
-  const v = live.values, now = {};
+  const v = live.values, now = {}, reconnecting = v.Connect_Reconnecting === true;
+  if (reconnecting) now["connect:reconnecting"] = reconnectingAlarm(v);
   for (const [key, source, flag, idVar, textVar] of ALARM_SOURCES)
-    if (v[flag] === true && v[idVar]) now[`${key}:${v[idVar]}`] = { source, id: v[idVar], text: v[textVar] || "" };
+    if (v[flag] === true && v[idVar] && !(reconnecting && key === "connect"))
+      now[`${key}:${v[idVar]}`] = { source, id: v[idVar], text: v[textVar] || "" };
   const rs = v.RobotStatus;
   if (v.RobotStatus_Valid === true && rs) {
     if (rs.RobotError) now[`robot:${rs.ErrorCode}`] = { source: "Robot", code: rs.ErrorCode, text: rs.ErrorText || "Robot error" };
@@ -58,7 +76,11 @@ function checkAlarms() {
   const now = currentAlarms(), stamp = new Date();
   let changed = false;
   for (const [key, a] of Object.entries(now)) {
-    if (alarms.active[key]) continue;
+    const held = alarms.active[key];
+    if (held) {                     // still active: its reason may change, it stays one (acknowledged) entry
+      if (held.id !== a.id || held.text !== a.text) { Object.assign(held, a); changed = true; }
+      continue;
+    }
     const entry = { ...a, key, time: stamp, ack: false, gone: null };
     alarms.list.unshift(entry);
     alarms.active[key] = entry;

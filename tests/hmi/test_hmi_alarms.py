@@ -1,7 +1,8 @@
 """The HMI's alarm banner and history and its Robot tile (issue 14) in headless Chromium, against the examples on
 the virtual PLC in real time and the simulator with its Ethernet Slave: a robot error raises the alarms (robot
 code and text, CBT_Connect's 16#4006), Acknowledge clears the banner, Play on the Robot tile restarts the
-project through CBT_ProjectControl and the message line reports the FB's answer."""
+project through CBT_ProjectControl and the message line reports the FB's answer; a link outage is one alarm
+from the loss until connected again, however many reconnect attempts it takes."""
 import pytest
 from selenium.webdriver.common.by import By
 
@@ -39,6 +40,11 @@ def acknowledge_until_quiet(browser):
     browser.wait_for(clicked_and_clear, "the banner to clear")
     rows = browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
     assert rows and all("acknowledged" in row for row in rows), rows
+
+
+def connection_rows(browser):
+    rows = browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
+    return [row for row in rows if "Connection" in row]
 
 
 def running_project(system, browser):
@@ -85,3 +91,37 @@ def test_a_refused_project_command_is_reported_as_an_error_not_as_sent(system):
     assert "error" in browser.driver.find_element(By.ID, "message").get_attribute("class")
     with system.sim.lock:
         system.robot.svr_source.model.estop = False
+
+
+def test_a_link_outage_is_one_alarm_through_every_reconnect_attempt_until_connected(system):
+    """CBT_Connect shows Error only during its back-off waits (docs/library/CBT_Connect.md, "Reconnect"): the HMI
+    must not raise a new alarm for every attempt. Black hole: the loss (16#2006) raises one connection alarm;
+    acknowledged, it stays active and the banner stays hidden while attempt 1 fails (16#3004, after Time_Out)
+    and attempt 2 runs; once the fault is cleared and the link is up again the same alarm is gone."""
+    browser = system.open("index")
+    running_project(system, browser)
+    system.wait(lambda: system.read("Connect_Connected"), "the connection", 15)
+    # this test's own history: what is active now comes back at the next poll, what is gone is forgotten
+    browser.driver.execute_script("alarms.list.length = 0; alarms.active = {}; saveAlarms(); drawAlarms();")
+    browser.wait_for(lambda d: text(browser, "robot-link") == "Listen node connected", "the link on the tile")
+    assert connection_rows(browser) == []
+    system.robot.inject("black_hole")
+    try:
+        browser.wait_for(lambda d: any("Connection lost, reconnecting" in row for row in connection_rows(browser)),
+                         "the connection alarm")
+        acknowledge_until_quiet(browser)
+        # attempt 1 ends after Time_Out (10 s) with 16#3004 and a 1 s back-off, then attempt 2 starts
+        browser.wait_for(lambda d: any("(attempt 2)" in row and "16#3004" in row for row in connection_rows(browser)),
+                         "the second reconnect attempt after the first failed", timeout=45)
+        rows = connection_rows(browser)
+        assert len(rows) == 1 and rows[0].endswith("active, acknowledged"), rows
+        assert banner(browser) == ""
+    finally:
+        system.robot.clear_faults()
+    system.wait(lambda: system.read("Connect_Connected"), "the reconnect after the fault was cleared", 30)
+    browser.wait_for(lambda d: text(browser, "robot-link") == "Listen node connected", "the link on the tile")
+    browser.wait_for(lambda d: any(row.endswith("gone, acknowledged") for row in connection_rows(browser)),
+                     "the connection alarm gone")
+    rows = connection_rows(browser)
+    assert len(rows) == 1 and "Connection lost, reconnecting" in rows[0], rows
+    assert banner(browser) == ""
