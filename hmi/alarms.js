@@ -1,7 +1,7 @@
 /* CBT HMI – alarms, the Robot tile and FB results (issue 14).
    - Alarm banner on every page: the newest unacknowledged alarm with its ErrorID, text and remedy.
-   - Alarm history on the main page (time, source, ErrorID or robot code, text, active / gone, acknowledged),
-     kept for the browser tab while pages change; Acknowledge marks alarms seen (it does not reset the PLC).
+   - Alarm history on the main page (time, source, ErrorID or robot code, text, active / gone, acknowledged;
+     a tapped row shows whole on the message line), kept for the browser tab while pages change; Acknowledge marks alarms seen (it does not reset the PLC).
    - Robot tile on the main page: project state, robot error (the robot's code and text), E-stop, mode, link;
      Play and Stop press the robot's stick buttons through CBT_ProjectControl (Project_Command/Project_Execute).
    - watchResult: the message line reports what the FB answered (Done, Error with ErrorID and text,
@@ -103,6 +103,8 @@ function alarmLine(a) {
   return `${a.source}${what ? " " + what : ""}: ${a.text}`;
 }
 
+function remedyOf(a) { return a.id && alarms.texts[idText(a.id)] ? alarms.texts[idText(a.id)].remedy : ""; }
+
 function acknowledge(entries) {
   for (const a of entries) a.ack = true;
   saveAlarms();
@@ -115,7 +117,7 @@ function drawAlarms() {
     const open = alarms.list.filter((a) => !a.ack);
     banner.hidden = open.length === 0;
     if (open.length) {
-      const a = open[0], remedy = a.id && alarms.texts[idText(a.id)] ? alarms.texts[idText(a.id)].remedy : "";
+      const a = open[0], remedy = remedyOf(a);
       banner.querySelector(".text").textContent = `${a.time.toLocaleTimeString()}  ${alarmLine(a)}` +
         (remedy ? ` — ${remedy}` : "") + (open.length > 1 ? `  (+${open.length - 1} more)` : "");
     }
@@ -129,6 +131,7 @@ function drawAlarms() {
     tr.insertCell().textContent = a.time.toLocaleTimeString();
     tr.insertCell().textContent = alarmLine(a);
     tr.insertCell().textContent = (a.gone ? "gone" : "active") + (a.ack ? ", acknowledged" : "");
+    tr.onclick = () => message(`${a.time.toLocaleTimeString()}  ${alarmLine(a)}` + (remedyOf(a) ? ` — ${remedyOf(a)}` : ""));
   }
 }
 
@@ -159,7 +162,7 @@ function robotTile(container) {
     <div class="buttons"><button class="primary" id="btn-project-play">Play</button>
       <button class="danger" id="btn-project-stop">Stop Project</button></div></div>
     <div class="alarms-head">Alarms <button id="btn-alarm-ack-all">Acknowledge all</button></div>
-    <table id="alarm-history"></table>`;
+    <div class="alarm-list"><table id="alarm-history"></table></div>`;
   container.append(area);
   const press = (command, what) => {
     executeCommand("Project_Execute", { Project_Command: PROJECT_CMD[command] }, what).then((sent) => {

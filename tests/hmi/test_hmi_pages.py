@@ -143,3 +143,40 @@ def test_pnp_segment_edit_writes_only_that_segment(page):
     browser.wait_for(lambda d: "Segment 5 updated" in browser.message(), "the update confirmation")
     assert plc.vars["PnP_MoveParameters"][4]["TargetPosition"]["Z"] == 180
     assert {path.split("]")[0] for path, _ in plc.writes} == {"PnP_MoveParameters[4"}
+
+
+def test_alarm_history_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
+    """Six alarms raised one after the other (a command FB's Error with a new ErrorID each time): the history on the
+    main page shows at least five of them whole, one line each, scrolls only vertically, the page still fits the
+    panel, and a tapped row shows its whole text on the message line."""
+    plc, open_page = page
+    browser = open_page("index")
+    browser.driver.execute_script("alarms.list.length = 0; alarms.active = {}; saveAlarms(); drawAlarms();")
+    texts = ["Speed out of range: 1..100 % for a PTP format, 1..4500 mm/s for a line or a circle",
+             "Connection lost: the robot did not answer the status query within 1 s"] * 3
+    try:
+        for n, text in enumerate(texts, 1):
+            with plc.lock:
+                plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=0x1010 + n, MoveAbs_ErrorDescrip=text)
+            browser.wait_for(lambda d: len(d.find_element(By.ID, "alarm-history").find_elements(By.TAG_NAME, "tr"))
+                             == n + 1, f"alarm {n} in the history")
+        whole, one_line, box_scrolls_sideways = browser.driver.execute_script("""
+            const table = document.getElementById('alarm-history');
+            let box = table;
+            while (box && !['auto', 'scroll'].includes(getComputedStyle(box).overflowY)) box = box.parentElement;
+            const b = box.getBoundingClientRect(), rows = [...table.rows].slice(1);
+            const whole = rows.filter((r) => { const q = r.getBoundingClientRect();
+              return q.top >= b.top - 0.5 && q.bottom <= b.bottom + 0.5; }).length;
+            const line = parseFloat(getComputedStyle(rows[0].cells[1]).lineHeight);
+            return [whole, rows.every((r) => r.getBoundingClientRect().height <= line + 2),
+                    box.scrollWidth > box.clientWidth];""")
+        assert whole >= 5 and one_line and not box_scrolls_sideways, (whole, one_line, box_scrolls_sideways)
+        assert browser.viewport_overflow() == []
+        browser.screenshot("fake_index_alarm_history")
+        browser.driver.find_element(By.ID, "alarm-history").find_elements(By.TAG_NAME, "tr")[2].click()
+        browser.wait_for(lambda d: texts[4] in browser.message(), "the tapped alarm on the message line")
+        assert "16#1015" in browser.message()
+    finally:
+        with plc.lock:
+            plc.vars.update(MoveAbs_Error=False, MoveAbs_ErrorID=0, MoveAbs_ErrorDescrip="")
+        browser.click("btn-alarm-ack-all")
