@@ -1,6 +1,7 @@
 """`make demo`: robot simulator + virtual PLC running the examples in real time + web HMI, stopped by Ctrl-C.
 
     python3 examples/run_demo.py [--host 127.0.0.1] [--robot-port 5890] [--svr-port 5891] [--hmi-port 8080]
+                                 [--control-port 5889]
 """
 from __future__ import annotations
 
@@ -18,11 +19,13 @@ for entry in (ROOT / "src", ROOT):
     if str(entry) not in sys.path:
         sys.path.insert(0, str(entry))
 
+from sim.control import robot_numbering  # noqa: E402
 from sim.server import SimServer  # noqa: E402
 from vplc.hmi.mapping import Mapping, MappingError  # noqa: E402
 from vplc.hmi.server import HmiServer  # noqa: E402
 
 SOURCES = [ROOT / "lib" / "CBT_Commands_Lib", ROOT / "examples"]
+CONTROL_HOST = "127.0.0.1"     # the simulator's control channel stays on loopback whatever --host says
 
 
 def robot_event_line(event: dict) -> str | None:
@@ -48,6 +51,30 @@ def robot_event_line(event: dict) -> str | None:
     if what is None:
         return None
     return f"[{event['t']:9.3f} s] robot {event['robot'] + 1}: {what}"
+
+
+def control_line(port: int) -> str:
+    """A command a user can paste into another terminal: stop the robot's project through the control channel."""
+    return (f"python3 -c 'import json, socket; s = socket.create_connection((\"{CONTROL_HOST}\", {port})); "
+            f"s.sendall(json.dumps({{\"cmd\": \"stop_project\", \"robot\": 0}}).encode() + b\"\\n\"); "
+            f"print(s.makefile().readline())'")
+
+
+def default_control_port(robot_port: int, taken: tuple[int, ...]) -> int:
+    """The port before the robot's (5889 for 5890), as sim/tmflow_listener.py derives it; 0 (any free port,
+    printed at start) when that one is taken or is one of the demo's other ports."""
+    derived = robot_port - 1
+    if derived < 1 or derived in taken:
+        return 0
+    probe = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        probe.bind((CONTROL_HOST, derived))
+    except OSError:
+        return 0
+    finally:
+        probe.close()
+    return derived
 
 
 class DemoError(Exception):
@@ -115,13 +142,18 @@ def parse_args(argv):
     parser.add_argument("--svr-port", type=tcp_port, default=None,
                         help="robot Ethernet Slave port (default: the robot port + 1, i.e. 5891)")
     parser.add_argument("--hmi-port", type=tcp_port, default=8080, help="web HMI port (default 8080)")
+    parser.add_argument("--control-port", type=tcp_port, default=None,
+                        help="simulator control channel port, always on 127.0.0.1 (default: the robot port - 1, "
+                             "i.e. 5889; any free port, printed at start, when that one is taken)")
     return parser.parse_args(argv)
 
 
 class Demo:
-    def __init__(self, host: str, robot_port: int, hmi_port: int, svr_port: int | None = None):
+    def __init__(self, host: str, robot_port: int, hmi_port: int, svr_port: int | None = None,
+                 control_port: int | None = None):
         self.host, self.robot_port, self.hmi_port = host, robot_port, hmi_port
         self.svr_port = svr_port or (robot_port + 1 if robot_port < 65535 else robot_port - 1)
+        self.control_port = control_port          # None: derived from the robot port at start
         self.stop_event = threading.Event()
         self.sim = self.plc = self.hmi = self.plc_thread = None
         self.fault: str | None = None
@@ -131,6 +163,16 @@ class Demo:
         check_port_free(self.host, self.robot_port, "robot simulator", "--robot-port")
         check_port_free(self.host, self.hmi_port, "web HMI", "--hmi-port")
         check_port_free(self.host, self.svr_port, "robot Ethernet Slave", "--svr-port")
+        if self.control_port is None:
+            self.control_port = default_control_port(self.robot_port, (self.svr_port, self.hmi_port))
+        else:
+            check_port_free(CONTROL_HOST, self.control_port, "simulator control channel", "--control-port")
+        ports = [("--robot-port", self.robot_port), ("--svr-port", self.svr_port), ("--hmi-port", self.hmi_port),
+                 ("--control-port", self.control_port)]
+        for i, (option, port) in enumerate(ports):
+            for other, same in ports[i + 1:]:
+                if port == same:
+                    raise DemoError(f"error: {option} and {other} are both {port}; give each server its own port.")
         try:
             mapping = Mapping.load()
         except MappingError as exc:
@@ -150,8 +192,8 @@ class Demo:
         with self.plc.lock:
             self.plc.write("Connect_AddressIP", self.host)
             self.plc.write("Connect_Dest_PortIP", self.robot_port)
-        self.sim = SimServer(host=self.host, port=self.robot_port, robots=1,
-                             svr_port=self.svr_port)
+        self.sim = SimServer(host=self.host, port=self.robot_port, robots=1, svr_port=self.svr_port,
+                             control_port=self.control_port, control_host=CONTROL_HOST)
         try:
             self.sim.start_background()
         except OSError as exc:
@@ -180,6 +222,9 @@ class Demo:
             "CBT_Commands_Lib demo is running:",
             f"  robot simulator   TM Listen Node, 1 robot on {self.host}:{self.robot_port}, "
             f"Ethernet Slave on {self.host}:{self.sim.robots[0].svr_port}",
+            f"  control channel   {CONTROL_HOST}:{self.sim.control.port}, the simulator's JSON-line requests "
+            f"({robot_numbering(1)}):",
+            "                    E-stop, project stop/start, cut the link (docs/simulator.md \"Control channel\")",
             f"  virtual PLC       PnP_Example + Commands_Example (ladder) in a {period_ms:g} ms task (real time)",
             f"  web HMI           {self.hmi.url} (without a key: monitor only)",
             "",
@@ -190,6 +235,8 @@ class Demo:
             "The keys are new at every start; keep them to the people who may move the robot.",
             "The Program (Ladder) page shows Commands_Example's rungs live.",
             "Robot-side events (robot error, project stopped, Listen node left) are printed below as they happen.",
+            "Stop the robot's project from another terminal (then press Play on the main page):",
+            f"  {control_line(self.sim.control.port)}",
             "Press Ctrl-C to stop.",
         ])
 
@@ -220,7 +267,7 @@ class Demo:
 
 def main(argv=None) -> int:
     args = parse_args(argv)
-    demo = Demo(args.host, args.robot_port, args.hmi_port, args.svr_port)
+    demo = Demo(args.host, args.robot_port, args.hmi_port, args.svr_port, args.control_port)
     signal.signal(signal.SIGTERM, lambda *_: demo.stop_event.set())
     try:
         demo.start()

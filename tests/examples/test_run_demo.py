@@ -56,12 +56,13 @@ def test_port_outside_the_tcp_range_is_refused():
     assert result.returncode == 2 and "70000 is not a TCP port (1..65535)" in result.stderr
 
 
-def start_demo(robot_port: int, hmi_port: int, svr_port: int):
+def start_demo(robot_port: int, hmi_port: int, svr_port: int, control_port: int):
     """The demo as `make demo` starts it; returns (process, banner text, queue of further stdout lines)."""
     import queue
     import threading
     demo = subprocess.Popen([sys.executable, str(DEMO), "--robot-port", str(robot_port), "--hmi-port",
-                             str(hmi_port), "--svr-port", str(svr_port)], stdout=subprocess.PIPE,
+                             str(hmi_port), "--svr-port", str(svr_port), "--control-port", str(control_port)],
+                            stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, cwd=ROOT)
     lines: queue.Queue = queue.Queue()
     errors: list[str] = []                  # drained all the time: a full stderr pipe would block the demo
@@ -93,29 +94,85 @@ def stop_demo(demo, lines) -> tuple[str, str]:
     return "".join(lines.queue), "".join(demo.errors)
 
 
+def control_request(port: int, request: dict) -> dict:
+    import json
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as conn:
+        conn.sendall(json.dumps(request).encode() + b"\n")
+        return json.loads(conn.makefile().readline())
+
+
+def wait_for_line(lines, text: str, timeout_s: float = 30.0) -> None:
+    """Wait until the demo prints a line containing ``text`` (other lines may come first, in any order)."""
+    import queue
+    import time
+    deadline, seen = time.monotonic() + timeout_s, []
+    while not any(text in line for line in seen):
+        try:
+            seen.append(lines.get(timeout=max(0.0, deadline - time.monotonic())))
+        except queue.Empty:
+            raise AssertionError(f"the demo did not print {text!r} within {timeout_s} s; it printed {seen}") from None
+    for line in seen:                 # stop_demo() reports everything the demo printed
+        lines.put(line)
+
+
 def test_demo_runs_everything_stops_cleanly_on_ctrl_c_and_starts_again_at_once():
     import json
     import urllib.request
     ports = []
-    while len(ports) < 3:
+    while len(ports) < 4:
         port = free_port()
         if port not in ports:
             ports.append(port)
-    robot_port, hmi_port, svr_port = ports
+    robot_port, hmi_port, svr_port, control_port = ports
     for attempt in range(2):          # the second start follows at once: the first one's connections in TIME_WAIT
-        demo, text, lines = start_demo(robot_port, hmi_port, svr_port)
+        demo, text, lines = start_demo(robot_port, hmi_port, svr_port, control_port)
         try:
             assert f"1 robot on 127.0.0.1:{robot_port}" in text and "1 ms task" in text
             assert f"http://127.0.0.1:{hmi_port}/" in text
+            assert f"control channel   127.0.0.1:{control_port}, the simulator's JSON-line requests" in text
             url = f"http://127.0.0.1:{hmi_port}/api/read?names=PnP_Segment"
             with urllib.request.urlopen(url, timeout=5) as r:
                 assert json.loads(r.read())["ok"] is True
             with socket.create_connection(("127.0.0.1", robot_port), timeout=5):
                 pass
+            answer = control_request(control_port, {"cmd": "state", "robot": 0})
+            assert answer["ok"] is True and answer["result"]["port"] == robot_port, answer
+            if attempt == 0:
+                # the command printed for the user, pasted into a shell as it is, stops the robot's project
+                pasted = [line for line in text.splitlines() if line.startswith("python3 -c ")]
+                assert len(pasted) == 1, text
+                shell = subprocess.run(["sh", "-c", pasted[0]], capture_output=True, text=True, timeout=30)
+                assert json.loads(shell.stdout) == {"ok": True, "result": None}, (shell.stdout, shell.stderr)
+                wait_for_line(lines, "robot 1: project stopped")
+                assert control_request(control_port, {"cmd": "state"})["result"]["project_running"] is False
         finally:
             out, err = stop_demo(demo, lines)
         assert demo.returncode == 0, (attempt, demo.returncode, out, err)
         assert "Demo stopped" in out and "Traceback" not in err
+
+
+def test_taken_control_port_is_named_and_two_servers_on_one_port_are_refused(busy_port):
+    result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(free_port()),
+                      "--control-port", str(busy_port))
+    assert result.returncode == 2
+    assert f"port {busy_port} on 127.0.0.1 (simulator control channel) is already in use" in result.stderr
+    assert "--control-port PORT" in result.stderr and "Traceback" not in result.stderr
+    port = free_port()
+    result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(port), "--control-port", str(port))
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert f"--hmi-port and --control-port are both {port}; give each server its own port." in result.stderr
+
+
+def test_control_port_defaults_to_the_port_before_the_robots_or_any_free_one(busy_port):
+    """As sim/tmflow_listener.py derives it: 5889 for 5890; 0 (any free port, printed) when that one is taken or
+    is one of the demo's own ports."""
+    sys.path.insert(0, str(ROOT / "examples"))
+    from run_demo import default_control_port
+    port = free_port()
+    assert default_control_port(port + 1, ()) in (port, 0)         # 0 only if another program took it meanwhile
+    assert default_control_port(busy_port + 1, ()) == 0
+    assert default_control_port(port + 1, (port,)) == 0
+    assert default_control_port(1, ()) == 0
 
 
 def test_taken_port_names_the_process_that_holds_it(busy_port):
