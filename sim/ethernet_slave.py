@@ -146,10 +146,13 @@ class EthernetSlave:
     def inject(self, robot, fault, **params):
         """``stall`` (enabled=True): no data table and no answers, connections stay open;
         ``corrupt_checksum`` (count=1): the next frames leave with a wrong checksum;
-        ``disconnect``: every Ethernet Slave client of the robot is closed now. ValueError when unknown."""
+        ``disconnect``: every Ethernet Slave client of the robot is closed now;
+        ``refuse_writes`` (status=6): every well-formed write is answered with that status code (1..7), nothing is
+        written. ValueError when unknown."""
         if fault not in FAULTS:
             raise ValueError(f"unknown Ethernet Slave fault '{fault}'; known: {', '.join(FAULTS)}")
-        unknown = set(params) - {"stall": {"enabled"}, "corrupt_checksum": {"count"}, "disconnect": set()}[fault]
+        unknown = set(params) - {"stall": {"enabled"}, "corrupt_checksum": {"count"}, "disconnect": set(),
+                                 "refuse_writes": {"status"}}[fault]
         if unknown:
             raise ValueError(f"Ethernet Slave fault '{fault}' has no parameter {', '.join(sorted(unknown))}")
         if fault == "stall":
@@ -159,13 +162,18 @@ class EthernetSlave:
             if type(count) is not int or not 1 <= count <= 1_000_000:
                 raise ValueError(f"'count' of fault 'corrupt_checksum' must be 1..1000000, got {count!r}")
             robot.svr.corrupt += count
+        elif fault == "refuse_writes":
+            status = params.get("status", 6)
+            if type(status) is not int or not 1 <= status <= 7:
+                raise ValueError(f"'status' of fault 'refuse_writes' must be 1..7 (a §17.4.1 code), got {status!r}")
+            robot.svr.refuse = status
         else:
             for conn in list(robot.svr_conns.values()):
                 self._drop(robot, conn, "fault: disconnect")
         robot._log("svr_fault", fault=fault, params=params)
 
     def clear_faults(self, robot):
-        robot.svr.stalled, robot.svr.corrupt = False, 0
+        robot.svr.stalled, robot.svr.corrupt, robot.svr.refuse = False, 0, 0
         robot._log("svr_fault", fault="cleared", params={})
 
     def close(self):

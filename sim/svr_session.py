@@ -44,7 +44,7 @@ DEFAULT_STREAM = (
 )
 
 
-FAULTS = ("stall", "corrupt_checksum", "disconnect")    # fault injection (docs/simulator.md), clear_faults() ends
+FAULTS = ("stall", "corrupt_checksum", "disconnect", "refuse_writes")    # fault injection (docs/simulator.md), clear_faults() ends
 
 
 class SvrConfigError(ValueError):
@@ -70,6 +70,7 @@ class SvrSession:
         self.stream_id = 0
         self.stalled = False      # fault "stall": no data table, requests read and dropped unanswered
         self.corrupt = 0          # fault "corrupt_checksum": this many more frames leave with a wrong checksum
+        self.refuse = 0           # fault "refuse_writes": every well-formed write is answered with this status
 
     def configure(self, items=None, mode=None, period=None):
         """Set the streamed data table (TransmitFile, §17.2): items in order, mode 1/2/3, period in s (0 = off)."""
@@ -208,6 +209,9 @@ class SvrSession:
         except SvrContentError as exc:
             self.log("svr_invalid", conn=conn, id=ident, reason=str(exc))
             self._status(conn, ident, INVALID_DATA)
+            return
+        if self.refuse:
+            self._status(conn, ident, self.refuse, pairs[0][0] if self.refuse >= NOT_EXIST and pairs else None)
             return
         checks = ((NOT_EXIST, lambda item: item is None),
                   (READ_ONLY, lambda item: not item.writable),

@@ -392,6 +392,19 @@ def test_fault_stall_stops_the_table_and_the_answers_until_cleared(h):
     assert h.until(lambda: len(peer.frames) >= 2, timeout=1)
 
 
+def test_fault_refuse_writes_answers_every_write_with_its_status_and_writes_nothing(h):
+    peer = h.connect_svr()
+    h.srv.svr.inject(h.robot, "refuse_writes", status=6)
+    assert ask(h, peer, "W1,2,Stick_Pause=1") == ("TMSVR", b"W1,0,06,ModeError;Stick_Pause")
+    h.srv.svr.inject(h.robot, "refuse_writes", status=1)
+    assert ask(h, peer, "W2,2,Ctrl_DO0=1") == ("TMSVR", b"W2,0,01,NotSupport")
+    assert values(h, peer, ["Project_Pause", "Ctrl_DO0"]) == {"Project_Pause": False, "Ctrl_DO0": 0}
+    with pytest.raises(ValueError, match="must be 1..7"):
+        h.srv.svr.inject(h.robot, "refuse_writes", status=0)
+    h.srv.svr.clear_faults(h.robot)
+    assert ask(h, peer, "W3,2,Ctrl_DO0=1") == ("TMSVR", b"W3,0,00,OK")
+
+
 def test_fault_corrupt_checksum_damages_the_next_frames_only(h):
     peer = h.connect_svr()
     h.srv.svr.inject(h.robot, "corrupt_checksum", count=2)
