@@ -162,3 +162,18 @@ def test_damaged_data_table_frame_is_dropped_and_counted(svr, raw):
     assert svr.read("Cobot.Status.ProjectRunning")                # nothing of the damaged table was taken
     assert svr.until(lambda: svr.read("Cobot.Status.Updates") > updates, 1)
     assert svr.read("status.Valid") and not svr.read("status.Error")
+
+
+@pytest.mark.parametrize("stop,error_id", [("robot error", 0x4006), ("project stopped", 0x4007)])
+def test_a_command_refused_while_the_project_is_stopped_says_why(svr, stop, error_id):
+    """With the Ethernet Slave, a command started while the robot's project is stopped is refused with what the
+    operator must fix: 16#4006 after a robot error, 16#4007 when the project was stopped without one."""
+    if stop == "robot error":
+        svr.robot.session.robot_error("Line: target pose is out of reach")
+    else:
+        svr.robot.inject("stop_project")
+    assert svr.until(lambda: svr.read("conn.ErrorID") == error_id, 2), hex(svr.read("conn.ErrorID"))
+    svr.set_struct("MoveParam", move_abs())
+    svr.write("MoveExec", True)
+    assert svr.until(lambda: svr.read("mover.Error"), 1)
+    assert svr.read("mover.ErrorID") == error_id and svr.events("motion_start") == []

@@ -149,3 +149,45 @@ def test_a_motion_whose_ok_reply_is_lost_completes_by_its_queue_tag(rig):
     assert rig.until(lambda: rig.read("movers[1].Done") or rig.read("movers[1].Error"), 8)
     assert rig.read("movers[1].Done") and rig.read("Cobot.BadFrames") == 1
     assert rig.plc.now_ns - start < 2 * SEC and len(rig.events("motion_start")) == 1
+
+
+def test_a_first_connect_that_fails_is_shown_and_then_retried_while_execute_is_held():
+    """A PLC that boots before its robot: the first connect ends in Error at Time_Out (PLCopen), then, Execute still
+    held, CBT_Connect keeps trying on the back-off like after a loss and connects by itself when the robot is up.
+    A command started meanwhile is refused with 16#200C (retrying), not 'execute CBT_Connect first'."""
+    r = Rig(connect=False)
+    try:
+        r.robot.inject("refuse_connections")
+        r.write("ConnExec", True)
+        assert r.until(lambda: r.read("conn.Error"), 15)
+        assert r.read("conn.ErrorID") == 0x2004
+        assert r.until(lambda: r.read("conn.Reconnecting") and r.read("conn.RetryCount") >= 1, 3)
+        assert r.read("Cobot.LinkErrorID") == 0x2004
+        go(r, 1, rz=10)
+        assert r.until(lambda: r.read("movers[1].Error"), 1)
+        assert r.read("movers[1].ErrorID") == 0x200C and r.events("motion_start") == []
+        assert r.read("movers[1].ErrorDescrip").startswith("Robot not connected: CBT_Connect is retrying")
+        r.robot.clear_faults()
+        assert r.until(lambda: r.read("conn.Connected"), 7)
+        assert not r.read("conn.Error") and not r.read("conn.Reconnecting") and r.read("Cobot.LinkErrorID") == 0
+    finally:
+        r.close()
+
+
+def test_a_command_started_while_the_link_is_down_says_why(rig):
+    """After a loss CBT_Connect retries; a command refused meanwhile names that state (16#200C) and what is
+    behind it is in stCBT_Connection.LinkErrorID (here 16#2006, the link fell silent)."""
+    rig.robot.inject("black_hole")
+    assert rig.until(lambda: rig.read("conn.Reconnecting"), 3)
+    assert rig.read("Cobot.LinkErrorID") == 0x2006
+    go(rig, 1, rz=10)
+    assert rig.until(lambda: rig.read("movers[1].Error"), 1)
+    assert rig.read("movers[1].ErrorID") == 0x200C
+    rig.write("ConnExec", False)                      # Execute falling: nothing is retried, nothing to say
+    rig.scans(2)
+    assert rig.read("Cobot.LinkErrorID") == 0
+    rig.write("MExec[1]", False)
+    rig.scans(1)
+    go(rig, 1, rz=10)
+    assert rig.until(lambda: rig.read("movers[1].Error"), 1)
+    assert rig.read("movers[1].ErrorID") == 0x2001
