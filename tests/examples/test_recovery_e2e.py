@@ -114,9 +114,9 @@ def free_port():
 def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp_path):
     """SIGKILL: no FIN, no RST from a process that is gone — the kernel answers for it. CBT_Connect (Execute held)
     reports the loss and reconnects by itself once the simulator is back; the cycle resumes with an operator
-    start. The simulator runs as its own process in real time, so this test runs the PLC in real time too."""
+    start where the part is and completes. The simulator runs as its own process in real time, so this test runs the PLC in real time too."""
     port = free_port()
-    cmd = [sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(port), "--no-svr"]
+    cmd = [sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(port), "--no-svr", "--speedup", "4"]
     env = {**os.environ, "PYTHONPATH": f"{ROOT / 'src'}{os.pathsep}{ROOT}"}
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     plc = load_plc(SOURCES)
@@ -148,9 +148,12 @@ def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp
         cycles = plc.read("PnP_CycleCount")
         plc.write("PnP_Example_Execute", False)
         assert run(lambda: not plc.read("PnP_MoveBusy"), 10)
+        held = plc.read("PnP_GripperClosed")
         plc.write("PnP_Example_Execute", True)            # operator start
-        assert run(lambda: plc.read("PnP_Segment") != 0 or plc.read("PnP_CycleCount") > cycles, 30)
-        assert run(lambda: plc.read("PnP_MoveDone") or plc.read("PnP_Waiting"), 30)
+        assert run(lambda: plc.read("PnP_MoveBusy"), 5)
+        assert plc.read("PnP_Segment") == (3 if held else 0)  # where the part is: place approach or pick approach
+        assert run(lambda: plc.read("PnP_CycleCount") > cycles, 40), plc.read("PnP_MoveErrorDescrip")
+        assert not plc.read("PnP_MoveError") and plc.read("Connect_Connected")
     finally:
         plc.close()
         proc.kill()

@@ -63,7 +63,7 @@ def test_data_type_folders_hold_members_and_declaration(lib_paste):
     assert enum[0][2].startswith("StopAndClearBuffer()")
     conn = _rows(lib_paste / "stCBT_Connection" / "members.tsv")
     members = {r[0]: r for r in conn}
-    assert conn[5][:3] == ["ReplyTimeout", "TIME", "T#5s"]
+    assert members["ReplyTimeout"][:3] == ["ReplyTimeout", "TIME", "T#5s"]
     assert members["Req"][:2] == ["Req", "ARRAY[1..16] OF stCBT_Request"]
     decl = (lib_paste / "stCBT_Connection" / "declaration.st").read_text(encoding="utf-8")
     assert decl.startswith("TYPE\n    stCBT_Connection : STRUCT") and decl.endswith("END_TYPE\n")
