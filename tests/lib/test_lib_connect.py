@@ -63,17 +63,6 @@ def test_connect_ends_with_not_in_listen_node_after_time_out():
         r.close()
 
 
-def test_connect_to_closed_port_ends_with_not_reachable_after_time_out():
-    r = Rig(connect=False)
-    try:
-        r.robot.inject("refuse_connections")
-        r.write("ConnExec", True)
-        assert r.until(lambda: r.read("conn.Error"), 15)
-        assert r.read("conn.ErrorID") == 0x2004
-    finally:
-        r.close()
-
-
 def test_execute_falling_closes_connection_without_error(rig):
     rig.write("ConnExec", False)
     assert rig.until(lambda: not rig.read("conn.Busy"), 1)

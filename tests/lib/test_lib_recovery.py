@@ -151,9 +151,10 @@ def test_a_motion_whose_ok_reply_is_lost_completes_by_its_queue_tag(rig):
     assert rig.plc.now_ns - start < 2 * SEC and len(rig.events("motion_start")) == 1
 
 
-def test_a_first_connect_that_fails_is_shown_and_then_retried_while_execute_is_held():
-    """A PLC that boots before its robot: the first connect ends in Error at Time_Out (PLCopen), then, Execute still
-    held, CBT_Connect keeps trying on the back-off like after a loss and connects by itself when the robot is up.
+def test_a_first_connect_to_a_closed_port_ends_not_reachable_after_time_out_and_is_then_retried():
+    """A PLC that boots before its robot: the first connect ends in Error 16#2004 at Time_Out (PLCopen), then,
+    Execute still held, CBT_Connect keeps trying on the back-off like after a loss and connects by itself when the
+    robot is up.
     A command started meanwhile is refused with 16#200C (retrying), not 'execute CBT_Connect first'."""
     r = Rig(connect=False)
     try:
