@@ -39,13 +39,30 @@ class Browser:
             options.add_argument(flag)
         self.driver = webdriver.Chrome(options=options, service=Service(paths[1]))
         self.driver.set_window_size(800, 480)
+        self._fit()
+
+    def _fit(self):
         dw, dh = self.driver.execute_script(
             "return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
         self.driver.set_window_size(800 + dw, 480 + dh)
 
+    def fresh(self) -> "Browser":
+        """The same Chromium with a new tab in place of the old one: no page, no sessionStorage (access key, alarm
+        list) left by the tests that used it before."""
+        old = self.driver.current_window_handle
+        self.driver.switch_to.new_window("tab")
+        new = self.driver.current_window_handle
+        self.driver.switch_to.window(old)
+        self.driver.close()
+        self.driver.switch_to.window(new)
+        self._fit()
+        return self
+
     def close(self):
-        self.driver.quit()
-        shutil.rmtree(self.profile, ignore_errors=True)
+        try:
+            self.driver.quit()
+        finally:
+            shutil.rmtree(self.profile, ignore_errors=True)
 
     def open(self, url: str):
         self.driver.get(url)

@@ -5,9 +5,11 @@ import pathlib
 import sys
 
 import pytest
+from selenium.common.exceptions import WebDriverException
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
+from browser import Browser  # noqa: E402
 from fake_plc import FakePlc, command_program, scanning, serving  # noqa: E402
 from hmi_http import Client  # noqa: E402
 from vplc.hmi.mapping import Mapping  # noqa: E402
@@ -34,3 +36,28 @@ def server(fake_plc, mapping):
 def client(server):
     """Engineer access: may change every writable variable (the role tests use their own clients)."""
     return Client(f"http://127.0.0.1:{server.port}", server.access.keys["engineer"])
+
+
+@pytest.fixture(scope="session")
+def _chromium_process():
+    started: list[Browser] = []
+    yield started
+    for browser in started:
+        browser.close()
+
+
+@pytest.fixture(scope="module")
+def chromium(_chromium_process):
+    """One Chromium per test process (a start costs seconds); each test module gets it with a fresh tab. If a
+    module left it unusable, the next one starts a new Chromium."""
+    if _chromium_process:
+        try:
+            return _chromium_process[0].fresh()
+        except WebDriverException:
+            broken = _chromium_process.pop()
+            try:
+                broken.close()
+            except WebDriverException:
+                pass                  # already gone; close() removed its profile directory all the same
+    _chromium_process.append(Browser())
+    return _chromium_process[0]

@@ -10,8 +10,8 @@ from test_hmi_end_to_end import System
 
 
 @pytest.fixture(scope="module")
-def system():
-    stack = System()
+def system(chromium):
+    stack = System(chromium)
     with stack.plc.lock:
         stack.plc.write("Connect_Execute", True)
     stack.wait(lambda: stack.read("Connect_Connected") and stack.read("RobotStatus_Valid"), "connected", 15)

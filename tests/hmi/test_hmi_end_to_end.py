@@ -25,7 +25,7 @@ SIM_SPEEDUP = 4.0     # the robot model runs 4x faster than the wall clock; PLC 
 
 
 class System:
-    def __init__(self):
+    def __init__(self, browser: Browser):
         self.mapping = Mapping.load()
         self.sim = SimServer(port=0, robots=1, speedup=SIM_SPEEDUP, svr_port=0)
         self.sim.start_background()
@@ -42,10 +42,9 @@ class System:
         self.plc_thread.start()
         self.hmi = HmiServer(self.plc, self.mapping, port=0)
         self.hmi.start()
-        self.browser = Browser()
+        self.browser = browser
 
     def close(self):
-        self.browser.close()
         self.hmi.stop()
         self.stop_event.set()
         self.plc_thread.join(timeout=5)
@@ -98,8 +97,8 @@ class System:
 
 
 @pytest.fixture(scope="module")
-def system():
-    stack = System()
+def system(chromium):
+    stack = System(chromium)
     yield stack
     stack.close()
 

@@ -18,14 +18,10 @@ TCP = {"X": 400.0, "Y": 0.0, "Z": 400.0, "RX": 180.0, "RY": 0.0, "RZ": 90.0}
 
 
 @pytest.fixture(scope="module")
-def stack():
+def stack(chromium):
     mapping = Mapping.load()
     with scanning(FakePlc(mapping, command_program)) as plc, serving(plc, mapping) as server:
-        browser = Browser()
-        try:
-            yield plc, server, browser
-        finally:
-            browser.close()
+        yield plc, server, chromium
 
 
 @pytest.fixture

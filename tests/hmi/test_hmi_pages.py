@@ -7,7 +7,6 @@ import pytest
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
-from browser import Browser
 from fake_plc import FakePlc, command_program
 from vplc.hmi.mapping import Mapping
 from vplc.hmi.server import HmiServer
@@ -16,7 +15,7 @@ PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "m
 
 
 @pytest.fixture(scope="module")
-def stack():
+def stack(chromium):
     mapping = Mapping.load()
     plc = FakePlc(mapping, command_program)
     stop = threading.Event()
@@ -29,9 +28,7 @@ def stack():
     thread.start()
     server = HmiServer(plc, mapping, port=0)
     server.start()
-    browser = Browser()
-    yield plc, server, browser
-    browser.close()
+    yield plc, server, chromium
     server.stop()
     stop.set()
     thread.join(timeout=5)

@@ -8,7 +8,7 @@ import threading
 import pytest
 from selenium.webdriver.common.by import By
 
-from browser import Browser, chromium_paths
+from browser import chromium_paths
 from hmi_http import Client
 from sim.server import SimServer
 from vplc.api import load_plc
@@ -22,7 +22,7 @@ pytestmark = pytest.mark.skipif(chromium_paths() is None, reason="chromium/chrom
 
 
 @pytest.fixture(scope="module")
-def system():
+def system(chromium):
     sim = SimServer(port=0, robots=1)
     sim.start_background()
     plc = load_plc(SOURCES)
@@ -34,9 +34,7 @@ def system():
     thread.start()
     hmi = HmiServer(plc, Mapping.load(), port=0)
     hmi.start()
-    browser = Browser()
-    yield plc, hmi, browser
-    browser.close()
+    yield plc, hmi, chromium
     hmi.stop()
     stop.set()
     thread.join(timeout=5)
