@@ -152,13 +152,14 @@ def test_demo_runs_everything_stops_cleanly_on_ctrl_c_and_starts_again_at_once()
 
 
 def test_taken_control_port_is_named_and_two_servers_on_one_port_are_refused(busy_port):
-    result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(free_port()),
-                      "--control-port", str(busy_port))
+    result = run_demo("--robot-port", str(free_port()), "--svr-port", str(free_port()), "--hmi-port",
+                      str(free_port()), "--control-port", str(busy_port))
     assert result.returncode == 2
     assert f"port {busy_port} on 127.0.0.1 (simulator control channel) is already in use" in result.stderr
     assert "--control-port PORT" in result.stderr and "Traceback" not in result.stderr
     port = free_port()
-    result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(port), "--control-port", str(port))
+    result = run_demo("--robot-port", str(free_port()), "--svr-port", str(free_port()), "--hmi-port", str(port),
+                      "--control-port", str(port))
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert f"--hmi-port and --control-port are both {port}; give each server its own port." in result.stderr
 
