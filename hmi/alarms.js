@@ -19,7 +19,7 @@ const ALARM_SOURCES = [
       `${g}_Error`, `${g}_ErrorID`, `${g}_ErrorDescrip`]),
 ];
 const PROJECT_CMD = { play: 0, pause: 1, stop: 2 };      // eCBT_ProjectCmd
-const alarms = { list: [], active: {}, texts: {} };
+const alarms = { list: [], active: {}, texts: {}, sawConnected: false };
 
 function alarmVariables() {
   return [...ALARM_SOURCES.flatMap((s) => s.slice(2)), "RobotStatus_Valid", "RobotStatus", "Connect_Reconnecting",
@@ -44,16 +44,18 @@ function saveAlarms() { sessionStorage.setItem("cbt-alarms", JSON.stringify(alar
 /* One alarm for a whole outage: CBT_Connect shows Error only during its back-off waits (FALSE during each
    attempt), so its own Error would raise and clear an alarm on every retry. While Connect_Reconnecting is TRUE
    the connection alarm stays active under one key; its ErrorID is the latest reason seen (Connect_ErrorID of
-   the loss or of the last failed attempt, else the connection's Robot_LastErrorID), updated in place. */
+   the loss or of the last failed attempt, else the connection's Robot_LastErrorID), updated in place. A first
+   connect that failed at Time_Out is retried the same way (Execute held): "not connected" unless this tab saw
+   the link up before. */
 function reconnectingAlarm(v) {
-  const held = alarms.active["connect:reconnecting"];
+  const held = alarms.active["connect:reconnecting"], lost = held ? held.lost : alarms.sawConnected;
   const id = v.Connect_ErrorID || (held && held.id) || v.Robot_LastErrorID || 0;
   const known = alarms.texts[idText(id)];
   const reason = v.Connect_Error === true && v.Connect_ErrorID === id && v.Connect_ErrorDescrip ? v.Connect_ErrorDescrip
     : held && held.id === id ? held.reason : known ? known.text : "";
   const attempt = v.Connect_RetryCount ? ` (attempt ${v.Connect_RetryCount})` : "";
-  return { source: "Connection", id, reason,
-    text: `Connection lost, reconnecting${attempt}${reason ? " — " + reason : ""}` };
+  return { source: "Connection", id, reason, lost,
+    text: `${lost ? "Connection lost, reconnecting" : "Not connected, retrying"}${attempt}${reason ? " — " + reason : ""}` };
 }
 
 /* what is in alarm now: {key: {source, id | code, text}} */
@@ -73,6 +75,7 @@ function currentAlarms() {
 
 function checkAlarms() {
   if (!live.online) return;
+  if (live.values.Connect_Connected === true) alarms.sawConnected = true;
   const now = currentAlarms(), stamp = new Date();
   let changed = false;
   for (const [key, a] of Object.entries(now)) {

@@ -177,3 +177,37 @@ def test_alarm_history_shows_five_whole_rows_without_a_horizontal_scrollbar(page
         with plc.lock:
             plc.vars.update(MoveAbs_Error=False, MoveAbs_ErrorID=0, MoveAbs_ErrorDescrip="")
         browser.click("btn-alarm-ack-all")
+
+
+def test_a_first_connect_retried_is_not_called_a_lost_connection(page):
+    """CBT_Connect retries a first connect that failed at Time_Out (Execute held, Reconnecting TRUE, never
+    connected): the one connection alarm says "Not connected, retrying"; after the link was up, a loss says
+    "Connection lost, reconnecting"."""
+    plc, open_page = page
+    with plc.lock:
+        plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=1,
+                        Connect_Error=True, Connect_ErrorID=0x2004, Connect_ErrorDescrip="Robot not reachable")
+    browser = open_page("index")
+    browser.driver.execute_script("alarms.list.length = 0; alarms.active = {}; alarms.sawConnected = false; "
+                                  "saveAlarms(); drawAlarms();")
+
+    def rows():
+        return browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
+    try:
+        browser.wait_for(lambda d: any("Not connected, retrying (attempt 1)" in r for r in rows()), "the retry alarm")
+        with plc.lock:                  # the fake PLC connects on the Execute edge and holds it while Execute
+            plc.vars.update(Connect_Execute=True, Connect_Reconnecting=False, Connect_Error=False,
+                            Connect_ErrorID=0, Connect_ErrorDescrip="")
+        browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the link up")
+        browser.wait_for(lambda d: rows() and rows()[0].endswith("gone"), "the retry alarm gone")
+        with plc.lock:
+            plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=0,
+                            Connect_Error=True, Connect_ErrorID=0x2006, Connect_ErrorDescrip="Link lost")
+        browser.wait_for(lambda d: any("Connection lost, reconnecting — Link lost" in r for r in rows()),
+                         "the outage alarm")
+        assert len(rows()) == 2, rows()
+    finally:
+        with plc.lock:
+            plc.vars.update(Connect_Execute=False, Connect_Reconnecting=False, Connect_Error=False, Connect_ErrorID=0,
+                            Connect_ErrorDescrip="", Connect_RetryCount=0)
+        browser.click("btn-alarm-ack-all")
