@@ -31,7 +31,7 @@ import socket
 
 from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX,
                      CONTROL_EVENTS_MAX, CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX)
-from .listener import Listener
+from .listener import Listener, receive
 from .session import TransitionError
 
 _FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission"}
@@ -106,12 +106,9 @@ class ControlChannel:
             return
         if client.closing:
             return
-        try:
-            data = sock.recv(65536)
-        except (BlockingIOError, InterruptedError):
+        data, failed = receive(sock)
+        if data is None and not failed:
             return
-        except OSError:
-            data = b""
         if not data:
             self._close(sock)
             return

@@ -15,13 +15,12 @@ import selectors
 import socket
 
 from . import codec
-from .listener import Listener
+from .listener import Listener, receive
 from .svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
 from .svr_source import RobotDataSource
 
 MAX_CLIENTS = 64
 MAX_OUTBOX = 1 << 20
-RECV_SIZE = 65536
 
 
 class _Conn:
@@ -91,15 +90,11 @@ class EthernetSlave:
         robot = conn.robot
         if conn.id not in robot.svr_conns:
             return
-        try:
-            data = conn.sock.recv(RECV_SIZE)
-        except (BlockingIOError, InterruptedError):
+        data, failed = receive(conn.sock)
+        if failed or data == b"":
+            self._drop(robot, conn, failed or "peer closed")
             return
-        except OSError as exc:
-            self._drop(robot, conn, f"receive failed: {exc.strerror}")
-            return
-        if not data:
-            self._drop(robot, conn, "peer closed")
+        if data is None:
             return
         conn.rbuf += data
         try:

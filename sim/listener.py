@@ -12,6 +12,19 @@ import socket
 
 from .limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
 
+RECV_SIZE = 65536                      # bytes taken from one connection per read
+
+
+def receive(sock: socket.socket) -> tuple[bytes | None, str | None]:
+    """One non-blocking read of an accepted connection: ``(data, None)``; ``(b"", None)`` when the peer closed;
+    ``(None, None)`` when nothing is there yet; ``(None, reason)`` when the socket failed."""
+    try:
+        return sock.recv(RECV_SIZE), None
+    except (BlockingIOError, InterruptedError):
+        return None, None
+    except OSError as exc:
+        return None, f"receive failed: {exc.strerror}"
+
 
 class Listener:
     def __init__(self, selector, host: str, port: int, key, what: str, backlog: int = 16,

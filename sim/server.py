@@ -26,7 +26,7 @@ import time
 from . import codec
 from .control import ControlChannel
 from .ethernet_slave import EthernetSlave
-from .listener import Listener
+from .listener import RECV_SIZE, Listener, receive
 from .eventlog import EventLog, text as _text
 from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
 from .faults import FaultState, check_params as check_fault_params
@@ -37,7 +37,6 @@ from .session import STOPPED, ListenSession
 
 MAX_CLIENTS = 256
 MAX_OUTBOX = 1 << 20
-RECV_SIZE = 65536
 RBUF_READ_BELOW = codec.MAX_DATA + 64     # a receive buffer this full holds a complete item: process it first
 EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all), and at
                             # most limits.EVENT_BYTES_MAX bytes (sim/eventlog.py)
@@ -420,12 +419,11 @@ class SimServer(FairInput):
             self._set_reading(robot, False)
             return
         if robot.session.input_bytes(conn.id) < RBUF_READ_BELOW:    # else: what is buffered goes first (fairness)
-            try:
-                data = conn.sock.recv(RECV_SIZE)
-            except (BlockingIOError, InterruptedError):
+            data, failed = receive(conn.sock)
+            if failed:
+                self._drop(robot, conn, failed)
                 return
-            except OSError as exc:
-                self._drop(robot, conn, f"receive failed: {exc.strerror}")
+            if data is None:
                 return
             if not data:
                 conn.eof = True
