@@ -123,7 +123,8 @@ def test_pnp_runs_two_cycles_with_dwell_pause_resume_and_stops_cleanly(rig):
     assert rig.read("PnP_Segment") == 1
     dwell_start = rig.plc.now_ns
     rig.until(lambda: not rig.read("PnP_Waiting"), "the end of the dwell", 5)
-    assert rig.plc.now_ns - dwell_start == pytest.approx(2 * SECOND, abs=0.01 * SECOND)
+    assert rig.plc.now_ns - dwell_start == pytest.approx(2 * SECOND, abs=0.01 * SECOND)   # T#2s as shipped
+    rig.plc.write("PnP_DwellTime", SECOND // 2)                # a new dwell time applies from the next dwell
 
     rig.until(lambda: rig.read("PnP_Segment") == 4 and rig.read("PnP_MoveBusy"), "the place move", 30)
     rig.run_for(0.2)
@@ -134,6 +135,10 @@ def test_pnp_runs_two_cycles_with_dwell_pause_resume_and_stops_cleanly(rig):
     assert rig.read("PnP_Segment") == 4, "the sequence must wait while the robot is paused"
     rig.plc.write("ProgramControl_Param.Command", 1)
     rig.command("ProgramControl")
+    rig.until(lambda: rig.read("PnP_Waiting"), "the dwell after place", 30)
+    dwell_start = rig.plc.now_ns
+    rig.until(lambda: not rig.read("PnP_Waiting"), "the end of the dwell", 5)
+    assert rig.plc.now_ns - dwell_start == pytest.approx(SECOND // 2, abs=0.01 * SECOND)
 
     rig.until(lambda: rig.read("PnP_CycleCount") >= 2, "two complete cycles", 120)
     rig.plc.write("PnP_Example_Execute", False)

@@ -124,6 +124,7 @@ def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp
         plc.write("Connect_AddressIP", "127.0.0.1")
         plc.write("Connect_Dest_PortIP", port)
         plc.write("Connect_SvrPort", 0)
+        plc.write("PnP_DwellTime", SECOND // 4)       # real time: a short settle time keeps the test short
         plc.write("Connect_Execute", True)
 
         def run(pred, seconds):

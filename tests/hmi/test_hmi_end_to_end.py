@@ -22,6 +22,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
 MOVE_WAIT_S = 30
 SIM_SPEEDUP = 4.0     # the robot model runs 4x faster than the wall clock; PLC timers stay real time
+DWELL_NS = 250_000_000  # PnP_DwellTime for the cycle tests (T#250ms)
 
 
 class System:
@@ -279,6 +280,8 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
     edit_place_speed(connected, browser, 1)                     # slow "place" move: a sure window to pause in
     targets = [[p["TargetPosition"][k] for k in ("X", "Y", "Z")] for p in connected.read("PnP_MoveParameters")]
     cycles = connected.read("PnP_CycleCount")
+    with connected.plc.lock:                                   # the gripper's settle time, T#2s as shipped
+        connected.plc.write("PnP_DwellTime", DWELL_NS)
     since = connected.event_count()
     browser.click("btn-execute")
     connected.wait(lambda: connected.read("PnP_Segment") == 4 and connected.robot_state()["moving"]

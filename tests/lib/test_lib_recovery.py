@@ -64,6 +64,27 @@ def test_black_hole_then_restore_reconnects_with_the_documented_back_off(rig):
     assert not rig.read("conn.Reconnecting") and rig.read("Cobot.InListenNode")
 
 
+def test_a_reconnect_attempt_into_a_black_hole_ends_at_time_out_with_3004_then_the_next_follows(rig):
+    """A robot that accepts the connection but never answers: each attempt keeps trying quietly (Busy, no Error)
+    until Time_Out, then shows 16#3004 during the back-off wait, and the next attempt starts 1 s later."""
+    seen, hook = watch_error_scans(rig)
+    rig.robot.inject("black_hole")
+    assert rig.until(lambda: rig.read("conn.RetryCount") >= 1, 3, on_scan=hook)
+    assert seen["ids"] == [0x2006]                                  # the loss, shown for a while, then attempt 1
+    started = rig.plc.now_ns
+    assert rig.until(lambda: rig.read("conn.Error"), 15, on_scan=hook)
+    timeout_s = rig.read("TimeOut")
+    assert (rig.plc.now_ns - started) / SEC == pytest.approx(timeout_s, abs=0.2)
+    assert rig.read("conn.ErrorID") == 0x3004 and rig.read("conn.Reconnecting")
+    failed = rig.plc.now_ns
+    assert rig.until(lambda: rig.read("conn.RetryCount") >= 2, 3, on_scan=hook)
+    assert (rig.plc.now_ns - failed) / SEC == pytest.approx(1.0, abs=0.05)
+    assert rig.read("conn.Busy") and not rig.read("conn.Error")
+    rig.robot.clear_faults()
+    assert rig.until(lambda: rig.read("conn.Connected"), 15), rig.read("conn.ErrorDescrip")
+    assert seen["ids"] == [0x2006, 0x3004]
+
+
 def test_back_off_between_refused_attempts_is_100ms_1s_2s_then_5s():
     r = Rig()
     try:
