@@ -277,7 +277,7 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
     browser.click("btn-preset")
     browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset")
     preset_speed = connected.read("PnP_MoveParameters")[4]["Speed"]
-    edit_place_speed(connected, browser, 1)                     # slow "place" move: a sure window to pause in
+    edit_place_speed(connected, browser, 2)                     # slow "place" move: a sure window to pause in
     targets = [[p["TargetPosition"][k] for k in ("X", "Y", "Z")] for p in connected.read("PnP_MoveParameters")]
     cycles = connected.read("PnP_CycleCount")
     with connected.plc.lock:                                   # the gripper's settle time, T#2s as shipped

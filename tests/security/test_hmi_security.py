@@ -330,7 +330,7 @@ def test_garbage_request_line_gets_a_json_4xx(hmi):
 
 def test_stalled_connections_are_bounded_and_time_out(hmi, monkeypatch):
     """600 stalled connections once kept 604 threads: now a fixed pool serves, idle clients are dropped."""
-    monkeypatch.setattr(hmi_server._Handler, "timeout", 0.5)
+    monkeypatch.setattr(hmi_server._Handler, "timeout", 0.25)
     threads_before = threading.active_count()
     stalled = [socket.create_connection(("127.0.0.1", hmi.port), timeout=5) for _ in range(120)]
     try:
