@@ -72,7 +72,7 @@ class Browser:
 
     def wait_for(self, condition, what: str, timeout: float = WAIT_S):
         try:
-            return WebDriverWait(self.driver, timeout, poll_frequency=0.05).until(condition)
+            return WebDriverWait(self.driver, timeout, poll_frequency=0.02).until(condition)
         except TimeoutException:
             raise AssertionError(f"timed out after {timeout} s waiting for {what}; "
                                  f"message line: {self.message()!r}") from None

@@ -290,7 +290,7 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
     connected.wait(lambda: connected.robot_state()["paused"], "the robot to pause")
     browser.screenshot("e2e_pnp_paused")
     paused_mark = connected.event_count()
-    assert connected.robot.wait_event("motion_end", timeout=1.0, since=len(connected.robot.events)) is None
+    assert connected.robot.wait_event("motion_end", timeout=0.5, since=len(connected.robot.events)) is None
     assert connected.read("PnP_Segment") == 4, "the sequence must wait while the robot is paused"
     assert connected.robot_state()["tcp"][2] > targets[4][2] + 1, "paused before reaching the place point"
     edit_place_speed(connected, browser, preset_speed)           # the paused move keeps speed 1 (latched at its
