@@ -40,13 +40,20 @@ def type_text(t) -> str:
 
 
 class Resolver:
+    """Reads and writes variables by path. A path is parsed once (names upper-cased, indexes read) and then only
+    walked, and each type gets its value converter once: traces and the HMI read the same paths every scan."""
+
     def __init__(self, plc) -> None:
         self.plc = plc
         gl = plc.project.global_lists
         self.list_names = {g.name.upper() for g in gl if g.name}
+        self._parsed: dict[str, tuple] = {}
 
-    def _locate(self, path: str):
-        """-> (container, key, type) of the variable at ``path``."""
+    def _parse(self, path: str) -> tuple:
+        """-> (root, steps): root "instance"/"globals" and its key, steps (segment text, NAME, index tuples)."""
+        plan = self._parsed.get(path)
+        if plan is not None:
+            return plan
         segs = path.strip().split(".")
         if not segs or not segs[0]:
             raise PathError(f"empty variable path {path!r}")
@@ -55,7 +62,6 @@ class Resolver:
         if first is None:
             raise PathError(f"`{segs[0]}` is not a variable name (in {path!r})")
         head = first.group(1).upper()
-        obj, ty, rest = None, None, segs
         if head in plc.type_named_instances and not first.group(2):
             names = " and ".join(f"`{n}`" for n in plc.type_named_instances[head])
             tail = ".".join(segs[1:])
@@ -63,36 +69,54 @@ class Resolver:
             raise PathError(f"`{segs[0]}` is a PROGRAM type; the configuration runs it as the instance {names}: "
                             f"use `{example}`")
         if head in plc.instances and not first.group(2):
-            obj, ty, rest = plc.instances[head], plc.instances[head].i__type, segs[1:]
+            root, rest = head, segs[1:]
         elif head in self.list_names and not first.group(2) and len(segs) > 1:
-            obj, ty, rest = plc.globals, None, segs[1:]
+            root, rest = None, segs[1:]
         else:
-            obj, ty = plc.globals, None
-        container, key, cur_t = None, None, ty
+            root, rest = None, segs
+        steps = []
         for seg in rest:
             m = _SEG.fullmatch(seg)
             if m is None:
                 raise PathError(f"`{seg}` is not a variable name (in {path!r})")
+            indexes = []
+            for idx_text in re.findall(r"\[([^\]]*)\]", m.group(2)):
+                try:
+                    indexes.append(tuple(int(x) for x in idx_text.split(",")))
+                except ValueError:
+                    raise PathError(f"index [{idx_text}] is not a list of integers (in {path!r})") from None
+            steps.append((seg, m.group(1).upper(), m.group(1), indexes))
+        plan = (root, tuple(steps))
+        if len(self._parsed) < 10_000:           # bounded: paths come from programs, traces and the HMI's table
+            self._parsed[path] = plan
+        return plan
+
+    def _locate(self, path: str):
+        """-> (container, key, type) of the variable at ``path``."""
+        root, steps = self._parse(path)
+        plc = self.plc
+        if root is not None:
+            obj = plc.instances[root]
+        else:
+            obj = plc.globals
+        container, key, cur_t = None, None, (obj.i__type if root is not None else None)
+        for seg, name, shown, indexes in steps:
             value = obj if container is None else container[key]
             info = getattr(type(value), "i__vars", None)
             if info is None:
                 raise PathError(f"`{seg}`: {path!r} goes into a value that has no members")
-            ent = info.get(m.group(1).upper())
+            ent = info.get(name)
             if ent is None:
                 where = getattr(value, "i__path", None) or getattr(getattr(value, "i__type", None), "name", "value")
-                raise PathError(f"`{m.group(1)}` is not a variable of {where} (in {path!r})")
+                raise PathError(f"`{shown}` is not a variable of {where} (in {path!r})")
             attr, cur_t = ent
             container, key = value.__dict__, attr
             if key + "__r" in container:                 # scalar VAR_IN_OUT: follow the reference
                 container, key = container[key + "__r"], container[key + "__k"]
-            for idx_text in re.findall(r"\[([^\]]*)\]", m.group(2)):
+            for idx in indexes:
                 at = T.unalias(cur_t)
                 if not isinstance(at, T.ArrayType):
                     raise PathError(f"`{seg}` is not an array (in {path!r})")
-                try:
-                    idx = tuple(int(x) for x in idx_text.split(","))
-                except ValueError:
-                    raise PathError(f"index [{idx_text}] is not a list of integers (in {path!r})") from None
                 arr = container[key]
                 try:
                     off = iec.ixo(idx[0], arr) if at.open else iec.ixn(idx, tuple(at.dims))
@@ -105,7 +129,7 @@ class Resolver:
 
     def read(self, path: str):
         c, k, t = self._locate(path)
-        return to_python(c[k], t)
+        return converter(t)(c[k])
 
     def type_text(self, path: str) -> str:
         return type_text(self._locate(path)[2])
@@ -115,19 +139,43 @@ class Resolver:
         c[k] = from_python(value, t, path, raw)
 
 
-def to_python(v, t):
+_CONVERTERS: dict[int, tuple] = {}
+
+
+def converter(t):
+    """The function turning a runtime value of type ``t`` into its API value (built once per type)."""
+    entry = _CONVERTERS.get(id(t))
+    if entry is not None and entry[0] is t:
+        return entry[1]
     u = T.base_of(t)
     if isinstance(u, T.EnumType):
+        names = {}
         for name, val in u.values.items():
-            if val == v:
-                return name
-        return v
-    if isinstance(u, T.ArrayType):
-        return [to_python(x, u.element) for x in v]
-    if isinstance(u, (T.StructType, T.PouType)):
-        info = getattr(type(v), "i__vars", {})
-        return {attr: to_python(getattr(v, attr), ft) for attr, ft in info.values() if hasattr(v, attr)}
-    return v
+            names.setdefault(val, name)              # the first name declared for a value, as before
+
+        def conv(v, names=names):
+            return names.get(v, v)
+    elif isinstance(u, T.ArrayType):
+        element = u.element
+
+        def conv(v, element=element):
+            each = converter(element)
+            return [each(x) for x in v]
+    elif isinstance(u, (T.StructType, T.PouType)):
+        def conv(v):
+            info = getattr(type(v), "i__vars", {})
+            return {attr: converter(ft)(getattr(v, attr)) for attr, ft in info.values() if hasattr(v, attr)}
+    else:
+        def conv(v):
+            return v
+    if len(_CONVERTERS) > 20_000:                # many programs loaded in one process (tests): start again
+        _CONVERTERS.clear()
+    _CONVERTERS[id(t)] = (t, conv)               # the type is kept, so its id cannot be reused
+    return conv
+
+
+def to_python(v, t):
+    return converter(t)(v)
 
 
 def from_python(value, t, path: str, raw: bool = False):
