@@ -106,3 +106,37 @@ END_CONFIGURATION
         plc.read("Main.n")
     with pytest.raises(ValueError, match="PROGRAM type"):
         plc.write("Main.n", 5)
+
+
+def test_a_path_read_again_follows_the_program_and_a_bad_path_fails_every_time(tmp_path):
+    """Paths are parsed once and walked at every read: values, array elements and references passed to a
+    VAR_IN_OUT follow the program; a wrong path or index gives the same error on every attempt."""
+    extra = """
+FUNCTION_BLOCK Fb
+VAR_IN_OUT r : INT; END_VAR
+VAR_OUTPUT seen : INT; END_VAR
+seen := r;
+END_FUNCTION_BLOCK
+"""
+    plc = plc_from(tmp_path, """
+n := n + 1;
+a[n MOD 3] := n;
+IF n MOD 2 = 1 THEN fb(r := x); ELSE fb(r := y); END_IF;
+""", "n : INT; a : ARRAY[0..2] OF INT; x : INT := 10; y : INT := 20; fb : Fb; m : eMode; p : stP;", extra + TYPES)
+    seen = []
+    for now in range(0, 4_000_000, 1_000_000):
+        plc.scan(now)
+        seen.append((plc.read("Main.n"), plc.read("Main.a[1]"), plc.read("Main.fb.r"), plc.read("Main.fb.seen")))
+    assert seen == [(1, 1, 10, 10), (2, 1, 20, 20), (3, 1, 10, 10), (4, 4, 20, 20)]
+    plc.write("Main.m", "Auto")
+    plc.write("Main.p.Name", "ab")
+    assert plc.read("Main.m") == "Auto" and plc.read("Main.p") == {"X": 0.0, "Name": "ab"}
+    plc.write("Main.m", "Off")
+    assert plc.read("Main.m") == "Off"
+    for _ in range(2):
+        with pytest.raises(ValueError, match="is not a variable of Main"):
+            plc.read("Main.nope")
+        with pytest.raises(ValueError, match=r"index|range"):
+            plc.read("Main.a[7]")
+        with pytest.raises(ValueError, match="not a list of integers"):
+            plc.read("Main.a[x]")
