@@ -213,3 +213,29 @@ def test_a_command_started_while_the_link_is_down_says_why(rig):
     go(rig, 1, rz=10)
     assert rig.until(lambda: rig.read("movers[1].Error"), 1)
     assert rig.read("movers[1].ErrorID") == 0x2001
+
+
+def test_a_link_status_query_running_at_a_quick_reconnect_neither_ends_the_new_link_nor_delays_the_next():
+    """A status query (SktGetTCPStatus, every 100 ms) still running when the link closes ends in the first calls
+    of the next link, about the closed socket: it is cleared at once and not taken as a loss of the new link,
+    and the next query of the new link starts on time."""
+    r = Rig(load_args=dict(socket_latency_ns=3_000_000))
+    try:
+        r.scans(50)
+        while r.read("Cobot.Now") + r.plc.period_ns - r.read("conn.Sock.StatusAt") < 100_000_000:
+            r.scans(1)                                   # the next scan starts a status query ...
+        r.write("ConnExec", False)
+        r.scans(1)                                       # ... and closes the link
+        assert r.read("conn.Sock.FbStatus.Busy")
+        r.write("ConnExec", True)
+        assert r.until(lambda: r.read("conn.Connected"), 2), r.read("conn.ErrorDescrip")
+        reconnected = r.plc.now_ns
+        queries = []
+
+        def hook(now):
+            if r.read("conn.Sock.FbStatus.Busy") and not queries:
+                queries.append(now - reconnected)
+        assert not r.until(lambda: not r.read("conn.Connected") or r.read("conn.Sock.Lost"), 0.5, on_scan=hook)
+        assert queries and queries[0] <= 150_000_000, queries
+    finally:
+        r.close()
