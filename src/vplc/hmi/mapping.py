@@ -9,7 +9,7 @@ import math
 import pathlib
 from http import HTTPStatus
 
-from .ranges import RangeTableError, apply_ranges, load_ranges
+from .ranges import RangeTableError, apply_ranges, load_ranges, read_json
 
 HMI_DIR = pathlib.Path(__file__).resolve().parents[3] / "hmi"
 DEFAULT_MAPPING = HMI_DIR / "mapping.json"
@@ -93,12 +93,7 @@ class Mapping:
     @classmethod
     def load(cls, path: pathlib.Path | str = DEFAULT_MAPPING) -> "Mapping":
         path = pathlib.Path(path)
-        try:
-            document = json.loads(path.read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise MappingError(f"{path}: cannot read the HMI variable table ({exc.strerror})") from None
-        except json.JSONDecodeError as exc:
-            raise MappingError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
+        document = read_json(path, "HMI variable table", MappingError)
         ranges_file = path.with_name(DEFAULT_RANGES.name)
         if ranges_file.exists():                # the limits come from the library's range table
             try:

@@ -18,13 +18,18 @@ class RangeTableError(ValueError):
     """hmi/ranges.json is unreadable or names something the variable table does not have."""
 
 
-def load_ranges(path: pathlib.Path) -> dict:
+def read_json(path: pathlib.Path, what: str, error: type[Exception]):
+    """The JSON document in ``path``; ``error`` names the file (and line and column) when it cannot be read."""
     try:
-        table = json.loads(path.read_text(encoding="utf-8"))
+        return json.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise RangeTableError(f"{path}: cannot read the range table ({exc.strerror})") from None
+        raise error(f"{path}: cannot read the {what} ({exc.strerror})") from None
     except json.JSONDecodeError as exc:
-        raise RangeTableError(f"{path}:{exc.lineno}: invalid JSON: {exc.msg}") from None
+        raise error(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
+
+
+def load_ranges(path: pathlib.Path) -> dict:
+    table = read_json(path, "range table", RangeTableError)
     return {k: v for k, v in table.items() if not k.startswith("_")}
 
 
