@@ -174,10 +174,6 @@ def converter(t):
     return conv
 
 
-def to_python(v, t):
-    return converter(t)(v)
-
-
 def from_python(value, t, path: str, raw: bool = False):
     """Checked conversion of an API value; ``raw`` lets an enumeration take any integer of its storage
     type, declared or not (what an HMI or a memory copy can put there on the controller)."""
