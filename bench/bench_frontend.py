@@ -11,10 +11,9 @@ import sys
 import tempfile
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "src"))
+from vplc.project import load_project
 
-from vplc.project import load_project  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 FB_TEMPLATE = """
 FUNCTION_BLOCK Worker{n}

@@ -18,13 +18,11 @@ import threading
 import time
 import urllib.request
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-for entry in (ROOT / "src", ROOT):
-    sys.path.insert(0, str(entry))
+from tmsim.server import SimServer
+from vplc.hmi.mapping import Mapping
+from vplc.hmi.server import HmiServer
 
-from sim.server import SimServer  # noqa: E402
-from vplc.hmi.mapping import Mapping  # noqa: E402
-from vplc.hmi.server import HmiServer  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 try:
     from vplc.api import load_plc
@@ -148,7 +146,6 @@ def scan_cost(rounds: int = 5) -> tuple[float, float, int]:
 
 def stand_in_round_trip() -> tuple[list[float], float]:
     """Round trip and lock hold time against tests/hmi/fake_plc.py scanning every 1 ms in a thread."""
-    sys.path.insert(0, str(ROOT / "tests" / "hmi"))
     from fake_plc import FakePlc, command_program
     mapping = Mapping.load()
     plc = FakePlc(mapping, command_program)

@@ -12,11 +12,10 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "src"))
+from vplc.api import load_plc          
+from vplc.project import load_project  
 
-from vplc.api import load_plc            # noqa: E402
-from vplc.project import load_project    # noqa: E402
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 LIB = os.path.join(ROOT, "lib", "CBT_Commands_Lib")
 EXAMPLES = os.path.join(ROOT, "examples")

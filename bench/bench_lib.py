@@ -1,6 +1,6 @@
 """Benchmarks of the CBT_Commands_Lib function blocks on the virtual PLC (1 ms task) against the simulator.
 
-    PYTHONPATH=src:. python3 bench/bench_lib.py
+    make bench          (or: PYTHONPATH=tests/lib .venv/bin/python bench/bench_lib.py)
 
 Figures (issue 6), each printed with its target, in two call orders (docs/library/design.md, "Latency"):
 documented = command FBs, then CBT_Connect; fast = CBT_Connect, command FBs, CBT_Connect (same instance).
@@ -15,15 +15,13 @@ Issue 15's figures of the original design are constants measured on the virtual 
 statements compare with ours, their µs only with that engine (printed so, never scaled).
 """
 import statistics
-import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT / "src"), str(ROOT), str(ROOT / "tests" / "lib")]
+from rig import ST, Rig, move_abs
+from latency import ORDERS, execute_to_socket, reply_to_done, scan, sustained
 
-from rig import ST, Rig, move_abs  # noqa: E402
-from latency import ORDERS, execute_to_socket, reply_to_done, scan, sustained  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def mark(value, target):
@@ -120,7 +118,7 @@ class ExamplesRig:
     Ethernet Slave, on virtual time (the cost() interface of Rig: .plc and .pump)."""
 
     def __init__(self):
-        from sim.server import SimServer
+        from tmsim.server import SimServer
         from vplc.api import load_plc
         self.sim = SimServer(host="127.0.0.1", port=0, robots=1, svr_port=0)
         self.sim.start()

@@ -11,13 +11,11 @@ import tempfile
 import threading
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "src"))
+from vplc.api import load_plc          
+import engine_compare                  
+from vplc.runtime.stats import ScanStats, percentile 
 
-from vplc.api import load_plc            # noqa: E402
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import engine_compare                    # noqa: E402
-from vplc.runtime.stats import ScanStats, percentile   # noqa: E402
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 EMPTY = "PROGRAM Main\nVAR x : BOOL; END_VAR\n;\nEND_PROGRAM\n"
 
@@ -155,10 +153,10 @@ def main() -> int:
         path = os.path.join(tmp, "big.st")
         with open(path, "w") as f:
             f.write(big)
-        code = ("import resource, sys, time; sys.path.insert(0, %r); from vplc.api import load_plc; "
+        code = ("import resource, time; from vplc.api import load_plc; "
                 "t0 = time.perf_counter(); p = load_plc([%r]); dt = time.perf_counter() - t0; "
                 "[p.scan(k * 1000000) for k in range(100)]; "
-                "print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)") % (os.path.join(ROOT, "src"), path)
+                "print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)") % path
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
         dt, rss = (float(x) for x in out.stdout.split())
         print(f"compile (load + check + codegen + instantiate) of {big.count(chr(10))} lines: {dt:.2f} s")

@@ -1,6 +1,6 @@
 """Scale (issue 15, target 2): 1, 8 and 32 robots from one program, each streaming blended motions.
 
-    PYTHONPATH=src:. python3 bench/bench_scale.py
+    .venv/bin/python bench/bench_scale.py
 
 The library (lib/CBT_Commands_Lib) and bench/st/Main_Stream.st on the virtual PLC, 1 ms task on virtual time,
 against the simulator's robots over loopback; the simulator is polled between scans and is not timed. Figures:
@@ -12,12 +12,11 @@ import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT / "src"), str(ROOT)]
+from tmsim.server import SimServer
+from vplc.api import load_plc
+from vplc.runtime.stats import percentile
 
-from sim.server import SimServer  # noqa: E402
-from vplc.api import load_plc  # noqa: E402
-from vplc.runtime.stats import percentile  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "bench" / "st" / "Main_Stream.st")]
 

@@ -24,15 +24,14 @@ import subprocess
 import sys
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from tmsim import codec
+from tmsim.server import SimServer
 
-from sim import codec  # noqa: E402
-from sim.server import SimServer  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 
 def start_cli(robots):
-    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", "0",
+    proc = subprocess.Popen([sys.executable, "-m", "tmsim", "--port", "0",
                              "--robots", str(robots), "--no-control"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     ports = []

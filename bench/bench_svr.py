@@ -18,12 +18,11 @@ import subprocess
 import sys
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from tmsim import codec
+from tmsim.server import SimServer
+from tmsim.svr_session import DEFAULT_STREAM
 
-from sim import codec  # noqa: E402
-from sim.server import SimServer  # noqa: E402
-from sim.svr_session import DEFAULT_STREAM  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 
 def frame_cost():
@@ -43,7 +42,7 @@ def frame_cost():
 
 
 def start_cli(robots, period):
-    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", "0",
+    proc = subprocess.Popen([sys.executable, "-m", "tmsim", "--port", "0",
                              "--robots", str(robots), "--no-control", "--svr-period", str(period)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     ports = []

@@ -22,7 +22,6 @@ BASELINE = "d79ff86"
 
 WORKER = r'''
 import hashlib, json, sys, time
-sys.path.insert(0, sys.argv[1])
 from vplc.api import load_plc
 
 def leaves(plc, prefix, value, out):
@@ -78,7 +77,7 @@ def compare(programs: dict[str, str], rev: str = BASELINE, rounds: int = 9, scan
             with open(path, "w") as f:
                 f.write(text)
             workers = [subprocess.Popen([sys.executable, "-c", WORKER, src, path, str(scans)], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, text=True, cwd=tmp, env={**os.environ, "PYTHONPATH": ""})
+                                        stdout=subprocess.PIPE, text=True, cwd=tmp, env={**os.environ, "PYTHONPATH": src})
                        for src in (old_src, new_src)]
             try:
                 digests = [json.loads(w.stdout.readline())["digest"] for w in workers]

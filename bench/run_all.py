@@ -5,6 +5,7 @@ them, so a failing benchmark is reported by name and the others still run.
 """
 from __future__ import annotations
 
+import os
 import pathlib
 import subprocess
 import sys
@@ -17,9 +18,13 @@ def main() -> int:
         print("No benchmarks found in bench/.")
         return 1
     failed = []
+    # the benchmarks drive the tests' rigs (tests/lib: the library on the virtual PLC against the simulator;
+    # tests/hmi: the stand-in PLC); the packages themselves come from the install (make install)
+    rigs = [str(here.parent / "tests" / "lib"), str(here.parent / "tests" / "hmi")]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(rigs + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     for script in scripts:
         print(f"\n=== {script.name} " + "=" * max(0, 60 - len(script.name)), flush=True)
-        result = subprocess.run([sys.executable, str(script)], cwd=here.parent)
+        result = subprocess.run([sys.executable, str(script)], cwd=here.parent, env=env)
         if result.returncode != 0:
             failed.append(script.name)
             print(f"!!! {script.name} ended with exit code {result.returncode}", flush=True)

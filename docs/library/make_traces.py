@@ -1,20 +1,18 @@
 """Regenerates the timing diagrams of docs/library/*.md from real runs (virtual PLC + simulator): one diagram per
 FB page, drawn from that page's own "## Example" program, plus the blended and error cases of CBT_MoveAbsolute.
 
-    PYTHONPATH=src:. python3 docs/library/make_traces.py
+    make traces          (or: PYTHONPATH=tests/lib .venv/bin/python docs/library/make_traces.py)
 """
 import re
-import sys
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path[:0] = [str(HERE.parents[1] / "src"), str(HERE.parents[1]), str(HERE.parents[1] / "tests" / "lib")]
+from rig import LIB, SEC, Rig, move_abs
+from tmsim.server import SimServer
+from test_lib_doc_examples import STEPS, example_of, on_simulator
+from vplc.api import PathError, load_plc
+from vplc.trace.recorder import Recorder, write_trace
 
-from rig import LIB, SEC, Rig, move_abs  # noqa: E402
-from sim.server import SimServer  # noqa: E402
-from test_lib_doc_examples import STEPS, example_of, on_simulator  # noqa: E402
-from vplc.api import PathError, load_plc  # noqa: E402
-from vplc.trace.recorder import Recorder, write_trace  # noqa: E402
+HERE = Path(__file__).resolve().parent
 
 OUT = HERE / "traces"
 PINS = ("Busy", "Active", "Connected", "Valid", "Done", "CommandAborted", "Error", "ErrorID")

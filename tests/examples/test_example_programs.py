@@ -7,7 +7,7 @@ import pathlib
 
 import pytest
 
-from sim.server import SimServer
+from tmsim.server import SimServer
 from vplc.api import load_plc
 from vplc.hmi.mapping import Mapping
 from vplc.project import load_project

@@ -3,7 +3,6 @@ real time) against two simulated robots over loopback. The run exits 0 when all 
 and once each, and 1 with the reason when one placement is broken."""
 from __future__ import annotations
 
-import os
 import pathlib
 import re
 import subprocess
@@ -11,11 +10,10 @@ import sys
 
 import pytest
 
-from sim.server import SimServer
+from tmsim.server import SimServer
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "palletizer"
-ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), str(ROOT)])}
 
 
 @pytest.fixture
@@ -30,7 +28,7 @@ def vplc_run(sim, *extra):
     ports = [f"--set=Palletizer.Port[{i + 1}]={port}" for i, port in enumerate(sim.ports)]
     return subprocess.run([sys.executable, "-m", "vplc", "run", str(ROOT / "lib" / "CBT_Commands_Lib"), str(EXAMPLE),
                            "--scenario", str(EXAMPLE / "commissioning.scn"), *ports, *extra],
-                          capture_output=True, text=True, env=ENV, timeout=300)
+                          capture_output=True, text=True, timeout=300)
 
 
 def placements(robot):

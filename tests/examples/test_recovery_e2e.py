@@ -3,7 +3,6 @@ virtual time) against the simulator with its Ethernet Slave over real loopback s
 log is the witness that nothing ran twice."""
 from __future__ import annotations
 
-import os
 import pathlib
 import signal
 import socket
@@ -13,7 +12,7 @@ import time
 
 import pytest
 
-from sim.server import SimServer
+from tmsim.server import SimServer
 from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -116,9 +115,8 @@ def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp
     reports the loss and reconnects by itself once the simulator is back; the cycle resumes with an operator
     start where the part is and completes. The simulator runs as its own process in real time, so this test runs the PLC in real time too."""
     port = free_port()
-    cmd = [sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(port), "--no-svr", "--speedup", "4"]
-    env = {**os.environ, "PYTHONPATH": f"{ROOT / 'src'}{os.pathsep}{ROOT}"}
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    cmd = [sys.executable, "-m", "tmsim", "--port", str(port), "--no-svr", "--speedup", "4"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     plc = load_plc(SOURCES)
     try:
         plc.write("Connect_AddressIP", "127.0.0.1")
@@ -143,7 +141,7 @@ def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp
         proc.wait(5)
         assert run(lambda: plc.read("PnP_MoveError") or plc.read("Connect_Reconnecting"), 5)
         assert run(lambda: plc.read("Connect_Reconnecting") and not plc.read("Connect_Connected"), 5)
-        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         assert run(lambda: plc.read("Connect_Connected"), 15), plc.read("Connect_ErrorDescrip")
         assert plc.read("Connect_RetryCount") >= 1
         cycles = plc.read("PnP_CycleCount")

@@ -165,10 +165,9 @@ def test_taken_control_port_is_named_and_two_servers_on_one_port_are_refused(bus
 
 
 def test_control_port_defaults_to_the_port_before_the_robots_or_any_free_one(busy_port):
-    """As sim/tmflow_listener.py derives it: 5889 for 5890; 0 (any free port, printed) when that one is taken or
+    """As the simulator's command line derives it: 5889 for 5890; 0 (any free port, printed) when that one is taken or
     is one of the demo's own ports."""
-    sys.path.insert(0, str(ROOT / "examples"))
-    from run_demo import default_control_port
+    from cbt_hmi.demo import default_control_port
     port = free_port()
     assert default_control_port(port + 1, ()) in (port, 0)         # 0 only if another program took it meanwhile
     assert default_control_port(busy_port + 1, ()) == 0
@@ -186,9 +185,8 @@ def test_taken_port_names_the_process_that_holds_it(busy_port):
 def test_robot_side_events_print_one_console_line_each():
     """The demo prints one line per robot-side event: a robot error, the project stopped and started, the flow
     leaving and entering the Listen node, a stick button pressed through the Ethernet Slave."""
-    from sim.server import SimServer
-    sys.path.insert(0, str(ROOT / "examples"))
-    from run_demo import robot_event_line
+    from tmsim.server import SimServer
+    from cbt_hmi.demo import robot_event_line
 
     sim = SimServer(port=0, robots=1, svr_port=0)
     sim.start()

@@ -1,18 +1,13 @@
 """Fixtures for the HMI server tests: a fake PLC scanning in a thread and the HMI server on an ephemeral port."""
 from __future__ import annotations
 
-import pathlib
-import sys
-
 import pytest
 from selenium.common.exceptions import WebDriverException
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-
-from browser import Browser  # noqa: E402
-from fake_plc import FakePlc, command_program, scanning, serving  # noqa: E402
-from hmi_http import Client  # noqa: E402
-from vplc.hmi.mapping import Mapping  # noqa: E402
+from browser import Browser
+from fake_plc import FakePlc, command_program, scanning, serving
+from hmi_http import Client
+from vplc.hmi.mapping import Mapping
 
 
 @pytest.fixture

@@ -13,7 +13,7 @@ import pytest
 from selenium.webdriver.common.by import By
 
 from browser import Browser
-from sim.server import SimServer
+from tmsim.server import SimServer
 from vplc.api import load_plc
 from vplc.hmi.mapping import Mapping
 from vplc.hmi.server import HmiServer

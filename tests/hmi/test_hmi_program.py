@@ -10,7 +10,7 @@ from selenium.webdriver.common.by import By
 
 from browser import chromium_paths
 from hmi_http import Client
-from sim.server import SimServer
+from tmsim.server import SimServer
 from vplc.api import load_plc
 from vplc.hmi.mapping import Mapping
 from vplc.hmi.server import HmiServer

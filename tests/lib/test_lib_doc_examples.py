@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from rig import LIB, ROOT, SEC
-from sim.server import SimServer
+from tmsim.server import SimServer
 from vplc.api import load_plc
 
 DOCS = ROOT / "docs" / "library"

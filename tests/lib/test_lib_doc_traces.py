@@ -46,4 +46,4 @@ def test_every_diagram_is_referenced_and_regenerates_identically(tmp_path):
     produced = {p.name for p in tmp_path.glob("*.svg")}
     assert produced == committed
     _, mismatch, errors = filecmp.cmpfiles(DOCS / "traces", tmp_path, sorted(committed), shallow=False)
-    assert mismatch == [] and errors == [], "run PYTHONPATH=src:. python3 docs/library/make_traces.py"
+    assert mismatch == [] and errors == [], "run make traces"

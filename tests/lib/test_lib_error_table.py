@@ -11,8 +11,7 @@ import pytest
 from rig import LIB, ROOT
 from vplc.api import load_plc
 
-sys.path.insert(0, str(ROOT / "docs" / "library"))
-import make_error_tables as tables  # noqa: E402
+from docs.library import make_error_tables as tables
 
 LITERAL = re.compile(r"WORD#16#([0-9A-Fa-f]{1,4})\b")
 

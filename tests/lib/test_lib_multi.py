@@ -1,5 +1,5 @@
 """32 robots from one program, each with its own stCBT_Connection, independent of each other."""
-from sim.server import SimServer
+from tmsim.server import SimServer
 from vplc.api import load_plc
 
 from rig import LIB, SEC, ST

@@ -2,14 +2,12 @@
 Ethernet Slave configured, both in test_lib_ethernet_slave.py), produced by the simulator's Ethernet Slave on
 virtual time over loopback — the robot's status codes of TMscript 2.24 §17.4.1, a silent Ethernet Slave — with
 the FB's ErrorID and ErrorDescrip (the text of docs/library/errors.tsv) and nothing done to the project."""
-import sys
 
 import pytest
 
-from rig import ROOT, SEC, Rig
+from rig import SEC, Rig
 
-sys.path.insert(0, str(ROOT / "docs" / "library"))
-import make_error_tables as tables  # noqa: E402
+from docs.library import make_error_tables as tables
 
 TEXTS = {int(code[3:], 16): row["text"] for code, row in tables.load().items()}
 

@@ -1,13 +1,9 @@
 """Helpers of the simulator security tests: the tests/sim harness (virtual clock, loopback) and a raw
 JSON-lines client of the control channel."""
 import json
-import pathlib
 import socket
-import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "sim"))
-
-from sim_harness import Harness, Peer, sct, sta  # noqa: E402,F401
+from tests.sim.sim_harness import Harness, Peer, sct, sta  # noqa: F401
 
 
 class ControlClient:

@@ -9,19 +9,15 @@ from __future__ import annotations
 import http.client
 import http.server
 import json
-import pathlib
 import socket
-import sys
 import threading
 
 import pytest
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "hmi"))
-
-from fake_plc import FakePlc, command_program, scanning, serving  # noqa: E402
-from hmi_http import Client  # noqa: E402
-from vplc.hmi import server as hmi_server  # noqa: E402
-from vplc.hmi.mapping import Mapping  # noqa: E402
+from tests.hmi.fake_plc import FakePlc, command_program, scanning, serving
+from tests.hmi.hmi_http import Client
+from vplc.hmi import server as hmi_server
+from vplc.hmi.mapping import Mapping
 from vplc.hmi.server import HmiServer  # noqa: E402
 
 MOVE = {"execute": "MoveAbs_Execute", "values": {"MoveAbs_Param.TargetPosition.Z": 300.0}}
@@ -211,7 +207,7 @@ def attacker_site(hmi):
 
 
 def test_a_page_of_another_origin_cannot_move_the_robot_in_chromium(hmi, plc, attacker_site):
-    from browser import Browser, chromium_paths
+    from tests.hmi.browser import Browser, chromium_paths
     if chromium_paths() is None:
         pytest.fail("chromium and chromedriver are needed: run `make browser`")
     browser = Browser()

@@ -2,7 +2,7 @@
 "--duration/--timeout accept absurd values" - the simulator's side): one line on stderr, exit code 2."""
 import pytest
 
-from sim import tmflow_listener
+from tmsim import cli
 
 
 @pytest.mark.parametrize("args, message", [
@@ -19,6 +19,6 @@ from sim import tmflow_listener
     (["--port", "-1"], "leaves the port range"),
 ])
 def test_out_of_range_number_is_one_line_error_before_anything_starts(capsys, args, message):
-    assert tmflow_listener.main(args + ["--port", "0"] if "--port" not in args else args) == 2
+    assert cli.main(args + ["--port", "0"] if "--port" not in args else args) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("tmflow_listener: error: ") and message in err, err

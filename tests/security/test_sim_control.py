@@ -5,8 +5,8 @@ import socket
 
 import pytest
 
-from sim.limits import CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX
-from sim.server import SimServer
+from tmsim.limits import CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX
+from tmsim.server import SimServer
 
 from sim_probe import ControlClient
 

@@ -2,7 +2,7 @@
 import pathlib
 import re
 
-from sim import limits
+from tmsim import limits
 
 DOC = pathlib.Path(__file__).resolve().parents[2] / "docs" / "simulator.md"
 

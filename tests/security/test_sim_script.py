@@ -5,8 +5,8 @@ Error), §2.3 (at most 2048 array elements), §2.5 (a value beyond the float ran
 Every probe gets a reply (OK or ERROR;line), nothing is dropped and the project keeps running."""
 import pytest
 
-from sim import script
-from sim.limits import (ARRAY_MAX, STATEMENTS_MAX, STEPS_MAX, STRING_MAX, TOKENS_MAX, VARIABLE_BYTES_MAX,
+from tmsim import script
+from tmsim.limits import (ARRAY_MAX, STATEMENTS_MAX, STEPS_MAX, STRING_MAX, TOKENS_MAX, VARIABLE_BYTES_MAX,
                         VARIABLES_MAX)
 
 from sim_probe import Harness, sct, sta
@@ -51,7 +51,7 @@ def test_squaring_an_int_wraps_at_32_bits(robot):
 
 
 def test_state_answer_after_a_large_integer_computation_is_valid_json():
-    from sim.server import SimServer
+    from tmsim.server import SimServer
     from sim_probe import ControlClient, Peer
     srv = SimServer(port=0, control_port=0).start_background()
     try:

@@ -2,8 +2,8 @@
 import select
 import socket
 
-from sim import codec
-from sim.server import SimServer
+from tmsim import codec
+from tmsim.server import SimServer
 
 
 class Peer:

@@ -3,10 +3,10 @@ import random
 import socket
 import time
 
-from sim import codec
-from sim.script import split_lines
-from sim.checker import check_script
-from sim.server import MAX_PENDING
+from tmsim import codec
+from tmsim.script import split_lines
+from tmsim.checker import check_script
+from tmsim.server import MAX_PENDING
 from sim_harness import Harness, sct, sta
 
 

@@ -7,9 +7,9 @@ import pathlib
 
 import pytest
 
-from sim import codec
-from sim.control import request as control_request
-from sim.server import SimServer
+from tmsim import codec
+from tmsim.control import request as control_request
+from tmsim.server import SimServer
 
 from sim_harness import Harness, sct, sta
 

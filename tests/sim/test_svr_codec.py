@@ -4,10 +4,10 @@ import struct
 
 import pytest
 
-from sim import codec
-from sim import svr_table as table
-from sim.svr_session import HEADERS
-from sim.svr_table import ITEMS, SvrContentError, SvrValueError
+from tmsim import codec
+from tmsim import svr_table as table
+from tmsim.svr_session import HEADERS
+from tmsim.svr_table import ITEMS, SvrContentError, SvrValueError
 
 TMSVR = HEADERS | {"CPERR"}
 

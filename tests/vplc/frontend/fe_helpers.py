@@ -1,10 +1,7 @@
 """Shared helpers of the front-end tests."""
 from __future__ import annotations
 
-import os
 import pathlib
-import subprocess
-import sys
 import textwrap
 
 from vplc.frontend.diagnostics import DiagnosticBag
@@ -30,12 +27,6 @@ def check_text(tmp_path, text: str, name: str = "t.st", **kw):
 
 def codes(proj, severity: str | None = None) -> list[str]:
     return [d.code for d in proj.diagnostics if severity is None or d.severity == severity]
-
-
-def run_cli(*args: str, cwd=None) -> subprocess.CompletedProcess:
-    env = dict(os.environ, PYTHONPATH=f"{ROOT / 'src'}{os.pathsep}{ROOT}")
-    return subprocess.run([sys.executable, "-m", "vplc", *args], capture_output=True, text=True, env=env,
-                          cwd=cwd or ROOT, timeout=120)
 
 
 def program(body: str, decls: str = "") -> str:

@@ -3,8 +3,6 @@ from __future__ import annotations
 
 import pytest
 
-from fe_helpers import run_cli
-
 
 def _write(tmp_path, name, data):
     p = tmp_path / name
@@ -28,7 +26,7 @@ CASES = {
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
-def test_bad_file_gives_diagnostic_and_exit_1(tmp_path, name):
+def test_bad_file_gives_diagnostic_and_exit_1(tmp_path, name, run_cli):
     data, code = CASES[name]
     result = run_cli("check", _write(tmp_path, f"{name}.st", data))
     assert result.returncode == 1, result.stdout + result.stderr
@@ -37,12 +35,12 @@ def test_bad_file_gives_diagnostic_and_exit_1(tmp_path, name):
     assert max(len(line) for line in result.stdout.splitlines()) < 1000
 
 
-def test_missing_file_gives_diagnostic_and_exit_1(tmp_path):
+def test_missing_file_gives_diagnostic_and_exit_1(tmp_path, run_cli):
     result = run_cli("check", str(tmp_path / "nope.st"))
     assert result.returncode == 1 and "error[ST0001]" in result.stdout and "does not exist" in result.stdout
 
 
-def test_one_million_character_line_of_valid_code_checks(tmp_path):
+def test_one_million_character_line_of_valid_code_checks(tmp_path, run_cli):
     path = _write(tmp_path, "wide.st", "PROGRAM P VAR x : INT; END_VAR x := 1;" + " " * 1_000_000 + "x := x; END_PROGRAM")
     result = run_cli("check", path)
     assert result.returncode == 0, result.stdout

@@ -4,10 +4,10 @@ from __future__ import annotations
 import json
 
 from vplc.cli import main as cli
-from fe_helpers import program, run_cli
+from fe_helpers import program
 
 
-def test_clean_file_exits_0_and_error_file_exits_1_with_rendered_caret(tmp_path):
+def test_clean_file_exits_0_and_error_file_exits_1_with_rendered_caret(tmp_path, run_cli):
     good = tmp_path / "good.st"
     good.write_text(program("x := 1;", "x : INT;"))
     assert run_cli("check", str(good)).returncode == 0
@@ -21,12 +21,12 @@ def test_clean_file_exits_0_and_error_file_exits_1_with_rendered_caret(tmp_path)
     assert lines[2].index("^") == lines[1].index("y;")
 
 
-def test_usage_error_exits_2():
+def test_usage_error_exits_2(run_cli):
     assert run_cli("check").returncode == 2
     assert run_cli("frobnicate").returncode == 2
 
 
-def test_json_format_lists_diagnostics(tmp_path):
+def test_json_format_lists_diagnostics(tmp_path, run_cli):
     bad = tmp_path / "bad.st"
     bad.write_text(program("x := y;", "x : INT;"))
     r = run_cli("check", "--format", "json", str(bad))
@@ -35,7 +35,7 @@ def test_json_format_lists_diagnostics(tmp_path):
     assert (d["code"], d["line"], d["column"], d["severity"]) == ("ST1001", 5, 6, "error")
 
 
-def test_warnings_as_errors_and_portable(tmp_path):
+def test_warnings_as_errors_and_portable(tmp_path, run_cli):
     f = tmp_path / "w.st"
     f.write_text(program("x := 1;", "x, unused : INT;"))
     assert run_cli("check", str(f)).returncode == 0
@@ -46,7 +46,7 @@ def test_warnings_as_errors_and_portable(tmp_path):
     assert r.returncode == 0 and "warning[ST2001]" in r.stdout
 
 
-def test_folders_are_searched_recursively_and_many_errors_reported(tmp_path):
+def test_folders_are_searched_recursively_and_many_errors_reported(tmp_path, run_cli):
     (tmp_path / "sub").mkdir()
     (tmp_path / "sub" / "a.st").write_text(program("x := a; y := b;", "x, y : INT;"))
     (tmp_path / "b.st").write_text(program("z := c;", "z : INT;"))

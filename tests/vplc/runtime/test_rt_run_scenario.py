@@ -4,7 +4,6 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-ENV = {**os.environ, "PYTHONPATH": os.path.join(ROOT, "src")}
 
 PROG = """PROGRAM Main
 VAR Start : BOOL; Count : INT; Level : REAL; Mode : STRING[10] := 'auto'; Wait : TIME := T#20ms; t : TON; END_VAR
@@ -16,7 +15,7 @@ END_PROGRAM
 
 
 def vplc(*args):
-    return subprocess.run([sys.executable, "-m", "vplc", *args], capture_output=True, text=True, env=ENV, timeout=60)
+    return subprocess.run([sys.executable, "-m", "vplc", *args], capture_output=True, text=True, timeout=60)
 
 
 def run(tmp_path, *args, scenario=None):

@@ -8,8 +8,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 
 
 def test_prelude_suites_pass():
-    r = subprocess.run([sys.executable, "-m", "vplc", "test", HERE], capture_output=True, text=True, timeout=120,
-                       env={**os.environ, "PYTHONPATH": os.path.join(ROOT, "src")})
+    r = subprocess.run([sys.executable, "-m", "vplc", "test", HERE], capture_output=True, text=True, timeout=120)
     last = r.stdout.strip().splitlines()[-1]
     assert r.returncode == 0, r.stdout + r.stderr
     assert last.endswith(" passed, 0 failed") and not last.startswith("0 ")

@@ -7,7 +7,6 @@ positional, INT_TO_STRING(LEN(...)) with LEN's UINT result (W501 6-107), UINT x 
 expression into NanoSecToTime (W501 6-106, 6-32)."""
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from functools import reduce
@@ -15,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from sim.server import SimServer
+from tmsim.server import SimServer
 from vplc.api import load_plc
 
 HERE = Path(__file__).resolve().parent
@@ -68,9 +67,8 @@ def client():
 
 
 def test_program_written_for_sysmac_studio_checks_clean_in_the_sysmac_dialect():
-    env = dict(os.environ, PYTHONPATH=f"{ROOT / 'src'}{os.pathsep}{ROOT}")
     r = subprocess.run([sys.executable, "-m", "vplc", "check", "--dialect", "sysmac", "--warnings-as-errors",
-                        str(PROGRAM)], capture_output=True, text=True, env=env, cwd=ROOT, timeout=120)
+                        str(PROGRAM)], capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert r.returncode == 0, r.stdout + r.stderr
     assert r.stdout.strip().endswith("1 file(s) checked: 0 error(s), 0 warning(s)")
 

@@ -1,0 +1,36 @@
+"""Fixtures every test package shares.
+
+`run_cli` starts one of the project's command lines (`vplc`, `tmsim`, `cbtdemo`) as a child process, the way a
+user starts it. The packages are installed editable into .venv by the Makefile; from a plain checkout
+(`python3 -m pytest`, nothing installed) the child finds them through PYTHONPATH, set here once for every child
+process a test starts.
+"""
+from __future__ import annotations
+
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+SRC = ROOT / "src"
+
+
+def pytest_configure(config):
+    paths = os.environ.get("PYTHONPATH", "").split(os.pathsep)
+    if str(SRC) not in paths:
+        os.environ["PYTHONPATH"] = os.pathsep.join(p for p in [str(SRC), *paths] if p)
+
+
+def _run_cli(*args, module: str = "vplc", cwd=None, timeout: float = 300, **kw) -> subprocess.CompletedProcess:
+    """`python -m <module> args...` from the checkout's root (or cwd), output captured as text."""
+    return subprocess.run([sys.executable, "-m", module, *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd or ROOT, timeout=timeout, **kw)
+
+
+@pytest.fixture(scope="session")
+def run_cli():
+    """A function that runs a project command line: run_cli("check", path) -> CompletedProcess."""
+    return _run_cli
