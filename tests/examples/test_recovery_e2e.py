@@ -92,9 +92,12 @@ def test_out_of_reach_mid_pnp_is_a_robot_error_acknowledged_and_resumed_without_
     plant.pulse("Project_Execute", "Project_Done", "project play")
     plant.until(lambda: plant.read("Connect_Connected"), "automatic reconnect", 8)
     assert not plant.read("RobotStatus.RobotError") and plant.read("RobotStatus.ProjectRunning")
+    plant.plc.write("PnP_Reset", True)                 # the cycle is Faulted: Reset, then a new start
+    plant.until(lambda: plant.read("PnP_State") == "Idle", "the reset", 1)
+    plant.plc.write("PnP_Reset", False)
     starts_before = len(plant.events("motion_start"))
     plant.plc.write("PnP_Example_Execute", True)
-    plant.until(lambda: plant.read("PnP_MoveBusy"), "the first move after the start", 1)
+    plant.until(lambda: plant.read("PnP_MoveBusy"), "the first move after the start", 2)
     assert plant.read("PnP_Segment") == 3                # with the part: on to the place approach
     plant.until(lambda: plant.read("PnP_CycleCount") >= 1, "the cycle to complete", 40)
     # resumed at the place approach with the part: no second pick, the part placed once
@@ -147,10 +150,11 @@ def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp
         cycles = plc.read("PnP_CycleCount")
         plc.write("PnP_Example_Execute", False)
         assert run(lambda: not plc.read("PnP_MoveBusy"), 10)
-        held = plc.read("PnP_GripperClosed")
-        plc.write("PnP_Example_Execute", True)            # operator start
-        assert run(lambda: plc.read("PnP_MoveBusy"), 5)
-        assert plc.read("PnP_Segment") == (3 if held else 0)  # where the part is: place approach or pick approach
+        plc.write("PnP_Reset", True)                      # the cycle is Faulted by the loss: Reset ...
+        assert run(lambda: plc.read("PnP_State") == "Idle", 2)
+        plc.write("PnP_Reset", False)
+        plc.write("PnP_Example_Execute", True)            # ... and an operator start (the robot's position
+        assert run(lambda: plc.read("PnP_MoveBusy"), 5)   # decides where the cycle goes on)
         assert run(lambda: plc.read("PnP_CycleCount") > cycles, 40), plc.read("PnP_MoveErrorDescrip")
         assert not plc.read("PnP_MoveError") and plc.read("Connect_Connected")
     finally:
