@@ -35,6 +35,9 @@ def register(subparsers) -> None:
     p.add_argument("--flat", action="store_true",
                    help="write every object in the global namespace (no NamespaceDecl), for importers "
                         "that do not take namespaces")
+    p.add_argument("--only", metavar="NAME[,NAME...]",
+                   help="write only these data types and POUs (the other sources are loaded to check them), e.g. "
+                        "one program for import into a project that has the library already")
     p.add_argument("--dialect", choices=("sysmac", "iec"), default="sysmac", help="language dialect (default: sysmac)")
     p.set_defaults(handler=run_export)
 
@@ -76,6 +79,17 @@ def run_export(args) -> int:
         print(f"vplc export: {errors} error(s) in the sources; nothing written", file=sys.stderr)
         return 1
     export = collect(proj)
+    if args.only:
+        wanted = {n.strip().upper() for n in args.only.split(",") if n.strip()}
+        missing = wanted - {i.name.upper() for i in export.items}
+        if missing:
+            return _usage(f"--only: no data type or POU named {', '.join(sorted(missing))} in the sources")
+        export.types = [t for t in export.types if t.name.upper() in wanted]
+        export.pous = [p for p in export.pous if p.name.upper() in wanted]
+        export.globals = []
+        export.namespaces = sorted({i.namespace for i in export.items if i.namespace})
+        if len(export.items) == 1:
+            export.title = export.items[0].name
     if not export.items:
         return _usage("the sources declare no data type and no POU; nothing to export")
     try:

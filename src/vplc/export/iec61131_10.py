@@ -1,24 +1,27 @@
 """IEC 61131-10 Ed.1 XML writer (the exchange format of Sysmac Studio's Tools > IEC 61131-10 XML > Import).
 
-Layout of the file (element order as in Omron's published sample; docs/toolchain/export.md lists what
-is not verified against Sysmac Studio)::
+Every file validates against Omron's two schemas (``IEC61131_10_Ed1_0_Spc1_0.xsd`` and its Sysmac extension
+``IEC61131_10_Ed1_0_SmcExt1_0_Spc1_0.xsd``, tests/vplc/export/test_export_sysmac_xsd.py); element and
+attribute names below are the schemas' own. Layout::
 
     Project (xmlns = www.iec.ch/public/TC65SC65BWG7TF10)
       FileHeader companyName productName productVersion
-      ContentHeader name creationDateTime
+      ContentHeader name creationDateTime / AddDataInfo/Info (the Sysmac extension is declared)
       Types
         GlobalNamespace
           NamespaceDecl name="CBT_Commands_Lib"           (omitted with flat=True)
             DataTypeDecl name                              (dependency order)
               Documentation? UserDefinedTypeSpec xsi:type="StructTypeSpec" | "EnumTypeWithNamedValueSpec" |
-                                                 "ArrayTypeSpec"   InitialValue?
-            Function | FunctionBlock | Program name        (call-dependency order)
-              Documentation? ResultType? Parameters(InputVars OutputVars InOutVars)? ExternalVars?
-              Vars* TempVars? MainBody/BodyContent xsi:type="ST"/ST
+                                                 "ArrayTypeSpec"
+            Function | FunctionBlock name                  (call-dependency order)
+              Documentation? ResultType? Parameters(InoutVars | InputVars | OutputVars, one per ST section)
+              ExternalVars* Vars* | TempVars* MainBody/BodyContent xsi:type="ST"/ST | "LD"/Rung*
+          Program name                                     (the schema allows programs in GlobalNamespace only)
+            Documentation? AddData(smcext:PouInfo) ExternalVars* Vars* MainBody/BodyContent "ST" | "smcext:LdSection"
       Instances
         Configuration/Resource/GlobalVars                  (only when the sources declare VAR_GLOBAL)
 
-Every variable is ``Variable name [orderWithinParamSet]`` with the children Documentation, Type,
+Every variable is ``Variable name [orderWithinParamSet]`` with the children Documentation, AddData, Type,
 InitialValue, Address in that order. The ST body is the source text unchanged. Output is deterministic:
 no wall-clock time, attributes in a fixed order, items in dependency order.
 """
@@ -37,11 +40,19 @@ IEC_NS = "www.iec.ch/public/TC65SC65BWG7TF10"
 XSI_NS = "http://www.w3.org/2001/XMLSchema-instance"
 SMC_NS = "https://www.ia.omron.com/Smc"
 SMC_SCHEMA = "IEC61131_10_Ed1_0_SmcExt1_0_Spc1_0.xsd"
+# The name under which Sysmac-generated files declare (AddDataInfo/Info) and use (AddData/Data) the Omron
+# extension, and its vendor: as in the public generator meyn-git/meyncraft, whose files Sysmac Studio imports.
+SMC_DATA_NAME = f"{SMC_NS} {SMC_SCHEMA}"
 SCHEMA_VERSION = "1"
 COMPANY = "CBT_Commands_Lib project"
 PRODUCT = "vplc (open IEC 61131-3 ST toolchain)"
 POU_ELEMENT = {"FUNCTION": "Function", "FUNCTION_BLOCK": "FunctionBlock", "PROGRAM": "Program"}
-PARAM_ELEMENT = {"VAR_INPUT": "InputVars", "VAR_OUTPUT": "OutputVars", "VAR_IN_OUT": "InOutVars"}
+# ParameterSet of the base schema: the in-out list is spelt ``InoutVars``.
+PARAM_ELEMENT = {"VAR_INPUT": "InputVars", "VAR_OUTPUT": "OutputVars", "VAR_IN_OUT": "InoutVars"}
+# EnumTypeWithNamedValueSpec/BaseType is the simple type ElementaryType, whose only value is DINT: a Sysmac
+# enumeration is always DINT-sized (values outside DINT are refused).
+ENUM_BASE = "DINT"
+DINT_RANGE = (-2**31, 2**31 - 1)
 
 
 def creation_time() -> str:
@@ -66,6 +77,12 @@ def _doc(parent: ET.Element, text: str) -> None:
         _sub(parent, "Documentation", {"xsi:type": "SimpleText"}, text=text)
 
 
+def _add_data(parent: ET.Element, tag: str, attrs: dict) -> None:
+    """``AddData/Data`` holding one element of the Omron extension (``smcext:`` prefix)."""
+    data = _sub(_sub(parent, "AddData"), "Data", {"name": SMC_DATA_NAME, "handleUnknown": "discard"})
+    _sub(data, f"smcext:{tag}", attrs)
+
+
 # ---- types ---------------------------------------------------------------------------------------
 
 def _bound(e: A.Expr) -> str:
@@ -77,7 +94,9 @@ def _array_spec(el: ET.Element, ref: A.ArrayTypeRef) -> None:
     _type_into(_sub(el, "BaseType"), ref.element)
     for n, dim in enumerate(ref.dims, start=1):
         ds = _sub(el, "DimensionSpec", {"dimensionNumber": str(n)})
-        if dim.lo is not None:                      # ARRAY[*]: a DimensionSpec without IndexRange
+        if dim.lo is None:                          # ARRAY[*]: the schema's VariableLength (fixed "true")
+            _sub(ds, "VariableLength", text="true")
+        else:
             _sub(ds, "IndexRange", {"lower": _bound(dim.lo), "upper": _bound(dim.hi)})
 
 
@@ -106,13 +125,21 @@ def _value_into(el: ET.Element, e: A.Expr) -> None:
         _sub(el, "SimpleValue", {"value": expr_text(e)})
 
 
-def _variable(parent: ET.Element, tag: str, d: A.VarDecl, comment: str, order: int | None = None) -> None:
+def _variable(parent: ET.Element, tag: str, d: A.VarDecl, comment: str, order: int | None = None, *,
+              constant: bool = False, plain: bool = False) -> None:
+    """One Variable (or Member). ``constant``: a CONSTANT parameter, which the schema marks per variable
+    (``smcext:ParameterSetVariableAdditionalProperties constant="true"``; ParameterSet lists have no
+    ``constant`` attribute). ``plain``: an ExternalVars entry (VariableDeclPlain: no InitialValue, no Address)."""
     attrs = {"name": d.name}
     if order is not None:
         attrs["orderWithinParamSet"] = str(order)
     v = _sub(parent, tag, attrs)
     _doc(v, comment)
+    if constant:
+        _add_data(v, "ParameterSetVariableAdditionalProperties", {"constant": "true"})
     _type_into(_sub(v, "Type"), d.type)
+    if plain:
+        return
     if d.init is not None:
         _value_into(_sub(v, "InitialValue"), d.init)
     if d.at:
@@ -121,6 +148,10 @@ def _variable(parent: ET.Element, tag: str, d: A.VarDecl, comment: str, order: i
 
 def _data_type(parent: ET.Element, item: TypeItem, project) -> None:
     decl = item.decl
+    if decl.init is not None:
+        raise ExportError(f"{item.path}: data type `{decl.name}` has an initial value of its own; IEC 61131-10 "
+                          "(UserDefinedTypeDecl) and Sysmac Studio's data types have none: give the initial "
+                          "value to the variables or members of that type")
     el = _sub(parent, "DataTypeDecl", {"name": decl.name})
     _doc(el, item.comment)
     spec = decl.spec
@@ -132,51 +163,143 @@ def _data_type(parent: ET.Element, item: TypeItem, project) -> None:
         ts = _sub(el, "UserDefinedTypeSpec", {"xsi:type": "EnumTypeWithNamedValueSpec"})
         values = enum_values(project, item)
         for v in spec.values:
-            _sub(ts, "Enumerator", {"name": v.name, "value": str(values[v.name.upper()])})
-        if spec.base is not None:
-            _type_into(_sub(ts, "BaseType"), spec.base)
+            value = values[v.name.upper()]
+            if not DINT_RANGE[0] <= value <= DINT_RANGE[1]:
+                raise ExportError(f"{item.path}: enumeration `{decl.name}`: value {v.name} = {value} is outside "
+                                  "DINT; Sysmac enumerations are DINT")
+            _sub(ts, "Enumerator", {"name": v.name, "value": str(value)})
+        _sub(ts, "BaseType", text=ENUM_BASE)
     elif isinstance(spec, A.ArrayTypeRef):
         _array_spec(_sub(el, "UserDefinedTypeSpec", {"xsi:type": "ArrayTypeSpec"}), spec)
     else:
         raise ExportError(f"{item.path}: data type `{decl.name}` ({type_text(spec)}) is an alias or subrange "
                           "type; the IEC 61131-10 export writes structures, enumerations and arrays only")
-    if decl.init is not None:
-        _value_into(_sub(el, "InitialValue"), decl.init)
 
 
 # ---- POUs ----------------------------------------------------------------------------------------
 
-def _pou(parent: ET.Element, item: PouItem) -> None:
+def _refuse(item: PouItem, what: str) -> None:
+    raise ExportError(f"{item.path}: {item.kind} `{item.name}`: {what}")
+
+
+def _pou(parent: ET.Element, item: PouItem, external: list, using: str | None = None) -> None:
+    """``using``: the namespace of a program written outside it (its names resolve there: UsingDirective)."""
     pou = item.pou
     el = _sub(parent, POU_ELEMENT[pou.kind], {"name": pou.name})
     _doc(el, item.comment)
+    if pou.kind == "PROGRAM":                       # Sysmac writes PouInfo for each program
+        _add_data(el, "PouInfo", {"version": __version__, "creationDateTime": creation_time(),
+                                  "modificationDateTime": creation_time()})
+    if using:
+        _sub(el, "UsingDirective", text=using)
     comment = item.var_comments
     if pou.kind == "FUNCTION":
         if pou.return_type is None:
             raise ExportError(f"{item.path}: FUNCTION `{pou.name}` has no result type")
         _type_into(_sub(el, "ResultType"), pou.return_type)
-    params = [(s, d) for s in pou.sections if s.kind in PARAM_ELEMENT for d in s.vars]
-    if params:
-        ps = _sub(el, "Parameters")
-        order = {id(d): i for i, (_s, d) in enumerate(params)}    # one counter, declaration order
-        for kind in ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT"):
-            group = [(s, d) for s, d in params if s.kind == kind]
-            if group:
-                g = _sub(ps, PARAM_ELEMENT[kind], _qualifiers(group[0][0]))
-                for _s, d in group:
-                    _variable(g, "Variable", d, comment.get(id(d), ""), order[id(d)])
-    _var_lists(el, item, "VAR_EXTERNAL", "ExternalVars", {})
-    if pou.kind == "FUNCTION":                      # a function's VAR are temporaries
-        _var_lists(el, item, ("VAR", "VAR_TEMP"), "TempVars", {})
-    else:
-        _var_lists(el, item, ("VAR", "VAR_STAT"), "Vars", {"accessSpecifier": "private"})
-        _var_lists(el, item, "VAR_TEMP", "TempVars", {})
+    _parameters(el, item)
     ladder = getattr(pou, "ladder", None)
-    if ladder is not None:                          # a ladder POU keeps its rungs (Sysmac's LdSection)
-        ld_body(_sub(el, "MainBody"), ladder)
+    helpers = {h.upper() for h in (ladder.helpers if ladder is not None else [])}   # the translation's own
+    _external_vars(el, item, external)
+    for section in pou.sections:
+        decls = [d for d in section.vars if d.name.upper() not in helpers]
+        if not decls or section.kind in PARAM_ELEMENT or section.kind == "VAR_EXTERNAL":
+            continue
+        if pou.kind == "FUNCTION":                  # a function's VAR are temporaries
+            tag, attrs = "TempVars", {}
+        elif section.kind == "VAR_TEMP":            # FunctionBlock and Program have no TempVars in the schema
+            _refuse(item, "VAR_TEMP has no counterpart in Sysmac Studio's function blocks and programs "
+                          "(the schema has TempVars for functions only); declare the variables in VAR")
+        else:
+            tag, attrs = "Vars", {"accessSpecifier": "private"}
+        lst = _sub(el, tag, {**attrs, **_qualifiers(section)})
+        for d in decls:
+            _variable(lst, "Variable", d, comment.get(id(d), ""))
+    if ladder is not None:                          # a ladder POU keeps its rungs
+        _check_ladder(item, ladder)
+        ld_body(_sub(el, "MainBody"), ladder, section=pou.kind == "PROGRAM")
         return
     bc = _sub(_sub(el, "MainBody"), "BodyContent", {"xsi:type": "ST"})
     _sub(bc, "ST", text=item.body)
+
+
+def _check_ladder(item: PouItem, ladder) -> None:
+    """Ladder elements the schema cannot express are refused, never written with another meaning: a
+    DataSource / DataSink has no ``negated`` and a DataSink no output (PLCopen's inOutVariable)."""
+    for n, rung in enumerate(ladder.rungs, start=1):
+        for e in rung.elements:
+            where = f"rung {n}: {e.describe()}"
+            if e.kind == "inout_var":
+                _refuse(item, f"{where} is written and read on in the rung (PLCopen inOutVariable); IEC 61131-10's "
+                              "DataSink has no output: use a coil (BOOL) or a second rung that reads the variable")
+            if e.kind in ("in_var", "out_var") and e.negated:
+                _refuse(item, f"{where} is negated; IEC 61131-10's DataSource / DataSink have no negation: "
+                              "negate the pin of the block instead")
+
+
+def _parameters(el: ET.Element, item: PouItem) -> None:
+    """``Parameters``: one list per source section, so each keeps its own RETAIN (the schema's ``retain``
+    on InputVars / OutputVars) and CONSTANT (per variable); ``orderWithinParamSet`` is one counter in
+    declaration order. Functions always have it (the schema requires it) and start with ``EN``, the BOOL
+    input every Sysmac function has (W501, user-defined functions: EN/ENO); vplc reads it back as the
+    implicit EN. Programs have none in the schema."""
+    pou = item.pou
+    sections = [s for s in pou.sections if s.kind in PARAM_ELEMENT and s.vars]
+    if pou.kind == "PROGRAM":
+        if sections:
+            _refuse(item, f"{sections[0].kind} in a program has no counterpart in Sysmac Studio (the schema's "
+                          "Program has no Parameters); use a function block or global variables")
+        return
+    ps = _sub(el, "Parameters")
+    order = 0
+    if pou.kind == "FUNCTION":
+        en = _sub(_sub(ps, "InputVars"), "Variable", {"name": "EN", "orderWithinParamSet": "0"})
+        _sub(_sub(en, "Type"), "TypeName", text="BOOL")
+        _sub(_sub(en, "InitialValue"), "SimpleValue", {"value": "TRUE"})
+        order = 1
+    for s in sections:
+        attrs = {}
+        if s.retain:
+            if s.kind == "VAR_IN_OUT":
+                _refuse(item, "VAR_IN_OUT RETAIN: an in-out refers to the caller's variable and cannot be "
+                              "retained (the schema's InoutVars has no retain)")
+            attrs["retain"] = "true"
+        if s.constant and s.kind == "VAR_OUTPUT":
+            _refuse(item, "VAR_OUTPUT CONSTANT: an output cannot be constant")
+        g = _sub(ps, PARAM_ELEMENT[s.kind], attrs)
+        for d in s.vars:
+            _variable(g, "Variable", d, item.var_comments.get(id(d), ""), order, constant=s.constant)
+            order += 1
+
+
+def _external_vars(el: ET.Element, item: PouItem, external: list) -> None:
+    """Declared VAR_EXTERNAL sections, then one list for the globals the body uses without declaring them:
+    Sysmac Studio needs every global a POU uses in its external variables (W501, external variables)."""
+    for section in item.pou.sections:
+        if section.kind == "VAR_EXTERNAL" and section.vars:
+            lst = _sub(el, "ExternalVars", {"constant": "true"} if section.constant else {})
+            for d in section.vars:
+                _variable(lst, "Variable", d, item.var_comments.get(id(d), ""), plain=True)
+    for constant in (True, False):
+        group = [d for d, c in external if c == constant]
+        if group:
+            lst = _sub(el, "ExternalVars", {"constant": "true"} if constant else {})
+            for d in group:
+                _variable(lst, "Variable", d, "", plain=True)
+
+
+def used_globals(item: PouItem) -> list:
+    """(declaration, constant) of every global the POU's body names without a VAR_EXTERNAL, first use first."""
+    declared = {d.name.upper() for s in item.pou.sections for d in s.vars}
+    seen: dict[str, tuple] = {}
+    for node in (n for stmt in item.pou.body for n in A.walk(stmt)):
+        sym = getattr(node, "sym", None) if isinstance(node, A.Name) else None
+        if sym is None or getattr(sym, "section", None) != "VAR_GLOBAL" or sym.decl is None:
+            continue
+        key = sym.name.upper()
+        if key not in declared and key not in seen:
+            seen[key] = (sym.decl, bool(sym.constant))
+    return list(seen.values())
 
 
 def _qualifiers(section: A.VarSection) -> dict:
@@ -186,19 +309,6 @@ def _qualifiers(section: A.VarSection) -> dict:
     if section.retain:
         attrs["retain"] = "true"
     return attrs
-
-
-def _var_lists(el: ET.Element, item: PouItem, kinds, tag: str, base_attrs: dict) -> None:
-    """One list element per source section of ``kinds`` (sections differ in CONSTANT / RETAIN)."""
-    kinds = (kinds,) if isinstance(kinds, str) else kinds
-    ladder = getattr(item.pou, "ladder", None)
-    helpers = {h.upper() for h in (ladder.helpers if ladder is not None else [])}   # the translation's own
-    for section in item.pou.sections:
-        decls = [d for d in section.vars if d.name.upper() not in helpers]
-        if section.kind in kinds and decls:
-            lst = _sub(el, tag, {**base_attrs, **_qualifiers(section)})
-            for d in decls:
-                _variable(lst, "Variable", d, item.var_comments.get(id(d), ""))
 
 
 # ---- document ------------------------------------------------------------------------------------
@@ -213,7 +323,8 @@ def build(export: ExportSet, project, *, flat: bool = False) -> ET.Element:
         "schemaVersion": SCHEMA_VERSION,
     })
     _sub(root, "FileHeader", {"companyName": COMPANY, "productName": PRODUCT, "productVersion": __version__})
-    _sub(root, "ContentHeader", {"name": export.name, "creationDateTime": creation_time()})
+    ch = _sub(root, "ContentHeader", {"name": export.name, "creationDateTime": creation_time()})
+    _sub(_sub(ch, "AddDataInfo"), "Info", {"name": SMC_DATA_NAME, "vendor": SMC_NS})
     gns = _sub(_sub(root, "Types"), "GlobalNamespace")
     containers: dict[str | None, ET.Element] = {None: gns}
     if not flat:
@@ -221,8 +332,9 @@ def build(export: ExportSet, project, *, flat: bool = False) -> ET.Element:
             containers[ns] = _sub(gns, "NamespaceDecl", {"name": ns})
     for t in export.types:
         _data_type(containers[None if flat else t.namespace], t, project)
-    for p in export.pous:
-        _pou(containers[None if flat else p.namespace], p)
+    for p in export.pous:                           # NamespaceDecl holds no Program in the schema
+        where = None if flat or p.kind == "PROGRAM" else p.namespace
+        _pou(containers[where], p, used_globals(p), using=p.namespace if not flat and where != p.namespace else None)
     instances = _sub(root, "Instances")
     if export.globals:
         _globals(instances, export)

@@ -74,6 +74,7 @@ class ExportSet:
     pous: list[PouItem]              # dependency order: every POU after the POUs it calls or instantiates
     globals: list[GlobalItem]
     namespaces: list[str]            # library namespaces present, sorted
+    title: str | None = None         # content name chosen by the caller (export --only of one object)
 
     @property
     def items(self) -> list:
@@ -81,7 +82,9 @@ class ExportSet:
 
     @property
     def name(self) -> str:
-        """Content name: the library namespace when there is exactly one, else ``Project``."""
+        """Content name: the caller's title, the library namespace when there is exactly one, else ``Project``."""
+        if self.title:
+            return self.title
         return self.namespaces[0] if len(self.namespaces) == 1 else "Project"
 
 

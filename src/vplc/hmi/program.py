@@ -31,7 +31,7 @@ class LadderView:
         self.pou = pou
         self.ladder = pou.ladder
         self.instance = instance
-        self.locals = {d.name.upper() for s in pou.sections for d in s.vars}
+        self.locals = {d.name.upper() for s in pou.sections if s.kind != "VAR_EXTERNAL" for d in s.vars}   # globals by name
         self.svg = svg_document(self.ladder)
         names = set()
         for rung in self.ladder.rungs:

@@ -1,12 +1,18 @@
-"""Read an IEC 61131-10 Ed.1 XML project: our own export (:mod:`vplc.export.iec61131_10`) and the
-ladder shape Sysmac Studio exchanges (docs/toolchain/export.md, section "Ladder bodies").
+"""Read an IEC 61131-10 Ed.1 XML project as Sysmac Studio writes it (Omron's schemas
+``IEC61131_10_Ed1_0_Spc1_0.xsd`` + ``IEC61131_10_Ed1_0_SmcExt1_0_Spc1_0.xsd``) and as vplc exports it.
 
 ``Types/GlobalNamespace`` holds data types and POUs, optionally inside ``NamespaceDecl``; a POU body is
-``MainBody/BodyContent`` of ``xsi:type="ST"`` (text) or ``smcext:LdSection`` (rungs). A rung lists
+``MainBody/BodyContent`` of ``xsi:type="ST"`` (text), ``smcext:LdSection`` or ``LD`` (rungs). A rung lists
 ``LdObject`` (LeftPowerRail, Contact, Coil, RightPowerRail), ``FbdObject`` (Block, DataSource, DataSink,
-Jump, Label, Return) and ``CommonObject`` comments; wires are ``ConnectionPointIn/Connection
-refConnectionPointOutId`` pointing at a ``ConnectionPointOut connectionPointOutId`` of the same rung.
-Global variables are read from ``Instances/Configuration/Resource/GlobalVars``.
+Jump) and ``CommonObject`` comments; wires are ``ConnectionPointIn/Connection refConnectionPointOutId``
+pointing at a ``ConnectionPointOut connectionPointOutId`` of the same rung. Global variables are read from
+``Instances/Configuration/Resource/GlobalVars``.
+
+Every element and attribute of the schemas that changes what a program does is read with its meaning or
+refused with an error naming it (docs/toolchain/export.md, "Reading"): nothing is read with another
+meaning. Spellings written by earlier vplc exports that the schemas refuse (``InOutVars``, ``Coil storage``,
+``Jump label``, ``FbdObject Label / Return``, an enumeration's ``BaseType/TypeName``, an empty open-array
+``DimensionSpec``, ``constant`` on a parameter list) are still read, each with a warning naming the rule.
 """
 from __future__ import annotations
 
@@ -16,8 +22,17 @@ from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit
 from .model import EDGES, STORAGES, Conn, Element, LadderBody, Pin, Rung
 from .xmlsafe import text_of, xsi_type
 
-POUS = {"Program": "PROGRAM", "FunctionBlock": "FUNCTION_BLOCK", "Function": "FUNCTION"}
+POUS = {"Program": "PROGRAM", "FunctionBlock": "FUNCTION_BLOCK", "Function": "FUNCTION",
+        "DebugProgram": "PROGRAM"}
 PARAMS = {"InputVars": "VAR_INPUT", "OutputVars": "VAR_OUTPUT", "InOutVars": "VAR_IN_OUT", "InoutVars": "VAR_IN_OUT"}
+# Elements of the Sysmac extension (namespace https://www.ia.omron.com/Smc) that may stand in an AddData/Data,
+# and what reading them means. Anything else in an Omron Data block is refused by name.
+SMC_IGNORED = {"DeviceInfo", "PouInfo", "GlobalVariableAdditionalProperties", "VariableComment",
+               "EnumeratorsComment", "MultiComment", "FunctionResultComment", "ConnectionPointInOrder",
+               "ConnectionPointOutOrder", "SmcSize"}   # identification, comments, network publish, drawing
+SMC_READ = {"ParameterSetVariableAdditionalProperties", "StructTypeSpecAdditionalProperties"}
+ELEMENTARY = {"BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "BYTE", "WORD", "DWORD",
+              "LWORD", "REAL", "LREAL", "TIME", "DATE", "TIME_OF_DAY", "TOD", "DATE_AND_TIME", "DT", "STRING"}
 LISTS = {"ExternalVars": "VAR_EXTERNAL", "Vars": "VAR", "TempVars": "VAR_TEMP"}
 LD_OBJECTS = {"LeftPowerRail": "left_rail", "RightPowerRail": "right_rail", "Contact": "contact", "Coil": "coil"}
 FBD_OBJECTS = {"Block": "block", "DataSource": "in_var", "DataSink": "out_var", "Jump": "jump", "Label": "label",
@@ -25,9 +40,31 @@ FBD_OBJECTS = {"Block": "block", "DataSource": "in_var", "DataSink": "out_var", 
 KNOWN = ", ".join([*LD_OBJECTS, *FBD_OBJECTS])
 
 
-def read(root: ET.Element) -> list[XmlUnit]:
+_warnings: list[tuple[str, str]] = []
+
+
+def _old(where: str, message: str) -> None:
+    """A spelling of an earlier vplc export that Omron's schemas refuse: read with its meaning, and said."""
+    _warnings.append((where, message))
+
+
+def read(root: ET.Element, warnings: list | None = None) -> list[XmlUnit]:
+    """The units of the file; ``warnings`` receives (where, message) for each old-export spelling read."""
+    _warnings.clear()
+    try:
+        return _read(root)
+    finally:
+        if warnings is not None:
+            warnings.extend(_warnings)
+        _warnings.clear()
+
+
+def _read(root: ET.Element) -> list[XmlUnit]:
     gns = root.find("Types/GlobalNamespace")
     units: dict[str | None, XmlUnit] = {None: XmlUnit(None)}
+    header = root.find("ContentHeader")
+    if header is not None:
+        _add_data(header, "ContentHeader")
     if gns is not None:
         _namespace(gns, None, units)
     for gl in root.iterfind("Instances/Configuration/Resource/GlobalVars"):
@@ -41,11 +78,41 @@ def _namespace(container: ET.Element, ns: str | None, units: dict) -> None:
     unit = units.setdefault(ns, XmlUnit(ns))
     for item in container:
         if item.tag == "NamespaceDecl":
-            _namespace(item, item.get("name") or None, units)
+            inner = item.get("name") or None
+            if ns is not None and inner is not None:
+                raise FormatError(f"namespace {ns}\\{inner}", "nested namespaces are not modelled by vplc; "
+                                  "declare the objects in one namespace")
+            _namespace(item, inner, units)
         elif item.tag in ("DataTypeDecl", "UserDefinedTypeDecl"):
             unit.types.append(_data_type(item))
         elif item.tag in POUS:
-            unit.pous.append(_pou(item))
+            using = [(u.text or "").strip() for u in item.iterfind("UsingDirective")]
+            if len(using) > 1 or (using and ns is not None):
+                raise FormatError(item.get("name", ""), "UsingDirective " + ", ".join(using) + ": vplc resolves "
+                                  "the names of a POU in one namespace only; qualify the names instead")
+            target = units.setdefault(using[0], XmlUnit(using[0])) if using else unit
+            target.pous.append(_pou(item))
+
+
+def _add_data(el: ET.Element, where: str) -> dict[str, ET.Element]:
+    """The Sysmac-extension elements in ``el``'s AddData, by name. A Data block of another vendor is skipped
+    (the schema's handleUnknown="discard"); an element of Omron's block that vplc does not know is refused."""
+    found: dict[str, ET.Element] = {}
+    for data in el.iterfind("AddData/Data"):
+        omron = "omron" in (data.get("name") or "").lower()
+        for child in data:
+            if child.tag in SMC_READ or child.tag in SMC_IGNORED:
+                found[child.tag] = child
+            elif omron:
+                raise FormatError(where, f"unknown Sysmac extension element <smcext:{child.tag}> in AddData; vplc "
+                                  "reads " + ", ".join(sorted(SMC_READ | SMC_IGNORED)))
+    return found
+
+
+def _smc_type(el: ET.Element) -> str:
+    """``xsi:type`` with its prefix as written (``smcext:LdSection``)."""
+    from .xmlsafe import XSI_TYPE
+    return el.get(XSI_TYPE, "")
 
 
 # ---- types and values ----------------------------------------------------------------------------
@@ -66,6 +133,9 @@ def _array(spec: ET.Element, where: str) -> str:
     dims = []
     for ds in spec.iterfind("DimensionSpec"):
         r = ds.find("IndexRange")
+        if r is None and ds.find("VariableLength") is None:
+            _old(where, "an open array dimension is an empty DimensionSpec; the schema needs IndexRange or "
+                        "VariableLength (read as ARRAY[*])")
         dims.append(f"{r.get('lower')}..{r.get('upper')}" if r is not None else "*")
     return f"ARRAY[{', '.join(dims)}] OF {type_text(spec.find('BaseType'), where)}"
 
@@ -94,6 +164,12 @@ def _doc(el: ET.Element) -> str:
 
 def _var(v: ET.Element, where: str) -> VarText:
     name = v.get("name", "")
+    edge = v.get("edgeDetection", "none")
+    if edge not in ("", "none"):
+        raise FormatError(f"{where}:variable {name}", f'edgeDetection="{edge}" (an input that is TRUE only on the '
+                          "edge of its value) is not modelled by vplc; pass the edge from the caller "
+                          "(R_TRIG / F_TRIG, or an edge contact)")
+    _add_data(v, f"{where}:variable {name}")
     addr = v.find("Address")
     return VarText(name, type_text(v.find("Type"), f"{where}:variable {name}"), value_text(v.find("InitialValue")),
                    _doc(v), addr.get("address") if addr is not None else None)
@@ -109,13 +185,23 @@ def _data_type(dt: ET.Element) -> TypeText:
     where = f"data type {name}"
     spec = dt.find("UserDefinedTypeSpec")
     kind = xsi_type(spec) if spec is not None else ""
+    if spec is not None:
+        props = _add_data(spec, where).get("StructTypeSpecAdditionalProperties")
+        offset = props.get("offsetType", "NJ") if props is not None else "NJ"
+        if offset != "NJ":
+            raise FormatError(where, f'StructTypeSpecAdditionalProperties offsetType="{offset}": member offsets '
+                              "other than the NJ layout are not modelled by vplc (its structures have no memory "
+                              "layout); use offsetType NJ")
+    _add_data(dt, where)
+    if kind == "StructTypeSpec" and spec.get("overlap", "false") in ("true", "1"):
+        raise FormatError(where, 'StructTypeSpec overlap="true" (a UNION: members sharing memory) is not modelled '
+                          "by this reader; declare it in ST as UNION or use a structure")
     if kind == "StructTypeSpec":
         fields = "".join(f"    {_line(_var(m, where))}\n" for m in spec.iterfind("Member"))
         text = f"STRUCT\n{fields}END_STRUCT"
     elif kind == "EnumTypeWithNamedValueSpec":
         values = ", ".join(f"{e.get('name')} := {e.get('value')}" for e in spec.iterfind("Enumerator"))
-        base = spec.find("BaseType")
-        text = f"({values})" + (f" {type_text(base, where)}" if base is not None else "")
+        text = f"({values})" + _enum_base(spec.find("BaseType"), where)
     elif kind == "EnumTypeSpec":
         text = "(" + ", ".join(e.get("name", "") for e in spec.iterfind("Enumerator")) + ")"
     elif kind == "ArrayTypeSpec":
@@ -123,6 +209,21 @@ def _data_type(dt: ET.Element) -> TypeText:
     else:
         raise FormatError(where, f"data type specification `{kind or '?'}` is not supported")
     return TypeText(name, text, value_text(dt.find("InitialValue")), _doc(dt))
+
+
+def _enum_base(base: ET.Element | None, where: str) -> str:
+    """The schema's BaseType is the elementary type name as text (ElementaryType: DINT)."""
+    if base is None:
+        _old(where, "an enumeration without BaseType; the schema requires it (read as DINT)")
+        return ""
+    if len(base):
+        _old(where, "the enumeration's BaseType holds a TypeName element; the schema wants the type name as "
+                    "text (<BaseType>DINT</BaseType>)")
+        return f" {type_text(base, where)}"
+    name = (base.text or "").strip()
+    if name.upper() not in ELEMENTARY:
+        raise FormatError(where, f"enumeration base type `{name}` is not an elementary type")
+    return f" {name}"
 
 
 def _line(v: VarText) -> str:
@@ -136,20 +237,34 @@ def _line(v: VarText) -> str:
 def _pou(el: ET.Element) -> PouText:
     name = el.get("name", "")
     out = PouText(POUS[el.tag], name, comment=_doc(el))
+    _add_data(el, name)
     rt = el.find("ResultType")
     if rt is not None:
         out.return_type = type_text(rt, f"{name}:result")
     params = []
     for holder in [*el.iterfind("Parameters"), *el.iterfind("ParameterSet")]:
         for lst in holder:
-            if lst.tag in PARAMS:
-                for v in lst.iterfind("Variable"):
-                    params.append((int(v.get("orderWithinParamSet", len(params))), PARAMS[lst.tag], lst, v))
+            if lst.tag not in PARAMS:
+                continue
+            if lst.tag == "InOutVars":
+                _old(name, "<InOutVars> is spelt InoutVars in the schema")
+            if lst.get("constant") == "true":
+                _old(name, f"<{lst.tag} constant=\"true\">: the schema marks a constant parameter per variable "
+                           "(smcext:ParameterSetVariableAdditionalProperties constant=\"true\")")
+            for v in lst.iterfind("Variable"):
+                props = _add_data(v, f"{name}:variable {v.get('name', '')}").get(
+                    "ParameterSetVariableAdditionalProperties")
+                constant = lst.get("constant") == "true" or (
+                    props is not None and props.get("constant", "false") in ("true", "1"))
+                params.append((int(v.get("orderWithinParamSet", len(params))), PARAMS[lst.tag], lst, v, constant))
     params.sort(key=lambda p: p[0])
-    for _order, kind, lst, v in params:                  # declaration order, one section per run of a kind
-        if not out.sections or out.sections[-1].kind != kind:
-            out.sections.append(SectionText(kind, constant=lst.get("constant") == "true",
-                                            retain=lst.get("retain") == "true"))
+    if out.kind == "FUNCTION":                           # Sysmac's EN / ENO are vplc's implicit EN / ENO
+        params = [p for p in params if not _en_eno(p[1], p[3])]
+    holder_of = None
+    for _order, kind, lst, v, constant in params:        # declaration order; one section per source section
+        if not out.sections or holder_of is not lst or out.sections[-1].constant != constant:
+            out.sections.append(SectionText(kind, constant=constant, retain=lst.get("retain") == "true"))
+            holder_of = lst
         out.sections[-1].vars.append(_var(v, name))
     for lst in el:
         if lst.tag in LISTS:
@@ -161,7 +276,7 @@ def _pou(el: ET.Element) -> PouText:
     kinds = {xsi_type(c) for c in contents}
     if kinds == {"ST"}:
         out.st_body = "\n".join((c.findtext("ST") or "") for c in contents)
-    elif kinds == {"LdSection"}:
+    elif kinds <= {"LdSection", "LD"}:
         contents.sort(key=lambda c: int(c.get("evaluationOrder", "0") or 0))
         rungs = []
         for section in contents:
@@ -169,8 +284,15 @@ def _pou(el: ET.Element) -> PouText:
         out.ladder = LadderBody(name, rungs)
     else:
         raise FormatError(name, f"body type {', '.join(sorted(kinds))} is not supported; the virtual PLC runs ST "
-                                "and LD (smcext:LdSection)")
+                                "and LD (LD, smcext:LdSection)")
     return out
+
+
+def _en_eno(kind: str, v: ET.Element) -> bool:
+    """A function's ``EN`` input or ``ENO`` output of type BOOL."""
+    want = {"VAR_INPUT": "EN", "VAR_OUTPUT": "ENO"}.get(kind)
+    return want is not None and v.get("name", "").upper() == want and \
+        (v.findtext("Type/TypeName") or "").strip().upper() == "BOOL"
 
 
 def _rungs(section: ET.Element, pou: str) -> list[Rung]:
@@ -193,15 +315,27 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
         if obj.tag == "CommonObject" and kind == "Comment":
             rung.comment = f"{rung.comment}\n{text_of(obj.find('Content'))}".strip()
             continue
+        place = f"{pou}:rung {number}:element {index}"
+        if _smc_type(obj) == "smcext:InlineST":
+            raise FormatError(place, f"unknown element <{obj.tag} xsi:type=\"InlineST\"> in a rung: Sysmac's "
+                              "smcext:InlineST (Structured Text inside a rung) is not modelled by vplc; move the ST "
+                              "into an ST POU or a function called from the rung")
         table = LD_OBJECTS if obj.tag == "LdObject" else FBD_OBJECTS if obj.tag == "FbdObject" else {}
         if kind not in table:
             if obj.tag in ("AddData", "Documentation"):
                 continue
-            raise FormatError(f"{pou}:rung {number}:element {index}",
-                              f"unknown element <{obj.tag} xsi:type=\"{kind}\"> in a rung; a rung has {KNOWN}")
+            raise FormatError(place, f"unknown element <{obj.tag} xsi:type=\"{_smc_type(obj) or kind}\"> in a rung; "
+                                     f"a rung has {KNOWN}")
+        if kind in ("Label", "Return"):
+            _old(place, f"<FbdObject xsi:type=\"{kind}\"> is not in the schema (a label is the Rung's label "
+                        "attribute; a return is a jump to the last rung)")
+        if kind == "DataSink" and not obj.get("identifier", "") and obj.find("ConnectionPointOut") is None:
+            continue                                     # Sysmac's empty sink: an output written nowhere
         eid = obj.get("globalId") or f"r{number}e{index}"
         ekind = table[kind]
         if ekind == "out_var" and obj.find("ConnectionPointOut") is not None:
+            _old(place, "a DataSink with a ConnectionPointOut is not in the schema (read as a variable written "
+                        "and read on)")
             ekind = "inout_var"                          # a DataSink that is also read further on
         objects.append((obj, Element(eid, ekind)))
         for pt in obj.iterfind("ConnectionPointOut"):
@@ -214,24 +348,35 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
         where = f"{pou}:rung {number}:{e.kind}"
         if e.kind in ("contact", "coil"):
             e.var = obj.get("operand", "")
-            e.negated = obj.get("negated", "false") in ("true", "negated")
+            where = f"{pou}:rung {number}:{e.kind} {e.var}"
+            e.negated = _flag(obj, "negated", where, ("true", "1", "negated"))
             e.edge = _choice(obj, "edge", EDGES, where)
-            e.storage = _choice(obj, "storage", STORAGES, where)
+            if e.kind == "coil":
+                e.storage = _latch(obj, where)
         elif e.kind in ("in_var", "out_var", "inout_var"):
             e.var = obj.get("identifier", "")
-            e.negated = obj.get("negated", "false") == "true"
-        elif e.kind in ("jump", "label"):
+            e.negated = _flag(obj, "negated", where)
+        elif e.kind == "jump":
+            e.var = obj.get("targetNetworkLabel", "")
+            if not e.var and obj.get("label"):
+                _old(where, "a Jump names its target in targetNetworkLabel, not label")
+                e.var = obj.get("label", "")
+        elif e.kind == "label":
             e.var = obj.get("label", "")
         elif e.kind == "block":
             e.type_name = obj.get("typeName", "")
             e.instance = obj.get("instanceName", "") or ""
+            where = f"{pou}:rung {number}:block {e.type_name}"
             for v in obj.iterfind("InputVariables/InputVariable"):
                 e.inputs.append(Pin(v.get("parameterName", ""), _point_ins(v, outs),
-                                    v.get("negated", "false") == "true", _choice(v, "edge", EDGES, where)))
+                                    _flag(v, "negated", where), _choice(v, "edge", EDGES, where)))
             for v in obj.iterfind("InOutVariables/InOutVariable"):
+                if _flag(v, "negated", where):
+                    raise FormatError(where, f"in-out `{v.get('parameterName', '')}` is negated; an in-out passes the "
+                                      "variable itself and cannot be negated")
                 e.inouts.append(Pin(v.get("parameterName", ""), _point_ins(v, outs)))
             for v in obj.iterfind("OutputVariables/OutputVariable"):
-                e.outputs.append(Pin(v.get("parameterName", ""), negated=v.get("negated", "false") == "true"))
+                e.outputs.append(Pin(v.get("parameterName", ""), negated=_flag(v, "negated", where)))
         if e.kind != "block" and e.kind not in ("left_rail", "in_var", "label"):
             e.inputs = [Pin("", _point_ins(obj, outs))]
         if e.kind == "label":
@@ -239,6 +384,28 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
             continue
         rung.elements.append(e)
     return rung
+
+
+def _flag(el: ET.Element, name: str, where: str, true=("true", "1")) -> bool:
+    """An xsd:boolean attribute (``true``/``1``, ``false``/``0``); anything else is refused."""
+    value = el.get(name, "false")
+    if value in true:
+        return True
+    if value in ("false", "0", ""):
+        return False
+    raise FormatError(where, f'{name}="{value}" is not a boolean (true, false, 1, 0)')
+
+
+def _latch(coil: ET.Element, where: str) -> str:
+    """A set / reset coil: the schema's ``latch``; ``storage`` is the spelling of earlier vplc exports."""
+    latch = _choice(coil, "latch", STORAGES, where)
+    storage = _choice(coil, "storage", STORAGES, where)
+    if storage != "none":
+        _old(where, f'Coil storage="{storage}": the schema spells it latch="{storage}"')
+        if latch not in ("none", storage):
+            raise FormatError(where, f'latch="{latch}" and storage="{storage}" contradict each other')
+        return storage
+    return latch
 
 
 def _choice(el: ET.Element, name: str, allowed, where: str) -> str:

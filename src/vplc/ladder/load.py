@@ -2,7 +2,7 @@
 namespace of the file) that :mod:`vplc.project` parses and checks with the ``.st`` files, and
 ``check_operands`` adds the ladder-only type rule after the checker ran.
 
-Diagnostic codes ST2101-ST2107 (docs/toolchain/diagnostics.md).
+Diagnostic codes ST2101-ST2108 (docs/toolchain/diagnostics.md).
 """
 from __future__ import annotations
 
@@ -53,7 +53,17 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
         return []
     try:
         out = []
-        for unit in reader(root):
+        warnings: list = []
+        units = reader(root, warnings) if reader is iec10_read.read else reader(root)
+        rules: dict[str, list[str]] = {}
+        for where, message in warnings:                  # spellings of earlier vplc exports, read as meant
+            rules.setdefault(message, []).append(where)
+        for message, places in rules.items():            # one warning per rule, at its first place
+            more = f" ({len(places)} places)" if len(places) > 1 else ""
+            place = LadderSource(path, "", [(0, 1, places[0] or "project")])
+            diags.warning("ST2108", f"{message}{more}; this spelling of an earlier vplc export breaks Omron's "
+                          "schema: export the file again", Span(place, 0, 1))
+        for unit in units:
             src = unit_source(path, unit)
             for exc in src.errors:                           # rungs that could not be translated, all of them
                 place = LadderSource(path, "", [(0, 1, exc.where)])

@@ -11,14 +11,15 @@ from vplc.frontend.source import SourceFile
 
 from tests.vplc.export.conftest import LIB, NS, XSI_TYPE, local, q
 
-PARAM_TAG = {"in": "InputVars", "out": "OutputVars", "inout": "InOutVars"}
+PARAM_TAG = {"in": "InputVars", "out": "OutputVars", "inout": "InoutVars"}
 POU_TAG = {"FUNCTION": "Function", "FUNCTION_BLOCK": "FunctionBlock", "PROGRAM": "Program"}
-# Element order rules learnt from IEC 61131-10 samples (Omron's published sample, CODESYS exports).
+# Element order rules of Omron's schemas (IEC61131_10_Ed1_0_Spc1_0.xsd; test_export_sysmac_xsd.py validates).
 PROJECT_ORDER = ["FileHeader", "ContentHeader", "Types", "Instances"]
 VARIABLE_ORDER = ["Documentation", "AddData", "Type", "InitialValue", "Address"]
-DATATYPE_ORDER = ["Documentation", "UserDefinedTypeSpec", "InitialValue"]
-POU_ORDER = ["Documentation", "ResultType", "Parameters", "ExternalVars", "Vars", "TempVars", "MainBody"]
-PARAMS_ORDER = ["InputVars", "OutputVars", "InOutVars"]
+DATATYPE_ORDER = ["Documentation", "UserDefinedTypeSpec"]
+POU_ORDER = ["Documentation", "AddData", "UsingDirective", "ResultType", "Parameters", "ExternalVars", "Vars",
+             "TempVars", "MainBody"]
+PARAM_LISTS = {"InputVars", "OutputVars", "InoutVars"}
 
 
 def _user_decls(proj):
@@ -124,14 +125,18 @@ def test_every_pou_is_exported_with_its_interface_in_declaration_order(lib_root,
         pt = pou.sym
         params = el.find(q("Parameters"))
         got = []
+        assert (params is not None) == (pou.kind != "PROGRAM"), f"{name}: Parameters (functions and FBs only)"
         if params is not None:
-            _assert_order(list(params), PARAMS_ORDER, f"{name}/Parameters")
+            assert {local(c) for c in params} <= PARAM_LISTS
             for group in params:
                 for v in group.findall(q("Variable")):
                     got.append((int(v.get("orderWithinParamSet")), v.get("name"), local(group),
                                 _type_text(v.find(q("Type")))))
         got.sort()
         assert [g[0] for g in got] == list(range(len(got)))
+        if pou.kind == "FUNCTION":                   # every Sysmac function starts with EN
+            assert got[0][1:] == ("EN", "InputVars", "BOOL")
+            got = got[1:]
         assert [(n, g, t) for _i, n, g, t in got] == \
             [(p.name, PARAM_TAG[p.direction], printer.type_ref(p.decl.type)) for p in pt.params]
         locals_tag = "TempVars" if pou.kind == "FUNCTION" else "Vars"
@@ -226,8 +231,8 @@ def test_synthetic_sources_cover_programs_constants_retain_at_and_globals(tmp_pa
     lib = tmp_path / "DemoLib"
     lib.mkdir()
     (lib / "types.st").write_text(
-        "TYPE\n    eMode : (Off, Slow := 5, Fast) INT;\n    aTable : ARRAY[0..2] OF INT := [1, 2(7)];\n"
-        "    stPoint : STRUCT\n        X : REAL := 1.5;\n        Tab : aTable;\n    END_STRUCT;\nEND_TYPE\n",
+        "TYPE\n    eMode : (Off, Slow := 5, Fast) INT;\n    aTable : ARRAY[0..2] OF INT;\n"
+        "    stPoint : STRUCT\n        X : REAL := 1.5;\n        Tab : aTable := [1, 2(7)];\n    END_STRUCT;\nEND_TYPE\n",
         encoding="utf-8")
     (lib / "Main.st").write_text(
         "PROGRAM Main\nVAR CONSTANT\n    Limit : INT := 10;\nEND_VAR\nVAR RETAIN\n    Count : DINT;   (* kept *)\n"
@@ -243,16 +248,19 @@ def test_synthetic_sources_cover_programs_constants_retain_at_and_globals(tmp_pa
     enum = ns.find(f"{q('DataTypeDecl')}[@name='eMode']/{q('UserDefinedTypeSpec')}")
     assert [(e.get("name"), e.get("value")) for e in enum.findall(q("Enumerator"))] == \
         [("Off", "0"), ("Slow", "5"), ("Fast", "6")]
-    assert enum.find(f"{q('BaseType')}/{q('TypeName')}").text == "INT"
+    assert enum.find(q("BaseType")).text == "DINT", "the schema's ElementaryType: Sysmac enumerations are DINT"
     table = ns.find(f"{q('DataTypeDecl')}[@name='aTable']")
     assert table.find(q("UserDefinedTypeSpec")).get(XSI_TYPE) == "ArrayTypeSpec"
-    values = table.findall(f"{q('InitialValue')}/{q('ArrayValue')}/{q('Value')}")
+    tab = ns.find(f"{q('DataTypeDecl')}[@name='stPoint']//{q('Member')}[@name='Tab']")
+    values = tab.findall(f"{q('InitialValue')}/{q('ArrayValue')}/{q('Value')}")
     assert [(v.get("repetitionValue"), v.find(q("SimpleValue")).get("value")) for v in values] == \
         [(None, "1"), ("2", "7")]
     names = [c.get("name") for c in ns]
     assert names.index("aTable") < names.index("stPoint")
-    prog = ns.find(f"{q('Program')}[@name='Main']")
-    assert [local(c) for c in prog] == ["ExternalVars", "Vars", "Vars", "Vars", "MainBody"]
+    assert ns.find(q("Program")) is None, "the schema's NamespaceDecl holds no Program"
+    prog = root.find(f"{q('Types')}/{q('GlobalNamespace')}/{q('Program')}[@name='Main']")
+    assert [local(c) for c in prog] == ["AddData", "UsingDirective", "ExternalVars", "Vars", "Vars", "Vars", "MainBody"]
+    assert prog.find(q("UsingDirective")).text == "DemoLib"
     const, retain, plain = prog.findall(q("Vars"))
     assert const.get("constant") == "true" and retain.get("retain") == "true"
     assert retain.find(f"{q('Variable')}/{q('Documentation')}").text == "kept"
