@@ -7,7 +7,7 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import types as T
 from ..frontend.builtins import default_string
-from . import duplicates, undeclared
+from . import data_size, duplicates, undeclared
 from .consteval import const_int
 from .scope import GENERIC_TYPES, Ambiguous
 from .symbols import VarSymbol
@@ -19,6 +19,7 @@ class Declarer:
     def __init__(self, ctx) -> None:
         self.ctx = ctx
         self.tables = ctx.tables
+        self.meter = data_size.Meter(ctx)
 
     # ---- pass 1: names --------------------------------------------------------------------------
     def register(self, unit: A.CompilationUnit) -> None:
@@ -243,6 +244,7 @@ class Declarer:
                     if direction:
                         pt.params.append(T.Param(decl.name, direction, vt, index, decl.init, decl))
                         index += 1
+        self.meter.check_pous([pou.sym for pou, _unit in self.ctx.pou_units])
 
     def declare_globals(self, sections, unit, list_name: str | None) -> None:
         for section in sections:
@@ -255,6 +257,7 @@ class Declarer:
                 sym = VarSymbol(decl.name, vt, "VAR_GLOBAL", None, decl, section.constant, section.retain,
                                 global_list=list_name)
                 decl.sym = sym
+                self.meter.check_global(decl, sym)
                 if getattr(unit, "vendor", False):           # Sysmac system-defined variables (P_On ...)
                     self.ctx.vendor_objects.add(id(sym))
                 prev = self.tables.globals.get(decl.name.upper())

@@ -8,7 +8,9 @@ Subcommands live in a registry: this module registers ``check``; the back end's 
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
+import os
 import sys
 
 from ..frontend.diagnostics import ERROR, NOTE, WARNING, to_json
@@ -83,9 +85,32 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.handler(args) or 0)
+        code = int(args.handler(args) or 0)
+        sys.stdout.flush()                  # a full disk must fail the command, not the interpreter's exit
+        return code
     except KeyboardInterrupt:
         print("vplc: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
+        _drop_stdout()
         return 0
+    except MemoryError:
+        print("vplc: error: out of memory; the input is too large for this machine", file=sys.stderr)
+        return 1
+    except OSError as exc:                  # writing the output failed (a full disk, /dev/full, an I/O error)
+        _drop_stdout()
+        what = "cannot write the output" if exc.errno in _WRITE_ERRORS else "operating system error"
+        target = f" ({exc.filename})" if exc.filename else ""
+        print(f"vplc: error: {what}{target}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+
+
+_WRITE_ERRORS = {errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG, errno.EROFS}
+
+
+def _drop_stdout() -> None:
+    """Forget what could not be written, so the interpreter's exit does not try (and fail) again."""
+    try:
+        sys.stdout = open(os.devnull, "w", encoding="utf-8")
+    except OSError:
+        sys.stdout = None

@@ -69,6 +69,9 @@ def run_cmd(args) -> int:
     from ..trace import Recorder, write_trace
     if bool(args.trace) != bool(args.trace_out):
         return _err("--trace and --trace-out go together")
+    for option, text in (("--trace", args.trace), ("--watch", args.watch)):
+        if text is not None and not _paths(text):
+            return _err(f"{option} {text!r} names no variable; give VAR,VAR,... like Main.Count,Main.Busy")
     if args.trace_out and not args.trace_out.lower().endswith((".vcd", ".svg")):
         return _err(f"--trace-out {args.trace_out!r} must end in .vcd or .svg")
     if args.trace_out:

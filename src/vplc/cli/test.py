@@ -70,6 +70,12 @@ def run_tests(args) -> int:
         print(f"vplc test: error: --timeout {args.timeout!r} must be a duration from 1ns to 1d of virtual time, "
               f"like 10s or 500ms", file=sys.stderr)
         return 2
+    if args.junit:
+        folder = os.path.dirname(os.path.abspath(args.junit))
+        if os.path.isdir(args.junit) or not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+            print(f"vplc test: error: --junit {args.junit!r}: give a file name in an existing, writable folder "
+                  f"({folder} does not exist or is not writable)", file=sys.stderr)
+            return 2
     proj = load_project(args.paths)
     if proj.has_errors:
         print(proj.render_diagnostics(), file=sys.stderr)
@@ -154,9 +160,14 @@ def report(results, errors, args, elapsed: float) -> int:
         if not any(tc.suite.split(".")[1:2] == [suite] for tc in results):
             failed += 1
             print(f"FAIL {suite}: {fault}")
-    if args.junit:
-        write_junit(args.junit, results, elapsed)
     print(f"{passed} passed, {failed} failed")
+    if args.junit:
+        try:
+            write_junit(args.junit, results, elapsed)
+        except OSError as exc:
+            print(f"vplc test: error: cannot write the JUnit report {args.junit}: {exc.strerror or exc}",
+                  file=sys.stderr)
+            return 1
     return 0 if failed == 0 else 1
 
 

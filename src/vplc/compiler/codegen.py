@@ -17,6 +17,7 @@ from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop
 from ..runtime.program import GEN_FILE, PouClass, Program
 from ..runtime.sysmac_fns import KEEPS_OUT_ON_ERROR
 
+BULK_CELLS = 1024         # a statement copying a structured value this large checks the watchdog after it
 CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)
 
 
@@ -296,6 +297,20 @@ class CodeGen(ExprGen):
         self.spill_ok = isinstance(st, (A.Assign, A.CallStmt, A.Case, A.For))
         m(st)
         self.spill_ok = False
+        if isinstance(st, (A.Assign, A.CallStmt)) and self.moves_bulk(st):
+            # a scan of large copies and no loop still meets the watchdog
+            self.emit("if _pc() > _DL[0]: _watchdog('still copying large arrays or structures')")
+
+    def moves_bulk(self, st) -> bool:
+        """Whether a statement reads, writes or passes a structured value of at least BULK_CELLS cells (a copy
+        of it takes long enough to matter to the watchdog)."""
+        memo = self.__dict__.setdefault("_cells_memo", {})
+        for node in A.walk(st):
+            ty = getattr(node, "ty", None)
+            if isinstance(node, A.Expr) and ty is not None and not is_scalar(ty) and \
+                    T.value_cells(ty, BULK_CELLS, memo) >= BULK_CELLS:
+                return True
+        return False
 
     def st_Empty(self, st) -> None:
         self.emit("pass")

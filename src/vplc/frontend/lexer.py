@@ -31,8 +31,8 @@ _TOKEN_RE = re.compile(
   | (?P<REAL>[0-9][0-9_]*\.[0-9][0-9_]*(?:[eE][+-]?[0-9]+)?|[0-9][0-9_]*[eE][+-]?[0-9]+)
   | (?P<INT>[0-9][0-9_]*)
   | (?P<IDENT>[A-Za-z_][A-Za-z0-9_]*)
-  | (?P<STRING>'(?:\$.|[^'$\r\n])*')
-  | (?P<WSTRING>"(?:\$.|[^"$\r\n])*")
+  | (?P<STRING>'(?:\$.|[^'$\r\n])*+')
+  | (?P<WSTRING>"(?:\$.|[^"$\r\n])*+")
   | (?P<BADSTRING>['"][^\r\n]*)
   | (?P<ADDRESS>%[IQM][XBWDL]?[0-9]+(?:\.[0-9]+)*|%[IQM]\*)
   | (?P<OP>:=|=>|<=|>=|<>|\*\*|\.\.|\\\\|[-+*/&=<>()\[\],;:.\#\\^])
@@ -57,18 +57,27 @@ class Token:
 
 
 def _skip_comment(text: str, pos: int) -> int:
-    """Return the offset after the comment that starts at ``pos`` (``(*`` nests, ``/*`` nests), or -1."""
+    """Return the offset after the comment that starts at ``pos`` (``(*`` nests, ``/*`` nests), or -1.
+
+    Linear in the comment's length: the next opener and the next closer are each searched again only once the
+    scan has passed them (100,000 nested openers followed by their closers are read once, not once per level)."""
     opener = text[pos:pos + 2]
     closer = "*)" if opener == "(*" else "*/"
+    n = len(text)
     depth = 0
     i = pos
-    n = len(text)
-    while i < n:
-        j = text.find(closer, i)
-        k = text.find(opener, i)
-        if j < 0:
-            return -1
-        if 0 <= k < j:
+    j = -1                          # the next closer at or after i
+    k = pos                         # the next opener at or after i (n: none left)
+    while True:
+        if j < i:
+            j = text.find(closer, i)
+            if j < 0:
+                return -1
+        if k < i:
+            k = text.find(opener, i)
+            if k < 0:
+                k = n
+        if k < j:
             depth += 1
             i = k + 2
         else:
@@ -76,7 +85,6 @@ def _skip_comment(text: str, pos: int) -> int:
             i = j + 2
             if depth == 0:
                 return i
-    return -1
 
 
 def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None) -> list[Token]:

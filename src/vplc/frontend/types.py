@@ -248,6 +248,49 @@ def base_of(t: Type) -> Type:
     return t
 
 
+INSTANCE_SECTIONS = ("VAR", "VAR_INPUT", "VAR_OUTPUT", "VAR_STAT", "VAR_TEMP")   # in-outs and externals refer
+
+
+def value_cells(t: Type, cap: int, memo: dict | None = None, _active: set | None = None) -> int:
+    """The memory a value of ``t`` takes, in cells: one per elementary value or string, plus one per array,
+    structure and function-block instance holding them. Counts stop just above ``cap`` (``cap + 1`` means "more");
+    a function block that contains itself counts once (the checker reports it as recursion)."""
+    t = unalias(t)
+    if not isinstance(t, (ArrayType, StructType, PouType)):
+        return 1
+    memo = {} if memo is None else memo
+    key = (id(t), cap)
+    known = memo.get(key)
+    if known is not None:
+        return known
+    active = set() if _active is None else _active
+    n = 1
+    if isinstance(t, ArrayType):
+        count = t.count()
+        if count:
+            n += count * value_cells(t.element, cap, memo, active)
+    elif isinstance(t, StructType):
+        for f in t.fields.values():
+            n += value_cells(f.type, cap, memo, active)
+            if n > cap:
+                break
+    elif t.kind == "fb" and t.pou is not None:
+        if id(t) in active:
+            return 1
+        active.add(id(t))
+        for section in t.pou.sections:
+            if section.kind in INSTANCE_SECTIONS:
+                for decl in section.vars:
+                    sym = getattr(decl, "sym", None)
+                    n += value_cells(sym.type, cap, memo, active) if sym is not None else 1
+            if n > cap:
+                break
+        active.discard(id(t))
+    n = min(n, cap + 1)
+    memo[key] = n
+    return n
+
+
 def same_type(a: Type, b: Type) -> bool:
     a, b = unalias(a), unalias(b)
     return a is b or a == b

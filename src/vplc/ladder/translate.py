@@ -25,6 +25,7 @@ from .decls import FormatError, PouText, SectionText, XmlUnit
 from .model import Conn, Element, LadderBody, Pin, Rung
 
 TRUE = "TRUE"
+SERIES_MARKS = 128        # marked ranges in one series expression before a helper variable carries its power on
 COMPARE = {"GT": ">", "GE": ">=", "EQ": "=", "LT": "<", "LE": "<=", "NE": "<>"}   # IEC comparison blocks
 
 
@@ -78,6 +79,19 @@ class Txt:
     def with_prec(self, prec: int) -> "Txt":
         self.prec = prec
         return self
+
+
+def _joined(parts: "list[Txt]", sep: str, prec: int) -> Txt:
+    """``parts`` joined by ``sep`` in one pass (adding them one by one would copy the text once per part)."""
+    texts, marks, n = [], [], 0
+    for i, t in enumerate(parts):
+        if i:
+            texts.append(sep)
+            n += len(sep)
+        texts.append(t.text)
+        marks.extend((s + n, e + n, lab) for s, e, lab in t.marks)
+        n += len(t.text)
+    return Txt("".join(texts), marks, prec)
 
 
 class Writer:
@@ -359,10 +373,7 @@ class RungCompiler:
             return Txt(TRUE)
         if len(terms) == 1:
             return terms[0]
-        out = terms[0].at_least(2)
-        for t in terms[1:]:
-            out = out + " OR " + t.at_least(2)
-        return out.with_prec(1)
+        return _joined([t.at_least(2) for t in terms], " OR ", 1)
 
     def materialize(self, value: Txt, kind: str = "P") -> Txt:
         if value.text == TRUE or (value.prec == 3 and value.text.startswith(self.prefix)):
@@ -402,6 +413,8 @@ class RungCompiler:
             self.out[(e.id, None)] = Txt(out)
             return
         op = ("NOT " + var).with_prec(3) if e.negated else var
+        if len(inp.marks) > SERIES_MARKS:      # a long series of contacts: carried on by a helper every ~60
+            inp = self.materialize(inp)        # contacts, so no expression (and no copy of one) grows with it
         value = op if inp.text == TRUE else (inp.at_least(2) + " AND " + op).with_prec(2)
         self.out[(e.id, None)] = self.shared(e, value.marked(lab))
 

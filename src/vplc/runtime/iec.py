@@ -200,6 +200,9 @@ def assign_into(dst, src) -> None:
     """Structure / array assignment: copy ``src`` into the existing ``dst`` object (keeps references)."""
     if isinstance(dst, (list, ArrView)):
         n = min(len(dst), len(src))
+        if n and type(src[0]) in (int, float, bool, str):      # elements of one elementary type: in one piece
+            dst[:n] = src[:n] if len(src) != n or type(src) is not list else src
+            return
         for i in range(n):
             x = src[i]
             if type(x) in (int, float, bool, str):

@@ -27,10 +27,10 @@ def make_watchdog(deadline: list, probation: list, limit_s: list):
     time is noted (``probation`` = [the deadline set, CPU time]); the fault comes when the program has used
     ``limit_s[0]`` of CPU time since. A scan that needs less CPU than the limit always finishes first; an endless
     loop faults after at most twice the limit of its own CPU time. Nothing of this costs a normal scan anything."""
-    def watchdog() -> None:
+    def watchdog(what: str = "a loop did not finish") -> None:
         cpu = time.thread_time()
         if probation[0] == deadline[0] and cpu - probation[1] >= limit_s[0]:
-            raise WatchdogError("a loop did not finish")
+            raise WatchdogError(what)
         if probation[0] != deadline[0]:               # first pass in this scan
             probation[1] = cpu
         deadline[0] = probation[0] = time.perf_counter() + limit_s[0] - (cpu - probation[1])

@@ -1,0 +1,125 @@
+"""Hostile programs (issue 23 item 9): a scan made of large copies and no loop meets the watchdog; a ladder rung of
+thousands of contacts in series compiles and runs in memory proportional to its length.
+
+Nothing here is timed: the watchdog test only needs a scan far longer than a small watchdog; memory is measured in
+a subprocess."""
+from __future__ import annotations
+
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from rt_helpers import plc_from
+
+from vplc.api import PlcFault, compile_program
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+
+
+def test_a_scan_of_large_array_copies_without_a_loop_is_stopped_by_the_watchdog(tmp_path):
+    # 400 whole-array copies of 500,000 DINTs: no ST loop, so no loop check ever ran (a 5 s scan went on)
+    plc = plc_from(tmp_path, "a := b; b := a;\n" * 200, "a, b : ARRAY[0..499999] OF DINT;", watchdog_ms=5)
+    with pytest.raises(PlcFault) as exc:
+        plc.scan(0)
+    assert exc.value.kind == "watchdog"
+    assert "watchdog: scan exceeded 5 ms (still copying large arrays or structures)" in str(exc.value)
+    assert exc.value.file.endswith("main.st") and exc.value.line >= 5
+
+
+def test_only_statements_moving_large_values_carry_the_watchdog_check(tmp_path):
+    src = tmp_path / "m.st"
+    src.write_text("TYPE stP : STRUCT x, y : REAL; END_STRUCT; END_TYPE\n"
+                   "PROGRAM Main\nVAR p, q : stP; s, t : ARRAY[0..99] OF INT; a, b : ARRAY[0..4095] OF BYTE; "
+                   "END_VAR\np := q;\ns := t;\na := b;\nEND_PROGRAM\n", encoding="utf-8")
+    code = compile_program([str(src)]).source
+    assert code.count("still copying large arrays or structures") == 1
+
+
+def test_whole_array_assignment_copies_every_element(tmp_path):
+    plc = plc_from(tmp_path, """
+        b[7] := 7; b[99999] := -1; a := b;
+        n[0].k[2] := 5; m := n;
+        """, """
+        a, b : ARRAY[0..99999] OF DINT;
+        m, n : ARRAY[0..2] OF stK;
+        """, extra="TYPE stK : STRUCT k : ARRAY[0..3] OF INT; END_STRUCT; END_TYPE\n")
+    plc.scan(0)
+    assert plc.read("Main.a[7]") == 7 and plc.read("Main.a[99999]") == -1 and plc.read("Main.a[8]") == 0
+    assert plc.read("Main.m[0].k[2]") == 5
+    plc.write("Main.a[7]", 1)
+    assert plc.read("Main.b[7]") == 7                 # a copy, not the same array
+
+
+def _series_rung_xml(n: int) -> str:
+    """A PLCopen XML program with one rung: the left rail, ``n`` contacts on A in series, a coil Q."""
+    parts = ['<leftPowerRail localId="1"><position x="0" y="0"/><connectionPointOut/></leftPowerRail>']
+    prev = 1
+    for i in range(n):
+        lid = 10 + i
+        parts.append(f'<contact localId="{lid}"><position x="{i}" y="0"/><connectionPointIn>'
+                     f'<connection refLocalId="{prev}"/></connectionPointIn><connectionPointOut/>'
+                     f'<variable>{"B" if i == n // 2 else "A"}</variable></contact>')
+        prev = lid
+    parts.append(f'<coil localId="5"><position x="{n}" y="0"/><connectionPointIn><connection refLocalId="{prev}"/>'
+                 '</connectionPointIn><connectionPointOut/><variable>Q</variable></coil>')
+    parts.append('<rightPowerRail localId="6"><position x="0" y="0"/><connectionPointIn>'
+                 '<connection refLocalId="5"/></connectionPointIn></rightPowerRail>')
+    variables = "".join(f'<variable name="{v}"><type><BOOL/></type></variable>' for v in "ABQ")
+    return ('<?xml version="1.0" encoding="utf-8"?>\n<project xmlns="http://www.plcopen.org/xml/tc6_0201">'
+            '<fileHeader companyName="t" productName="t" productVersion="1" creationDateTime="2024-01-01T00:00:00"/>'
+            '<contentHeader name="t"><coordinateInfo><fbd><scaling x="1" y="1"/></fbd><ld><scaling x="1" y="1"/>'
+            '</ld><sfc><scaling x="1" y="1"/></sfc></coordinateInfo></contentHeader><types><dataTypes/><pous>'
+            '<pou name="Main" pouType="program"><interface><localVars>' + variables + '</localVars></interface>'
+            '<body><LD>' + "".join(parts) + '</LD></body></pou></pous></types><instances><configurations/>'
+            '</instances></project>\n')
+
+
+def test_a_rung_of_a_thousand_contacts_in_series_runs_with_the_meaning_of_the_drawing(tmp_path):
+    path = tmp_path / "series.xml"
+    path.write_text(_series_rung_xml(1000), encoding="utf-8")
+    from vplc.api import load_plc
+    plc = load_plc([str(path)])
+    for a, b, q in ((True, True, True), (True, False, False), (False, True, False), (True, True, True)):
+        plc.write("Main.A", a)
+        plc.write("Main.B", b)
+        plc.scan(plc.now_ns + 1_000_000)
+        assert plc.read("Main.Q") is q
+
+
+_MEASURE = r"""
+import json, sys, tracemalloc
+sys.path.insert(0, sys.argv[1]); sys.path.insert(0, sys.argv[2])
+from test_rt_hostile import _series_rung_xml
+from vplc.frontend.diagnostics import DiagnosticBag
+from vplc.frontend.parser import parse
+from vplc.ladder import plcopen_read
+from vplc.ladder.translate import unit_source
+from vplc.ladder.xmlsafe import read
+out = {}
+for n in (1000, 4000):
+    path = sys.argv[3] + f"/s{n}.xml"
+    open(path, "w", encoding="utf-8").write(_series_rung_xml(n))
+    units = list(plcopen_read.read(read(path)[1]))
+    tracemalloc.start()
+    diags = DiagnosticBag()
+    for unit in units:                      # the rung into ST, the ST into a syntax tree
+        parse(unit_source(path, unit), diags)
+    out[n] = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert not diags.items, [d.message for d in diags.items]
+print(json.dumps(out))
+"""
+
+
+def test_a_long_series_rung_is_translated_in_memory_linear_in_its_length(tmp_path):
+    # 10,000 contacts in series took 1.96 GB (20,000: out of memory): each contact's power was a copy of the whole
+    # expression before it, and every copy was kept
+    out = subprocess.run([sys.executable, "-c", _MEASURE, str(ROOT / "src"), str(pathlib.Path(__file__).parent),
+                          str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    peak = {int(k): v for k, v in json.loads(out.stdout).items()}
+    assert peak[4000] < 5 * peak[1000], peak           # linear (4x contacts), not quadratic (16x)
+    assert peak[4000] < 40_000_000, peak
