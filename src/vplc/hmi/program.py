@@ -31,7 +31,8 @@ class LadderView:
         self.pou = pou
         self.ladder = pou.ladder
         self.instance = instance
-        self.locals = {d.name.upper() for s in pou.sections if s.kind != "VAR_EXTERNAL" for d in s.vars}   # globals by name
+        # a VAR_EXTERNAL operand is read as the global it names
+        self.locals = {d.name.upper() for s in pou.sections if s.kind != "VAR_EXTERNAL" for d in s.vars}
         self.svg = svg_document(self.ladder)
         names = set()
         for rung in self.ladder.rungs:

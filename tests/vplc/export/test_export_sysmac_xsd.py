@@ -105,7 +105,8 @@ SYNTHETIC = {
                         "VAR_INPUT\n    X : REAL;\nEND_VAR\nScale := X * Factor;\nEND_FUNCTION\n",
     "DemoLib/Now.st": "FUNCTION Now : INT\nNow := 7;\nEND_FUNCTION\n",
     "DemoLib/Keep.st": "FUNCTION_BLOCK Keep\nVAR_INPUT\n    Go : BOOL;\nEND_VAR\nVAR_INPUT RETAIN\n    Count : DINT;\n"
-                       "END_VAR\nVAR_IN_OUT\n    Buf : ARRAY[*] OF BYTE;\nEND_VAR\nVAR_OUTPUT\n    Last : DINT;\nEND_VAR\n"
+                       "END_VAR\nVAR_IN_OUT\n    Buf : ARRAY[*] OF BYTE;\nEND_VAR\n"
+                       "VAR_OUTPUT\n    Last : DINT;\nEND_VAR\n"
                        "IF Go THEN Last := Count; END_IF;\nEND_FUNCTION_BLOCK\n",
     "Main.st": "PROGRAM Main\nVAR\n    K : DemoLib\\Keep;\n    B : ARRAY[0..3] OF BYTE;\n    M : DemoLib\\eMode;\n"
                "    Y : REAL;\nEND_VAR\nK(Go := gRun, Count := 3, Buf := B);\nY := DemoLib\\Scale(X := gSpeed);\n"

@@ -1,0 +1,243 @@
+"""Reading IEC 61131-10 as Sysmac Studio writes it (Omron's schemas IEC61131_10_Ed1_0_Spc1_0.xsd and
+IEC61131_10_Ed1_0_SmcExt1_0_Spc1_0.xsd): every element and attribute that changes what the program does is
+either run with its meaning or refused with an error naming it — never read with another meaning. One test
+per attribute; files of earlier vplc exports keep loading with warning ST2108."""
+from __future__ import annotations
+
+import pytest
+
+from ld_xml import IEC10_HEAD, iec10_program
+from vplc.api import load_plc
+from vplc.project import load_project
+
+MS = 1_000_000
+SMC = 'name="https://www.ia.omron.com/Smc IEC61131_10_Ed1_0_SmcExt1_0_Spc1_0.xsd" handleUnknown="discard"'
+RAIL = '<LdObject xsi:type="LeftPowerRail"><ConnectionPointOut connectionPointOutId="1"/></LdObject>'
+
+
+def cin(*ids) -> str:
+    return "<ConnectionPointIn>" + "".join(f'<Connection refConnectionPointOutId="{i}"/>' for i in ids) + \
+        "</ConnectionPointIn>"
+
+
+def contact(var, src, out, **attrs) -> str:
+    a = "".join(f' {k}="{v}"' for k, v in attrs.items())
+    return (f'<LdObject xsi:type="Contact" operand="{var}"{a}>{cin(src)}'
+            f'<ConnectionPointOut connectionPointOutId="{out}"/></LdObject>')
+
+
+def coil(var, src, **attrs) -> str:
+    a = "".join(f' {k}="{v}"' for k, v in attrs.items())
+    return f'<LdObject xsi:type="Coil" operand="{var}"{a}>{cin(src)}</LdObject>'
+
+
+def doc(inner: str) -> str:
+    return IEC10_HEAD + inner + "</GlobalNamespace></Types><Instances/></Project>\n"
+
+
+def write(tmp_path, text: str, name="sysmac.xml"):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def diagnostics(*paths):
+    proj = load_project([str(p) for p in paths])
+    return [d for d in proj.diagnostics if d.severity in ("error", "warning")]
+
+
+def refused(path, *words):
+    errors = [d for d in diagnostics(path) if d.severity == "error"]
+    assert errors, "the construct must be refused"
+    text = errors[0].location() + ": " + errors[0].message
+    for w in words:
+        assert w in text, text
+    return errors[0]
+
+
+class Run:
+    def __init__(self, path, extra=()):
+        self.plc = load_plc([str(path), *map(str, extra)], task="Main@1ms")
+        self.t = 0
+
+    def scan(self, **values):
+        for k, v in values.items():
+            self.plc.write(f"Main.{k}", v)
+        self.plc.scan(self.t)
+        self.t += MS
+        return self
+
+    def __getitem__(self, name):
+        return self.plc.read(f"Main.{name}")
+
+
+def test_latch_set_and_reset_coils_hold_their_value(tmp_path):
+    rungs = [RAIL + contact("A", 1, 2) + coil("Q", 2, latch="set"),
+             RAIL + contact("B", 1, 2) + coil("Q", 2, latch="reset")]
+    r = Run(write(tmp_path, iec10_program({"A": "BOOL", "B": "BOOL", "Q": "BOOL"}, rungs)))
+    assert r.scan(A=True)["Q"] is True
+    assert r.scan(A=False)["Q"] is True, "latch=set holds without power"
+    assert r.scan(B=True)["Q"] is False
+    assert r.scan(B=False)["Q"] is False, "latch=reset holds"
+    assert diagnostics(tmp_path / "sysmac.xml") == []
+
+
+def test_edge_contacts_and_edge_block_inputs_keep_their_edge(tmp_path):
+    rungs = [RAIL + contact("A", 1, 2, edge="rising") + coil("P", 2),
+             RAIL + contact("A", 1, 2, edge="falling") + coil("N", 2)]
+    r = Run(write(tmp_path, iec10_program({"A": "BOOL", "P": "BOOL", "N": "BOOL"}, rungs)))
+    seen = [(r.scan(A=a)["P"], r["N"]) for a in (True, True, False, False)]
+    assert seen == [(True, False), (False, False), (False, True), (False, False)]
+
+
+def test_edge_detection_on_an_input_variable_is_refused_by_name(tmp_path):
+    fb = ('<FunctionBlock name="Edge"><Parameters><InputVars><Variable name="Go" orderWithinParamSet="0" '
+          'edgeDetection="rising"><Type><TypeName>BOOL</TypeName></Type></Variable></InputVars></Parameters>'
+          '<MainBody><BodyContent xsi:type="ST"><ST>;</ST></BodyContent></MainBody></FunctionBlock>')
+    refused(write(tmp_path, doc(fb)), "Edge:variable Go", 'edgeDetection="rising"', "not modelled")
+
+
+@pytest.mark.parametrize("value, closed", [("true", True), ("1", True), ("false", False), ("0", False)])
+def test_negated_contact_is_a_normally_closed_contact(tmp_path, value, closed):
+    rungs = [RAIL + contact("A", 1, 2, negated=value) + coil("Q", 2)]
+    r = Run(write(tmp_path, iec10_program({"A": "BOOL", "Q": "BOOL"}, rungs)))
+    assert r.scan(A=False)["Q"] is closed and r.scan(A=True)["Q"] is (not closed)
+
+
+def test_negated_with_a_value_that_is_not_a_boolean_is_refused(tmp_path):
+    rungs = [RAIL + contact("A", 1, 2, negated="yes") + coil("Q", 2)]
+    refused(write(tmp_path, iec10_program({"A": "BOOL", "Q": "BOOL"}, rungs)), "contact A", 'negated="yes"')
+
+
+def test_a_union_is_refused_not_read_as_a_structure(tmp_path):
+    t = ('<DataTypeDecl name="uWord"><UserDefinedTypeSpec xsi:type="StructTypeSpec" overlap="true">'
+         '<Member name="W"><Type><TypeName>WORD</TypeName></Type></Member>'
+         '<Member name="B"><Type><TypeName>BYTE</TypeName></Type></Member></UserDefinedTypeSpec></DataTypeDecl>')
+    refused(write(tmp_path, doc(t)), "data type uWord", 'overlap="true"', "UNION")
+
+
+@pytest.mark.parametrize("offset, ok", [("NJ", True), ("CJ", False), ("User", False)])
+def test_struct_member_offsets_other_than_nj_are_refused(tmp_path, offset, ok):
+    t = ('<DataTypeDecl name="stPair"><UserDefinedTypeSpec xsi:type="StructTypeSpec">'
+         '<Member name="A"><Type><TypeName>INT</TypeName></Type></Member>'
+         f'<AddData><Data {SMC}><smcext:StructTypeSpecAdditionalProperties offsetType="{offset}"/></Data></AddData>'
+         '</UserDefinedTypeSpec></DataTypeDecl>')
+    path = write(tmp_path, doc(t))
+    if ok:
+        assert diagnostics(path) == []
+    else:
+        refused(path, "data type stPair", f'offsetType="{offset}"', "not modelled")
+
+
+def test_inline_st_in_a_rung_is_refused_by_name(tmp_path):
+    inline = ('<LdObject xsi:type="smcext:InlineST">' + cin(1) + '<ConnectionPointOut connectionPointOutId="2"/>'
+              "<ST>Q := TRUE;</ST></LdObject>")
+    refused(write(tmp_path, iec10_program({"Q": "BOOL"}, [RAIL + inline])), "Main:rung 1", "smcext:InlineST")
+
+
+def test_jump_with_target_network_label_skips_to_the_labelled_rung(tmp_path):
+    jump = '<FbdObject xsi:type="Jump" targetNetworkLabel="Later">' + cin(2) + "</FbdObject>"
+    rungs = [RAIL + contact("Skip", 1, 2) + jump, RAIL + contact("A", 1, 2) + coil("Mid", 2),
+             RAIL + contact("A", 1, 2) + coil("End", 2)]
+    text = iec10_program({"Skip": "BOOL", "A": "BOOL", "Mid": "BOOL", "End": "BOOL"}, rungs)
+    text = text.replace('<Rung evaluationOrder="3">', '<Rung evaluationOrder="3" label="Later">')
+    r = Run(write(tmp_path, text))
+    r.scan(Skip=True, A=True)
+    assert (r["Mid"], r["End"]) == (False, True)
+    r.scan(Skip=False)
+    assert r["Mid"] is True
+
+
+FUNCTION_EN = ('<Function name="Twice"><ResultType><TypeName>INT</TypeName></ResultType><Parameters>'
+               '<InputVars><Variable name="EN" orderWithinParamSet="0"><Type><TypeName>BOOL</TypeName></Type>'
+               '<InitialValue><SimpleValue value="TRUE"/></InitialValue></Variable>'
+               '<Variable name="X" orderWithinParamSet="1"><Type><TypeName>INT</TypeName></Type></Variable></InputVars>'
+               '<OutputVars><Variable name="ENO" orderWithinParamSet="2"><Type><TypeName>BOOL</TypeName></Type>'
+               '</Variable></OutputVars></Parameters>'
+               '<MainBody><BodyContent xsi:type="ST"><ST>Twice := X * 2;</ST></BodyContent></MainBody></Function>')
+
+
+def test_a_functions_en_and_eno_are_the_implicit_ones(tmp_path):
+    src = write(tmp_path, doc(FUNCTION_EN), "twice.xml")
+    (tmp_path / "Main.st").write_text("PROGRAM Main\nVAR Y : INT; END_VAR\nY := Twice(21);\nEND_PROGRAM\n",
+                                      encoding="utf-8")
+    r = Run(src, extra=[tmp_path / "Main.st"])
+    assert r.scan()["Y"] == 42, "a positional call does not see EN: Sysmac's EN is vplc's implicit EN"
+
+
+def _param_fb(props: str, list_attrs: str = "") -> str:
+    return ('<FunctionBlock name="Fb"><Parameters>'
+            f'<InputVars{list_attrs}><Variable name="Limit" orderWithinParamSet="0">{props}'
+            '<Type><TypeName>INT</TypeName></Type><InitialValue><SimpleValue value="5"/></InitialValue></Variable>'
+            '</InputVars><InputVars><Variable name="Go" orderWithinParamSet="1"><Type><TypeName>BOOL</TypeName>'
+            '</Type></Variable></InputVars></Parameters>'
+            '<MainBody><BodyContent xsi:type="ST"><ST>Limit := 7;</ST></BodyContent></MainBody></FunctionBlock>')
+
+
+def test_constant_parameter_is_constant(tmp_path):
+    props = (f'<AddData><Data {SMC}><smcext:ParameterSetVariableAdditionalProperties constant="true"/></Data>'
+             '</AddData>')
+    d = refused(write(tmp_path, doc(_param_fb(props))), "`Limit` is a CONSTANT and cannot be written")
+    assert d.code == "ST1301"
+    assert diagnostics(write(tmp_path, doc(_param_fb("")), "plain.xml")) == [], "without it the input is writable"
+
+
+def test_retain_stays_on_its_own_parameter_list(tmp_path):
+    proj = load_project([str(write(tmp_path, doc(_param_fb("", ' retain="true"'))))])
+    assert not proj.has_errors, proj.render_diagnostics()
+    fb = next(i for u in proj.units for i in getattr(u, "items", []) if getattr(i, "name", "") == "Fb")
+    inputs = [(s.retain, [d.name for d in s.vars]) for s in fb.sections if s.kind == "VAR_INPUT"]
+    assert inputs == [(True, ["Limit"]), (False, ["Go"])], "RETAIN does not spread to the next list"
+
+
+def test_unknown_sysmac_extension_element_is_an_error_naming_it(tmp_path):
+    fb = _param_fb(f'<AddData><Data {SMC}><smcext:FutureThing mode="x"/></Data></AddData>')
+    refused(write(tmp_path, doc(fb)), "smcext:FutureThing")
+    other = _param_fb('<AddData><Data name="https://example.com/tool" handleUnknown="discard"><Note/></Data></AddData>')
+    assert diagnostics(write(tmp_path, doc(other), "other.xml")) == [], "another vendor's data is discarded"
+
+
+def test_nested_namespaces_are_refused(tmp_path):
+    t = ('<NamespaceDecl name="Outer"><NamespaceDecl name="Inner"><DataTypeDecl name="eX">'
+         '<UserDefinedTypeSpec xsi:type="EnumTypeWithNamedValueSpec"><Enumerator name="A" value="0"/>'
+         '<BaseType>DINT</BaseType></UserDefinedTypeSpec></DataTypeDecl></NamespaceDecl></NamespaceDecl>')
+    refused(write(tmp_path, doc(t)), "Outer", "Inner", "nested namespaces")
+
+
+def test_enumeration_base_type_is_the_schemas_text_and_dint(tmp_path):
+    t = ('<DataTypeDecl name="eX"><UserDefinedTypeSpec xsi:type="EnumTypeWithNamedValueSpec">'
+         '<Enumerator name="A" value="0"/><Enumerator name="B" value="70000"/><BaseType>DINT</BaseType>'
+         '</UserDefinedTypeSpec></DataTypeDecl>')
+    assert diagnostics(write(tmp_path, doc(t))) == []
+    refused(write(tmp_path, doc(t.replace("<BaseType>DINT", "<BaseType>eY")), "bad.xml"), "eY")
+
+
+def test_ld_body_of_a_function_block_runs(tmp_path):
+    fb = ('<FunctionBlock name="Pass"><Parameters><InputVars><Variable name="I" orderWithinParamSet="0"><Type>'
+          '<TypeName>BOOL</TypeName></Type></Variable></InputVars><OutputVars><Variable name="O" '
+          'orderWithinParamSet="1"><Type><TypeName>BOOL</TypeName></Type></Variable></OutputVars></Parameters>'
+          '<MainBody><BodyContent xsi:type="LD"><Rung evaluationOrder="1">' + RAIL + contact("I", 1, 2)
+          + coil("O", 2) + '<FbdObject xsi:type="DataSink" identifier=""/></Rung></BodyContent></MainBody>'
+          '</FunctionBlock>')
+    src = write(tmp_path, doc(fb), "pass.xml")
+    (tmp_path / "Main.st").write_text("PROGRAM Main\nVAR P : Pass; A : BOOL; Q : BOOL; END_VAR\nP(I := A, O => Q);\n"
+                                      "END_PROGRAM\n", encoding="utf-8")
+    r = Run(src, extra=[tmp_path / "Main.st"])
+    assert r.scan(A=True)["Q"] is True and r.scan(A=False)["Q"] is False
+
+
+def test_files_of_earlier_exports_load_with_a_warning_naming_the_rule(tmp_path):
+    old_jump = '<FbdObject xsi:type="Jump" label="Later">' + cin(2) + "</FbdObject>"
+    rungs = [RAIL + contact("A", 1, 2) + coil("Q", 2, storage="set"), RAIL + contact("Skip", 1, 2) + old_jump,
+             RAIL + contact("A", 1, 2) + coil("Mid", 2), RAIL + contact("A", 1, 2) + coil("End", 2)]
+    text = iec10_program({"A": "BOOL", "Skip": "BOOL", "Q": "BOOL", "Mid": "BOOL", "End": "BOOL"}, rungs)
+    text = text.replace('<Rung evaluationOrder="4">', '<Rung evaluationOrder="4" label="Later">')
+    path = write(tmp_path, text)
+    found = diagnostics(path)
+    assert all(d.severity == "warning" and d.code == "ST2108" for d in found)
+    messages = " | ".join(d.message for d in found)
+    assert 'latch="set"' in messages and "targetNetworkLabel" in messages
+    r = Run(path)
+    r.scan(A=True, Skip=True)
+    assert (r["Q"], r["Mid"], r["End"]) == (True, False, True), "storage=set is a set coil; the jump skips"
+    assert r.scan(A=False, Skip=False)["Q"] is True and r["Mid"] is False
