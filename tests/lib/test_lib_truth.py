@@ -191,6 +191,46 @@ def test_a_robot_error_ends_the_motion_with_4006_in_every_phase_of_the_two_chann
         rig.close()
 
 
+def delay_data_tables(rig, hold):
+    """The robot's Ethernet Slave output is held back while hold(now) is TRUE, then delivered one frame per
+    simulator poll: tables that left the robot before an event arrive after the Listen-node close."""
+    slave = rig.srv.svr
+    original = slave._flush
+
+    def flush(robot):
+        if hold(rig.srv._now):
+            return
+        for client in robot.svr.clients.values():
+            rest, client.outbox = client.outbox[1:], client.outbox[:1]
+            original(robot)
+            client.outbox = rest + client.outbox
+    slave._flush = flush
+
+
+def test_a_robot_error_is_4006_even_when_a_table_from_before_the_stop_arrives_after_the_close():
+    """The race between the two channels: a data table that left the robot before the robot error (project
+    running) arrives after the Listen node closed. Taking it as the cause ended the motion with 16#200B; the
+    motion ends with 16#4006 and CBT_Connect shows 16#4006 only."""
+    rig = Rig(svr_port=0)
+    try:
+        rig.scans(200)
+        fault = []
+
+        def hold(now):
+            if not fault and any(e.get("event") == "robot_fault" for e in rig.events("state")):
+                fault.append(now)
+            return not fault or now < fault[0] + 0.25
+        delay_data_tables(rig, hold)
+        rig.scans(150)                                                  # tables from before the error wait
+        rig.set_struct("MoveParam", move_abs(MovementCommand=0, DataFormat=2, TargetPosition=UNREACHABLE))
+        rig.write("MoveExec", True)
+        ok, seen = error_ids_until(rig, lambda: rig.read("mover.Error") and rig.read("conn.RetryCount") >= 2, 6)
+        assert ok and rig.read("mover.ErrorID") == 0x4006, hex(rig.read("mover.ErrorID"))
+        assert seen == [0x4006], [hex(i) for i in seen]
+    finally:
+        rig.close()
+
+
 def test_a_refused_reconnect_attempt_does_not_claim_time_out_has_passed():
     """Without the Ethernet Slave the cause of a close cannot be known; a reconnect attempt refused 100 ms after
     the loss says what happened (the connect was refused), not that Time_Out (10 s) has passed."""
