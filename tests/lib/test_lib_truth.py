@@ -79,15 +79,44 @@ def test_motions_cleared_by_another_clients_stop_are_never_reported_done():
         rig.close()
 
 
-# ---- item 2: a CPERR names no script ---------------------------------------------------------------------------
-def test_a_cperr_goes_to_the_damaged_script_not_to_the_one_waiting_behind_another_clients_script():
-    """Another client's Sleep(3000) holds the robot's script queue; motion A waits behind it; motion B's frame is
-    damaged on the way and the robot answers CPERR 02 at once. A is not failed: it runs 3 s later and ends Done;
-    B, which never ran, ends with 16#3012 as soon as A's reply shows that the CPERR can only be B's."""
+@pytest.mark.parametrize("delay_ms", range(0, 2000, 200))
+def test_after_another_clients_stop_every_motion_reports_what_the_robot_did(delay_ms):
+    """The same stop at ten moments of the three motions: a mover is Done exactly when the robot finished its
+    motion; every other one ends with 16#4004 - never Done, never twice."""
     rig = Rig()
     other = OtherClient(rig)
     try:
-        other.script("H", "Sleep(3000)")
+        for k in (1, 2, 3):
+            go(rig, k, rz=30.0 * k, speed=40)
+        assert rig.until(lambda: all(rig.read(f"movers[{k}].Busy") for k in (1, 2, 3)), 1)
+        rig.until(lambda: False, delay_ms / 1000)
+        other.script("X", "StopAndClearBuffer(0)")
+        rig.scans(20)
+        go(rig, 4, rz=5.0, speed=100)
+        assert rig.until(lambda: all(settled(rig, k) for k in (1, 2, 3, 4)), 15)
+        finished = ended_at(rig)
+        assert rig.read("movers[4].Done") and finished.count(5) == 1
+        for k in (1, 2, 3):
+            if round(30.0 * k) in finished:
+                assert rig.read(f"movers[{k}].Done"), (k, finished)
+            else:
+                assert rig.read(f"movers[{k}].ErrorID") == 0x4004, (k, finished, rig.read(f"movers[{k}].ErrorID"))
+    finally:
+        other.close()
+        rig.close()
+
+
+# ---- item 2: a CPERR names no script ---------------------------------------------------------------------------
+@pytest.mark.parametrize("hold_ms", [3000, 2700, 2400, 2100, 1800, 1500, 1200, 900, 600, 300])
+def test_a_cperr_goes_to_the_damaged_script_not_to_the_one_waiting_behind_another_clients_script(hold_ms):
+    """Another client's Sleep(3000) holds the robot's script queue; motion A waits behind it; motion B's frame is
+    damaged on the way and the robot answers CPERR 02 at once. A is not failed: it runs 3 s later and ends Done;
+    B, which never ran, ends with 16#3012 as soon as A's reply shows that the CPERR can only be B's (ten
+    lengths of the other client's script)."""
+    rig = Rig()
+    other = OtherClient(rig)
+    try:
+        other.script("H", f"Sleep({hold_ms})")
         rig.scans(5)
         go(rig, 1, rz=20.0, speed=100)                                  # A
         rig.scans(3)
