@@ -438,7 +438,11 @@ def _call(node, args, ctx, line):
         robot.enqueue_motion(_motion(name, args, line))
         return True
     if name == "ChangeBase":
-        robot.enqueue_setting("base", args[0] if len(args) == 1 else list(args))
+        # §13.5 syntax 1: the index picks one of the bases a vision job found; for the name of a plain base
+        # it has no meaning ("the base index is invalid", the manual's ChangeBase("RobotBase", 10)). The
+        # simulator's bases are all plain ones, so the index is not used.
+        single = len(args) == 1 or isinstance(args[0], str)
+        robot.enqueue_setting("base", args[0] if single else list(args))
         return True
     if name == "ChangeTCP":
         if len(args) == 1 or (args and isinstance(args[0], list)):

@@ -46,6 +46,9 @@ INPUT_DONE = "done"                 # no complete item is left in the receive bu
 INPUT_LEFT = "left"                 # a bound of the turn ended it: input may be left for the next turn
 FRAME_LIMIT = "frame_limit"         # the connection's received frames reached ``frame_limit``
 
+# TMscript 2.24 §15.8: a priority command is a line that is literally ScriptExit(0|1) or StopAndClearBuffer(0|1|2)
+# ("not the use with variables and functions"); StopAndClearBuffer with any other argument goes to the checker,
+# which refuses it (tmscript.py: §13.4 defines no parameter)
 _PRIORITY = re.compile(r"^\s*(ScriptExit|StopAndClearBuffer)\s*\(\s*(\d)\s*\)\s*$")
 _PRIORITY_ARGS = {"ScriptExit": (0, 1), "StopAndClearBuffer": (0, 1, 2)}
 

@@ -27,7 +27,8 @@ FUNCTIONS: dict[str, tuple[bool, list[tuple[tuple[str, ...], str, tuple[str, ...
     "Move_PTP": (True, [((S, FA, I, I, I, B), B, ALL), ((S,) + P6 + (I, I, I, B), B, ALL)]),
     "Move_Line": (True, [((S, FA, I, I, I, B), B, ALL), ((S,) + P6 + (I, I, I, B), B, ALL)]),
     "Move_PLine": (True, [((S, FA, I, I, I), B, ALL), ((S,) + P6 + (I, I, I), B, ALL)]),
-    "ChangeBase": (True, [((S,), B, ALL), ((FA,), B, ALL), (P6, B, ALL)]),                 # §13.5
+    # §13.5 syntax 1 (name, base index; 2.24 only: TMflow 1.84 lists the name alone) .. syntax 4
+    "ChangeBase": (True, [((S, I), B, NEW), ((S,), B, ALL), ((FA,), B, ALL), (P6, B, ALL)]),
     "ChangeTCP": (True, [((S,), B, ALL), ((FA,), B, ALL), ((FA, F), B, ALL), ((FA, F, FA), B, ALL),
                          (P6, B, ALL), (P6 + (F,), B, ALL), ((F,) * 16, B, ALL)]),           # §13.6
     "ChangeLoad": (True, [((F,), B, ALL)]),                                                  # §13.7
@@ -40,7 +41,10 @@ FUNCTIONS: dict[str, tuple[bool, list[tuple[tuple[str, ...], str, tuple[str, ...
     "QueueTag": (True, [((I,), B, ALL), ((I, I), B, ALL)]),                                  # §13.1
     "WaitQueueTag": (False, [((), VOID, NEW), ((I,), I, ALL), ((I, I), I, ALL)]),            # §13.2
     "CheckQueueTag": (False, [((I,), I, NEW)]),                                              # §13.3
-    "StopAndClearBuffer": (False, [((), B, ALL), ((I,), B, ALL)]),                           # §13.4
+    # §13.4 defines no parameter. The priority forms StopAndClearBuffer(0|1|2) (§15.8) are no function: the
+    # session acts on a line that is literally one of them before the script is checked; with any other
+    # argument (a variable, an expression) the line is invalid, ERROR;line, and nothing of the packet runs
+    "StopAndClearBuffer": (False, [((), B, ALL)]),
     "Pause": (False, [((), B, ALL)]),
     "Resume": (False, [((), B, ALL)]),
     "ScriptExit": (False, [((), B, ALL), ((I,), B, ALL)]),                                   # §15
