@@ -1,18 +1,64 @@
 /* CBT HMI: the PnP Sequence page. The six CBT_MoveAbsolute segments of PnP_Example drawn in side view over the
    whole panel, at one scale with a scale bar and the base height marked; each segment carries its name on the
-   path (tap it to edit the segment), the one in progress is orange, and the TCP trail comes from the server. */
+   path (tap it to edit the segment), the one in progress is orange, and the TCP trail comes from the server.
+   The cycle's state (PnP_State) is the PLC's: the page shows it with what the operator can do next, and offers
+   Start, End Cycle and Reset only when the PLC takes them. */
 "use strict";
 
 let pnpParams = null;
 let pnpGeometry = null;
 
+const PNP_STATES = ["Idle", "Running", "Stopping", "Stopped", "Faulted"];   // ePnP_State, in its order
+const PNP_STATE_TEXT = {
+  Idle: "Ready. Press Start to run the cycle.",
+  Running: "The cycle is running. End Cycle stops after the current segment; Stop Motion stops the robot at once.",
+  Stopping: "Stopping: the robot is ending the current command.",
+  Stopped: "Stopped by Stop Motion. Nothing moves until you press Start; the cycle then goes on where it stopped.",
+  Faulted: "The cycle stopped on a fault. Remove the cause, press Reset, then Start.",
+};
+
+function pnpState() {
+  const v = live.values.PnP_State;
+  return typeof v === "number" ? PNP_STATES[v] : v;
+}
+
+/* What the operator can do now, from the PLC's state: [button enabled by id, explanation] */
+function pnpOptions() {
+  const v = live.values, state = pnpState();
+  const connected = v.Connect_Connected === true, stopHeld = v.Robot_Stopping === true;
+  const startable = (state === "Idle" || state === "Stopped") && connected && !stopHeld;
+  let text = PNP_STATE_TEXT[state] || "Waiting for the PLC …";
+  if (state === "Faulted" && v.PnP_MoveError)
+    text = `Fault ${idText(v.PnP_MoveErrorID)}: ${v.PnP_MoveErrorDescrip}. Remove the cause, press Reset, then Start.`;
+  if ((state === "Idle" || state === "Stopped") && !connected)
+    text = "The robot is not connected: connect it on the Connect page, then press Start.";
+  else if ((state === "Idle" || state === "Stopped") && stopHeld)
+    text = "Stop Motion is still active: wait until it is released, then press Start.";
+  if (v.PnP_OutcomeUnknown && state !== "Running")
+    text += " The last command may have run: Start first checks where the robot is and goes on from there.";
+  return { state, text, enabled: { "btn-execute": startable, "btn-stop": state === "Running" && v.PnP_Example_Execute === true,
+    "btn-reset": state === "Faulted" } };
+}
+
+function showPnPState() {
+  const box = document.getElementById("pnp-state");
+  if (!box) return;
+  const { state, text, enabled } = pnpOptions();
+  box.dataset.state = state || "";
+  document.getElementById("pnp-state-name").textContent = state ? `Cycle: ${state}` : "Cycle: –";
+  document.getElementById("pnp-state-text").textContent = text;
+  for (const [id, on] of Object.entries(enabled)) document.getElementById(id).disabled = !on;
+}
+
 function buildPnP() {
   const main = frame("PnP Sequence", false);
   main.innerHTML = `<div class="pnpdraw"><svg id="pnp-svg"></svg>
       <div class="pos" id="pnp-note">Side view. Tap a segment's name to edit it. Orange: segment in progress; green: TCP trail.</div></div>
-    <div class="side"><div class="buttons">
-      <button class="wide" id="btn-preset">Preset Values</button>
-      <button class="primary" id="btn-execute">Execute</button><button class="danger" id="btn-stop">Stop</button>
+    <div class="side"><div class="pnp-state" id="pnp-state" data-state="">
+        <b id="pnp-state-name">Cycle: –</b><span id="pnp-state-text">Waiting for the PLC …</span></div>
+      <div class="buttons">
+      <button class="primary" id="btn-execute" disabled>Start</button><button id="btn-stop" disabled>End Cycle</button>
+      <button id="btn-reset" disabled>Reset</button><button id="btn-preset">Preset Values</button>
       <button class="warn" id="btn-pause">Pause</button><button id="btn-resume">Resume</button></div>
     <div id="pnp-status"></div></div>
     <dialog id="seg-dialog"><header><h1 id="seg-title">Segment</h1></header><div class="body" id="seg-body"></div>
@@ -20,10 +66,9 @@ function buildPnP() {
   const statusBox = document.getElementById("pnp-status");
   const [lamps] = indicators("PnP_MoveActive");
   statusBox.append(lamps);
-  statusBox.append(statusTable("Cycle Status", [["Execute", "PnP_Example_Execute"], ["Segment", "PnP_Segment"],
+  statusBox.append(statusTable("Cycle Status", [["State", "PnP_State"], ["Segment", "PnP_Segment"],
     ["Waiting", "PnP_Waiting"], ["Gripper closed", "PnP_GripperClosed"], ["Cycles", "PnP_CycleCount"],
-    ["Busy", "PnP_MoveBusy"], ["Error", "PnP_MoveError"], ["ErrorID", "PnP_MoveErrorID"], ["ErrorDescrip", "PnP_MoveErrorDescrip"],
-    ["Pause/Resume", "ProgramControl_Done"], ["P/R Error", "ProgramControl_Error"]]));
+    ["Busy", "PnP_MoveBusy"], ["Error", "PnP_MoveError"], ["ErrorID", "PnP_MoveErrorID"], ["ErrorDescrip", "PnP_MoveErrorDescrip"]]));
   statusBox.style.cssText = "display:flex;flex-direction:column;gap:4px;flex:1;min-height:0";
   return main;
 }
@@ -96,7 +141,8 @@ function drawPnP() {
 function updatePnP() {
   if (!pnpGeometry) return;
   const { X, Y } = pnpGeometry;
-  const active = live.values.PnP_Example_Execute || live.values.PnP_MoveBusy ? live.values.PnP_Segment : -1;
+  const state = pnpState();
+  const active = state === "Running" || state === "Stopping" ? live.values.PnP_Segment : -1;
   for (let i = 0; i < 6; i++) {
     document.getElementById(`seg-${i}`).classList.toggle("active", i === active);
     document.getElementById(`edit-${i}`).classList.toggle("active", i === active);
@@ -154,22 +200,38 @@ async function pnpPage() {
     try { await api("/api/write", { values: flatPreset }); await loadPnP(); message("Preset PnP cycle written to the PLC.", "ok"); }
     catch (e) { message("Preset Values: " + e.message, "error"); }
   };
-  const setRun = async (on) => {
+  /* Start and Reset are rising edges (/api/execute); the message says what the PLC made of them */
+  const edge = async (variable, what, expect) => {
+    message(`${what} …`);
     try {
-      await api("/api/write", { values: { PnP_Example_Execute: on } });
-      message(on ? "PnP cycle started: it repeats while Execute stays on." : "PnP stop requested: the cycle ends after the current move.", "ok");
-    } catch (e) { message("PnP: " + e.message, "error"); }
+      await api("/api/execute", { execute: variable });
+      if (live.kick) live.kick();
+      const firstPoll = live.polls + 2;
+      const check = () => {
+        if (live.polls < firstPoll) { setTimeout(check, POLL_MS); return; }
+        const { state, text } = pnpOptions();
+        if (expect.includes(state)) message(`${what}: the cycle is ${state}. ${state === "Running" ? "" : text}`.trim());
+        else message(`${what} not taken: ${text}`, "error");
+      };
+      setTimeout(check, POLL_MS);
+    } catch (e) { message(`${what}: ${e.message}`, "error"); }
   };
-  document.getElementById("btn-execute").onclick = () => setRun(true);
-  document.getElementById("btn-stop").onclick = () => setRun(false);
+  document.getElementById("btn-execute").onclick = () => edge("PnP_Example_Execute", "Start", ["Running"]);
+  document.getElementById("btn-reset").onclick = () => edge("PnP_Reset", "Reset", ["Idle"]);
+  document.getElementById("btn-stop").onclick = async () => {
+    try {
+      await api("/api/write", { values: { PnP_Example_Execute: false } });
+      message("End Cycle: the robot finishes the current segment, then the cycle is Idle.");
+    } catch (e) { message("End Cycle: " + e.message, "error"); }
+  };
   const control = (cmd, what) => executeCommand("ProgramControl_Execute", { "ProgramControl_Param.Command": cmd }, what)
     .then((sent) => sent && watchResult("ProgramControl", what, what === "Pause" ? "the robot holds its path." : "the robot continues."));
   document.getElementById("btn-pause").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Pause, "Pause");
   document.getElementById("btn-resume").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Resume, "Resume");
-  live.listeners.push(updatePnP, fetchTrail);
+  live.listeners.push(updatePnP, showPnPState, fetchTrail);
   window.addEventListener("resize", drawPnP);
   try { await loadPnP(); } catch (e) { message("Cannot read the PnP parameters: " + e.message, "error"); }
-  startPolling(["PnP_Example_Execute", "PnP_Segment", "PnP_Waiting", "PnP_GripperClosed", "PnP_CycleCount", "PnP_MoveBusy",
+  startPolling(["PnP_Example_Execute", "PnP_State", "PnP_OutcomeUnknown", "PnP_Segment", "PnP_Waiting", "PnP_GripperClosed", "PnP_CycleCount", "PnP_MoveBusy",
     "PnP_MoveActive", "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",
     "ProgramControl_Busy", "ProgramControl_Done", "ProgramControl_Error", "ProgramControl_ErrorID",
     "ProgramControl_CommandAborted", "ProgramControl_ErrorDescrip", "Connect_Connected", "ReadPos_Valid",

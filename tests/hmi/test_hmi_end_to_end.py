@@ -299,11 +299,10 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
     connected.wait(lambda: connected.read("PnP_CycleCount") >= cycles + 2, "two complete cycles", timeout=90)
     browser.wait_for(lambda d: int(browser.status("PnP_CycleCount") or 0) >= cycles + 2, "the cycle count")
     browser.screenshot("e2e_pnp_running")
-    browser.click("btn-stop")
-    # stopped: the next start begins where the part is (place approach with a part in the gripper)
-    connected.wait(lambda: not connected.read("PnP_MoveBusy")
-                   and connected.read("PnP_Segment") == (3 if connected.read("PnP_GripperClosed") else 0),
-                   "the sequence to stop")
+    browser.click("btn-stop")                                    # End Cycle: after the current segment
+    connected.wait(lambda: connected.read("PnP_State") == "Idle" and not connected.read("PnP_MoveBusy"),
+                   "the cycle to end")
+    browser.wait_for(lambda d: browser.status("PnP_State") == "Idle", "Idle on the page")
     ends = [e["pose"][:3] for e in connected.events("motion_end", since)]
     for segment in range(6):
         reached = [end for end in ends if end == pytest.approx(targets[segment], abs=0.5)]
@@ -312,6 +311,81 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
     sent = commands(connected, since)
     assert sent.count("Pause()") == 1 and sent.count("Resume()") == 1
     assert sent.index("Pause()") < sent.index("Resume()")
+    assert connected.read("PnP_MoveError") is False
+
+
+def press_stop_motion(system) -> Browser:
+    """The Stop Motion page as the operator uses it: Stop Immediately, Execute; the page holds Stop until Done,
+    shows Done for 1.5 s, then releases it. Returns once the page has released Stop."""
+    browser = system.open("stop")
+    browser.click("btn-preset")                                  # Stop Immediately
+    browser.click("btn-execute")
+    browser.wait_for(lambda d: "Execute reset" in browser.message(), "the page to release Stop")
+    assert system.read("Stop_Execute") is False and system.read("Cobot.Stopping") is False
+    return browser
+
+
+def pnp_page_offers(browser) -> dict:
+    return {name: browser.driver.find_element(By.ID, f"btn-{name}").is_enabled()
+            for name in ("execute", "stop", "reset")}
+
+
+def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(connected):
+    """Issue 25 item 1: Stop on the Stop Motion page while the cycle dwells at the pick point, and again while a
+    move runs. The page releases Stop 1.5 s later; the robot must not move again by itself, and the PnP page
+    shows Stopped and offers Start (not Reset, not End Cycle); Start moves the robot again."""
+    browser = connected.open("pnp")
+    browser.click("btn-preset")
+    browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset")
+    with connected.plc.lock:
+        connected.plc.write("PnP_DwellTime", 20 * 1_000_000_000)   # a long dwell: the stop surely hits it
+        connected.plc.write("PnP_MoveParameters[4].Speed", 2)      # a slow place move: a sure window for a stop
+    cycles = connected.read("PnP_CycleCount")
+    browser.wait_for(lambda d: pnp_page_offers(browser) == {"execute": True, "stop": False, "reset": False},
+                     "Start offered while Idle")
+    browser.click("btn-execute")
+    connected.wait(lambda: connected.read("PnP_Waiting") and connected.read("PnP_Segment") == 1, "the dwell at pick")
+
+    press_stop_motion(connected)                                 # 1) while dwelling
+    connected.wait(lambda: connected.read("PnP_State") == "Stopped", "the latched stop")
+    with connected.plc.lock:
+        connected.plc.write("PnP_DwellTime", DWELL_NS)           # the next dwell is short again
+    mark = connected.event_count()
+    time.sleep(2.0)                                              # 8 s of robot time after the release
+    assert connected.events("motion_start", mark) == [], "the robot moved again by itself"
+    assert connected.read("PnP_State") == "Stopped" and connected.read("PnP_Example_Execute") is True
+    browser = connected.open("pnp")
+    browser.wait_for(lambda d: "Cycle: Stopped" in d.find_element(By.ID, "pnp-state").text, "Stopped on the page")
+    assert "Nothing moves until you press Start" in browser.driver.find_element(By.ID, "pnp-state").text
+    assert pnp_page_offers(browser) == {"execute": True, "stop": False, "reset": False}
+    assert browser.viewport_overflow() == []
+    browser.screenshot("e2e_pnp_stopped_dwelling")
+    browser.click("btn-execute")                                 # the deliberate start
+    browser.wait_for(lambda d: "Start: the cycle is Running" in browser.message(), "the start taken")
+    connected.wait(lambda: connected.events("motion_start", mark), "the robot to move after Start")
+
+    target = connected.read("PnP_MoveParameters")[4]["TargetPosition"]["Z"]
+    connected.wait(lambda: connected.read("PnP_Segment") == 4 and connected.robot_state()["moving"]
+                   and connected.robot_state()["tcp"][2] < target + 100, "the slow place move")
+    press_stop_motion(connected)                                 # 2) while moving
+    assert connected.read("PnP_State") == "Stopped" and connected.read("PnP_MoveError") is False
+    mark = connected.event_count()
+    time.sleep(2.0)
+    assert connected.events("motion_start", mark) == [], "the robot moved again by itself"
+    assert not connected.robot_state()["moving"] and connected.read("PnP_State") == "Stopped"
+    browser = connected.open("pnp")
+    browser.wait_for(lambda d: "Cycle: Stopped" in d.find_element(By.ID, "pnp-state").text, "Stopped on the page")
+    assert pnp_page_offers(browser) == {"execute": True, "stop": False, "reset": False}
+    browser.screenshot("e2e_pnp_stopped_mid_move")
+    with connected.plc.lock:
+        connected.plc.write("PnP_MoveParameters[4].Speed", 30)
+    browser.click("btn-execute")
+    browser.wait_for(lambda d: "Start: the cycle is Running" in browser.message(), "the start taken")
+    browser.wait_for(lambda d: pnp_page_offers(browser) == {"execute": False, "stop": True, "reset": False},
+                     "End Cycle offered while Running")
+    connected.wait(lambda: connected.read("PnP_CycleCount") > cycles, "the cycle to complete", timeout=60)
+    browser.click("btn-stop")
+    connected.wait(lambda: connected.read("PnP_State") == "Idle", "the cycle to end")
     assert connected.read("PnP_MoveError") is False
 
 
