@@ -11,6 +11,7 @@ major fault (watchdog included), a failed expectation or an operator stop before
 from __future__ import annotations
 
 import os
+import signal
 import sys
 import threading
 import time
@@ -48,6 +49,9 @@ def register(subparsers) -> None:
     p.add_argument("--spin-us", type=int, default=300, metavar="US",
                    help="real time: busy-wait this long before each scan for lower jitter (default 300)")
     p.add_argument("--watchdog", default="500ms", metavar="T", help="major fault when one scan runs longer (default 500ms)")
+    p.add_argument("--max-overruns", type=int, metavar="N",
+                   help="real time: fail the run (exit 1) on more than N overruns (task periods missed because a "
+                        "scan was still running when the next one was due)")
     p.set_defaults(handler=run_cmd)
 
 
@@ -64,7 +68,7 @@ MAX_SPIN_US = 10_000
 
 def run_cmd(args) -> int:
     from ..api import LoadError, PlcFault, load_plc, parse_task
-    from ..runtime.stats import ScanStats
+    from ..runtime.stats import OverrunCount, ScanStats
     from ..runtime.values import PathError
     from ..trace import Recorder, write_trace
     if bool(args.trace) != bool(args.trace_out):
@@ -96,6 +100,11 @@ def run_cmd(args) -> int:
         return _err(f"--watchdog {args.watchdog!r} must be a duration from 1ns to 60s, like 500ms")
     if not 0 <= args.spin_us <= MAX_SPIN_US:
         return _err(f"--spin-us must be 0 .. {MAX_SPIN_US:,} microseconds")
+    if args.max_overruns is not None:
+        if args.virtual_time:
+            return _err("--max-overruns applies to real time; on --virtual-time every scan gets the time it takes")
+        if not 0 <= args.max_overruns <= MAX_CYCLES:
+            return _err(f"--max-overruns must be 0 .. {MAX_CYCLES:,}")
     try:
         scenario = scn.load(args.scenario) if args.scenario else scn.Scenario()
         for text in args.set:
@@ -128,10 +137,13 @@ def run_cmd(args) -> int:
         return _err(str(exc))
     runner = scn.Runner(plc, scenario)
     stats = ScanStats() if args.stats else None
-    print(start_line(plc, args, scenario, duration), flush=True)
+    if stats is None and not args.virtual_time:
+        stats = OverrunCount()                 # every real-time run reports its overruns in its final line
     reason = None
     hooks = Hooks(plc, runner, rec, watch, args.cycles, duration)
+    previous = _on_sigterm(_terminate)
     try:
+        print(start_line(plc, args, scenario, duration), flush=True)
         if args.virtual_time:
             _run_virtual(plc, hooks, stats)
         else:
@@ -139,14 +151,20 @@ def run_cmd(args) -> int:
     except PlcFault as exc:
         print(f"vplc run: controller stopped: {exc}", file=sys.stderr)
         reason = f"major fault at {scn.seconds(plc.now_ns)}: {str(exc).splitlines()[0]}"
-    except KeyboardInterrupt:
-        print("vplc run: stopped by the operator", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        who = "SIGTERM" if isinstance(exc, Terminated) else "the operator"
+        print(f"vplc run: stopped by {who}", file=sys.stderr)
         if not scenario.empty and runner.failure is None and runner.end_check(plc.now_ns):
-            reason = f"stopped by the operator at {scn.seconds(plc.now_ns)} before the scenario was decided"
+            reason = f"stopped by {who} at {scn.seconds(plc.now_ns)} before the scenario was decided"
     finally:
+        _on_sigterm(previous)
         plc.close()
     if reason is None:
         reason = runner.end_check(hooks.last_ns)
+    overruns = None if args.virtual_time else stats.overruns
+    if reason is None and args.max_overruns is not None and overruns > args.max_overruns:
+        reason = (f"{overruns} overrun(s), more than --max-overruns {args.max_overruns} (task periods missed "
+                  "because a scan was still running when the next one was due)")
     count, latest = plc.instruction_errors
     if count:
         print(f"vplc run: {count} instruction error(s) (ENO FALSE on the controller: the program went on, the "
@@ -155,7 +173,7 @@ def run_cmd(args) -> int:
             print(f"  {message}", file=sys.stderr)
     if watch is not None:
         print(watch.final(hooks.last_ns))
-    if stats is not None:
+    if args.stats:
         print(stats.summary())
     if rec is not None:
         try:
@@ -165,14 +183,37 @@ def run_cmd(args) -> int:
             return 1
         print(f"trace written to {args.trace_out}")
     held = sum(1 for e in scenario.expects if e.state == "held")
+    late = f"; {overruns} overrun(s)" if overruns is not None else ""
     if reason is not None:
-        print(f"vplc run: FAILED: {reason}", file=sys.stderr)
+        print(f"vplc run: FAILED: {reason}{late if 'overrun' not in reason else ''}", file=sys.stderr)
         return 1
-    summary = f"{hooks.scans} scan(s), {scn.seconds(hooks.last_ns)} of controller time"
+    summary = f"{hooks.scans} scan(s), {scn.seconds(hooks.last_ns)} of controller time{late}"
     if scenario.expects:
         summary += f"; {held} of {len(scenario.expects)} expectation(s) held"
     print(f"vplc run: OK: {summary}")
     return 0
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM during a run: it ends like Ctrl-C, with the final values, the statistics and the trace written."""
+
+
+def _terminate(signum, frame) -> None:
+    raise Terminated()
+
+
+_NOT_SET = object()
+
+
+def _on_sigterm(handler):
+    """Install ``handler`` for SIGTERM and return the one it replaces (``_NOT_SET`` where signals cannot be set:
+    a thread other than the main one, a platform without SIGTERM; then nothing is installed or restored)."""
+    if handler is _NOT_SET or not hasattr(signal, "SIGTERM"):
+        return _NOT_SET
+    try:
+        return signal.signal(signal.SIGTERM, signal.SIG_DFL if handler is None else handler)
+    except ValueError:
+        return _NOT_SET
 
 
 def parse_window(text: str) -> tuple[int, int]:
@@ -236,11 +277,13 @@ def socket_use(plc) -> str:
 
 
 class Watch:
-    """Prints each change of the watched variables as `time  VAR = value`, and a table at the end."""
+    """Prints each change of the watched variables as `time  VAR = value` in PLC notation, and a table at the end."""
 
     def __init__(self, plc, paths: list[str]) -> None:
+        from ..runtime.values import plc_text
         self.plc, self.paths = plc, paths
-        self.is_time = {p: plc.var_type(p).upper() in ("TIME", "LTIME") for p in paths}   # PathError first
+        plc.var_type(paths[0])                                                   # PathError first
+        self.text = {p: plc_text(plc._resolver._locate(p)[2]) for p in paths}   # PLC notation, per type
         self.values: dict[str, object] = {}
         self.width = max(len(p) for p in paths)
 
@@ -258,9 +301,8 @@ class Watch:
         return "\n".join(lines)
 
     def show(self, path: str, v) -> str:
-        if self.is_time[path] and isinstance(v, int):
-            return "T#" + ("-" if v < 0 else "") + _period(abs(v)).replace(" ", "") if v else "T#0s"
-        return str(v) if isinstance(v, (dict, list)) else scn.fmt(v)
+        """16#4006 for a WORD, Idle for an enumeration, T#1.5s, (X := 1, Y := 16#00) ... (issue 27)."""
+        return self.text[path](v)
 
 
 class Hooks:

@@ -248,6 +248,12 @@ def base_of(t: Type) -> Type:
     return t
 
 
+def bits_literal(value: int, bits: int) -> str:
+    """A bit string (BYTE, WORD, DWORD, LWORD) in the notation an engineer reads on the controller: hexadecimal,
+    all its digits (16#4006, 16#0A, 16#0001_0000 is written 16#00010000)."""
+    return f"16#{int(value) & ((1 << bits) - 1):0{max(1, bits // 4)}X}"
+
+
 INSTANCE_SECTIONS = ("VAR", "VAR_INPUT", "VAR_OUTPUT", "VAR_STAT", "VAR_TEMP")   # in-outs and externals refer
 
 

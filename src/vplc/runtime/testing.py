@@ -10,6 +10,7 @@ import math
 import sys
 from dataclasses import dataclass, field
 
+from ..frontend import types as T
 from .faults import GEN_FILE
 
 
@@ -119,15 +120,25 @@ def _equals(rt, Expected, Actual, Message) -> bool:
     return _record(rt, Expected == Actual, _msg(Message or "", f"expected {_fmt(Expected)}, got {_fmt(Actual)}"))
 
 
+def _equals_bits(bits: int):
+    """AssertEquals_BYTE .. _LWORD: the values in the notation the controller shows them, 16#4006 (not 16390)."""
+    def equals(rt, Expected, Actual, Message) -> bool:
+        return _record(rt, Expected == Actual, _msg(Message or "", f"expected {T.bits_literal(Expected, bits)}, "
+                                                                   f"got {T.bits_literal(Actual, bits)}"))
+    return equals
+
+
 def _equals_real(rt, Expected, Actual, Delta, Message) -> bool:
     ok = not (math.isnan(Expected) or math.isnan(Actual)) and abs(Expected - Actual) <= abs(Delta or 0.0)
     return _record(rt, ok, _msg(Message or "", f"expected {Expected:g} (+/- {Delta:g}), got {Actual:g}"))
 
 
-_TYPES = ("BOOL", "BYTE", "WORD", "DWORD", "LWORD", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT",
+_BITS = {"BYTE": 8, "WORD": 16, "DWORD": 32, "LWORD": 64}
+_TYPES = ("BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT",
           "TIME", "LTIME", "DATE", "TIME_OF_DAY", "DATE_AND_TIME", "STRING")
 
 FUNCTIONS = {"TEST": TEST, "TEST_FINISHED": TEST_FINISHED, "IS_TEST_FINISHED": IS_TEST_FINISHED,
              "AssertTrue": AssertTrue, "AssertFalse": AssertFalse,
              "AssertEquals_REAL": _equals_real, "AssertEquals_LREAL": _equals_real,
-             **{f"AssertEquals_{t}": _equals for t in _TYPES}}
+             **{f"AssertEquals_{t}": _equals for t in _TYPES},
+             **{f"AssertEquals_{t}": _equals_bits(bits) for t, bits in _BITS.items()}}

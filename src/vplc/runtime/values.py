@@ -174,6 +174,81 @@ def converter(t):
     return conv
 
 
+WATCH_ELEMENTS = 32          # array elements written out in PLC notation; the rest is counted
+
+
+def plc_text(t):
+    """The function writing an API value of type ``t`` (what ``read`` returns) in PLC notation: TRUE/FALSE, bit
+    strings in 16#, enumerations by name, durations as T#..., arrays as [a, b, ...] and structures and instances
+    as (Member := value, ...). Strings are written as they are at the top level and quoted inside a value."""
+    return _text(t, top=True)
+
+
+def _text(t, top: bool = False):
+    u = T.base_of(t)
+    if isinstance(u, T.ElementaryType):
+        if u.kind == "bool":
+            return lambda v: "TRUE" if v else "FALSE"
+        if u.kind == "bit":
+            return lambda v, bits=u.bits: T.bits_literal(v, bits) if isinstance(v, int) else str(v)
+        if u.kind in ("time", "ltime"):
+            return lambda v: duration_literal(v) if isinstance(v, int) else str(v)
+        if u.kind == "real":
+            return real_literal
+        return str
+    if isinstance(u, T.StringType):
+        return str if top else (lambda v: "'" + str(v).replace("$", "$$").replace("'", "$'") + "'")
+    if isinstance(u, T.ArrayType):
+        each = _text(u.element)
+
+        def array(v):
+            shown = [each(x) for x in v[:WATCH_ELEMENTS]]
+            if len(v) > WATCH_ELEMENTS:
+                shown.append(f"… {len(v) - WATCH_ELEMENTS} more")
+            return "[" + ", ".join(shown) + "]"
+        return array
+    if isinstance(u, T.StructType):
+        members = [(f.name, _text(f.type)) for f in u.fields.values()]
+    elif isinstance(u, T.PouType) and u.pou is not None:
+        members = [(d.name, _text(d.sym.type)) for s in u.pou.sections if s.kind in INSTANCE_VISIBLE
+                   for d in s.vars if getattr(d, "sym", None) is not None]
+    else:
+        return str
+
+    def struct(v):
+        if not isinstance(v, dict):
+            return str(v)
+        parts = []
+        for name, text in members:
+            key = name if name in v else name + "_"          # members named like a Python keyword get a "_"
+            if key in v:
+                parts.append(f"{name} := {text(v[key])}")
+        return "(" + ", ".join(parts) + ")"
+    return struct
+
+
+INSTANCE_VISIBLE = ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT", "VAR")
+
+
+def real_literal(v) -> str:
+    """A REAL / LREAL with six significant digits that still reads as a real: 0.0, 1.5, 1e+10, -2.5e-07."""
+    if not isinstance(v, float):
+        return str(v)
+    text = f"{v:.6g}"
+    return text if any(c in text for c in ".eni") else text + ".0"
+
+
+def duration_literal(ns: int) -> str:
+    """T#... of a duration in nanoseconds, in the largest unit that keeps it short: T#1.5s, T#-5ms, T#0s."""
+    if not ns:
+        return "T#0s"
+    sign, a = ("-" if ns < 0 else ""), abs(ns)
+    for unit, scale in (("s", 10**9), ("ms", 10**6), ("us", 10**3)):
+        if a >= scale:
+            return f"T#{sign}{a / scale:g}{unit}"
+    return f"T#{sign}{a}ns"
+
+
 def from_python(value, t, path: str, raw: bool = False):
     """Checked conversion of an API value; ``raw`` lets an enumeration take any integer of its storage
     type, declared or not (what an HMI or a memory copy can put there on the controller)."""

@@ -16,6 +16,8 @@ class Recorder:
                 self.kinds.append(("bool", 1))
             elif isinstance(t, T.ElementaryType) and t.kind == "real":
                 self.kinds.append(("real", t.bits))
+            elif isinstance(t, T.ElementaryType) and t.kind == "bit":
+                self.kinds.append(("bits", t.bits))            # BYTE .. LWORD: drawn in 16# notation
             elif isinstance(t, T.ElementaryType):
                 self.kinds.append(("int", t.bits))
             elif isinstance(t, (T.StringType, T.EnumType)):

@@ -3,11 +3,13 @@
 BOOL is a square wave whose high pulses stay at least ``MIN_PULSE`` pixels wide, however long the trace (a
 pulse that had to be widened also gets a marker above it); REAL/LREAL are analog curves scaled to their range
 in the window, with the range written at the left; other values are a bus with the value written where it
-fits, and changes too dense to draw one by one become a hatched band. ``window`` (FROM, TO) in ns draws only
+fits (bit strings BYTE .. LWORD in 16# notation, as the controller shows them), and changes too dense to draw one by one become a hatched band. ``window`` (FROM, TO) in ns draws only
 that part of the run."""
 from __future__ import annotations
 
 from xml.sax.saxutils import escape
+
+from ..frontend import types as T
 
 ROW, LABEL_W, WIDTH, HIGH = 34, 220, 900, 18
 ANALOG_ROW = 56                # REAL rows are taller: the curve needs height to be read
@@ -101,7 +103,7 @@ def _analog_row(ch, x, t1, top, bottom) -> list[str]:
             f'<polyline points="{" ".join(pts)}" fill="none" stroke="{BLUE}" stroke-width="1.5"/>']
 
 
-def _bus_row(ch, x, t1, hi, base) -> list[str]:
+def _bus_row(ch, x, t1, hi, base, fmt=_fmt) -> list[str]:
     out = []
     mid = (hi + base) / 2
     segs = [(x(t), x(t2), v) for (t, v), (t2, _) in zip(ch, ch[1:] + [(t1, None)])]
@@ -119,7 +121,7 @@ def _bus_row(ch, x, t1, hi, base) -> list[str]:
             continue
         out.append(f'<polygon points="{x1 + 3:.1f},{hi} {x2:.1f},{hi} {x2:.1f},{base} {x1 + 3:.1f},{base} '
                    f'{x1:.1f},{mid}" fill="#eef" stroke="{BLUE}"/>')
-        text = _fmt(v)
+        text = fmt(v)
         if x2 - x1 > 6 * len(text) + 8:
             out.append(f'<text x="{x1 + 6:.1f}" y="{base - 4}" font-size="10">{escape(text)}</text>')
         i += 1
@@ -142,7 +144,7 @@ def render_svg(rec, window: tuple[int, int] | None = None) -> str:
            f'<rect width="{WIDTH}" height="{h}" fill="white"/>']
     top = 10
     labels = getattr(rec, "labels", None) or rec.paths
-    for i, (p, (kind, _bits)) in enumerate(zip(labels, rec.kinds)):
+    for i, (p, (kind, bits)) in enumerate(zip(labels, rec.kinds)):
         rh = heights[i]
         base, hi = top + rh - 8, top + rh - 8 - (HIGH if kind != "real" else rh - 14)
         label_y = base - 4 if kind != "real" else (hi + base) / 2 + 4
@@ -154,6 +156,8 @@ def render_svg(rec, window: tuple[int, int] | None = None) -> str:
                 out += _bool_row(ch, x, t1, hi, base)
             elif kind == "real":
                 out += _analog_row(ch, x, t1, hi, base)
+            elif kind == "bits":                  # BYTE .. LWORD in the controller's notation: 16#4006
+                out += _bus_row(ch, x, t1, hi, base, lambda v, n=bits: T.bits_literal(v, n))
             else:
                 out += _bus_row(ch, x, t1, hi, base)
         top += rh

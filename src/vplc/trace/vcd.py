@@ -1,5 +1,5 @@
-"""Value Change Dump (IEEE 1364) writer; timescale 1 ns. BOOL -> 1-bit wire, integers -> n-bit vectors,
-REAL/LREAL -> real, STRING and enumerations -> GTKWave string variables."""
+"""Value Change Dump (IEEE 1364) writer; timescale 1 ns. BOOL -> 1-bit wire, integers and bit strings -> n-bit
+vectors, REAL/LREAL -> real, STRING and enumerations -> GTKWave string variables."""
 from __future__ import annotations
 
 import datetime
@@ -20,7 +20,7 @@ def _value(kind: str, bits: int, v, ident: str) -> str:
         return f"{1 if v else 0}{ident}"
     if kind == "real":
         return f"r{float(v)!r} {ident}"
-    if kind == "int":
+    if kind in ("int", "bits"):
         return f"b{int(v) & ((1 << bits) - 1):b} {ident}"
     return f"s{str(v).replace(' ', '_') or '_'} {ident}"
 
@@ -29,8 +29,8 @@ def write_vcd(rec, filename: str) -> None:
     lines = [f"$date {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M:%S} UTC $end",
              "$version vplc virtual PLC $end", "$timescale 1ns $end", "$scope module plc $end"]
     for i, (p, (kind, bits)) in enumerate(zip(rec.paths, rec.kinds)):
-        vtype = {"bool": "wire", "int": "wire", "real": "real", "text": "string"}[kind]
-        width = {"bool": 1, "int": bits, "real": 64, "text": 1}[kind]
+        vtype = {"bool": "wire", "int": "wire", "bits": "wire", "real": "real", "text": "string"}[kind]
+        width = {"bool": 1, "int": bits, "bits": bits, "real": 64, "text": 1}[kind]
         lines.append(f"$var {vtype} {width} {_ident(i)} {p.replace(' ', '_')} $end")
     lines += ["$upscope $end", "$enddefinitions $end"]
     events: dict[int, list[str]] = {}
