@@ -71,7 +71,7 @@ const DEFAULT_STATUS = ["Busy", "Done", "CommandAborted", "Error", "ErrorID", "E
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
 let MAP = null;
-const live = { values: {}, online: false, listeners: [], kick: null, polls: 0 };
+const live = { values: {}, online: false, fault: null, listeners: [], kick: null, polls: 0 };
 
 /* ---------- server access ---------- */
 /* The access key comes in the address printed at start-up (…/#key=…): kept for this browser tab only and
@@ -322,6 +322,26 @@ function showStatus() {
   }
 }
 
+/* ---------- PLC state in the header ---------- */
+/* After a major fault the PLC stops scanning and closes its sockets; the server stays up and says so
+   (docs/hmi.md, "PLC fault"): the header names the fault, the page is greyed out as no longer valid. */
+function showPlcState(pillPlc, pillRobot) {
+  const fault = live.fault;
+  const what = fault ? (fault.what.length > 40 ? fault.what.slice(0, 39) + "…" : fault.what) : "";
+  pillPlc.textContent = fault ? `PLC fault — ${what}` : live.online ? "PLC online" : "PLC offline";
+  pillPlc.title = fault ? fault.message : "";
+  pillPlc.className = "pill " + (live.online ? "on" : "off");
+  const connected = !fault && live.values.Connect_Connected === true;
+  pillRobot.textContent = fault ? "Robot link closed" : connected ? "Robot connected" : "Robot not connected";
+  pillRobot.className = "pill " + (connected ? "on" : "off");
+  const panel = document.querySelector(".panel");
+  if (Boolean(fault) !== panel.classList.contains("plc-fault")) {
+    panel.classList.toggle("plc-fault", Boolean(fault));
+    if (fault) message(`PLC major fault: ${fault.message}. The PLC has stopped: the values shown are the last `
+      + "ones before the fault and are not valid; nothing can be sent until the PLC is restarted.", "error");
+  }
+}
+
 /* ---------- polling ---------- */
 function startPolling(names) {
   names = [...new Set([...names, ...alarmVariables()].filter((n) => MAP.variables[n]))];
@@ -331,13 +351,10 @@ function startPolling(names) {
       const data = await readVars(names);
       Object.assign(live.values, data.values);
       live.polls += 1;
-      live.online = true;
-    } catch (e) { live.online = false; }
-    pillPlc.textContent = live.online ? "PLC online" : "PLC offline";
-    pillPlc.className = "pill " + (live.online ? "on" : "off");
-    const connected = live.values.Connect_Connected === true;
-    pillRobot.textContent = connected ? "Robot connected" : "Robot not connected";
-    pillRobot.className = "pill " + (connected ? "on" : "off");
+      live.fault = data.plc === "fault" ? data.fault : null;
+      live.online = !live.fault;          // after a major fault the values are the last ones, no longer valid
+    } catch (e) { live.online = false; live.fault = null; }
+    showPlcState(pillPlc, pillRobot);
     showStatus();
     checkAlarms();
     for (const f of live.listeners) f();

@@ -6,6 +6,7 @@ variable; malformed requests answered with a clean 4xx; a bounded number of serv
 """
 from __future__ import annotations
 
+import contextlib
 import http.client
 import http.server
 import json
@@ -16,6 +17,7 @@ import pytest
 
 from tests.hmi.fake_plc import FakePlc, command_program, scanning, serving
 from tests.hmi.hmi_http import Client
+from vplc.hmi import front
 from vplc.hmi import server as hmi_server
 from vplc.hmi.mapping import Mapping
 from vplc.hmi.server import HmiServer  # noqa: E402
@@ -38,6 +40,17 @@ def plc(mapping):
 def hmi(plc, mapping):
     with serving(plc, mapping) as server:
         yield server
+
+
+@contextlib.contextmanager
+def hmi_with(plc, mapping, host: str = "127.0.0.1", **limits):
+    """An HMI server with its own bind address and deadlines (front.HttpLimits) on an ephemeral port."""
+    server = HmiServer(plc, mapping, host=host, port=0, limits=front.HttpLimits(**limits))
+    server.start()
+    try:
+        yield server
+    finally:
+        server.stop()
 
 
 def raw_request(port: int, method: str, path: str, body: bytes = b"", headers: dict | None = None):
@@ -160,6 +173,35 @@ def test_localhost_name_is_accepted_on_a_loopback_server(hmi):
     assert status == 200
 
 
+@pytest.mark.parametrize("method, path", [("GET", "/api/read?names=Connect_AddressIP,MoveAbs_Param"),
+                                          ("GET", "/api/mapping"), ("GET", "/"), ("GET", "/hmi.js"),
+                                          ("POST", "/api/execute")])
+@pytest.mark.parametrize("host", ["rebind.attacker.example", "127.0.0.1.nip.io", "localhost.attacker.example"])
+def test_dns_rebinding_is_refused_on_a_server_bound_to_every_address(plc, mapping, method, path, host):
+    """Bound to 0.0.0.0 (the demo's --host 0.0.0.0), the Host check was off: a rebound name read every value
+    (writes got 401). Now every request, reads and pages included, must name this server: 421."""
+    with hmi_with(plc, mapping, host="0.0.0.0") as server:
+        headers = {"Host": f"{host}:{server.port}", "Content-Type": "application/json",
+                   "X-HMI-Key": server.access.keys["operator"]}
+        status, payload, _ = raw_request(server.port, method, path,
+                                         json.dumps(MOVE).encode() if method == "POST" else b"", headers)
+    assert status == 421 and b"addressed to this HMI" in payload
+    assert plc.writes == []
+
+
+@pytest.mark.parametrize("host", ["127.0.0.1", "localhost", "192.0.2.10", "[::1]", "[2001:db8::10]"])
+def test_an_address_or_this_machine_is_served_on_a_server_bound_to_every_address(plc, mapping, host):
+    """What an operator types on a plant network: the PC's IP address (or localhost on the PC itself)."""
+    with hmi_with(plc, mapping, host="0.0.0.0") as server:
+        status, _, _ = raw_request(server.port, "GET", "/api/read?names=Connect_AddressIP",
+                                   headers={"Host": f"{host}:{server.port}"})
+        wrong_port, _, _ = raw_request(server.port, "GET", "/api/read?names=Connect_AddressIP",
+                                       headers={"Host": f"{host}:{server.port + 1}"})
+        machine, _, _ = raw_request(server.port, "GET", "/api/session",
+                                    headers={"Host": f"{socket.gethostname()}:{server.port}"})
+    assert (status, wrong_port, machine) == (200, 421, 200)
+
+
 # --- the cross-origin attack in a real browser ---------------------------------------------------------------
 
 ATTACK_PAGE = """<!doctype html><html><body>
@@ -271,11 +313,11 @@ def test_a_content_length_of_5000_digits_is_413_without_python_text(hmi):
                                                  f"{hmi_server.MAX_BODY} bytes")
 
 
-def test_a_body_shorter_than_its_content_length_gets_408_when_the_connection_times_out(hmi, plc, monkeypatch):
+def test_a_body_shorter_than_its_content_length_gets_408_at_its_deadline(plc, mapping):
     """Content-Length 100 with 4 bytes sent got no answer at all: the connection closed silently after the
-    idle timeout. Now the timeout answers 408 with a JSON error, then closes (a 0.3 s timeout here)."""
-    monkeypatch.setattr(hmi_server._Handler, "timeout", 0.3)
-    with socket.create_connection(("127.0.0.1", hmi.port), timeout=5) as sock:
+    idle timeout. Now the body deadline answers 408 with a JSON error, then closes (0.3 s here)."""
+    with hmi_with(plc, mapping, body_s=0.3) as hmi, \
+            socket.create_connection(("127.0.0.1", hmi.port), timeout=5) as sock:
         sock.sendall(b"POST /api/write HTTP/1.1\r\nHost: 127.0.0.1:" + str(hmi.port).encode() +
                      b"\r\nContent-Type: application/json\r\nX-HMI-Key: " + hmi.access.keys["operator"].encode() +
                      b"\r\nContent-Length: 100\r\n\r\n{\"va")
@@ -324,24 +366,28 @@ def test_garbage_request_line_gets_a_json_4xx(hmi):
     assert json.loads(body)["ok"] is False
 
 
-def test_stalled_connections_are_bounded_and_time_out(hmi, monkeypatch):
-    """600 stalled connections once kept 604 threads: now a fixed pool serves, idle clients are dropped."""
-    monkeypatch.setattr(hmi_server._Handler, "timeout", 0.25)
+def test_stalled_connections_are_bounded_and_time_out(plc, mapping):
+    """600 stalled connections once kept 604 threads: now they hold no thread at all, and each one's header
+    deadline answers it 408 and closes it."""
     threads_before = threading.active_count()
-    stalled = [socket.create_connection(("127.0.0.1", hmi.port), timeout=5) for _ in range(120)]
-    try:
-        for sock in stalled:
-            sock.sendall(b"GET /api/session HTTP/1.0\r\n")          # never finishes the header
-        assert threading.active_count() <= threads_before + hmi_server.WORKERS + 1
-        for sock in stalled:                                       # every one ends: a 503 or a close at timeout
-            sock.settimeout(5)
-            while sock.recv(4096):
-                pass
-    finally:
-        for sock in stalled:
-            sock.close()
-    status, _, _ = raw_request(hmi.port, "GET", "/api/session")
-    assert status == 200
+    with hmi_with(plc, mapping, header_s=0.25, idle_s=0.25) as hmi:
+        stalled = [socket.create_connection(("127.0.0.1", hmi.port), timeout=5) for _ in range(120)]
+        try:
+            for sock in stalled:
+                sock.sendall(b"GET /api/session HTTP/1.0\r\n")          # never finishes the header
+            status, _, _ = raw_request(hmi.port, "GET", "/api/session")
+            assert status == 200
+            assert threading.active_count() <= threads_before + front.WORKERS + 1
+            answers = []
+            for sock in stalled:                                   # every one ends: 408, then the close
+                answer = b""
+                while chunk := sock.recv(4096):
+                    answer += chunk
+                answers.append(answer.split(b" ", 2)[1])
+        finally:
+            for sock in stalled:
+                sock.close()
+    assert set(answers) == {b"408"}
 
 
 def test_many_simultaneous_pollers_are_all_answered(hmi):
@@ -357,7 +403,7 @@ def test_many_simultaneous_pollers_are_all_answered(hmi):
         t.start()
     for t in threads:
         t.join(timeout=10)
-    assert hmi_server.LISTEN_BACKLOG >= 128
+    assert front.LISTEN_BACKLOG >= 128
     assert sorted(set(results)) == [200] and len(results) == 50
 
 

@@ -9,44 +9,41 @@ variables too.
 API (all answers are JSON objects with "ok"):
   GET  /api/mapping                         the variable table (types, ranges, enumerations, roles)
   GET  /api/session                         {"ok", "role"}: the role the request's X-HMI-Key grants
-  GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "values": {name: value}}
+  GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "plc": "run"|"fault", ["fault",] "values": {...}}
   GET  /api/program[/state?pou=NAME]        ladder drawings and their live power flow (vplc.hmi.program)
   POST /api/write   {"values": {path: v}}   validate all, then write all in one scan gap
   POST /api/execute {"execute": "X_Execute", "values": {path: v}}
                                             validate, write the values and Execute := FALSE, wait for one
                                             PLC scan, then Execute := TRUE (a clean rising edge per press)
 
-The server is a bounded pool of worker threads: a connection idle for CONNECTION_TIMEOUT_S is closed (one
-whose announced body has not arrived by then is answered 408 first), and beyond WORKERS + WAITING
-connections a new one is answered 503 at once.
+One thread reads every request without blocking, each within its deadlines (header, body), answers complete
+reads itself and passes complete writes to a bounded pool of workers; connections are limited per client
+address and in all, and the longest-waiting one makes room for a new one (vplc.hmi.front), so slow or idle
+clients cannot lock the operator out. After a major fault of the PLC every answer says so (/api/read:
+"plc": "fault") and writes are refused.
 """
 from __future__ import annotations
 
+import io
 import json
 import logging
 import mimetypes
 import pathlib
 import re
-import sys
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
 from http import HTTPStatus
-from http.server import BaseHTTPRequestHandler, HTTPServer
+from http.server import BaseHTTPRequestHandler
 from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
+from .front import MAX_BODY, HttpFront, HttpLimits
 from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, validate
 from .trail import Trail
 
-MAX_BODY = 16 * 1024
 MAX_DIGITS = 40                    # digits of one number in a request body (a LINT has 19, an LREAL 17)
 MAX_NAMES = 400
 SCAN_WAIT_S = 1.0
-CONNECTION_TIMEOUT_S = 10.0        # a client that sends nothing for this long is disconnected
-WORKERS = 16                       # requests served at once
-WAITING = 48                       # connections queued for a worker before new ones get 503
-LISTEN_BACKLOG = 128
 
 log = logging.getLogger("vplc.hmi")
 
@@ -62,6 +59,19 @@ def _number_digits(text: str) -> str:
     return text
 
 
+def plc_fault(plc) -> dict | None:
+    """The PLC's major fault, None while it can scan: {"message": the controller's whole text, "what": the
+    cause alone (after "major fault in <instance>: ")}. vplc's Plc keeps the fault in engine.fault from the scan
+    that faulted on; the PLC no longer scans, its variables keep the values of that moment and its sockets are
+    closed (vplc.runtime.engine). A PLC stand-in without an engine never faults."""
+    fault = getattr(getattr(plc, "engine", None), "fault", None)
+    if fault is None:
+        return None
+    message = str(fault)
+    what = message.partition(": major fault in ")[2].partition(": ")[2]
+    return {"message": message, "what": what or message}
+
+
 def _json_body(raw: bytes):
     """The decoded request body; RequestError saying what is wrong with it."""
     try:
@@ -73,64 +83,30 @@ def _json_body(raw: bytes):
         raise RequestError("the request body is nested too deeply") from None
 
 
-class _PooledHTTPServer(HTTPServer):
-    """HTTPServer whose connections are served by a bounded pool of threads (not a thread per connection)."""
+# Requests the front-end thread answers itself: they only read (a file, the table, variables under plc.lock for
+# microseconds), so a hand-over to a worker would cost more than the answer. Writes, which wait for PLC scans,
+# and the Program page, whose first request compiles the ladder drawings, go to the workers.
+_ANSWERED_AT_ONCE = (b"GET ", b"HEAD ")
+_PROGRAM_PAGE = b"/api/program"
 
-    request_queue_size = LISTEN_BACKLOG
-    allow_reuse_address = True
 
-    def __init__(self, address, handler):
-        # the pool exists before the base class binds: a refused bind calls server_close(), which shuts it down
-        self._pool = ThreadPoolExecutor(WORKERS, thread_name_prefix="hmi-http")
-        self._slots = threading.BoundedSemaphore(WORKERS + WAITING)
-        super().__init__(address, handler)
-
-    def process_request(self, request, client_address):
-        if not self._slots.acquire(blocking=False):
-            try:
-                request.sendall(b"HTTP/1.0 503 Service Unavailable\r\nContent-Type: application/json\r\n"
-                                b"Content-Length: 58\r\nConnection: close\r\n\r\n"
-                                b'{"ok": false, "error": "the HMI server is busy, retry"}\r\n\r\n')
-            except OSError:
-                pass
-            self.shutdown_request(request)
-            return
-        self._pool.submit(self._serve, request, client_address)
-
-    def _serve(self, request, client_address):
-        try:
-            self.finish_request(request, client_address)
-        except Exception:           # noqa: BLE001 - one broken connection must never stop the server
-            self.handle_error(request, client_address)
-        finally:
-            self.shutdown_request(request)
-            self._slots.release()
-
-    def handle_error(self, request, client_address):
-        exc = sys.exc_info()[1]
-        if isinstance(exc, (BrokenPipeError, ConnectionResetError, ConnectionAbortedError)):
-            log.debug("HMI client %s:%s left before the answer was sent (%s)", *client_address[:2],
-                      type(exc).__name__)       # a browser leaving a page mid-request: normal, one line
-            return
-        log.debug("HMI connection from %s ended abnormally", client_address[0], exc_info=True)
-
-    def server_close(self):
-        super().server_close()
-        self._pool.shutdown(wait=False, cancel_futures=True)
+def _answered_at_once(request: bytes) -> bool:
+    return request.startswith(_ANSWERED_AT_ONCE) and not request.startswith(_PROGRAM_PAGE, request.find(b" ") + 1)
 
 
 class HmiServer:
     """HTTP server for one PLC. start() binds (port 0 = ephemeral), serves in a thread; stop() ends it."""
 
     def __init__(self, plc, mapping: Mapping | None = None, host: str = "127.0.0.1", port: int = 8080,
-                 root: pathlib.Path = HMI_DIR, access: AccessPolicy | None = None):
+                 root: pathlib.Path = HMI_DIR, access: AccessPolicy | None = None, limits: HttpLimits | None = None):
         self.plc = plc
+        self.limits = limits or HttpLimits()
         self.mapping = mapping or Mapping.load()
         self.host = host
         self.requested_port = port
         self.root = pathlib.Path(root).resolve()
         self.access = access or AccessPolicy()
-        self._httpd: _PooledHTTPServer | None = None
+        self._httpd: HttpFront | None = None
         self._thread: threading.Thread | None = None
         self.requests = 0
         self._execute_lock = threading.Lock()
@@ -155,11 +131,9 @@ class HmiServer:
 
     def start(self) -> None:
         handler = type("BoundHandler", (_Handler,), {"hmi": self})
-        self._httpd = _PooledHTTPServer((self.host, self.requested_port), handler)
+        self._httpd = HttpFront((self.host, self.requested_port), handler, self.limits, _answered_at_once)
         self.access.bind(self.host, self.port)
-        # the serving loop notices stop() within its poll interval: 20 ms keeps a stop quick at ~50 idle wake-ups a second
-        self._thread = threading.Thread(target=self._httpd.serve_forever, kwargs={"poll_interval": 0.02},
-                                        name="hmi-http", daemon=True)
+        self._thread = threading.Thread(target=self._httpd.serve_forever, name="hmi-http", daemon=True)
         self._thread.start()
         if self.trail is not None:
             self.trail.start()
@@ -169,8 +143,8 @@ class HmiServer:
             self.trail.stop()
         if self._httpd:
             self._httpd.shutdown()
-            self._httpd.server_close()
             self._thread.join(timeout=5)
+            self._httpd.server_close()
             self._httpd = None
 
     # --- operations behind the API -------------------------------------------------------------
@@ -185,11 +159,21 @@ class HmiServer:
         with self.plc.lock:
             values = {name: self.plc.read(name) for name in names}
             now = self.plc.now_ns
+            fault = plc_fault(self.plc)
         for name in names:
             leaf = self.mapping.leaves.get(name)
             if leaf is not None and leaf.type in ("DATE_AND_TIME", "DT"):
                 values[name] = format_dt(values[name])
-        return {"ok": True, "time_ns": now, "values": jsonable(values)}
+        if fault is None:
+            return {"ok": True, "time_ns": now, "plc": "run", "values": jsonable(values)}
+        # the values are those of the faulted scan's moment: shown, but marked as no longer valid
+        return {"ok": True, "time_ns": now, "plc": "fault", "fault": fault, "values": jsonable(values)}
+
+    def _refuse_when_faulted(self) -> None:
+        fault = plc_fault(self.plc)
+        if fault is not None:
+            raise RequestError(f"the PLC has stopped with a major fault ({fault['what']}): nothing was written; "
+                               f"restart the PLC", HTTPStatus.SERVICE_UNAVAILABLE)
 
     def _checked(self, values, role: str) -> list[tuple[str, object]]:
         if not isinstance(values, dict) or not values:
@@ -234,6 +218,7 @@ class HmiServer:
 
     def write(self, body: dict, role: str) -> dict:
         checked = self._checked(body.get("values"), role)
+        self._refuse_when_faulted()
         with self.plc.lock:
             now = self._write_all(checked)
         return {"ok": True, "time_ns": now}
@@ -246,6 +231,7 @@ class HmiServer:
         self._writable(name, role)
         values = body.get("values") or {}
         checked = self._checked(values, role) if values else []
+        self._refuse_when_faulted()
         # A clean rising edge: every task completes a cycle with Execute FALSE, then one with it TRUE, before
         # the answer goes back. A scan that only advances the clock (no task due) does not count, and
         # Execute requests are taken one at a time, so no command is ever merged with another or lost.
@@ -273,24 +259,30 @@ class HmiServer:
         deadline = time.monotonic() + SCAN_WAIT_S
         while not all(now > then for now, then in zip(self.plc.task_cycles, cycles_at)):
             if time.monotonic() > deadline:
+                self._refuse_when_faulted()          # a fault since the request came: say so, not "not scanning"
                 raise RequestError(f"the PLC is not scanning: {what}", HTTPStatus.SERVICE_UNAVAILABLE)
             time.sleep(0.0005)
 
 
 class _Handler(BaseHTTPRequestHandler):
+    """The answer to one complete request the front end has read (``wfile`` holds it afterwards).
+
+    ``body_late``: the request's body did not arrive whole within its deadline (the front end passes what came)."""
+
     hmi: HmiServer
     server_version = "CBT-HMI/1.0"
-    timeout = CONNECTION_TIMEOUT_S
+
+    def __init__(self, request: bytes, client_address, body_late: bool = False):  # noqa: D107
+        self.client_address = client_address
+        self.request = self.server = None
+        self.rfile, self.wfile = io.BytesIO(request), io.BytesIO()
+        self.body_late = body_late
+        self.close_connection = True
+        self.handle_one_request()
 
     def log_message(self, format, *args):  # noqa: A002 - signature of the base class
         """Quiet: the demo prints its own status lines; details go to the debug log."""
         log.debug("HMI %s: " + format, self.client_address[0], *args)
-
-    def handle(self):
-        try:
-            super().handle()
-        except (ConnectionError, TimeoutError) as exc:
-            log.debug("HMI client %s left early: %s", self.client_address[0], exc)
 
     def send_error(self, code, message=None, explain=None):
         """Malformed requests (bad request line, oversized headers) get a short JSON answer too."""
@@ -410,11 +402,10 @@ class _Handler(BaseHTTPRequestHandler):
             raise self._unread(f"request body of {shown} bytes exceeds the limit of {MAX_BODY} bytes",
                                HTTPStatus.REQUEST_ENTITY_TOO_LARGE)
         length = int(digits)
-        try:
-            raw = self.rfile.read(length)
-        except TimeoutError:
+        raw = self.rfile.read(length)
+        if len(raw) < length and self.body_late:
             raise self._unread(f"the request body did not arrive: Content-Length announced {length} bytes, "
-                               f"fewer came within {self.timeout:g} s", HTTPStatus.REQUEST_TIMEOUT) from None
+                               f"fewer came within {self.hmi.limits.body_s:g} s", HTTPStatus.REQUEST_TIMEOUT)
         if len(raw) < length:
             raise self._unread(f"the request body ended after {len(raw)} of the {length} bytes that "
                                f"Content-Length announced")
