@@ -179,7 +179,8 @@ class Demo:
         self.control_port = control_port          # None: derived from the robot port at start
         self.stop_event = threading.Event()
         self.sim = self.plc = self.hmi = self.plc_thread = None
-        self.fault: str | None = None
+        self.fault: str | None = None            # the PLC's major fault: the PLC stopped, the rest stays up
+        self._fault_printed = False
         self._seen: dict[int, int] = {}          # robot index -> events already looked at (absolute count)
 
     def start(self) -> None:
@@ -233,12 +234,13 @@ class Demo:
         self.plc_thread.start()
 
     def _run_plc(self) -> None:
+        """Scan until the demo stops. A major fault stops the PLC alone: the simulator and the web HMI go on,
+        and the HMI shows the fault on every page (docs/hmi.md, "PLC fault") until Ctrl-C."""
         from vplc.api import PlcFault
         try:
             self.plc.run_realtime(self.stop_event)
         except PlcFault as exc:
             self.fault = f"PLC major fault - the virtual PLC stopped:\n{exc}"
-            self.stop_event.set()
 
     def banner(self) -> str:
         period_ms = self.plc.period_ns / 1e6
@@ -263,6 +265,15 @@ class Demo:
             f"  {control_line(self.sim.control.port)}",
             "Press Ctrl-C to stop.",
         ])
+
+    def console_lines(self) -> list[str]:
+        """What to print since the last call: the robot-side events, and the PLC's major fault once."""
+        lines = self.robot_events()
+        if self.fault is not None and not self._fault_printed:
+            self._fault_printed = True
+            lines.append(f"{self.fault}\nThe web HMI stays up and shows the fault (values no longer valid, writes "
+                         f"refused); restart the demo to run the PLC again. Press Ctrl-C to stop.")
+        return lines
 
     def robot_events(self) -> list[str]:
         """Console lines of the robot-side events logged since the last call."""
@@ -305,7 +316,7 @@ def main(argv=None) -> int:
         signal.signal(signal.SIGINT, lambda *_: demo.stop_event.set())
         print(demo.banner(), flush=True)
         while not demo.stop_event.wait(0.5):
-            for line in demo.robot_events():
+            for line in demo.console_lines():
                 print(line, flush=True)
     except DemoError as exc:
         print(exc, file=sys.stderr)
@@ -316,7 +327,7 @@ def main(argv=None) -> int:
         signal.signal(signal.SIGINT, signal.SIG_IGN)     # a second Ctrl-C must not interrupt the shutdown
         demo.stop()
     if demo.fault:
-        print(demo.fault, file=sys.stderr)
+        print(f"Demo stopped after a {demo.fault}", file=sys.stderr)
         return 1
     print("Demo stopped: simulator, virtual PLC and web HMI are shut down.")
     return 0
