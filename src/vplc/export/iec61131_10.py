@@ -241,7 +241,7 @@ def _parameters(el: ET.Element, item: PouItem) -> None:
     """``Parameters``: one list per source section, so each keeps its own RETAIN (the schema's ``retain``
     on InputVars / OutputVars) and CONSTANT (per variable); ``orderWithinParamSet`` is one counter in
     declaration order. Functions always have it (the schema requires it) and start with ``EN``, the BOOL
-    input every Sysmac function has (W501, user-defined functions: EN/ENO); vplc reads it back as the
+    input every Sysmac function has (issue 24 field notes, docs/toolchain/export.md); vplc reads it as the
     implicit EN. Programs have none in the schema."""
     pou = item.pou
     sections = [s for s in pou.sections if s.kind in PARAM_ELEMENT and s.vars]
@@ -274,7 +274,8 @@ def _parameters(el: ET.Element, item: PouItem) -> None:
 
 def _external_vars(el: ET.Element, item: PouItem, external: list) -> None:
     """Declared VAR_EXTERNAL sections, then one list for the globals the body uses without declaring them:
-    Sysmac Studio needs every global a POU uses in its external variables (W501, external variables)."""
+    Sysmac Studio needs every global a program uses among its external variables (field notes of
+    engineers who imported generated files; meyncraft writes them the same way)."""
     for section in item.pou.sections:
         if section.kind == "VAR_EXTERNAL" and section.vars:
             lst = _sub(el, "ExternalVars", {"constant": "true"} if section.constant else {})

@@ -29,8 +29,8 @@ KIND_TAG = {"left_rail": ("LdObject", "LeftPowerRail"), "right_rail": ("LdObject
             "contact": ("LdObject", "Contact"), "coil": ("LdObject", "Coil"), "block": ("FbdObject", "Block"),
             "in_var": ("FbdObject", "DataSource"), "out_var": ("FbdObject", "DataSink"),
             "inout_var": ("FbdObject", "DataSink"), "jump": ("FbdObject", "Jump"), "return": ("FbdObject", "Jump")}
-# Sysmac's pin names of MOVE (W502, MOVE: EN, In -> ENO, Out); ST names are case-insensitive, so vplc reads
-# them as IN / OUT.
+# Sysmac's pin names of MOVE (EN, In -> ENO, Out: field notes of engineers who imported generated files);
+# ST names are case-insensitive, so vplc reads them as IN / OUT.
 PIN_SPELLING = {"MOVE": {"IN": "In", "OUT": "Out"}}
 RETURN_LABEL = "Return_End"
 

@@ -73,3 +73,50 @@ def test_command_is_registered_with_python_m_vplc(tmp_path):
                        cwd=ROOT)
     assert r.returncode == 0, r.stderr
     assert "data type(s)" in r.stdout and "POU(s)" in r.stdout
+
+
+REFUSED = {   # what Omron's IEC 61131-10 schemas cannot express is refused, never written with another meaning
+    "type initial value": ("TYPE\n    aT : ARRAY[0..1] OF INT := [1, 2];\nEND_TYPE\n",
+                           "data type `aT` has an initial value of its own"),
+    "VAR_TEMP in an FB": ("FUNCTION_BLOCK F\nVAR_TEMP\n    t : INT;\nEND_VAR\nt := 1;\nEND_FUNCTION_BLOCK\n",
+                          "FUNCTION_BLOCK `F`: VAR_TEMP has no counterpart"),
+    "VAR_INPUT in a program": ("PROGRAM P\nVAR_INPUT\n    i : INT;\nEND_VAR\n;\nEND_PROGRAM\n",
+                               "PROGRAM `P`: VAR_INPUT in a program has no counterpart"),
+}
+
+
+def test_what_the_sysmac_schema_cannot_express_is_refused(tmp_path, capsys):
+    for name, (text, message) in REFUSED.items():
+        src = tmp_path / f"{name.replace(' ', '_')}.st"
+        src.write_text(text, encoding="utf-8")
+        out = tmp_path / "out.xml"
+        code, _, err = run(capsys, "export", str(src), "-o", str(out))
+        assert code == 1 and not out.exists(), name
+        _one_line(err)
+        assert message in err, (name, err)
+
+
+def test_negated_data_source_and_in_out_variable_in_a_rung_are_refused(tmp_path, capsys):
+    from tests.vplc.ladder.ld_xml import coil, contact, inoutvar, invar, outvar, program, rail, right
+    cases = {"inout": ([rail(1), contact(2, "A", 1), inoutvar(3, "X", 2), coil(4, "Q", 3), right(5, 4)],
+                       "rung 1: variable X is written and read on"),
+             "negated": ([rail(1), invar(2, "A"), outvar(3, "Q", 2)], "rung 1: variable Q is negated")}
+    for name, (body, message) in cases.items():
+        src = program(tmp_path, {"A": "BOOL", "X": "BOOL", "Q": "BOOL"}, body, file=f"{name}.xml")
+        if name == "negated":
+            src.write_text(src.read_text(encoding="utf-8").replace("<outVariable ", '<outVariable negated="true" '),
+                           encoding="utf-8")
+        code, _, err = run(capsys, "export", str(src), "-o", str(tmp_path / "out.xml"))
+        assert code == 1 and message in err, (name, err)
+
+
+def test_only_writes_the_named_objects_and_names_a_missing_one(tmp_path, capsys):
+    out = tmp_path / "one.xml"
+    code, stdout, err = run(capsys, "export", str(LIB), str(ROOT / "examples"), "--only", "Commands_Example",
+                            "-o", str(out))
+    assert code == 0 and "0 data type(s), 1 POU(s)" in stdout, err
+    text = out.read_text(encoding="utf-8")
+    assert text.count('<Program name="Commands_Example">') == 1 and "<DataTypeDecl" not in text
+    assert '<ContentHeader name="Commands_Example"' in text
+    code, _, err = run(capsys, "export", str(LIB), "--only", "NoSuchThing", "-o", str(out))
+    assert code == 2 and "--only: no data type or POU named NOSUCHTHING" in err
