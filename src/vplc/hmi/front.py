@@ -27,7 +27,8 @@ MAX_CONNECTIONS = 512              # open connections in all
 MAX_CONNECTIONS_PER_CLIENT = 128   # open connections of one client address
 MAX_HEAD = 32 * 1024               # request line and headers of one request (400 names in /api/read fit): 431
 MAX_BODY = 16 * 1024               # request body: the handler answers 413 beyond
-LINGER_S = 1.0                     # after an answer, the client's last bytes are read and dropped this long
+LINGER_S = 1.0                     # after answering a request not read to its end, what still comes is
+                                   # read and dropped this long (a close with unread bytes resets the answer)
 WORKERS = 16                       # requests answered in worker threads at once (complete requests only)
 LISTEN_BACKLOG = 128
 
@@ -65,14 +66,14 @@ def _head_end(data: bytearray) -> int:
     return min(ends) if ends else -1
 
 
-def _declared_body(head: bytes) -> int:
-    """Bytes of body the front end waits for: the Content-Length when it is a whole number within MAX_BODY,
-    else 0 (the handler refuses the request without reading a body)."""
+def _declared_body(head: bytes) -> int | None:
+    """Bytes of body the front end waits for: the Content-Length when it is a whole number within MAX_BODY, 0
+    without one, None when it is refused (the handler answers 400 or 413 and the body is not read)."""
     for line in head.split(b"\n")[1:]:
         name, colon, value = line.partition(b":")
         if colon and name.strip().lower() == b"content-length":
             digits = value.strip()
-            return int(digits) if digits.isdigit() and len(digits) <= 12 and int(digits) <= MAX_BODY else 0
+            return int(digits) if digits.isdigit() and len(digits) <= 12 and int(digits) <= MAX_BODY else None
     return 0
 
 
@@ -87,13 +88,14 @@ def _answer(status: HTTPStatus, message: str) -> bytes:
 class _Connection:
     """One client connection and what the front end knows of its current request."""
 
-    __slots__ = ("sock", "peer", "client", "data", "state", "since", "deadline", "need", "out", "events")
+    __slots__ = ("sock", "peer", "client", "data", "state", "since", "deadline", "need", "whole", "out", "events")
 
     def __init__(self, sock, peer, now: float, idle_s: float):
         self.sock, self.peer, self.client = sock, peer, peer[0]
         self.data = bytearray()
         self.state, self.since, self.deadline = _IDLE, now, now + idle_s
         self.need = 0                  # bytes of the current request: header + declared body
+        self.whole = False             # the request was read to its end and nothing may follow: close at once
         self.out = memoryview(b"")
         self.events = 0                # what the selector watches for
 
@@ -268,7 +270,7 @@ class HttpFront:
             return
         if not chunk:
             if connection.data:                       # a request cut short: the handler says what is missing
-                self._dispatch(connection, late=False)
+                self._dispatch(connection, late=False, ended=True)
             else:
                 self._close(connection)
             return
@@ -291,13 +293,16 @@ class HttpFront:
                 self._refuse(connection, HTTPStatus.REQUEST_HEADER_FIELDS_TOO_LARGE,
                              f"the request header is larger than {MAX_HEAD // 1024} KiB")
                 return
-            connection.need = end + _declared_body(bytes(data[:end]))
+            declared = _declared_body(bytes(data[:end]))
+            connection.need, connection.whole = end + (declared or 0), declared is not None
             connection.state, connection.deadline = _BODY, time.monotonic() + self.limits.body_s
         if connection.state == _BODY and len(data) >= connection.need:
             self._dispatch(connection, late=False)
 
-    def _dispatch(self, connection: _Connection, late: bool) -> None:
+    def _dispatch(self, connection: _Connection, late: bool, ended: bool = False) -> None:
+        """``late``: the body's deadline passed; ``ended``: the client closed its side of the connection."""
         request = bytes(connection.data[:connection.need or len(connection.data)])
+        connection.whole = ended or (connection.whole and not late and len(connection.data) == len(request))
         connection.data.clear()                       # one request per connection: what follows is dropped
         connection.state = _BUSY
         self._watch(connection, 0)
@@ -308,6 +313,7 @@ class HttpFront:
 
     def _refuse(self, connection: _Connection, status: HTTPStatus, message: str) -> None:
         connection.data.clear()
+        connection.whole = False
         self._start_sending(connection, _answer(status, message))
 
     def _expire(self, now: float) -> None:
@@ -377,6 +383,9 @@ class HttpFront:
         connection.out = connection.out[sent:]
         if connection.out:
             self._watch(connection, selectors.EVENT_WRITE)
+            return
+        if connection.whole:
+            self._close(connection)
             return
         # a lingering close: the client reads the whole answer before the connection goes (closing with unread
         # request bytes would reset it and could destroy the answer on the way)
