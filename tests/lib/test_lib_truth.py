@@ -277,3 +277,21 @@ def test_a_refused_reconnect_attempt_does_not_claim_time_out_has_passed():
         assert all("Time_Out" not in text for _, text in texts), texts
     finally:
         rig.close()
+
+
+def test_a_status_query_damaged_on_the_way_is_asked_again_not_taken_for_a_lost_link():
+    """The robot answers a damaged TMSTA 00 with CPERR 02, which proves it alive: the query is asked again and
+    the link stays up; a motion in flight ends Done, not 16#200B after a reconnect."""
+    rig = Rig()
+    try:
+        go(rig, 1, rz=120.0, speed=20)                                  # a few seconds
+        assert rig.until(lambda: rig.read("movers[1].Active"), 1)
+        damage_frames_with(rig, b"$TMSTA,2,00,")
+        assert rig.until(lambda: rig.events("bad_frame"), 1)
+        assert rig.until(lambda: settled(rig, 1), 10)
+        assert rig.read("movers[1].Done"), rig.read("movers[1].ErrorDescrip")
+        assert not rig.until(lambda: not rig.read("Cobot.Connected"), 2)
+        assert rig.read("Cobot.Connected") and rig.read("conn.RetryCount") == 0 and len(rig.events("connect")) == 1
+        assert rig.read("Cobot.LastErrorID") == 0x3012
+    finally:
+        rig.close()
