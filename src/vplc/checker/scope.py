@@ -13,14 +13,21 @@ from .symbols import EnumValueSymbol, VarSymbol
 GENERIC_TYPES: dict[str, T.SpecialType] = {}
 
 
-def _generic(name: str, pred) -> None:
-    t = T.SpecialType(name, "generic")
+def _generic(name: str, pred, shown: str | None = None) -> None:
+    t = T.SpecialType(shown or name, "generic")
     t.accepts = pred  # type: ignore[attr-defined]
     GENERIC_TYPES[name] = t
 
 
+def _elementary_or_array(t: T.Type) -> bool:
+    u = T.unalias(t)
+    return T.is_elementary(u) or (isinstance(u, T.ArrayType) and T.is_elementary(u.element))
+
+
 _generic("ANY", lambda t: True)
 _generic("ANY_ELEMENTARY", T.is_elementary)
+# ToAryByte's In and AryByteTo's OutVal: an elementary value or an array of one (W502 2-455, 2-461)
+_generic("ANY_ELEMENTARY_OR_ARRAY", _elementary_or_array, "ANY_ELEMENTARY or an array of it")
 _generic("ANY_NUM", T.is_num)
 _generic("ANY_INT", T.is_int)
 _generic("ANY_REAL", T.is_real)

@@ -30,18 +30,35 @@ def _value_bytes(v, t) -> bytes:
 
 
 def _order(data: bytes, order: int) -> bytes:
-    """Apply the byte order word by word: words are taken low word first, Order acts inside each word."""
-    if order != HIGH_LOW or len(data) < 2:
+    """The bytes in the order Order asks for. _LOW_HIGH: as they are in memory (least significant first).
+    _HIGH_LOW: taken two by two, high byte first; an odd count is completed with 16#00 first (W502 2-455: a
+    one-byte In lands in AryOut[1] with 16#00 in AryOut[0]; In[i] of a byte array with i even goes to
+    AryOut[i+1], with i odd to AryOut[i-1]; an odd element count ends with 16#00 swapped in)."""
+    if order != HIGH_LOW:
         return data
-    out = bytearray()
-    for i in range(0, len(data), 2):
-        out += data[i:i + 2][::-1]
+    if len(data) % 2:
+        data += b"\0"
+    out = bytearray(len(data))
+    out[0::2] = data[1::2]
+    out[1::2] = data[0::2]
     return bytes(out)
 
 
+def _elementary(t):
+    b = T.base_of(t)
+    return T.base_of(b.base) if isinstance(b, T.EnumType) else b
+
+
 def ToAryByte(rt, In, In_t, Order, AryOut) -> int:
-    data = _value_bytes(In, In_t)
-    if not isinstance(T.base_of(In_t), T.StringType):
+    """W502 2-453 .. 2-455: In (a value, or an array of values: their bytes one after the other) into AryOut."""
+    u = T.unalias(In_t)
+    if isinstance(u, T.ArrayType):
+        element = u.element
+        data = b"".join(_value_bytes(x, element) for x in In)
+    else:
+        element = In_t
+        data = _value_bytes(In, In_t)
+    if not isinstance(_elementary(element), T.StringType):
         data = _order(data, Order)
     if len(data) > len(AryOut):
         raise RuntimeFaultError(f"ToAryByte: {len(data)} bytes do not fit in the {len(AryOut)}-byte array")
@@ -49,27 +66,54 @@ def ToAryByte(rt, In, In_t, Order, AryOut) -> int:
     return len(data)
 
 
+def _decode(data: bytes, b):
+    """A value of elementary type ``b`` from its little-endian memory image ``data`` (exactly its size)."""
+    if b.kind == "real":
+        return struct.unpack("<f" if len(data) == 4 else "<d", data)[0]
+    if b.kind == "bool":
+        return bool(data[0] & 1)                 # W502 2-461: bit 0 of the byte
+    return int.from_bytes(data, "little", signed=b.kind == "int")
+
+
+def _size(b) -> int:
+    return 4 if b.kind == "real" and b.bits == 32 else max(1, b.bits // 8)
+
+
 def AryByteTo(rt, In, Size, Order, OutVal, OutVal_t) -> bool:
+    """W502 2-459 .. 2-461: Size bytes of In, in Order, into OutVal (a value, or an array of values)."""
     if Size > len(In):
         raise RuntimeFaultError(f"AryByteTo: Size {Size} exceeds the {len(In)} bytes of the array")
     data = bytes(In[i] & 0xFF for i in range(Size))
+    u = T.unalias(OutVal_t)
+    if isinstance(u, T.ArrayType):
+        _bytes_to_array(data, Order, OutVal, _elementary(u.element))
+        return True
     container, key = OutVal
-    b = T.base_of(OutVal_t)
-    if isinstance(b, T.EnumType):
-        b = T.base_of(b.base)
+    b = _elementary(OutVal_t)
     if isinstance(b, T.StringType):
         text = data.split(b"\0", 1)[0].decode("latin-1")
         container[key] = text[:b.capacity]
         return True
-    n = 4 if b.kind == "real" and b.bits == 32 else max(1, b.bits // 8)
-    data = _order(data[:n].ljust(n, b"\0"), Order)
-    if b.kind == "real":
-        container[key] = struct.unpack("<f" if n == 4 else "<d", data)[0]
-    elif b.kind == "bool":
-        container[key] = data[0] != 0
-    else:
-        container[key] = int.from_bytes(data, "little", signed=b.kind == "int")
+    n = _size(b)
+    container[key] = _decode(_order(data, Order)[:n].ljust(n, b"\0"), b)
     return True
+
+
+def _bytes_to_array(data: bytes, order: int, out, b) -> None:
+    """An array OutVal: a BOOL array takes the bits, bit 0 of the first byte into OutVal[0] (W502 2-461: In[0] into
+    OutVal[0] .. OutVal[7], In[1] into OutVal[8] .. OutVal[15], ...; _HIGH_LOW swaps the bytes two by two first);
+    other arrays take one element per element size. Elements the bytes do not reach keep their values; bytes
+    beyond the last element are discarded."""
+    if isinstance(b, T.StringType):
+        raise RuntimeFaultError("AryByteTo: an array of STRING as OutVal is not modelled by vplc")
+    data = _order(data, order)
+    if b.kind == "bool":
+        for i in range(min(len(out), 8 * len(data))):
+            out[i] = bool(data[i >> 3] >> (i & 7) & 1)
+        return
+    n = _size(b)
+    for i in range(min(len(out), len(data) // n)):
+        out[i] = _decode(data[i * n:(i + 1) * n], b)
 
 
 def StringToAry(rt, In, AryOut) -> int:
