@@ -1,5 +1,10 @@
 """Lexer: one compiled regular expression, matched token by token (nested comments scanned by hand).
 
+Every repetition over a token's parts is possessive (``*+``, ``++``): Python's regular expression engine keeps
+backtracking state for each repetition of a group, hundreds of bytes per character, so a 10 MB string literal
+or a T# literal of a million units would otherwise need gigabytes. None of these tokens needs to give back a
+repetition to match.
+
 Tokens keep their kind, text and offsets; keywords are ordinary ``IDENT`` tokens recognised by the parser
 through ``Token.up`` (IEC keywords are case-insensitive). Comments and whitespace are dropped; pragmas
 ``{...}`` are returned as ``PRAGMA`` tokens (the parser attaches ``{native}`` to the next POU and reports
@@ -12,7 +17,7 @@ import re
 from .diagnostics import DiagnosticBag
 from .source import SourceFile, Span
 
-_DURATION = r"[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]+)?(?i:ms|us|ns|d|h|m|s)_?)+"
+_DURATION = r"[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]+)?(?i:ms|us|ns|d|h|m|s)_?)++"
 _CLOCK = r"[0-9]+:[0-9]+(?::[0-9]+(?:\.[0-9]+)?)?"
 _YMD = r"[0-9]{4}-[0-9]{1,2}-[0-9]{1,2}"
 
@@ -34,7 +39,7 @@ _TOKEN_RE = re.compile(
   | (?P<STRING>'(?:\$.|[^'$\r\n])*+')
   | (?P<WSTRING>"(?:\$.|[^"$\r\n])*+")
   | (?P<BADSTRING>['"][^\r\n]*)
-  | (?P<ADDRESS>%[IQM][XBWDL]?[0-9]+(?:\.[0-9]+)*|%[IQM]\*)
+  | (?P<ADDRESS>%[IQM][XBWDL]?[0-9]+(?:\.[0-9]+)*+|%[IQM]\*)
   | (?P<OP>:=|=>|<=|>=|<>|\*\*|\.\.|\\\\|[-+*/&=<>()\[\],;:.\#\\^])
   | (?P<BAD>.)
     """,

@@ -42,6 +42,28 @@ def test_a_long_string_literal_is_lexed_in_memory_proportional_to_nothing_but_it
         assert r["peak"] < 4 * r["n"] + 200_000, (quote, unit, r["peak"])
 
 
+_MEASURE_TEXT = r"""
+import json, sys, tracemalloc
+sys.path.insert(0, sys.argv[1])
+from vplc.frontend.diagnostics import DiagnosticBag
+from vplc.frontend.lexer import tokenize
+from vplc.frontend.source import SourceFile
+text = sys.argv[2] + sys.argv[3] * int(sys.argv[4]) + sys.argv[5]
+tracemalloc.start()
+tokens = tokenize(SourceFile("x.st", text), DiagnosticBag())
+print(json.dumps({"peak": tracemalloc.get_traced_memory()[1], "n": len(text), "kinds": [t.kind for t in tokens]}))
+"""
+
+
+def test_long_duration_and_address_literals_are_lexed_in_memory_proportional_to_their_text():
+    # a T# literal of 200,000 units took ~500 bytes per character, a %IX address of 200,000 parts ~330
+    for head, unit, tail, kind in (("T#", "1s", ";", "TIME"), ("%IX1", ".1", ";", "ADDRESS")):
+        out = subprocess.run([sys.executable, "-c", _MEASURE_TEXT, str(ROOT / "src"), head, unit, "200000", tail],
+                             capture_output=True, text=True, check=True, timeout=120)
+        r = json.loads(out.stdout)
+        assert r["kinds"][0] == kind and r["peak"] < 4 * r["n"] + 200_000, (kind, r["peak"])
+
+
 def test_a_long_string_literal_too_long_for_its_variable_is_reported_where_it_is(tmp_path):
     proj = check_text(tmp_path, program("s := '" + "a" * 200_000 + "';", "s : STRING[10];"))
     d = [d for d in proj.diagnostics if d.code == "ST1601"]
