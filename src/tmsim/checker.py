@@ -26,21 +26,34 @@ def check_script(lines: list[ast.Line], variables: dict[str, str], version: str 
     ``variables`` are the node-session variables (name -> type). Returns the variables the script
     would declare; the caller adds them only if the script runs.
     """
-    scope = dict(variables)
-    declared = {}
+    checker = ScriptChecker(variables, version)
     for line in lines:
+        checker.check(line)
+    return checker.declared
+
+
+class ScriptChecker:
+    """``check_script`` one line at a time, in script order (the session spreads a long script's checking
+    over several turns of the scheduler)."""
+
+    def __init__(self, variables: dict[str, str], version: str = table.V224):
+        self.variables = variables
+        self.version = version
+        self.scope = dict(variables)
+        self.declared: dict[str, str] = {}
+
+    def check(self, line: ast.Line):
         if line.error:
-            continue
-        checker = _LineChecker(scope, line.warnings, version)
+            return
+        checker = _LineChecker(self.scope, line.warnings, self.version)
         try:
             checker.statement(line.stmt)
         except CheckError as exc:
             line.error = str(exc)
-        if isinstance(line.stmt, ast.Decl) and line.stmt.name not in variables:
+        if isinstance(line.stmt, ast.Decl) and line.stmt.name not in self.variables:
             var_type = line.stmt.type + ("[]" if line.stmt.is_array else "")
-            scope[line.stmt.name] = var_type
-            declared[line.stmt.name] = var_type
-    return declared
+            self.scope[line.stmt.name] = var_type
+            self.declared[line.stmt.name] = var_type
 
 
 def _assignable(target: str, value: str) -> str | None:

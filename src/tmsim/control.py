@@ -19,7 +19,9 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
 Every field is checked (type, range, finite numbers, nesting, line length: sim/limits.py); a bad
 request gets ``ok: false`` with the reason and the connection stays usable, except after a line
 longer than CONTROL_LINE_MAX (answered, then closed). Answers are written without blocking; a client
-that lets more than CONTROL_OUTBOX_MAX bytes of answers pile up is closed.
+that lets more than CONTROL_OUTBOX_MAX bytes of answers pile up is closed. Each client is served in
+turns bounded in work (CONTROL_TURN_REQUESTS requests, CONTROL_TURN_BYTES of answers); a client is not
+read while its answers wait to be written or requests of it wait for their turn (back-pressure).
 """
 from __future__ import annotations
 
@@ -29,8 +31,8 @@ import re
 import selectors
 import socket
 
-from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX,
-                     CONTROL_EVENTS_MAX, CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX)
+from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
+                     CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_BYTES, CONTROL_TURN_REQUESTS)
 from .listener import Listener, receive
 from .session import TransitionError
 
@@ -62,6 +64,8 @@ class ControlChannel:
         self.host = host
         self.port = self.listener.port
         self.clients: dict[socket.socket, _Client] = {}
+        self.backlog: dict[socket.socket, _Client] = {}      # clients with requests left after their turn
+        self.turns_deferred = 0                               # turns that left requests for a later turn
         self._commands = {
             "ping": lambda robot, req: "pong",
             "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.state,
@@ -99,12 +103,15 @@ class ControlChannel:
         self.listener.tick(now)
 
     def _serve_client(self, _robot, sock):
+        """The socket is ready: write what waits, then read; the requests are answered in the client's turn
+        (``serve_backlog``, right after in the same poll). A client who has requests left over from its
+        last turn is not read meanwhile."""
         client = self.clients.get(sock)
         if client is None:
             return
         if client.wbuf and not self._write(client):
             return
-        if client.closing:
+        if client.closing or sock in self.backlog:
             return
         data, failed = receive(sock)
         if data is None and not failed:
@@ -113,6 +120,14 @@ class ControlChannel:
             self._close(sock)
             return
         client.rbuf += data
+        self.backlog[sock] = client             # its turn comes in serve_backlog, between the robots' turns
+
+    def _turn(self, client):
+        """Answer at most CONTROL_TURN_REQUESTS requests of ``client``, and none more once the answers of this
+        turn reach CONTROL_TURN_BYTES (a turn is bounded in work: 15 clients each sending 64 KiB of requests
+        must not hold the robots' servers); the rest waits in ``backlog`` for the next turn."""
+        sock, answered, written = client.sock, 0, 0
+        self.backlog.pop(sock, None)
         while not client.closing:
             end = client.rbuf.find(b"\n")
             if end < 0:
@@ -122,6 +137,10 @@ class ControlChannel:
                     self._answer(client, _error(f"request line longer than {CONTROL_LINE_MAX} bytes; "
                                                 f"connection closed"))
                 break
+            if answered >= CONTROL_TURN_REQUESTS or written >= CONTROL_TURN_BYTES:
+                self.backlog[sock] = client
+                self.turns_deferred += 1
+                return
             line = bytes(client.rbuf[:end])
             del client.rbuf[:end + 1]
             if len(line) > CONTROL_LINE_MAX:
@@ -130,10 +149,27 @@ class ControlChannel:
                 answer = _error(f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed")
             else:
                 answer = self.execute(line)
+            before = len(client.wbuf)
             if not self._answer(client, answer):
                 return
+            answered += 1
+            written += max(0, len(client.wbuf) - before) or 1
         if client.closing and not client.wbuf:
             self._close(sock)
+
+    def serve_backlog(self):
+        """One turn for every client with requests left over (round robin). A client that does not read its
+        answers piles them up and is closed at CONTROL_OUTBOX_MAX (``_answer``)."""
+        for sock, client in list(self.backlog.items()):
+            if sock not in self.clients:
+                self.backlog.pop(sock, None)
+            else:
+                self._turn(client)
+                self.server._breathe()          # the robots' sockets are served between two turns
+
+    @property
+    def has_backlog(self) -> bool:
+        return bool(self.backlog)
 
     def _answer(self, client, answer) -> bool:
         """Queue one answer and write what the socket takes; False when the client was closed. A client is
@@ -166,6 +202,7 @@ class ControlChannel:
         return True
 
     def _close(self, sock, reason=None):
+        self.backlog.pop(sock, None)
         if self.clients.pop(sock, None) is not None and reason:
             self.server._log_server("control_closed", reason=reason)
         try:

@@ -1,7 +1,8 @@
 """Event log of one robot: every event as a dict, bounded in memory by count and by bytes.
 
 Mixed into ``server.Robot``, which provides ``_server`` (``event_limit``, ``event_bytes_limit``,
-``log_file``), ``index`` and ``session`` (its clock). The JSONL file gets every event whole; memory keeps
+``log_file``), ``index`` and ``session`` (its clock). The JSONL file (``LogFile``, rotated at
+LOG_FILE_BYTES_MAX) gets every event whole; memory keeps
 the newest ones: when the count or the bytes exceed the robot's share, the oldest are dropped until half
 of both is left (``events_dropped`` counts them, so an index that counts every event ever logged stays
 valid: the control channel's ``since``).
@@ -9,7 +10,10 @@ valid: the control channel's ``since``).
 from __future__ import annotations
 
 import json
+import os
 import threading
+
+from .limits import LOG_FILE_BYTES_MAX, WORK_LOG_BYTES
 
 EVENT_OVERHEAD = 200        # bytes an event counts, plus the length of its texts
 
@@ -26,12 +30,16 @@ class EventLog:
         session = self.__dict__.get("session")
         event = {"t": round(session.now, 6) if session is not None else 0.0, "robot": self.index, "kind": kind,
                  **fields}
-        if self._server.log_file is not None:
-            self._server.log_file.write(json.dumps(event, ensure_ascii=False) + "\n")
         size = EVENT_OVERHEAD
         for value in fields.values():
             if type(value) is str:
                 size += len(value)
+        handled = size                           # bytes kept, and as many written to the file
+        if self._server.log_file is not None:
+            self._server.log_file.write(json.dumps(event, ensure_ascii=False) + "\n")
+            handled += size
+        if session is not None:                  # keeping and writing the event is work of the robot's turn
+            session.meter.work += handled // WORK_LOG_BYTES
         budget = self._server.event_bytes_limit
         if size > budget // 4:                   # one huge event must not push out all others
             event, size = _shortened(event, budget // 4), budget // 4
@@ -78,6 +86,32 @@ class EventLog:
             return found[0] if flag.wait(timeout) else None
         finally:
             self._waiters.remove(entry)
+
+
+class LogFile:
+    """The JSONL event log file (``--log``), bounded: once it holds LOG_FILE_BYTES_MAX bytes it is renamed to
+    ``<name>.1`` (replacing an older one) and a new file is begun, so both together stay below twice the
+    bound (plus one event)."""
+
+    def __init__(self, path):
+        self.path = str(path)
+        self._file = open(self.path, "ab", buffering=0)
+        self.size = self._file.tell()
+        self.rotations = 0
+
+    def write(self, text: str):
+        if self.size >= LOG_FILE_BYTES_MAX:
+            self._file.close()
+            os.replace(self.path, self.path + ".1")
+            self._file = open(self.path, "ab", buffering=0)
+            self.size = 0
+            self.rotations += 1
+        data = text.encode("utf-8", "backslashreplace")
+        self._file.write(data)
+        self.size += len(data)
+
+    def close(self):
+        self._file.close()
 
 
 def _shortened(event, size):

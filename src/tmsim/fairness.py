@@ -2,7 +2,8 @@
 
 The server only schedules: which client's input is processed next and how much of it. One turn lets the
 robot's session (``ListenSession.process``) handle at most SERVE_ITEMS items of one client's input and
-decode at most SERVE_SCAN; what is left waits in that client's receive buffer in the session
+decode at most SERVE_SCAN, and do at most TURN_WORK units of work (sim/work.py: checking and running
+scripts, logging; a script that is not done goes on in the robot's next turn, ``SimServer._advance``); what is left waits in that client's receive buffer in the session
 (``_backlog``), which is not read further meanwhile, while the other clients get their turn, round
 robin. A client whose last read filled the receive size or who has input left over is "greedy":
 ``SimServer._serve`` serves it after the others. The session limits the CPERR answers to bad packets
@@ -13,7 +14,7 @@ from __future__ import annotations
 import time
 
 from . import codec
-from .limits import SERVE_ITEMS, SERVE_SCAN
+from .limits import SERVE_ITEMS, SERVE_SCAN, TURN_WORK
 from .session import FRAME_LIMIT, INPUT_DONE
 
 MAX_PENDING = 1000          # buffered scripts per robot (TCP back-pressure beyond, see server.py)
@@ -27,6 +28,7 @@ class FairInput:
         waits for the next turn (``_backlog``), after the other clients' turns. The fault ``close_after``
         closes the connection right after the frame that reaches its count (its replies are sent first)."""
         key = (robot.index, conn.id)
+        robot.session.meter.begin(TURN_WORK)
         _, outcome = robot.session.process(conn.id, SERVE_ITEMS, SERVE_SCAN, max_waiting=MAX_PENDING,
                                            frame_limit=robot.faults.close_after)
         if outcome == INPUT_DONE:

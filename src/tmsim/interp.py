@@ -7,6 +7,7 @@
     ("idle", None, None)      WaitQueueTag(): until every queued motion is done
     ("delay", None, s)        Sleep(ms), WaitQueueTag(0, ms)
     ("room", None, None)      a queued statement while the FIFO is full
+    ("turn", None, None)      the turn's work budget is spent (ctx.meter, sim/work.py): go on in a later turn
 
 It returns "exit" when ScriptExit() ran (the rest of the packet is ignored), else None.
 Immediate statements run when reached; motions, queue tags, base/TCP/load changes and DO/AO writes
@@ -31,8 +32,9 @@ from . import script as ast
 from . import tmscript as table
 from .codec import encode as encode_frame
 from .limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
-                     VARIABLES_MAX)
+                     VARIABLES_MAX, WORK_STEP)
 from .motion import MotionRequest
+from .work import WorkMeter
 
 MOTIONS = ("PTP", "Line", "Circle", "PLine", "Move_PTP", "Move_Line", "Move_PLine")
 _DEFAULTS = {"int": 0, "float": 0.0, "string": "", "bool": False, "byte": 0}
@@ -45,7 +47,7 @@ class ScriptRuntimeError(Exception):
 class Context:
     """What a running script may touch; the session fills it in."""
 
-    def __init__(self, robot, variables, types, listen_send, stop_and_clear, log_line, log_event=None):
+    def __init__(self, robot, variables, types, listen_send, stop_and_clear, log_line, log_event=None, meter=None):
         self.robot = robot
         self.vars = variables
         self.types = types
@@ -55,12 +57,15 @@ class Context:
         self.stop_and_clear = stop_and_clear    # () -> None
         self.log_line = log_line                # (line) -> None
         self.log_event = log_event or (lambda kind, **fields: None)     # (kind, **fields) -> None
+        self.meter = meter or WorkMeter()       # the turn's work (sim/work.py): a spent turn suspends the script
 
 
 def run_script(lines, ctx: Context):
     for line in lines:
         if isinstance(line.stmt, ast.Empty):
             continue
+        if ctx.meter.spent:                     # between two statements: the rest in a later turn
+            yield ("turn", None, None)
         ctx.log_line(line)
         try:
             stmt = line.stmt
@@ -120,6 +125,7 @@ def _size(value) -> int:
 
 def _work(ctx, steps):
     ctx.steps += steps
+    ctx.meter.work += steps * WORK_STEP
     if ctx.steps > STEPS_MAX:
         raise ScriptRuntimeError(f"the script needs more than {STEPS_MAX} steps of work; "
                                  f"send it in smaller packets")
@@ -512,7 +518,9 @@ def _call(node, args, ctx, line):
         if not 90 <= sub <= 99:
             return -2
         value_type = ctx.types.get(node.args[-1].id) if isinstance(node.args[-1], ast.Name) else None
-        ctx.listen_send(ip_filter, sub, encode_value(value, value_type))
+        payload = encode_value(value, value_type)
+        _work(ctx, len(payload) // 256)          # sending is string work: counted by its size, as building one
+        ctx.listen_send(ip_filter, sub, payload)
         return 0
     if name == "ListenPacket":             # the frame text, as in the manual: no CR LF at the end
         header, data = ("TMSCT", args[0]) if len(args) == 1 else args

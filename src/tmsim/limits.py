@@ -29,6 +29,15 @@ DEPTH_MAX = 100                             # nesting of one expression (operand
 STEPS_MAX = 20_000                          # work of one script: statements + expression nodes + array
                                             # elements copied / 8 + string characters built / 256
 
+# ---- work of one turn of the scheduler (sim/work.py): one unit is about 4 us of the simulator's time ---------
+TURN_WORK = 1_000                           # units one turn of one robot may do; then its work goes on later
+WORK_CHAR = 1                               # a character of a script line parsed and checked ...
+WORK_LINE = 4                               # ... plus this per line
+WORK_STEP = 1                               # an interpreter step (STEPS_MAX; a ListenSend counts its bytes / 256)
+WORK_PLAN = 120                             # planning one motion ...
+WORK_PVT_CARTESIAN = 1_000                  # ... a Cartesian PVTPoint (13 inverse-kinematics solutions)
+WORK_LOG_BYTES = 1_024                      # bytes of event text kept or written to the file per unit
+
 # ---- one project (the flow's variables while it stays in the Listen node) ----------------------
 VARIABLES_MAX = 1_000                       # declared variables
 VARIABLE_BYTES_MAX = 8 << 20                # their memory: 8 bytes a number, 1 a character (as text)
@@ -40,9 +49,12 @@ CONTROL_OUTBOX_MAX = 4 << 20                # unsent answer bytes per client; be
 CONTROL_EVENTS_MAX = 1_000                  # events in one "events" answer (page on with "next") ...
 CONTROL_ANSWER_BYTES = 1 << 20              # ... and their bytes as the event log counts them (at least one)
 CONTROL_CLIENTS_MAX = 16
+CONTROL_TURN_REQUESTS = 8                   # requests of one client answered in one turn ...
+CONTROL_TURN_BYTES = 64 << 10               # ... and no more once this turn's answers reach this many bytes
 
 # ---- robot servers (per robot unless noted) -----------------------------------------------------
 EVENT_BYTES_MAX = 20 << 20                  # event log kept in memory, all robots together
+LOG_FILE_BYTES_MAX = 64 << 20               # the --log file: then renamed to FILE.1 and begun anew
 ACCEPT_BACKOFF_S = 0.1                      # out of descriptors: stop accepting for this long
 OUT_OF_DESCRIPTORS = (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM)   # accept() errors that pause it
 SERVE_ITEMS = 8                             # items of one client's input processed in one turn ...

@@ -11,7 +11,9 @@ from collections import deque
 
 from . import kinematics as kin
 from .motion import MotionError, MotionRequest, Planner
+from .limits import WORK_PLAN, WORK_PVT_CARTESIAN
 from .robot_errors import classify
+from .work import WorkMeter
 
 HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)
 FIFO_LIMIT = 1000       # queued items (motions, tags, settings) per robot; a script waits while it is full
@@ -33,6 +35,8 @@ class RobotModel:
         self.io = {}
         self.fifo = deque()
         self.active = None
+        self.meter = WorkMeter()   # the robot's turn budget, shared with its session (sim/work.py)
+        self.owed = 0.0            # seconds of robot clock not run yet: the turn's budget ended the tick
         self.active_t = 0.0
         self.paused = False
         self.tag_history = tag_history
@@ -115,6 +119,7 @@ class RobotModel:
                 else:
                     del self.tags[tag]
         self.fifo.clear()
+        self.owed = 0.0
         self.pvt_mode, self.pvt_velocity = None, (0.0,) * 6       # a stop also ends PVT mode
         return dropped
 
@@ -140,7 +145,12 @@ class RobotModel:
         return self.pvt_mode
 
     def tick(self, dt: float) -> list[dict]:
+        """Run ``dt`` seconds of the arm (plus what an earlier tick owes). Planning a motion is the costly
+        part (WORK_PLAN, a Cartesian PVTPoint WORK_PVT_CARTESIAN): once the turn's budget is spent, the
+        next motion is not started in this tick; the time left is owed and runs first in the next tick,
+        so the timeline of the motions stays exactly the same, only later on the wall clock."""
         events = []
+        dt, self.owed = dt + self.owed, 0.0
         while not self.paused:
             if self.active is not None:
                 rate = self.motion_rate(self.active.request)
@@ -157,6 +167,9 @@ class RobotModel:
                 continue
             if not self.fifo:
                 break
+            if self.meter.spent and self.fifo[0][0] == "motion":
+                self.owed = dt
+                break
             kind, value = self.fifo.popleft()
             handler = getattr(self, "_run_" + kind)
             event = handler(value)
@@ -167,6 +180,7 @@ class RobotModel:
         return events
 
     def _run_motion(self, request):
+        self.meter.add(WORK_PVT_CARTESIAN if request.function == "PVTPoint" and self.pvt_mode == 1 else WORK_PLAN)
         planner = Planner(self._matrix(self.base_pose), self._matrix(self.tool_pose))    # cached matrices
         try:
             if request.function == "PVTPoint":

@@ -472,19 +472,27 @@ def parse_line(text: str) -> object:
 def split_lines(script: str) -> list[Line]:
     """Split a script on CR LF (the protocol's line separator) and parse each line. The line that goes
     beyond STATEMENTS_MAX statements or TOKENS_MAX tokens is an error; the lines after it are not parsed."""
-    lines, statements, tokens, full = [], 0, 0, False
+    return list(iter_lines(script))
+
+
+def iter_lines(script: str):
+    """``split_lines`` one line at a time (a generator), so that a caller can spread the parsing of a long
+    script over several turns of the simulator's scheduler."""
+    statements, tokens, full = 0, 0, False
     for number, text in enumerate(script.split("\r\n"), start=1):
         line = Line(number, text)
-        lines.append(line)
         if full:
             line.stmt = Empty()
+            yield line
             continue
         if "\r" in text or "\n" in text:
             line.error = "lines must be separated by CR LF"
+            yield line
             continue
         stmt, cost = _parse(text)
         if isinstance(stmt, Empty):
             line.stmt = stmt
+            yield line
             continue
         statements += 1
         tokens += cost
@@ -497,4 +505,4 @@ def split_lines(script: str) -> list[Line]:
         else:
             line.stmt = stmt
         full = statements > STATEMENTS_MAX or tokens > TOKENS_MAX
-    return lines
+        yield line

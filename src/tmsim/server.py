@@ -27,10 +27,10 @@ from . import codec
 from .control import ControlChannel
 from .ethernet_slave import EthernetSlave
 from .listener import RECV_SIZE, Listener, receive
-from .eventlog import EventLog, text as _text
+from .eventlog import EventLog, LogFile, text as _text
 from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
 from .faults import FaultState, check_params as check_fault_params
-from .limits import EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX
+from .limits import EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, TURN_WORK
 from .profiles import Profile
 from .robot import RobotModel
 from .session import STOPPED, ListenSession
@@ -154,7 +154,7 @@ class SimServer(FairInput):
         self.event_bytes_limit = EVENT_BYTES_MAX // robots           # per robot: all together keep <= 20 MiB
         self.pending_bytes_limit = max(4 * codec.MAX_DATA, PENDING_BYTES_MAX // robots)
         try:
-            self.log_file = open(log_path, "a", encoding="utf-8", buffering=1) if log_path else None
+            self.log_file = LogFile(log_path) if log_path else None
         except OSError as exc:
             raise OSError(exc.errno, f"cannot open the event log {log_path}: {exc.strerror}") from None
         self.selector = selectors.DefaultSelector()
@@ -297,8 +297,10 @@ class SimServer(FairInput):
                 self.svr.poll(self._now)
             if self.control is not None:
                 self.control.tick(self._now)
-            ready = self._serve(0.0 if self._backlog else timeout)
+            ready = self._serve(0.0 if self._has_work() else timeout)
             self._serve_backlog()
+            if self.control is not None and self.control.backlog:
+                self.control.serve_backlog()
             self._start_touched()
             for robot in self.robots:
                 self._flush(robot)
@@ -308,6 +310,11 @@ class SimServer(FairInput):
                     self._set_reading(robot, True)
             if self.manage_gc:
                 _collect_garbage(idle=not ready)
+
+    def _has_work(self) -> bool:
+        """Work is left over from earlier turns (client input, control requests): the next poll must not wait."""
+        return bool(self._backlog) or (self.control is not None and self.control.has_backlog) or \
+            any(robot.session.has_turn_work for robot in self.robots)
 
     def _breathe(self, budgeted=False):
         """Between two pieces of work: serve the sockets when IO_SLICE_S has passed since they were
@@ -374,6 +381,7 @@ class SimServer(FairInput):
     def _advance(self, robot):
         """Advance one robot's session; an unexpected error becomes a robot error of that robot (its project
         stops, event ``internal_error``) instead of ending the thread that serves every robot."""
+        robot.session.meter.begin(TURN_WORK)
         try:
             robot.session.advance(self._now)
         except Exception as exc:          # noqa: BLE001 - safety net, see docstring

@@ -15,13 +15,13 @@ from collections import deque
 from dataclasses import dataclass, field
 
 from . import codec
-from .checker import check_script
+from .checker import ScriptChecker
 from .eventlog import text as _text
 from .interp import Context, ScriptRuntimeError, run_script
-from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN
+from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE
 from .profiles import Profile
 from .robot import RobotModel
-from .script import split_lines
+from .script import iter_lines
 
 STOPPED, IDLE, IN_NODE, EXITING = "project_stopped", "not_in_node", "in_node", "exiting"
 
@@ -64,7 +64,6 @@ class Packet:
 class Running:
     packet: Packet
     gen: object
-    warnings: list
     wait: tuple | None = None          # ("tag", tag, deadline or None) or ("room", None, None)
 
 
@@ -89,6 +88,7 @@ class ListenSession:
         self.profile = profile or Profile()
         self.robot = robot or RobotModel()
         self.robot.tag_history, self.robot.stop_tags = self.profile.tag_history, self.profile.stop_tags
+        self.meter = self.robot.meter       # work of the current turn (sim/work.py), shared with the robot
         self.send_message = send_message
         self.log = log or (lambda kind, **fields: None)
         self.state = STOPPED
@@ -282,27 +282,41 @@ class ListenSession:
             self._start(packet)
 
     def _start(self, packet):
-        lines = split_lines(packet.script)
         if self.faults["reply_error"] > 0:
             self.faults["reply_error"] -= 1
             self.log("fault", fault="reply_error", id=packet.id)
             self._reply(packet, "ERROR;1")
             return
-        check_script(lines, self.types, self.profile.tmflow)
+        self.running = Running(packet, self._script(packet))
+        self._step(None)
+
+    def _script(self, packet):
+        """Check the packet line by line, then run it (a generator, like sim.interp.run_script, whose waits
+        it passes on). Returns the reply status and whether ScriptExit() ran. Parsing and checking count
+        WORK_CHAR per character and WORK_LINE per line; when the turn's budget is spent, the rest waits for
+        a later turn (wait "turn"): a 64 KiB script never holds the other robots and clients."""
+        meter = self.meter
+        checker = ScriptChecker(self.types, self.profile.tmflow)
+        lines = []
+        for line in iter_lines(packet.script):
+            if meter.spent:
+                yield ("turn", None, None)
+            checker.check(line)
+            lines.append(line)
+            meter.add(WORK_LINE + WORK_CHAR * len(line.text))
         errors = [line.number for line in lines if line.error]
         for line in lines:
             if line.error:
                 self.log("script_error", id=packet.id, line=line.number, text=line.text, reason=line.error)
         if errors:
-            self._reply(packet, "ERROR;" + ";".join(map(str, errors)))
-            return
+            return "ERROR;" + ";".join(map(str, errors)), False
         warnings = [line.number for line in lines if line.warnings]
         ctx = Context(self.robot, self.variables, self.types, self._listen_send, self._stop_robot,
                       lambda line, p=packet: self.log("script_line", conn=p.conn, id=p.id,
                                                       line=line.number, text=line.text),
-                      self.log)
-        self.running = Running(packet, run_script(lines, ctx), warnings)
-        self._step(None)
+                      self.log, meter)
+        exit_ = yield from run_script(lines, ctx)
+        return "OK" + "".join(f";{n}" for n in warnings), exit_ == "exit"
 
     def _step(self, value):
         run = self.running
@@ -310,8 +324,9 @@ class ListenSession:
             request = run.gen.send(value)
         except StopIteration as stop:
             self.running = None
-            self._reply(run.packet, "OK" + "".join(f";{n}" for n in run.warnings))
-            if stop.value == "exit":
+            status, exit_ = stop.value
+            self._reply(run.packet, status)
+            if exit_:
                 self.fire("script_exit")
                 self._check_drain()
             return
@@ -330,7 +345,11 @@ class ListenSession:
         tag: 1 completed / -1 not existed end the wait at once, 0 when the timeout passes (§13.2)."""
         while self.running is not None and self.running.wait is not None:
             kind, tag, deadline = self.running.wait
-            if kind == "room":                  # a queued statement waits for room in the full FIFO
+            if kind == "turn":                  # the budget of a turn ended its work: go on in a new turn
+                if self.meter.spent:
+                    return
+                result = None
+            elif kind == "room":                  # a queued statement waits for room in the full FIFO
                 if not self.robot.has_room:
                     return
                 result = None
@@ -451,7 +470,8 @@ class ListenSession:
             handled += 1
             if frame_limit is not None and client.frames_in >= frame_limit:
                 return handled, FRAME_LIMIT
-            if handled >= max_items or (max_waiting is not None and len(self.pending) >= max_waiting):
+            if handled >= max_items or (max_waiting is not None and len(self.pending) >= max_waiting) or \
+                    self.meter.spent:
                 return handled, INPUT_LEFT
         return handled, INPUT_LEFT
 
@@ -481,6 +501,12 @@ class ListenSession:
         if self.running is not None and self.running.packet.conn == conn:
             return True
         return any(p.conn == conn for p in self.pending)
+
+    @property
+    def has_turn_work(self) -> bool:
+        """Work that a spent turn left for a later one: a script to check or run on, motions owed time."""
+        return (self.running is not None and self.running.wait is not None and self.running.wait[0] == "turn") \
+            or (self.robot.owed > 0.0 and not self.robot.idle)
 
     @property
     def buffered(self) -> int:

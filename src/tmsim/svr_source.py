@@ -174,6 +174,25 @@ class RobotDataSource:
         if model.estop:
             self.robot.session.robot_error("emergency stop pressed", source="estop")
 
+    def set_input(self, name: str, value):
+        """An input of the robot changes, as a sensor wired to it would change it: ``Ctrl_DI0``..``Ctrl_DI15`` and
+        ``End_DI0``..``End_DI3`` take 0 or 1, ``Ctrl_AI0``/``Ctrl_AI1``/``End_AI0``/``End_AI1`` volts in -10..10
+        (Appendix D item names). The data table shows it from its next frame. ValueError naming the item when it is
+        not an input or the value does not fit it."""
+        item, key = ITEMS.get(name), io_key(name)
+        if item is None or key is None or key.partition(".")[2][:2] not in ("DI", "AI"):
+            raise ValueError(f"{name!r} is not an input item (Ctrl_DI0..15, Ctrl_AI0..1, End_DI0..3, End_AI0..1)")
+        if item.type == "float":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not -10 <= value <= 10:
+                raise ValueError(f"{name} takes volts in -10..10, got {value!r}")
+            value = float(value)
+        elif isinstance(value, float) or value not in (0, 1):
+            raise ValueError(f"{name} takes 0 or 1, got {value!r}")
+        else:
+            value = int(value)
+        self.model.io[key] = value
+        self.log("io", point=key, value=value, source="input")
+
     def set_auto_mode(self, auto: bool):
         self.model.auto_mode = bool(auto)
         self.log("operation_mode", mode="auto" if auto else "manual")
