@@ -200,3 +200,30 @@ def test_a_header_larger_than_the_limit_is_431(mapping):
 def test_limits_that_cannot_work_are_refused(field, value):
     with pytest.raises(ValueError, match=field if field != "per_client" else "per_client"):
         HttpLimits(**{field: value})
+
+
+def test_a_client_that_does_not_take_its_answer_is_closed_at_the_send_deadline(mapping, tmp_path):
+    """The answer is sent without waiting: what the socket does not take has SEND_DEADLINE_S to go, then the
+    connection is closed (a 16 MiB file to a client that reads nothing, 0.3 s here)."""
+    size = 16 * 1024 * 1024
+    (tmp_path / "large.js").write_bytes(b"/" * size)
+    with scanning(FakePlc(mapping, command_program)) as plc:
+        server = HmiServer(plc, mapping, port=0, root=tmp_path, limits=HttpLimits(send_s=0.3))
+        server.start()
+        try:
+            with socket.create_connection(("127.0.0.1", server.port), timeout=5) as sock:
+                sock.sendall(f"GET /large.js HTTP/1.0\r\nHost: 127.0.0.1:{server.port}\r\n\r\n".encode())
+                front = server._httpd
+                for held in (True, False):                  # until the front end has taken it, then given it up
+                    for _ in range(500):
+                        if bool(front._connections) == held:
+                            break
+                        threading.Event().wait(0.01)
+                received = 0
+                with contextlib.suppress(ConnectionResetError):
+                    while chunk := sock.recv(1 << 20):
+                        received += len(chunk)
+            status, _ = Client(f"http://127.0.0.1:{server.port}").json("/api/read?names=Stop_Busy")
+        finally:
+            server.stop()
+    assert not front._connections and 0 < received < size and status == 200

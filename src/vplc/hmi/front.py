@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import queue
 import selectors
 import socket
@@ -138,6 +139,7 @@ class HttpFront:
         self._connections: set[_Connection] = set()
         self._by_client: dict[str, set[_Connection]] = {}
         self._stopping = False
+        self._next_due = math.inf                # no deadline of a waiting connection is earlier than this
         self.evicted = self.refused = 0          # connections closed to make room / refused with 503 (counters)
 
     # --- the front-end thread ------------------------------------------------------------------------------
@@ -145,9 +147,8 @@ class HttpFront:
         try:
             while not self._stopping:
                 now = time.monotonic()
-                deadline = min((c.deadline for c in self._connections if c.state != _BUSY), default=now + 1.0)
                 waiting = False
-                for key, mask in self._selector.select(min(max(deadline - now, 0.0), 1.0)):
+                for key, mask in self._selector.select(min(max(self._next_due - now, 0.0), 1.0)):
                     if key.data is None:
                         waiting = True
                     elif key.data == "wake":
@@ -159,7 +160,9 @@ class HttpFront:
                 self._take_answers()
                 if waiting:                    # after the reads: a request already here is safe from eviction
                     self._accept()
-                self._expire(time.monotonic())
+                now = time.monotonic()
+                if now >= self._next_due:
+                    self._expire(now)
         finally:
             for connection in list(self._connections):
                 self._close(connection)
@@ -217,6 +220,7 @@ class HttpFront:
                 sock.close()
                 continue
             connection = _Connection(sock, peer, time.monotonic(), self.limits.idle_s)
+            self._next_due = min(self._next_due, connection.deadline)
             self._connections.add(connection)
             self._by_client.setdefault(connection.client, set()).add(connection)
             self._watch(connection, selectors.EVENT_READ)
@@ -281,6 +285,7 @@ class HttpFront:
 
     def _start_request(self, connection: _Connection, now: float) -> None:
         connection.state, connection.since, connection.deadline = _HEAD, now, now + self.limits.header_s
+        self._next_due = min(self._next_due, connection.deadline)
 
     def _advance(self, connection: _Connection) -> None:
         """Hand the request to a worker as soon as its header and its declared body are here."""
@@ -296,6 +301,7 @@ class HttpFront:
             declared = _declared_body(bytes(data[:end]))
             connection.need, connection.whole = end + (declared or 0), declared is not None
             connection.state, connection.deadline = _BODY, time.monotonic() + self.limits.body_s
+            self._next_due = min(self._next_due, connection.deadline)
         if connection.state == _BODY and len(data) >= connection.need:
             self._dispatch(connection, late=False)
 
@@ -317,7 +323,16 @@ class HttpFront:
         self._start_sending(connection, _answer(status, message))
 
     def _expire(self, now: float) -> None:
-        for connection in [c for c in self._connections if c.state != _BUSY and c.deadline <= now]:
+        """Act on every deadline that has passed; learn the next one (one pass over the connections)."""
+        due, self._next_due = [], math.inf
+        for connection in self._connections:
+            if connection.state == _BUSY:
+                continue
+            if connection.deadline <= now:
+                due.append(connection)
+            elif connection.deadline < self._next_due:
+                self._next_due = connection.deadline
+        for connection in due:
             if connection.state == _HEAD:
                 self._refuse(connection, HTTPStatus.REQUEST_TIMEOUT,
                              f"the request header did not arrive within {self.limits.header_s:g} s")
@@ -369,6 +384,7 @@ class HttpFront:
     def _start_sending(self, connection: _Connection, answer: bytes) -> None:
         connection.out = memoryview(answer)
         connection.state, connection.deadline = _SEND, time.monotonic() + self.limits.send_s
+        self._next_due = min(self._next_due, connection.deadline)
         self._send(connection)
 
     def _send(self, connection: _Connection) -> None:
@@ -396,6 +412,7 @@ class HttpFront:
             return
         now = time.monotonic()
         connection.state, connection.since, connection.deadline = _LINGER, now, now + LINGER_S
+        self._next_due = min(self._next_due, connection.deadline)
         self._watch(connection, selectors.EVENT_READ)
 
     def handle_error(self, request, client_address):
