@@ -7,11 +7,17 @@
    background thread, connected. Target <= 100 ms.
 2. Scan cost: mean wall time of plc.scan() (taken with plc.lock, as run_realtime does) without HMI, then
    with the HMI server answering two browsers that poll the PnP page's variables every 50 ms. Target <= 10 %.
+3. Read round trip: GET /api/read of the PnP page's variables, one after the other, against the HMI tests'
+   stand-in PLC (the HTTP server's own cost, not the ST program's).
+4. Under 70 slow clients: the same read, the Stop page and a Stop press while 70 connections send their request
+   header one byte every 5 s and open a new connection whenever the server answers 408 (issue 23, item 6).
+   Target: every request served; the latency stays that of an idle server.
 """
 from __future__ import annotations
 
 import json
 import pathlib
+import socket
 import statistics
 import sys
 import threading
@@ -32,6 +38,8 @@ except ImportError:          # toolchain runtime not in this checkout: measure t
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
 ROUND_TRIPS = 40
 SCANS = 3000
+READS = 1000
+SLOW_CLIENTS, SLOW_GAP_S, SLOW_RUN_S = 70, 5.0, 12.0
 PNP_PAGE_VARS = ["PnP_Example_Execute", "PnP_Segment", "PnP_Waiting", "PnP_CycleCount", "PnP_MoveBusy",
                  "PnP_MoveDone", "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",
                  "ProgramControl_Busy", "ProgramControl_Done", "ProgramControl_Error",
@@ -144,8 +152,8 @@ def scan_cost(rounds: int = 5) -> tuple[float, float, int]:
     return statistics.median(without), statistics.median(with_hmi), served
 
 
-def stand_in_round_trip() -> tuple[list[float], float]:
-    """Round trip and lock hold time against tests/hmi/fake_plc.py scanning every 1 ms in a thread."""
+def stand_in_hmi():
+    """A stand-in PLC scanning every 1 ms in a thread and its HMI server; call the returned finish() at the end."""
     from fake_plc import FakePlc, command_program
     mapping = Mapping.load()
     plc = FakePlc(mapping, command_program)
@@ -158,6 +166,17 @@ def stand_in_round_trip() -> tuple[list[float], float]:
     runner.start()
     hmi = HmiServer(plc, mapping, port=0)
     hmi.start()
+
+    def finish():
+        hmi.stop()
+        stop.set()
+        runner.join(timeout=5)
+    return hmi, finish
+
+
+def stand_in_round_trip() -> tuple[list[float], float]:
+    """Round trip and lock hold time against tests/hmi/fake_plc.py scanning every 1 ms in a thread."""
+    hmi, finish = stand_in_hmi()
     try:
         samples = []
         read_url = hmi.url + "api/read?names=ChangeBase_Done,ChangeBase_Busy,ChangeBase_Error"
@@ -174,9 +193,104 @@ def stand_in_round_trip() -> tuple[list[float], float]:
             held.append(time.perf_counter_ns() - start)
         return samples, statistics.fmean(held) / 1000
     finally:
-        hmi.stop()
+        finish()
+
+
+def read_latencies(url: str, count: int) -> list[float]:
+    samples = []
+    for _ in range(count):
+        start = time.perf_counter()
+        get(url)
+        samples.append((time.perf_counter() - start) * 1000)
+    return sorted(samples)
+
+
+def read_round_trip() -> list[float]:
+    hmi, finish = stand_in_hmi()
+    try:
+        url = hmi.url + "api/read?names=" + ",".join(PNP_PAGE_VARS)
+        read_latencies(url, 50)                                   # warm up
+        return read_latencies(url, READS)
+    finally:
+        finish()
+
+
+def under_slow_clients() -> tuple[list[float], list[float], int, int]:
+    """(read latencies, page + Stop latencies in ms, 408 answers the slow clients got, their connections)."""
+    hmi, finish = stand_in_hmi()
+    header = (f"GET /api/read?names=PnP_Segment HTTP/1.1\r\nHost: 127.0.0.1:{hmi.port}\r\n"
+              f"X-Padding: {'p' * 64}\r\n\r\n").encode()
+    stop = threading.Event()
+    counts = {"408": 0, "connections": 0}
+
+    def slow_clients():
+        def connect():
+            counts["connections"] += 1
+            sock = socket.create_connection(("127.0.0.1", hmi.port), timeout=5)
+            sock.setblocking(False)
+            return [sock, 0]
+        held = [connect() for _ in range(SLOW_CLIENTS)]
+        while not stop.wait(SLOW_GAP_S / SLOW_CLIENTS):        # one byte per client every SLOW_GAP_S, in turn
+            entry = held.pop(0)
+            sock, sent = entry
+            try:
+                answer = sock.recv(4096)
+            except BlockingIOError:
+                answer = None
+            except OSError:
+                answer = b""
+            if answer is None:
+                try:
+                    sock.send(header[sent:sent + 1])
+                    entry[1] += 1
+                except OSError:
+                    answer = b""
+            if answer is not None:                               # answered 408 (or closed): a new connection
+                counts["408"] += answer.startswith(b"HTTP/1.0 408")
+                sock.close()
+                entry = connect()
+            held.append(entry)
+        for sock, _ in held:
+            sock.close()
+
+    attacker = threading.Thread(target=slow_clients, daemon=True)
+    attacker.start()
+    try:
+        url = hmi.url + "api/read?names=" + ",".join(PNP_PAGE_VARS)
+        reads, others = [], []
+        end = time.monotonic() + SLOW_RUN_S
+        while time.monotonic() < end:
+            reads += read_latencies(url, 20)
+            start = time.perf_counter()
+            with urllib.request.urlopen(hmi.url + "stop.html", timeout=5) as response:
+                response.read()
+            post(hmi.url + "api/execute", {"execute": "Stop_Execute", "values": {}}, hmi.access.keys["operator"])
+            others.append((time.perf_counter() - start) * 1000)
+            time.sleep(0.05)
+    finally:
         stop.set()
-        runner.join(timeout=5)
+        attacker.join(timeout=10)
+        finish()
+    return sorted(reads), sorted(others), counts["408"], counts["connections"]
+
+
+def percentile(samples: list[float], share: float) -> float:
+    return samples[max(0, int(len(samples) * share) - 1)]
+
+
+def http_rows() -> None:
+    reads = read_round_trip()
+    print(f"/api/read round trip ({len(PNP_PAGE_VARS)} variables, stand-in PLC), {len(reads)} reads one after "
+          f"the other:")
+    print(f"  median {statistics.median(reads):6.2f} ms   p95 {percentile(reads, 0.95):6.2f} ms   "
+          f"max {reads[-1]:6.2f} ms")
+    reads, others, answered_408, connections = under_slow_clients()
+    print(f"Under {SLOW_CLIENTS} slow clients (a header byte every {SLOW_GAP_S:g} s each, {connections} connections "
+          f"in {SLOW_RUN_S:g} s, {answered_408} answered 408):")
+    print(f"  /api/read median {statistics.median(reads):6.2f} ms   p95 {percentile(reads, 0.95):6.2f} ms   "
+          f"max {reads[-1]:6.2f} ms   ({len(reads)} reads, all served)")
+    print(f"  Stop page + Stop press median {statistics.median(others):6.2f} ms   max {others[-1]:6.2f} ms   "
+          f"({len(others)} of each, all served)")
 
 
 def main() -> int:
@@ -190,6 +304,7 @@ def main() -> int:
               f"   max {samples[-1]:6.1f} ms   (target <= 100 ms)")
         print(f"plc.lock held per PnP-page read ({len(PNP_PAGE_VARS)} variables): {held_us:.1f} us; "
               f"2 pages at 20 Hz hold it {held_us * 40 / 1000:.2f} ms per second of PLC time")
+        http_rows()
         return 0
     samples = sorted(round_trip())
     p95 = samples[int(len(samples) * 0.95) - 1]
@@ -201,6 +316,7 @@ def main() -> int:
     print(f"PLC scan cost of the examples + library (median of 5 x {SCANS} scans each way):")
     print(f"  without HMI {without:8.1f} us/scan   with HMI serving 2 pages at 20 Hz "
           f"({served} requests) {with_hmi:8.1f} us/scan   added {added:+5.1f} %   (target <= 10 %)")
+    http_rows()
     return 0
 
 
