@@ -28,16 +28,20 @@ function pnpOptions() {
   const connected = v.Connect_Connected === true, stopHeld = v.Robot_Stopping === true;
   const startable = (state === "Idle" || state === "Stopped") && connected && !stopHeld;
   let text = PNP_STATE_TEXT[state] || "Waiting for the PLC …";
-  if (state === "Faulted" && v.PnP_MoveError)
+  if (state === "Faulted" && v.PnP_OutcomeUnknown)
+    text = `Fault ${idText(v.PnP_MoveErrorID)}: the robot's answer was lost, the last command may have run. ` +
+      "Press Reset, then Start: the cycle first checks where the robot is and goes on from there.";
+  else if (state === "Faulted" && v.PnP_MoveError)
     text = `Fault ${idText(v.PnP_MoveErrorID)}: ${v.PnP_MoveErrorDescrip}. Remove the cause, press Reset, then Start.`;
   if ((state === "Idle" || state === "Stopped") && !connected)
     text = "The robot is not connected: connect it on the Connect page, then press Start.";
   else if ((state === "Idle" || state === "Stopped") && stopHeld)
     text = "Stop Motion is still active: wait until it is released, then press Start.";
-  if (v.PnP_OutcomeUnknown && state !== "Running")
+  if (v.PnP_OutcomeUnknown && (state === "Idle" || state === "Stopped"))
     text += " The last command may have run: Start first checks where the robot is and goes on from there.";
-  return { state, text, enabled: { "btn-execute": startable, "btn-stop": state === "Running" && v.PnP_Example_Execute === true,
-    "btn-reset": state === "Faulted" } };
+  const enabled = { "btn-execute": startable, "btn-stop": state === "Running" && v.PnP_Example_Execute === true,
+    "btn-reset": state === "Faulted" };
+  return { state, text, enabled };
 }
 
 function showPnPState() {
@@ -210,7 +214,8 @@ async function pnpPage() {
       const check = () => {
         if (live.polls < firstPoll) { setTimeout(check, POLL_MS); return; }
         const { state, text } = pnpOptions();
-        if (expect.includes(state)) message(`${what}: the cycle is ${state}. ${state === "Running" ? "" : text}`.trim());
+        if (expect.includes(state))
+          message(`${what}: the cycle is ${state}. ${state === "Running" ? "" : text}`.trim());
         else message(`${what} not taken: ${text}`, "error");
       };
       setTimeout(check, POLL_MS);

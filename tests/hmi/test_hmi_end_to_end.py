@@ -389,6 +389,49 @@ def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(co
     assert connected.read("PnP_MoveError") is False
 
 
+def test_pnp_fault_with_an_unknown_outcome_is_reset_on_the_page_and_the_move_is_not_repeated(connected):
+    """The link is cut while the place move runs: the move's outcome is unknown (16#200B), the cycle is Faulted
+    and the page offers Reset only; after Reset, Start checks where the robot is: it finished the place move on
+    its own, so the move is not sent again and the cycle goes on with the gripper."""
+    browser = connected.open("pnp")
+    browser.click("btn-preset")
+    browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset")
+    with connected.plc.lock:
+        connected.plc.write("PnP_DwellTime", DWELL_NS)
+        connected.plc.write("PnP_MoveParameters[4].Speed", 5)      # a slow place move: a sure window for the cut
+    place = connected.read("PnP_MoveParameters")[4]["TargetPosition"]
+    place = [place[k] for k in ("X", "Y", "Z")]
+    cycles = connected.read("PnP_CycleCount")
+    mark = connected.event_count()
+    browser.click("btn-execute")
+    connected.wait(lambda: connected.read("PnP_Segment") == 4 and connected.robot_state()["moving"]
+                   and connected.robot_state()["tcp"][2] < place[2] + 100, "the place move")
+    with connected.sim.lock:
+        connected.robot.inject("disconnect")
+    connected.wait(lambda: connected.read("PnP_State") == "Faulted", "the fault")
+    assert connected.read("PnP_MoveErrorID") == 0x200B and connected.read("PnP_OutcomeUnknown") is True
+    browser.wait_for(lambda d: "Cycle: Faulted" in d.find_element(By.ID, "pnp-state").text, "Faulted on the page")
+    text = browser.driver.find_element(By.ID, "pnp-state").text
+    assert "16#200B" in text and "Press Reset, then Start" in text and "may have run" in text
+    assert pnp_page_offers(browser) == {"execute": False, "stop": False, "reset": True}
+    browser.screenshot("e2e_pnp_faulted_outcome_unknown")
+    connected.wait(lambda: connected.read("Connect_Connected"), "the reconnect")
+    browser.click("btn-reset")
+    browser.wait_for(lambda d: "Reset: the cycle is Idle" in browser.message(), "the reset taken")
+    browser.wait_for(lambda d: pnp_page_offers(browser) == {"execute": True, "stop": False, "reset": False},
+                     "Start offered after Reset")
+    with connected.plc.lock:
+        connected.plc.write("PnP_MoveParameters[4].Speed", 30)
+    browser.click("btn-execute")
+    connected.wait(lambda: connected.read("PnP_CycleCount") > cycles, "the cycle to complete", timeout=60)
+    to_place = [e for e in connected.events("motion_start", mark) if e["to"][:3] == pytest.approx(place, abs=0.5)]
+    assert len(to_place) == 1, "the place move was sent again although the robot had arrived"
+    opens = [e for e in connected.events("io", mark) if e["point"] == "EndModule.DO[0]" and e["value"] == 0]
+    assert opens and opens[0]["t"] > to_place[0]["t"]
+    browser.click("btn-stop")
+    connected.wait(lambda: connected.read("PnP_State") == "Idle", "the cycle to end")
+
+
 def test_connection_loss_shows_on_the_connect_page(connected):
     browser = connected.open("connect")
     browser.wait_status("Connect_Connected", "true")
