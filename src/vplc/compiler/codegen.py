@@ -361,9 +361,32 @@ class CodeGen(ExprGen):
         self.emit(f"{lv} = {code}")
 
     def st_If(self, st: A.If) -> None:
+        if len(st.branches) <= CASE_CHAIN:
+            self.if_chain(st.branches, st.span, st.else_body)
+            return
+        # thousands of ELSIF: consecutive chains of CASE_CHAIN branches, the next one tried only while no
+        # condition has held (the same order and first-match semantics; see st_Case)
+        pending = self.tmp("_p")
+        self.emit(f"{pending} = False")
+        for start in range(0, len(st.branches), CASE_CHAIN):
+            if start:
+                self.emit(f"if {pending}:")
+                self.ind += 1
+                self.emit(f"{pending} = False")
+            self.if_chain(st.branches[start:start + CASE_CHAIN], st.span, None, pending)
+            if start:
+                self.ind -= 1
+        if st.else_body:
+            self.emit(f"if {pending}:")
+            self.ind += 1
+            self.block(st.else_body)
+            self.ind -= 1
+
+    def if_chain(self, branches, span, else_body, pending: str | None = None) -> None:
+        """One if/elif chain; then the ELSE part, or (``pending``) a flag set when no condition held."""
         extra = 0
-        for i, br in enumerate(st.branches):
-            self.at(br.span or st.span)
+        for i, br in enumerate(branches):
+            self.at(br.span or span)
             if i == 0:
                 self.spill_ok = True
                 self.emit(f"if {self.cond(br.cond)}:")
@@ -383,11 +406,14 @@ class CodeGen(ExprGen):
             self.ind += 1
             self.block(br.body)
             self.ind -= 1
-        if st.else_body:
+        if else_body:
             self.emit("else:")
             self.ind += 1
-            self.block(st.else_body)
+            self.block(else_body)
             self.ind -= 1
+        elif pending is not None:
+            self.emit("else:")
+            self.emit(f"    {pending} = True")
         self.ind -= extra
 
     def st_Case(self, st: A.Case) -> None:
