@@ -295,3 +295,25 @@ def test_a_status_query_damaged_on_the_way_is_asked_again_not_taken_for_a_lost_l
         assert rig.read("Cobot.LastErrorID") == 0x3012
     finally:
         rig.close()
+
+
+def test_a_damaged_status_frame_is_no_evidence_that_a_script_waiting_behind_another_clients_lost_its_reply():
+    """Another client's Sleep(3000) holds the queue; a blended motion A waits for its OK. A status answer is
+    damaged on the way: the status query asked at once is answered at once (status queries do not wait for
+    scripts), but the dropped frame was a TMSTA, not A's reply - A is not ended 'reply lost' (16#3005) while
+    the robot still runs it: it ends Done when its OK comes."""
+    rig = Rig()
+    other = OtherClient(rig)
+    try:
+        other.script("H", "Sleep(3000)")
+        rig.scans(5)
+        go(rig, 1, rz=20.0, speed=100, blend=True)
+        rig.scans(3)
+        rig.robot.inject("corrupt_checksum", count=1, match="$TMSTA")
+        assert rig.until(lambda: rig.read("Cobot.BadFrames") == 1, 1)
+        assert rig.until(lambda: settled(rig, 1), 6)
+        assert rig.read("movers[1].Done"), rig.read("movers[1].ErrorDescrip")
+        assert rig.until(lambda: ended_at(rig) == [20], 3)
+    finally:
+        other.close()
+        rig.close()
