@@ -96,6 +96,53 @@ def per_scan(tmp, label, text, scans=5000):
     return plc
 
 
+AXES_N = 16
+
+
+def axes_program(n: int = AXES_N) -> str:
+    """n axes moving back and forth between 0 and 100 mm, each with one MC_Power and one MC_MoveAbsolute."""
+    return f"""PROGRAM Main
+VAR pwr : ARRAY[0..{n - 1}] OF MC_Power; mv : ARRAY[0..{n - 1}] OF MC_MoveAbsolute; i : INT;
+    go : ARRAY[0..{n - 1}] OF BOOL; tgt : ARRAY[0..{n - 1}] OF LREAL; END_VAR
+FOR i := 0 TO {n - 1} DO
+    pwr[i](Axis := _MC_AX[i], Enable := TRUE);
+    mv[i](Axis := _MC_AX[i], Execute := go[i], Position := tgt[i], Velocity := 500.0);
+    IF mv[i].Done THEN tgt[i] := 100.0 - tgt[i]; go[i] := FALSE; ELSE go[i] := pwr[i].Status; END_IF;
+END_FOR;
+END_PROGRAM
+"""
+
+
+def axes_cost(tmp: str, n: int = AXES_N, scans: int = 5000) -> None:
+    """Issue 27: what a virtual servo axis costs per scan: the motion processing alone (timed around it) and the
+    whole scan with the two instructions each axis is given."""
+    cfg = os.path.join(tmp, "axes.toml")
+    with open(cfg, "w") as f:
+        f.write("".join(f"[[axis]]\nnumber = {k}\nmax_velocity = 1000.0\nmax_acceleration = 5000.0\n"
+                        for k in range(n)))
+    plc = load(tmp, "axes.st", axes_program(n), axes=cfg)
+    ctl = plc.motion
+    task = plc.engine.tasks[0]
+    cycle, spent = type(ctl).cycle, []
+
+    def timed(c):
+        s0 = time.perf_counter_ns()
+        cycle(c)
+        spent.append(time.perf_counter_ns() - s0)
+    task.programs[-1] = (ctl, timed)
+    scan_times, t = [], 0
+    for _ in range(scans):
+        s0 = time.perf_counter_ns()
+        plc.scan(t)
+        scan_times.append(time.perf_counter_ns() - s0)
+        t += 1_000_000
+    moving = sum(1 for a in ctl.axes if a.profile is not None)
+    print(f"  virtual servo axes ({n}, {moving} moving at the end): motion processing median "
+          f"{percentile(spent, .5) / 1000 / n:5.2f} us, p99 {percentile(spent, .99) / 1000 / n:5.2f} us per axis "
+          f"and scan (target <= 2 us); whole scan with MC_Power + MC_MoveAbsolute per axis "
+          f"{percentile(scan_times, .5) / 1000 / n:5.2f} us per axis")
+
+
 def versus_baseline(rev: str) -> None:
     """Issue 15, target 3: this engine against the engine of commit ``rev`` on the same programs, same run."""
     targets = {"100 R_TRIG + 100 TON": 2.5, "300-line CASE sequence": 1.5}
@@ -121,6 +168,7 @@ def main() -> int:
         seq_text = sequence_program()
         print(f"  (sequence program: {seq_text.count(chr(10))} lines)")
         plc = per_scan(tmp, "300-line CASE sequence", seq_text)
+        axes_cost(tmp)
 
         n, t0 = 20000, time.perf_counter()
         plc.run_until(lambda: False, n * plc.period_ns)

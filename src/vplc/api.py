@@ -41,11 +41,12 @@ def parse_task(task: str) -> tuple[str, int]:
 
 def load_plc(paths, task: str = "Main@1ms", programs=None, *, dialect: str = "sysmac",
              watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
-             count_statements: bool = False, clock_base_ns: int | None = None) -> "Plc":
-    """A new PLC instance (its own variables, tasks and sockets) running the compiled ``paths``."""
+             count_statements: bool = False, clock_base_ns: int | None = None, axes=None) -> "Plc":
+    """A new PLC instance (its own variables, tasks and sockets) running the compiled ``paths``; ``axes``: the
+    axis configuration file of its virtual servo axes (docs/toolchain/runtime_sysmac.md section 5)."""
     program = compile_program(paths, dialect=dialect, count_statements=count_statements)
     return Plc(program, task, programs, watchdog_ms=watchdog_ms, socket_limit=socket_limit,
-               socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns)
+               socket_latency_ns=socket_latency_ns, clock_base_ns=clock_base_ns, axes=axes)
 
 
 _COMPILED: OrderedDict = OrderedDict()      # source fingerprint -> Program, most recently used last
@@ -114,7 +115,8 @@ class Plc:
     """One virtual controller: its own copy of a compiled program's variables, its tasks and its sockets."""
 
     def __init__(self, program, task="Main@1ms", programs=None, *, watchdog_ms: float = 500.0,
-                 socket_limit: int = 30, socket_latency_ns: int = 0, clock_base_ns: int | None = None) -> None:
+                 socket_limit: int = 30, socket_latency_ns: int = 0, clock_base_ns: int | None = None,
+                 axes=None) -> None:
         self.program = program
         self.project = program.project
         self.module = module = program.load()
@@ -137,7 +139,26 @@ class Plc:
                             "large arrays") from None
         except Exception as exc:   # noqa: BLE001 - an initial value that faults
             raise LoadError(f"error: initialising the variables failed: {self.engine.make_fault(exc)}") from None
+        self.motion = self._attach_axes(axes) if axes is not None else None
         self._resolver = Resolver(self)
+
+    def _attach_axes(self, axes):
+        """Virtual servo axes behind _MC_AX: ``axes`` is the path of an axis configuration file (or the tuple
+        ``runtime.motion_config.load_axes`` returns). Their motion processing runs after the programs of the
+        highest-priority task, in each of its periods (the NJ/NX primary periodic task)."""
+        from .runtime.motion import MotionController
+        from .runtime.motion_config import AxisConfigError, load_axes
+        try:
+            configs = load_axes(axes) if isinstance(axes, (str, os.PathLike)) else tuple(axes)
+            ctl = MotionController(self.engine, configs, self.globals)
+        except AxisConfigError as exc:
+            raise LoadError(f"error: {exc}") from None
+        except ValueError as exc:
+            raise LoadError(f"error: {os.fspath(axes) if isinstance(axes, (str, os.PathLike)) else 'axes'}: "
+                            f"{exc}") from None
+        self.engine.motion = ctl
+        self.engine.tasks[0].programs.append((ctl, type(ctl).cycle))
+        return ctl
 
     # ---- tasks --------------------------------------------------------------------------------
     def _program(self, name: str):

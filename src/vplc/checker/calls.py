@@ -185,7 +185,10 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
             ctx.diags.error("ST1103", f"{what}: in-out parameter of type {p.type.name} cannot refer to "
                             f"`{ck.text(value)}` of type {have.name}; the types must be identical", value.span)
             return ba
-        assign_target.check_write(ck, value, f"in-out {p.name}")
+        if getattr(T.base_of(p.type), "name", "").upper() != "_SAXIS_REF":
+            # the system axis variable _MC_AX[n] is read-only, yet every motion instruction (and a user's FB
+            # wrapping them) takes it as an in-out (W508)
+            assign_target.check_write(ck, value, f"in-out {p.name}")
         return ba
     ck.coerce(value, have, p.type, what)
     return ba

@@ -39,6 +39,8 @@ def register(subparsers) -> None:
     p.add_argument("--set", action="append", default=[], metavar="VAR=VALUE@TIME",
                    help="write a variable when the run reaches TIME (default 0s), e.g. Main.Start=TRUE@2s "
                         "(repeatable)")
+    p.add_argument("--axes", metavar="FILE",
+                   help="axis configuration (TOML) of the virtual servo axes behind _MC_AX[n] (runtime_sysmac.md §5)")
     p.add_argument("--scenario", metavar="FILE",
                    help="timed writes and expectations (`at 2s set Main.Start TRUE`, `expect Main.Placed = 24 "
                         "within 60s`); the run ends when every expectation is decided")
@@ -115,7 +117,7 @@ def run_cmd(args) -> int:
         if args.task is not None:
             parse_task(args.task)
         plc = load_plc(args.paths, task=args.task or "Main@1ms", programs=args.program, watchdog_ms=wd / 1e6,
-                       count_statements=args.stats)
+                       count_statements=args.stats, axes=args.axes)
     except LoadError as exc:
         print(str(exc), file=sys.stderr)
         return 2

@@ -28,6 +28,8 @@ def register(subparsers) -> None:
     p.add_argument("paths", nargs="+", metavar="PATH",
                    help="ST (.st) or PLCopen / IEC 61131-10 (.xml) file, or a folder searched recursively for both")
     p.add_argument("--junit", metavar="FILE", help="also write the results as JUnit XML")
+    p.add_argument("--axes", metavar="FILE",
+                   help="axis configuration (TOML) of the virtual servo axes behind _MC_AX[n] (runtime_sysmac.md §5)")
     p.add_argument("--timeout", default="10s", help="virtual time allowed for all tests to finish (default 10s)")
     p.add_argument("-v", "--verbose", action="store_true", help="list passing tests too")
     p.set_defaults(handler=run_tests)
@@ -94,7 +96,7 @@ def run_tests(args) -> int:
             with open(runner, "w", encoding="utf-8") as f:
                 f.write(runner_source(remaining))
             try:
-                plc = load_plc(list(args.paths) + [runner], task=f"{RUNNER}@1ms", programs=[RUNNER])
+                plc = load_plc(list(args.paths) + [runner], task=f"{RUNNER}@1ms", programs=[RUNNER], axes=args.axes)
             except LoadError as exc:
                 print(str(exc), file=sys.stderr)
                 return 2

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from . import iec
 from . import sockets as S
+from .motion_fbs import NATIVE_FBS as MOTION_FBS
 from .sysmac_fns import FUNCTIONS
 from .testing import FUNCTIONS as TEST_FUNCTIONS
 
@@ -238,4 +239,5 @@ class SktTCPAccept(_SocketFB):
 
 NATIVE_FBS = {c.__name__: c for c in (SktTCPConnect, SktTCPSend, SktTCPRcv, SktGetTCPStatus, SktClearBuf,
                                       SktClose, SktTCPAccept)}
+NATIVE_FBS.update(MOTION_FBS)           # W508 single-axis motion instructions on virtual axes
 NATIVE_FUNCTIONS = {**FUNCTIONS, **TEST_FUNCTIONS}

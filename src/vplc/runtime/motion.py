@@ -1,0 +1,440 @@
+"""Virtual servo axes: the PLCopen axis state machine as Omron's NJ/NX motion control implements it (W507 axis
+states, W508 single-axis instructions) and trapezoidal profiles evaluated in closed form.
+
+A :class:`MotionController` owns the axes of one PLC. The motion instructions (``motion_fbs``) hand it
+commands; :meth:`MotionController.cycle` runs after the programs of the primary task in every one of its
+periods, as the motion control processing of an NJ/NX primary periodic task does, advances each axis to the
+scan time and writes ``_MC_AX[n]``. Positions are never integrated: every motion is a :class:`Profile` of
+constant-acceleration segments from its start, so the command position at time t is the closed-form value.
+The servo is ideal (``Act`` = ``Cmd``).
+"""
+from __future__ import annotations
+
+import math
+
+from .motion_config import UNITS, AxisConfig
+
+# ---- ErrorIDs and axis error codes (docs/toolchain/runtime_sysmac.md section 5.3) ---------------------------
+# Omron's W508 error table was not readable in the manual corpus: the values are chosen in Omron's 16#54xx
+# motion-instruction range; the names say what the instruction refused.
+ERR_AXIS_UNUSED = 0x5401       # the axis is not a configured virtual axis
+ERR_DISABLED = 0x5402          # motion command while the servo is OFF (Disabled)
+ERR_ERRORSTOP = 0x5403         # command while the axis is in ErrorStop
+ERR_STOPPING = 0x5404          # command while MC_Stop holds the axis in Stopping
+ERR_MOVING = 0x5405            # MC_Home / MC_SetPosition while the axis moves
+ERR_VELOCITY = 0x5410          # Velocity out of range
+ERR_ACCELERATION = 0x5411      # Acceleration negative
+ERR_DECELERATION = 0x5412      # Deceleration negative
+ERR_JERK = 0x5413              # Jerk negative
+ERR_DIRECTION = 0x5414         # Direction not allowed for the instruction
+ERR_BUFFER_MODE = 0x5415       # BufferMode out of range
+ERR_POSITION = 0x5416          # target (or SetPosition value) outside the software limits, or not finite
+ERR_OVERRIDE = 0x5417          # VelFactor outside 0 .. 500 %
+ERR_BUFFER_FULL = 0x5418       # a second buffered command while one is already waiting
+AXIS_SW_LIMIT_POS = 0x6440     # axis minor fault: positive software limit reached (MFaultLvl.Code)
+AXIS_SW_LIMIT_NEG = 0x6441     # axis minor fault: negative software limit reached
+
+# axis states (W507 axis status, exactly one is TRUE)
+DISABLED, STANDSTILL, DISCRETE, CONTINUOUS, HOMING, STOPPING, ERRORSTOP = (
+    "Disabled", "Standstill", "Discrete", "Continuous", "Homing", "Stopping", "ErrorStop")
+
+# command status seen by the instruction that gave it
+WAITING, ACTIVE, DONE, ABORTED = "waiting", "active", "done", "aborted"
+
+MAX_OVERRIDE = 5.0             # MC_SetOverride VelFactor 0 .. 500 %
+
+
+class Profile:
+    """Motion from (t0, x0, v0) as segments of constant acceleration; after the last segment the axis keeps
+    the final velocity (0 for a positioning, the target velocity for velocity control)."""
+
+    __slots__ = ("parts", "i", "t_end", "x_end", "v_end", "hold")
+
+    def __init__(self, t0: float, x0: float, v0: float, segments, target: float | None = None) -> None:
+        parts = []
+        t, x, v = t0, x0, v0
+        for d, a in segments:
+            if d > 0.0:
+                parts.append((t + d, t, x, v, a))
+                x += v * d + 0.5 * a * d * d
+                v += a * d
+                t += d
+        self.parts, self.i, self.t_end = parts, 0, t
+        self.x_end, self.v_end = (target, 0.0) if target is not None else (x, v)
+        self.hold = False           # True: a positioning held at velocity 0 by a 0 % override
+
+    def at(self, t: float) -> tuple[float, float, float, bool]:
+        """(position, velocity, acceleration, finished) at time t (seconds)."""
+        parts, i = self.parts, self.i
+        while i < len(parts) and t >= parts[i][0]:
+            i += 1
+        self.i = i
+        if i == len(parts):
+            return self.x_end + self.v_end * (t - self.t_end), self.v_end, 0.0, True
+        _, ts, x, v, a = parts[i]
+        tau = t - ts
+        return x + v * tau + 0.5 * a * tau * tau, v + a * tau, a, False
+
+
+def plan_position(x0: float, v0: float, xt: float, vmax: float, acc: float, dec: float) -> list:
+    """Segments (duration, acceleration) that take the axis from (x0, v0) to rest at xt: accelerate with acc,
+    cruise at vmax, decelerate with dec (a triangle when the distance is short). Moving away from the target,
+    or too fast to stop before it, the axis first decelerates to a stop and then comes back."""
+    dist = xt - x0
+    s = 1.0 if dist > 0 or (dist == 0 and v0 < 0) else -1.0
+    d, u = abs(dist), v0 * s               # distance and velocity in the direction of the target
+    segs = []
+    if u < 0:                              # moving away: stop first
+        segs.append((-u / dec, s * dec))
+        d += u * u / (2 * dec)
+        u = 0.0
+    elif u * u / (2 * dec) > d * (1 + 1e-12) + 1e-12:       # cannot stop in time: stop beyond, come back
+        segs.append((u / dec, -s * dec))
+        over = u * u / (2 * dec) - d
+        return segs + plan_position(0.0, 0.0, -s * over, vmax, acc, dec)
+    if d <= 0.0 and u <= 0.0:
+        return segs
+    if u > vmax:                           # slower than now (override lowered): decelerate to vmax, cruise, stop
+        cruise = d - u * u / (2 * dec)
+        return segs + [((u - vmax) / dec, -s * dec), (max(cruise, 0.0) / vmax, 0.0), (vmax / dec, -s * dec)]
+    vp = math.sqrt((d + u * u / (2 * acc)) / (1 / (2 * acc) + 1 / (2 * dec)))
+    cruise = 0.0
+    if vp > vmax:
+        vp = vmax
+        cruise = d - (vmax * vmax - u * u) / (2 * acc) - vmax * vmax / (2 * dec)
+    segs.append(((vp - u) / acc, s * acc))
+    if cruise > 0:
+        segs.append((cruise / vp, 0.0))
+    segs.append((vp / dec, -s * dec))
+    return segs
+
+
+def plan_velocity(v0: float, vt: float, acc: float, dec: float) -> list:
+    """Segments from velocity v0 to vt: speeding up with acc, slowing down with dec (through 0 when the
+    direction changes: first dec to 0, then acc)."""
+    if v0 * vt < 0:
+        return [(abs(v0) / dec, math.copysign(dec, -v0)), (abs(vt) / acc, math.copysign(acc, vt))]
+    if abs(vt) >= abs(v0):
+        return [((abs(vt) - abs(v0)) / acc, math.copysign(acc, vt if vt else v0))]
+    return [((abs(v0) - abs(vt)) / dec, math.copysign(dec, -v0))]
+
+
+class Command:
+    """One execution of a motion instruction on an axis."""
+
+    __slots__ = ("kind", "fb", "status", "in_velocity", "target", "velocity", "acc", "dec", "direction")
+
+    def __init__(self, kind: str, fb, target=0.0, velocity=0.0, acc=0.0, dec=0.0, direction=1.0) -> None:
+        self.kind, self.fb, self.status, self.in_velocity = kind, fb, WAITING, False
+        self.target, self.velocity, self.acc, self.dec, self.direction = target, velocity, acc, dec, direction
+
+
+class Axis:
+    """One virtual servo axis and the _sAXIS_REF value the program sees."""
+
+    def __init__(self, cfg: AxisConfig, ref) -> None:
+        self.cfg, self.ref = cfg, ref
+        self.state = DISABLED
+        self.pos = self.vel = self.acc = 0.0
+        self.homed = cfg.homed
+        self.powered = False
+        self.power_request = False
+        self.override = 1.0
+        self.profile: Profile | None = None
+        self.active: Command | None = None      # the command the profile belongs to
+        self.queued: Command | None = None      # a buffered command waiting for the active one
+        self.stop_cmd: Command | None = None    # MC_Stop holding the axis in Stopping
+        self.stop_execute = False               # that MC_Stop's Execute at its last call
+        self.error_code = 0
+        self.limit_stop = False                 # decelerating onto a software limit
+        self.instant: list[Command] = []        # MC_Home / MC_SetPosition for this period
+        self.last_dir = 1.0
+        ref.Cfg.AxNo = cfg.number
+        ref.Cfg.AxEnable = 2                    # _mcUsedAxis
+        ref.Cfg.AxType = 2                      # _mcVirServo
+        ref.Scale.Units = UNITS[cfg.units]
+        ref.Scale.Num, ref.Scale.Den = 1, 1.0
+        ref.Scale.MaxPos = cfg.limit_positive if cfg.limit_positive is not None else 0.0
+        ref.Scale.MinPos = cfg.limit_negative if cfg.limit_negative is not None else 0.0
+        ref.DrvStatus.Ready = ref.DrvStatus.MainPower = True
+        ref.Details.Homed = self.homed
+        self._set_state(DISABLED)
+        self._write()
+
+    # ---- what the program sees -------------------------------------------------------------------
+    def _set_state(self, state: str) -> None:
+        st = self.ref.Status
+        setattr(st, self.state, False)
+        self.state = state
+        setattr(st, state, True)
+        st.Ready = state == STANDSTILL
+        self.ref.Details.Idle = state in (STANDSTILL, DISABLED) or (state in (STOPPING, ERRORSTOP)
+                                                                   and self.profile is None)
+
+    def _write(self) -> None:
+        ref = self.ref
+        cmd, act = ref.Cmd, ref.Act
+        cmd.Pos = act.Pos = self.pos
+        cmd.Vel = act.Vel = self.vel
+        cmd.AccDec = self.acc
+        ref.Details.InHome = self.homed and self.pos == self.cfg.home_position and self.vel == 0.0
+
+    # ---- limits ------------------------------------------------------------------------------------
+    def limits_active(self) -> bool:
+        return self.homed and self.cfg.limit_positive is not None
+
+    def in_limits(self, x: float) -> bool:
+        return not self.limits_active() or self.cfg.limit_negative <= x <= self.cfg.limit_positive
+
+    def vmax_of(self, velocity: float) -> tuple[float, bool]:
+        """Command velocity after the axis maximum and the override; True when the maximum limited it."""
+        limited = velocity > self.cfg.max_velocity
+        return min(velocity, self.cfg.max_velocity) * self.override, limited
+
+    def ramp(self, value: float, maximum: float) -> float:
+        """Acceleration or deceleration actually used: 0 (no limit in W508) and values above the axis maximum
+        run at the axis maximum (our choice: the axis parameter 'Acceleration/Deceleration Over' is not
+        modelled)."""
+        return maximum if value <= 0.0 or value > maximum else value
+
+    # ---- commands -----------------------------------------------------------------------------------
+    def _finish(self, cmd: Command | None, status: str) -> None:
+        if cmd is not None and cmd.status in (WAITING, ACTIVE):
+            cmd.status = status
+
+    def abort_all(self) -> None:
+        self._finish(self.active, ABORTED)
+        self._finish(self.queued, ABORTED)
+        self.active = self.queued = None
+
+    def start(self, cmd: Command, t: float) -> None:
+        """Make ``cmd`` the axis' motion from now on (Aborting, or a buffered command whose turn came)."""
+        if self.profile is not None and self.profile.t_end != t:     # where the axis is now, in closed form
+            self.pos, self.vel, self.acc, _ = self.profile.at(t)
+        if self.active is not cmd:
+            self._finish(self.active, ABORTED)
+        if self.stop_cmd is not None and cmd.kind != "stop":
+            self.stop_cmd = None
+        self.active, cmd.status = cmd, ACTIVE
+        self.limit_stop = False
+        k = cmd.kind
+        if k == "velocity":
+            self.last_dir = cmd.direction
+            vt, limited = self.vmax_of(cmd.velocity)
+            self.ref.Details.VelLimit = limited
+            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, cmd.direction * vt, cmd.acc,
+                                                                        cmd.dec))
+            self._set_state(CONTINUOUS)
+        elif k == "position":
+            self.plan_to(cmd, t)
+            self._set_state(DISCRETE)
+        elif k in ("halt", "stop"):
+            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.dec, cmd.dec)
+                                   if self.vel else [], None)
+            self._set_state(DISCRETE if k == "halt" else STOPPING)
+
+    def plan_to(self, cmd: Command, t: float) -> None:
+        vmax, limited = self.vmax_of(cmd.velocity)
+        self.ref.Details.VelLimit = limited
+        if vmax <= 0.0:                         # 0 % override: decelerate and hold, still in motion
+            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.acc, cmd.dec))
+            self.profile.hold = True
+        else:
+            self.profile = Profile(t, self.pos, self.vel, plan_position(self.pos, self.vel, cmd.target, vmax,
+                                                                          cmd.acc, cmd.dec), cmd.target)
+        if self.vel == 0.0 and cmd.target != self.pos:
+            self.last_dir = 1.0 if cmd.target > self.pos else -1.0
+
+    def set_override(self, factor: float, t: float) -> None:
+        if factor == self.override:
+            return
+        self.override = factor
+        cmd = self.active
+        if cmd is not None and cmd.kind in ("position", "velocity") and self.state in (DISCRETE, CONTINUOUS):
+            self.start(cmd, t)
+
+    # ---- the motion control processing of one period -----------------------------------------------
+    def advance(self, t: float) -> None:
+        """Evaluate the motion at time t; a buffered command starts exactly when the one before it ends
+        (Done, or InVelocity after a velocity command), so the command position stays continuous."""
+        while True:
+            prof = self.profile
+            x, v, a, finished = prof.at(t)
+            if self.limits_active():
+                x, v, a, finished = self._guard_limits(x, v, a, finished, t)
+                prof = self.profile
+            self.pos, self.vel, self.acc = x, v, a
+            cmd = self.active
+            if not finished or prof.hold:
+                break
+            if cmd is not None and cmd.kind == "velocity":
+                cmd.in_velocity = True
+                if self.queued is None:
+                    break
+            if self.queued is not None:
+                self.pos, self.vel = prof.x_end, prof.v_end
+                self._finish(cmd, DONE)
+                nxt, self.queued, self.active = self.queued, None, None
+                self.start(nxt, prof.t_end)
+                continue
+            self.profile = None
+            self.vel = self.acc = 0.0
+            self._end_of_motion()
+            break
+        self._write()
+
+    def _end_of_motion(self) -> None:
+        cmd = self.active
+        if self.state == ERRORSTOP:
+            self.limit_stop = False
+            self._set_state(ERRORSTOP)
+            return
+        if cmd is not None and cmd.kind == "stop":
+            cmd.status = DONE
+            if not self.stop_execute:
+                self.release_stop()
+            else:
+                self._set_state(STOPPING)
+            return
+        self._finish(cmd, DONE)
+        self.active = None
+        self._set_state(STANDSTILL)
+
+    def release_stop(self) -> None:
+        """MC_Stop is done and its Execute is FALSE: the axis leaves Stopping (W507 state chart)."""
+        self.stop_cmd = None
+        if self.active is not None and self.active.kind == "stop":
+            self.active = None
+        if self.state == STOPPING and self.profile is None:
+            self._set_state(STANDSTILL)
+
+    def run_instant(self) -> None:
+        """MC_Home (zero position preset) and MC_SetPosition given in this period."""
+        for cmd in self.instant:
+            if cmd.status != WAITING:
+                continue
+            self.define_position(cmd.target, True)
+            cmd.status = DONE
+            if self.state == HOMING:
+                self._set_state(STANDSTILL)
+        self.instant.clear()
+
+    def _guard_limits(self, x, v, a, finished, t):
+        """Software limits on the command position (W507): a motion that would pass a limit decelerates with
+        the axis' maximum deceleration so that it stops on the limit, and the axis goes to ErrorStop with a
+        minor fault; a position already past a limit is held on it."""
+        lo, hi = self.cfg.limit_negative, self.cfg.limit_positive
+        if self.limit_stop:
+            return x, v, a, finished
+        if x > hi or x < lo:
+            x = hi if x > hi else lo
+            self._limit_fault(x, t)
+            self.profile = Profile(t, x, 0.0, [])
+            return x, 0.0, 0.0, True
+        if v != 0.0:
+            edge = hi if v > 0 else lo
+            room = abs(edge - x)
+            brake = v * v / (2 * self.cfg.max_deceleration)
+            if room <= brake:
+                self._limit_fault(edge, t)
+                dec = v * v / (2 * room) if room > 0 else 0.0
+                segs = [(abs(v) / dec, math.copysign(dec, -v))] if dec > 0 else []
+                self.profile = Profile(t, x, v if dec > 0 else 0.0, segs, edge)
+                self.limit_stop = True
+                return (x, v, -math.copysign(dec, v), False) if dec > 0 else (edge, 0.0, 0.0, True)
+        return x, v, a, finished
+
+    def _limit_fault(self, edge: float, t: float) -> None:
+        self.error(AXIS_SW_LIMIT_POS if edge == self.cfg.limit_positive else AXIS_SW_LIMIT_NEG)
+
+    def error(self, code: int) -> None:
+        """An axis minor fault: the commands are aborted, the axis goes to ErrorStop (W507 state chart)."""
+        self.abort_all()
+        self._finish(self.stop_cmd, ABORTED)
+        self.stop_cmd = None
+        self.error_code = code
+        self.ref.MFaultLvl.Active, self.ref.MFaultLvl.Code = True, code
+        self._set_state(ERRORSTOP)
+
+    def power(self, on: bool) -> None:
+        """Servo ON / OFF (applied in the motion processing after the program, so MC_Power's Status follows
+        one period later). Servo OFF stops the axis at once and aborts its commands."""
+        if on == self.powered:
+            return
+        self.powered = self.ref.DrvStatus.ServoOn = on
+        if not on:
+            self.abort_all()
+            self._finish(self.stop_cmd, ABORTED)
+            self.stop_cmd = None
+            self.profile = None
+            self.vel = self.acc = 0.0
+            self._write()
+            if self.state != ERRORSTOP:
+                self._set_state(DISABLED)
+        elif self.state == DISABLED:
+            self._set_state(STANDSTILL)
+
+    def reset(self) -> bool:
+        """MC_Reset: clear the axis error once the axis has stopped. False while it still decelerates."""
+        if self.state != ERRORSTOP:
+            return True
+        if self.profile is not None:
+            return False
+        self.error_code = 0
+        self.ref.MFaultLvl.Active, self.ref.MFaultLvl.Code = False, 0
+        self._set_state(STANDSTILL if self.powered else DISABLED)
+        return True
+
+    def define_position(self, x: float, homed: bool = True) -> None:
+        """Zero position preset (MC_Home) and MC_SetPosition: the command position becomes x; home is defined."""
+        self.pos = x
+        self.homed = homed
+        self.ref.Details.Homed = homed
+        self._write()
+
+
+class MotionController:
+    """The axes of one PLC and the motion processing that runs in its primary task."""
+
+    def __init__(self, rt, configs, globals_obj) -> None:
+        self.rt = rt
+        table = getattr(globals_obj, "_MC_AX", None)
+        if table is None:
+            raise ValueError("the prelude's _MC_AX is not loaded")
+        self.axes: list[Axis] = []
+        self.by_ref: dict[int, Axis] = {}
+        for cfg in configs:
+            ref = table[cfg.number]
+            if cfg.name is not None:             # a global _sAXIS_REF of that name is the same axis
+                alias = self._global(globals_obj, cfg.name)
+                if alias is None:
+                    raise ValueError(f"axis {cfg.number}: the program declares no global variable "
+                                     f"`{cfg.name}` of type _sAXIS_REF")
+                setattr(globals_obj, alias, ref)
+            axis = Axis(cfg, ref)
+            self.axes.append(axis)
+            self.by_ref[id(ref)] = axis
+        n = len(self.axes)
+        self.i__path = f"motion control of {n} ax{'is' if n == 1 else 'es'}"     # how `vplc run` lists it
+
+    @staticmethod
+    def _global(globals_obj, name: str):
+        info = getattr(type(globals_obj), "i__vars", {})
+        entry = info.get(name.upper())
+        if entry is None or getattr(entry[1], "name", "").upper() != "_SAXIS_REF":
+            return None
+        return entry[0]
+
+    def axis_of(self, ref) -> Axis | None:
+        return self.by_ref.get(id(ref))
+
+    def cycle(self) -> None:
+        """The motion control processing of one primary-task period: every axis to the scan time."""
+        t = self.rt.now_ns / 1e9
+        for axis in self.axes:
+            if axis.power_request != axis.powered:
+                axis.power(axis.power_request)
+            if axis.instant:
+                axis.run_instant()
+            if axis.profile is not None:
+                axis.advance(t)

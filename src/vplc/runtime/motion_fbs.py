@@ -1,0 +1,474 @@
+"""The single-axis motion instructions of W508 (declared in prelude/sysmac_motion.st) on virtual axes.
+
+Output timing (PLCopen Part 1 as W508 describes it for every motion instruction; details we chose are in
+docs/toolchain/runtime_sysmac.md section 5):
+
+* the rising edge of Execute starts the instruction: Busy TRUE in that call (Active too when the axis takes
+  the command at once, i.e. always except a Buffered command waiting for the one before it); a parameter or
+  state error sets Error and ErrorID in that call instead;
+* the motion runs in the motion processing after the program (``motion.MotionController.cycle``), so Done,
+  InVelocity and CommandAborted appear at the earliest in the next call;
+* Done, CommandAborted and Error stay TRUE while Execute is TRUE and are cleared in the call that sees
+  Execute FALSE; if Execute was already FALSE when they came, they are TRUE for that one call.
+
+What vplc does not model is refused as a major fault naming the instruction and the value (Jerk other than 0,
+the blending buffer modes), never run with another meaning.
+"""
+from __future__ import annotations
+
+import math
+
+from . import motion as M
+from .faults import RuntimeFaultError
+
+_BLENDING = {2: "_mcBlendingLow", 3: "_mcBlendingPrevious", 4: "_mcBlendingNext", 5: "_mcBlendingHigh"}
+
+
+def _axis(fb):
+    """The virtual axis behind fb.Axis, or None after recording why (Error 16#5401 follows)."""
+    ctl = getattr(fb.i__rt, "motion", None)
+    axis = ctl.axis_of(fb.Axis) if ctl is not None else None
+    if axis is None:
+        why = "no axis configuration was given (vplc run/test --axes FILE, load_plc(axes=...))" if ctl is None \
+            else "it is not one of the axes of the axis configuration"
+        fb.i__rt.instruction_error(f"{type(fb).__name__}: the Axis passed is not a virtual axis: {why}; "
+                                   f"ErrorID 16#{M.ERR_AXIS_UNUSED:04X}")
+    return axis
+
+
+def _now(fb) -> float:
+    return fb.i__rt.now_ns / 1e9
+
+
+class _ExecuteFB:
+    """Execute / Done / Busy / CommandAborted / Error handshake shared by the instructions with Execute."""
+
+    DONE_OUT = "Done"
+
+    def __init__(self, rt, path: str) -> None:
+        self.i__rt, self.i__path = rt, path
+        self.Axis = None
+        self.Execute = False
+        self.Busy = self.CommandAborted = self.Error = False
+        setattr(self, self.DONE_OUT, False)
+        self.ErrorID = 0
+        self.i__prev = False
+        self.i__cmd = None
+        self.i__final = False
+
+    def i__run(self) -> None:
+        ex = self.Execute
+        if self.i__final and not ex:
+            self._clear()
+        if ex and not self.i__prev:
+            self._clear()
+            self.i__cmd = None
+            axis = _axis(self)
+            if axis is None:
+                self._fail(M.ERR_AXIS_UNUSED)
+            else:
+                code = self.begin(axis)
+                if code:
+                    self._fail(code)
+        elif self.i__cmd is not None:
+            self._poll(self.i__cmd)
+        self.i__prev = ex
+
+    def _clear(self) -> None:
+        setattr(self, self.DONE_OUT, False)
+        self.CommandAborted = self.Error = False
+        self.ErrorID = 0
+        self.i__final = False
+
+    def _fail(self, code: int) -> None:
+        self.Busy = False
+        self._set_active(False)
+        self.Error, self.ErrorID, self.i__final = True, code, True
+
+    def _set_active(self, value: bool) -> None:
+        pass
+
+    def _poll(self, cmd) -> None:
+        st = cmd.status
+        if st == M.DONE:
+            setattr(self, self.DONE_OUT, True)
+            self._end()
+        elif st == M.ABORTED:
+            self.CommandAborted = True
+            self._end()
+        elif st == M.ACTIVE:
+            self._set_active(True)
+
+    def _end(self) -> None:
+        self.Busy = False
+        self._set_active(False)
+        self.i__cmd, self.i__final = None, True
+
+    def _issue(self, cmd) -> None:
+        self.i__cmd = cmd
+        self.Busy = True
+
+    def begin(self, axis) -> int:
+        raise NotImplementedError
+
+
+class _MoveFB(_ExecuteFB):
+    """Instructions with Active and BufferMode: MoveAbsolute, MoveRelative, MoveVelocity, Halt, Stop."""
+
+    def __init__(self, rt, path: str) -> None:
+        super().__init__(rt, path)
+        self.Active = False
+        self.Velocity = self.Acceleration = self.Deceleration = self.Jerk = 0.0
+        self.BufferMode = 0
+
+    def _set_active(self, value: bool) -> None:
+        self.Active = value
+
+    def _state_error(self, axis) -> int:
+        """The PLCopen state diagram (W507): no motion from Disabled, ErrorStop or Stopping."""
+        if axis.state == M.ERRORSTOP:
+            return M.ERR_ERRORSTOP
+        if axis.state == M.DISABLED:
+            return M.ERR_DISABLED
+        if axis.state == M.STOPPING:
+            return M.ERR_STOPPING
+        return 0
+
+    def _ramps(self, need_velocity: bool, velocity_zero_ok: bool = False) -> int:
+        name = type(self).__name__
+        v, a, d, j = self.Velocity, self.Acceleration, self.Deceleration, self.Jerk
+        if need_velocity and not (math.isfinite(v) and (v > 0 or (velocity_zero_ok and v == 0))):
+            return M.ERR_VELOCITY
+        if not (math.isfinite(a) and a >= 0):
+            return M.ERR_ACCELERATION
+        if not (math.isfinite(d) and d >= 0):
+            return M.ERR_DECELERATION
+        if not (math.isfinite(j) and j >= 0):
+            return M.ERR_JERK
+        if j > 0:
+            raise RuntimeFaultError(f"{name}: Jerk {j:g} is not modelled by vplc (trapezoidal profiles only); "
+                                    "use Jerk := 0")
+        return self._buffer_mode()
+
+    def _buffer_mode(self) -> int:
+        bm = self.BufferMode
+        if bm in _BLENDING:
+            raise RuntimeFaultError(f"{type(self).__name__}: BufferMode {_BLENDING[bm]} is not modelled by vplc "
+                                    "(only _mcAborting and _mcBuffered)")
+        return 0 if bm in (0, 1) else M.ERR_BUFFER_MODE
+
+    def _give(self, axis, cmd) -> int:
+        """Hand cmd to the axis: at once (Aborting, or Buffered on an axis at rest) or after the running one."""
+        act = axis.active
+        if self.BufferMode == 1 and act is not None and act.status == M.ACTIVE and act.fb is not self \
+                and not act.in_velocity:
+            if axis.queued is not None:
+                return M.ERR_BUFFER_FULL
+            axis.queued = cmd
+            self._issue(cmd)
+            return 0
+        if axis.queued is not None and axis.queued.fb is self:
+            axis.queued = None
+        axis.start(cmd, _now(self))
+        self._issue(cmd)
+        self.Active = True
+        return 0
+
+
+class MC_MoveAbsolute(_MoveFB):
+    """W508 MC_MoveAbsolute. Linear count mode: Direction is checked (0..4) and otherwise not used."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Position = 0.0
+        self.Direction = 4
+
+    def target(self, axis) -> float:
+        return self.Position
+
+    def begin(self, axis) -> int:
+        code = self._state_error(axis) or self._ramps(True)
+        if code:
+            return code
+        if not 0 <= self.Direction <= 4:
+            return M.ERR_DIRECTION
+        x = self.target(axis)
+        if not math.isfinite(x) or not axis.in_limits(x):
+            return M.ERR_POSITION
+        cfg = axis.cfg
+        cmd = M.Command("position", self, x, self.Velocity, axis.ramp(self.Acceleration, cfg.max_acceleration),
+                        axis.ramp(self.Deceleration, cfg.max_deceleration))
+        return self._give(axis, cmd)
+
+
+class MC_MoveRelative(MC_MoveAbsolute):
+    """W508 MC_MoveRelative: the target is Distance from the command position when the motion starts (from the
+    target of the command before it when Buffered)."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Distance = 0.0
+
+    def target(self, axis) -> float:
+        base = axis.pos
+        act = axis.active
+        if self.BufferMode == 1 and act is not None and act.kind == "position" and act.status == M.ACTIVE:
+            base = act.target
+        elif axis.profile is not None:
+            base = axis.profile.at(_now(self))[0]
+        return base + self.Distance
+
+
+class MC_MoveVelocity(_MoveFB):
+    """W508 MC_MoveVelocity: Direction _mcPositiveDirection, _mcNegativeDirection or _mcCurrentDirection."""
+
+    DONE_OUT = "InVelocity"
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Direction = 0
+        self.Continuous = False
+
+    def begin(self, axis) -> int:
+        code = self._state_error(axis) or self._ramps(True, velocity_zero_ok=True)
+        if code:
+            return code
+        d = self.Direction
+        if d == 0:
+            sign = 1.0
+        elif d == 2:
+            sign = -1.0
+        elif d == 3:
+            sign = (1.0 if axis.vel > 0 else -1.0) if axis.vel else axis.last_dir
+        else:
+            return M.ERR_DIRECTION
+        cfg = axis.cfg
+        cmd = M.Command("velocity", self, 0.0, self.Velocity, axis.ramp(self.Acceleration, cfg.max_acceleration),
+                        axis.ramp(self.Deceleration, cfg.max_deceleration), sign)
+        return self._give(axis, cmd)
+
+    def _poll(self, cmd) -> None:
+        if cmd.status == M.ACTIVE:
+            self.Active = True
+            self.InVelocity = cmd.in_velocity
+        elif cmd.status == M.ABORTED or cmd.status == M.DONE:
+            self.InVelocity = False
+            self.CommandAborted = True
+            self._end()
+
+    def _clear(self) -> None:
+        super()._clear()
+        self.InVelocity = False
+
+
+class MC_Halt(_MoveFB):
+    """W508 MC_Halt: decelerates to a stop (Discrete); another instruction may abort it."""
+
+    def begin(self, axis) -> int:
+        code = self._state_error(axis) or self._ramps(False)
+        if code:
+            return code
+        cmd = M.Command("halt", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration))
+        return self._give(axis, cmd)
+
+
+class MC_Stop(_MoveFB):
+    """W508 MC_Stop: aborts every command, decelerates to a stop and holds the axis in Stopping while Execute
+    is TRUE; the axis goes to Standstill when MC_Stop is Done and called with Execute FALSE."""
+
+    def begin(self, axis) -> int:
+        if axis.state == M.ERRORSTOP:
+            return M.ERR_ERRORSTOP
+        if axis.state == M.DISABLED:
+            return M.ERR_DISABLED
+        code = self._ramps(False)
+        if code:
+            return code
+        cmd = M.Command("stop", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration))
+        axis.abort_all()
+        if axis.stop_cmd is not None and axis.stop_cmd.fb is not self:
+            axis._finish(axis.stop_cmd, M.ABORTED)
+        axis.stop_cmd, axis.stop_execute = cmd, True
+        axis.start(cmd, _now(self))
+        self._issue(cmd)
+        self.Active = True
+        self.i__stop = cmd
+        return 0
+
+    def i__run(self) -> None:
+        super().i__run()
+        stop = self.i__stop
+        if stop is None:
+            return
+        ctl = getattr(self.i__rt, "motion", None)
+        axis = ctl.axis_of(self.Axis) if ctl is not None else None
+        if axis is None or axis.stop_cmd is not stop:
+            self.i__stop = None
+            return
+        axis.stop_execute = self.Execute
+        if not self.Execute and stop.status == M.DONE:
+            axis.release_stop()
+            self.i__stop = None
+
+    i__stop = None          # the stop this instance gave, until the axis leaves Stopping
+
+
+class MC_Home(_ExecuteFB):
+    """W508 MC_Home with the zero position preset homing method: home = the configured home_position."""
+
+    def begin(self, axis) -> int:
+        if axis.state == M.ERRORSTOP:
+            return M.ERR_ERRORSTOP
+        if axis.state == M.DISABLED:
+            return M.ERR_DISABLED
+        if axis.state == M.STOPPING:
+            return M.ERR_STOPPING
+        if axis.state != M.STANDSTILL:
+            return M.ERR_MOVING
+        cmd = M.Command("home", self, axis.cfg.home_position)
+        axis.instant.append(cmd)
+        axis._set_state(M.HOMING)
+        self._issue(cmd)
+        return 0
+
+
+class MC_SetPosition(_ExecuteFB):
+    """W508 MC_SetPosition: the command and actual position become Position (the virtual servo has no following
+    error, so every ReferenceType gives the same result); home becomes defined."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Position = 0.0
+        self.ReferenceType = 0
+
+    def begin(self, axis) -> int:
+        if axis.state == M.ERRORSTOP:
+            return M.ERR_ERRORSTOP
+        if axis.state not in (M.STANDSTILL, M.DISABLED):
+            return M.ERR_MOVING
+        x = self.Position
+        if not math.isfinite(x) or (axis.cfg.limit_positive is not None
+                                    and not axis.cfg.limit_negative <= x <= axis.cfg.limit_positive):
+            return M.ERR_POSITION
+        cmd = M.Command("setpos", self, x)
+        axis.instant.append(cmd)
+        self._issue(cmd)
+        return 0
+
+
+class MC_Reset(_ExecuteFB):
+    """W508 MC_Reset: clears the axis error; Busy until the axis has stopped, then Done. Failure stays FALSE
+    (a virtual axis has no error cause that outlasts the reset)."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Failure = False
+
+    def begin(self, axis) -> int:
+        self._issue(M.Command("reset", self))
+        self.i__axis = axis
+        self._try()
+        return 0
+
+    def _poll(self, cmd) -> None:
+        self._try()
+
+    def _try(self) -> None:
+        if self.i__axis.reset():
+            self.Done = True
+            self._end()
+
+
+class _EnableFB:
+    def __init__(self, rt, path: str) -> None:
+        self.i__rt, self.i__path = rt, path
+        self.Axis = None
+        self.Enable = False
+        self.Busy = self.Error = False
+        self.ErrorID = 0
+
+
+class MC_Power(_EnableFB):
+    """W508 MC_Power: servo ON while Enable is TRUE; Status TRUE once it is ON (after the motion processing of
+    the period); Busy follows Enable."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Status = False
+
+    def i__run(self) -> None:
+        en = self.Enable
+        ctl = getattr(self.i__rt, "motion", None)
+        axis = ctl.axis_of(self.Axis) if ctl is not None else None
+        if axis is None:
+            if en and not self.Error:
+                _axis(self)
+                self.Error, self.ErrorID = True, M.ERR_AXIS_UNUSED
+            elif not en:
+                self.Error, self.ErrorID = False, 0
+            self.Status = self.Busy = False
+            return
+        axis.power_request = en
+        self.Busy = en
+        self.Status = en and axis.powered
+
+
+class MC_ReadAxisError(_EnableFB):
+    """W508 MC_ReadAxisError: AxisErrorID is the axis' minor fault code while Enable is TRUE."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.Valid = False
+        self.AxisErrorID = 0
+
+    def i__run(self) -> None:
+        if not self.Enable:
+            self.Valid = self.Busy = self.Error = False
+            self.ErrorID = self.AxisErrorID = 0
+            return
+        ctl = getattr(self.i__rt, "motion", None)
+        axis = ctl.axis_of(self.Axis) if ctl is not None else None
+        if axis is None:
+            if not self.Error:
+                _axis(self)
+            self.Valid, self.Busy, self.Error, self.ErrorID = False, False, True, M.ERR_AXIS_UNUSED
+            return
+        self.Valid = self.Busy = True
+        self.AxisErrorID = axis.error_code
+
+
+class MC_SetOverride(_EnableFB):
+    """W508 MC_SetOverride: while Enable is TRUE the command velocity is VelFactor % (0 .. 500) of what the
+    instructions ask; 0 % holds the axis without ending its motion. AccFactor and JerkFactor are not used."""
+
+    def __init__(self, rt, path):
+        super().__init__(rt, path)
+        self.VelFactor = self.AccFactor = self.JerkFactor = 100.0
+        self.Enabled = False
+
+    def i__run(self) -> None:
+        ctl = getattr(self.i__rt, "motion", None)
+        axis = ctl.axis_of(self.Axis) if ctl is not None else None
+        if not self.Enable:
+            if self.Enabled and axis is not None:
+                axis.set_override(1.0, _now(self))
+            self.Enabled = self.Busy = self.Error = False
+            self.ErrorID = 0
+            return
+        if axis is None:
+            if not self.Error:
+                _axis(self)
+            self.Enabled, self.Busy, self.Error, self.ErrorID = False, False, True, M.ERR_AXIS_UNUSED
+            return
+        f = self.VelFactor
+        if not (math.isfinite(f) and 0.0 <= f <= M.MAX_OVERRIDE * 100):
+            self.Enabled, self.Busy, self.Error, self.ErrorID = False, False, True, M.ERR_OVERRIDE
+            return
+        self.Error, self.ErrorID = False, 0
+        axis.set_override(f / 100.0, _now(self))
+        self.Enabled = self.Busy = True
+
+
+NATIVE_FBS = {c.__name__: c for c in (MC_Power, MC_Home, MC_MoveAbsolute, MC_MoveRelative, MC_MoveVelocity,
+                                      MC_Stop, MC_Halt, MC_Reset, MC_ReadAxisError, MC_SetPosition,
+                                      MC_SetOverride)}

@@ -1,0 +1,349 @@
+"""Single-axis motion instructions on a virtual axis: documented outputs scan by scan, profiles against the closed
+form, state transitions and refused transitions. Each test names the W508 instruction section (NJ/NX-series Motion
+Control Instructions Reference Manual) or the W507 axis-state chart it pins; the manual's page numbers were not
+readable in our manual corpus, see docs/toolchain/runtime_sysmac.md section 5."""
+import pytest
+
+from motion_rig import Rig, duration, files, trapezoid
+from vplc.api import PlcFault
+from vplc.runtime import motion as M
+
+
+@pytest.fixture
+def rig(tmp_path_factory):
+    return Rig(files(tmp_path_factory))
+
+
+def test_power_status_comes_one_period_after_enable_and_servo_off_disables(rig):
+    """W508 MC_Power: Busy while Enable; Status once the servo is ON (after the motion processing)."""
+    rig.scan()
+    assert (rig.r("pwr.Busy"), rig.r("pwr.Status")) == (True, False)
+    assert rig.state() == "Standstill" and rig.ax("DrvStatus.ServoOn")
+    rig.scan()
+    assert rig.r("pwr.Status")
+    rig.set(power=False)
+    rig.scan()
+    assert (rig.r("pwr.Busy"), rig.r("pwr.Status"), rig.state()) == (False, False, "Disabled")
+
+
+def test_move_absolute_follows_the_closed_form_trapezoid_and_reports_done(rig):
+    """W508 MC_MoveAbsolute: Busy and Active from the Execute edge, Done once the target is reached; the command
+    position is the trapezoid of Velocity, Acceleration and Deceleration (Discrete, then Standstill)."""
+    rig.powered()
+    rig.set(doAbs1=True)
+    rig.scan()
+    t0 = rig.t
+    assert rig.outputs("abs1") == (True, True, False, False, False) and rig.state() == "Discrete"
+    total = duration(100.0, 50.0, 1000.0, 500.0)
+    worst = 0.0
+    while not rig.r("abs1.Done"):
+        x, v = trapezoid(rig.t - t0, 100.0, 50.0, 1000.0, 500.0)
+        worst = max(worst, abs(rig.ax("Cmd.Pos") - x), abs(rig.ax("Cmd.Vel") - v) * 1e-3)
+        assert rig.ax("Act.Pos") == rig.ax("Cmd.Pos")
+        rig.scan()
+        assert rig.k < 5000
+    assert worst < 1e-9
+    # Done in the first call after the motion processing that reached the target
+    assert rig.t == pytest.approx(t0 + total, abs=2.001e-3) and rig.t > t0 + total
+    assert rig.outputs("abs1") == (False, False, True, False, False)
+    assert (rig.ax("Cmd.Pos"), rig.ax("Cmd.Vel"), rig.state()) == (100.0, 0.0, "Standstill")
+    rig.scan(3)
+    assert rig.r("abs1.Done"), "Done stays TRUE while Execute is TRUE"
+    rig.set(doAbs1=False)
+    rig.scan()
+    assert rig.outputs("abs1") == (False, False, False, False, False)
+
+
+def test_short_move_is_a_triangle_below_the_velocity(rig):
+    """W508 MC_MoveAbsolute: a distance too short to reach Velocity gives a triangular profile."""
+    rig.powered()
+    rig.set(pos1=1.0, doAbs1=True)
+    rig.scan()
+    t0 = rig.t
+    peak = 0.0
+    while not rig.r("abs1.Done"):
+        rig.scan()
+        x, v = trapezoid(rig.t - t0, 1.0, 50.0, 1000.0, 500.0)
+        assert rig.ax("Cmd.Pos") == pytest.approx(x, abs=1e-9)
+        peak = max(peak, rig.ax("Cmd.Vel"))
+    assert peak < 50.0 and peak == pytest.approx((1.0 / (1 / 2000 + 1 / 1000)) ** 0.5, rel=0.05)
+
+
+def test_done_shows_for_one_call_when_execute_dropped_before_the_end(rig):
+    """W508 common timing: if Execute is FALSE when the instruction completes, Done is TRUE for one period."""
+    rig.powered()
+    rig.set(pos1=2.0, doAbs1=True)
+    rig.scan()
+    rig.set(doAbs1=False)
+    seen = []
+    for _ in range(300):
+        rig.scan()
+        seen.append(rig.r("abs1.Done"))
+    assert seen.count(True) == 1
+    assert rig.ax("Cmd.Pos") == 2.0
+
+
+def test_move_relative_adds_distance_to_the_command_position(rig):
+    """W508 MC_MoveRelative: the target is Distance from the command current position."""
+    rig.powered()
+    rig.set(setTo=5.0, doSetPos=True)
+    rig.scan(2)
+    assert rig.ax("Cmd.Pos") == 5.0 and rig.r("setp.Done")
+    rig.set(dist=-3.0, doRel=True)
+    rig.scan()
+    t0 = rig.t
+    while not rig.r("rel.Done"):
+        rig.scan()
+        x, _ = trapezoid(rig.t - t0, 3.0, 50.0, 1000.0, 500.0)
+        assert rig.ax("Cmd.Pos") == pytest.approx(5.0 - x, abs=1e-9)
+    assert rig.ax("Cmd.Pos") == 2.0
+
+
+def test_move_velocity_ramps_to_in_velocity_and_reverses_through_zero(rig):
+    """W508 MC_MoveVelocity: InVelocity once the velocity is reached (Continuous state); a new velocity command
+    in the other direction decelerates with Deceleration to 0, then accelerates with Acceleration."""
+    rig.powered()
+    rig.set(doVel=True, vv=20.0)
+    rig.scan()
+    t0 = rig.t
+    assert rig.state() == "Continuous" and rig.outputs("vel", ("Busy", "Active", "InVelocity")) == (True, True, False)
+    while not rig.r("vel.InVelocity"):
+        rig.scan()
+        assert rig.ax("Cmd.Vel") == pytest.approx(min(20.0, 1000.0 * (rig.t - t0)), abs=1e-9)
+    assert rig.t == pytest.approx(t0 + 0.02 + 0.001, abs=1e-9)
+    rig.scan(100)
+    assert rig.ax("Cmd.Vel") == 20.0 and rig.r("vel.Busy")
+    x_before = rig.ax("Cmd.Pos")
+    assert x_before == pytest.approx(20.0 * (rig.t - t0) - 20.0 * 0.02 / 2, abs=1e-9)
+    # re-execution with the other direction (W508: the running velocity command takes the new values)
+    rig.set(doVel=False)
+    rig.scan()
+    rig.set(doVel=True, dir="_mcNegativeDirection")
+    rig.scan()
+    t1 = rig.t
+    rig.scan(20)
+    assert rig.ax("Cmd.Vel") == pytest.approx(20.0 - 500.0 * (rig.t - t1), abs=1e-9)
+    rig.scan(30)
+    assert rig.ax("Cmd.Vel") == pytest.approx(-1000.0 * (rig.t - t1 - 0.04), abs=1e-9)
+
+
+def test_a_second_move_aborts_the_first_which_reports_command_aborted(rig):
+    """W508 BufferMode _mcAborting: the new instruction takes over at once; the aborted one shows
+    CommandAborted (Busy and Active FALSE) in its next call; the profile continues from the current motion."""
+    rig.powered()
+    rig.set(doAbs1=True)
+    rig.scan(200)
+    x, v = rig.ax("Cmd.Pos"), rig.ax("Cmd.Vel")
+    rig.set(pos2=20.0, doAbs2=True)
+    rig.scan()
+    assert rig.outputs("abs2") == (True, True, False, False, False)
+    assert rig.ax("Cmd.Pos") == pytest.approx(x + v * 0.001, abs=1e-6)
+    rig.scan()
+    assert rig.outputs("abs1") == (False, False, False, True, False)
+    while not rig.r("abs2.Done"):
+        rig.scan()
+        assert rig.k < 5000
+    assert rig.ax("Cmd.Pos") == 20.0 and rig.r("abs1.CommandAborted")
+    rig.set(doAbs1=False)
+    rig.scan()
+    assert not rig.r("abs1.CommandAborted")
+
+
+def test_a_buffered_move_starts_exactly_when_the_first_is_done(rig):
+    """W508 BufferMode _mcBuffered: the instruction waits (Busy, not Active) until the running one is Done, then
+    starts from its end; the first's Done and the second's Active appear in the same call."""
+    rig.powered()
+    rig.set(pos1=10.0, doAbs1=True)
+    rig.scan(5)
+    rig.set(pos2=4.0, buf2="_mcBuffered", doAbs2=True)
+    rig.scan()
+    assert rig.outputs("abs2") == (True, False, False, False, False)
+    t_end1 = 0.002 + duration(10.0, 50.0, 1000.0, 500.0)          # abs1 started in the scan at 2 ms
+    while not rig.r("abs1.Done"):
+        assert not rig.r("abs2.Active")
+        rig.scan()
+    assert rig.r("abs2.Active") and not rig.r("abs1.CommandAborted")
+    while not rig.r("abs2.Done"):
+        rig.scan()
+        x, _ = trapezoid(rig.t - t_end1, 6.0, 50.0, 1000.0, 500.0)
+        if not rig.r("abs2.Done"):
+            assert rig.ax("Cmd.Pos") == pytest.approx(10.0 - x, abs=1e-9)
+    assert rig.ax("Cmd.Pos") == 4.0
+
+
+def test_buffered_relative_move_counts_from_the_target_of_the_running_one(rig):
+    """W508 MC_MoveRelative with _mcBuffered: the distance is added to the target of the move before it."""
+    rig.powered()
+    rig.set(pos1=10.0, doAbs1=True)
+    rig.scan(3)
+    rig.set(dist=5.0, bufRel="_mcBuffered", doRel=True)
+    while not rig.r("rel.Done"):
+        rig.scan()
+        assert rig.k < 5000
+    assert rig.ax("Cmd.Pos") == 15.0
+
+
+def test_stop_holds_the_axis_in_stopping_while_execute_is_true(rig):
+    """W508 MC_Stop and the W507 state chart: Stopping until MC_Stop is Done and its Execute FALSE; every other
+    motion instruction is refused meanwhile; the running move reports CommandAborted."""
+    rig.powered()
+    rig.set(doVel=True, vv=100.0)
+    rig.scan(200)
+    v0 = rig.ax("Cmd.Vel")
+    rig.set(doStop=True, stopDec=1000.0)
+    rig.scan()
+    t0 = rig.t
+    assert rig.state() == "Stopping" and rig.outputs("stp") == (True, True, False, False, False)
+    rig.scan()
+    assert rig.r("vel.CommandAborted")
+    while not rig.r("stp.Done"):
+        rig.scan()
+        if not rig.r("stp.Done"):
+            assert rig.ax("Cmd.Vel") == pytest.approx(max(v0 - 1000.0 * (rig.t - t0), 0.0), abs=1e-9)
+    assert rig.ax("Cmd.Vel") == 0.0
+    rig.set(doAbs1=True)
+    rig.scan()
+    assert rig.r("abs1.Error") and rig.r("abs1.ErrorID") == M.ERR_STOPPING
+    rig.scan(50)
+    assert rig.state() == "Stopping" and rig.r("stp.Done")
+    rig.set(doStop=False, doAbs1=False)
+    rig.scan()
+    assert rig.state() == "Standstill" and not rig.r("stp.Done")
+
+
+def test_stop_with_execute_already_false_ends_in_standstill(rig):
+    """W507 state chart: Stopping ends when MC_Stop is Done with Execute FALSE."""
+    rig.powered()
+    rig.set(doVel=True)
+    rig.scan(50)
+    rig.set(doStop=True)
+    rig.scan()
+    rig.set(doStop=False)
+    rig.scan(100)
+    assert rig.state() == "Standstill" and rig.ax("Cmd.Vel") == 0.0
+
+
+def test_halt_decelerates_in_discrete_and_can_be_taken_over(rig):
+    """W508 MC_Halt: Discrete while decelerating, Done at velocity 0, then Standstill; unlike MC_Stop another
+    instruction may abort it (MC_Halt then shows CommandAborted)."""
+    rig.powered()
+    rig.set(doVel=True, vv=50.0)
+    rig.scan(100)
+    rig.set(doHalt=True)
+    rig.scan()
+    assert rig.state() == "Discrete" and rig.outputs("hlt") == (True, True, False, False, False)
+    while not rig.r("hlt.Done"):
+        rig.scan()
+    assert rig.state() == "Standstill"
+    rig.set(doHalt=False, doVel=False)
+    rig.scan()
+    rig.set(doVel=True)
+    rig.scan(30)
+    rig.set(doHalt=True)
+    rig.scan(5)
+    rig.set(doAbs1=True)
+    rig.scan(2)
+    assert rig.r("hlt.CommandAborted") and rig.state() == "Discrete" and rig.r("abs1.Active")
+
+
+@pytest.mark.parametrize("fb,flag", [("abs1", "doAbs1"), ("vel", "doVel"), ("hlt", "doHalt"), ("home", "doHome")])
+def test_motion_from_disabled_is_refused(rig, fb, flag):
+    """W507 state chart: no motion instruction is accepted while the servo is OFF (Disabled)."""
+    rig.set(power=False, **{flag: True})
+    rig.scan()
+    assert rig.r(f"{fb}.Error") and rig.r(f"{fb}.ErrorID") == M.ERR_DISABLED and not rig.r(f"{fb}.Busy")
+    assert rig.state() == "Disabled"
+
+
+def test_home_defines_home_at_standstill_and_is_refused_while_moving(rig):
+    """W508 MC_Home (zero position preset): Homing for the call, then Standstill with Details.Homed and the
+    command position at home; from Discrete or Continuous the instruction is refused."""
+    rig.powered()
+    rig.set(setTo=7.0, doSetPos=True)
+    rig.scan(2)
+    assert rig.ax("Details.Homed")                    # W508 MC_SetPosition defines home
+    rig.set(doHome=True)
+    rig.scan()
+    assert rig.r("home.Busy")
+    rig.scan()
+    assert rig.r("home.Done") and rig.ax("Cmd.Pos") == 0.0 and rig.ax("Details.InHome")
+    rig.set(doHome=False, doVel=True)
+    rig.scan(5)
+    rig.set(doHome=True)
+    rig.scan()
+    assert rig.r("home.Error") and rig.r("home.ErrorID") == M.ERR_MOVING and rig.state() == "Continuous"
+
+
+def test_override_scales_the_velocity_and_zero_holds_the_axis_in_motion(rig):
+    """W508 MC_SetOverride: VelFactor % of the commanded velocity while Enabled; 0 % stops the axis without ending
+    the instruction; back to 100 % when Enable is FALSE."""
+    rig.powered()
+    rig.set(doOvr=True, factor=50.0)
+    rig.scan()
+    assert rig.r("ovr.Enabled")
+    rig.set(doVel=True, vv=40.0)
+    rig.scan(100)
+    assert rig.ax("Cmd.Vel") == 20.0
+    rig.set(factor=0.0)
+    rig.scan(100)
+    assert rig.ax("Cmd.Vel") == 0.0 and rig.state() == "Continuous" and rig.r("vel.Busy")
+    rig.set(doOvr=False)
+    rig.scan(100)
+    assert rig.ax("Cmd.Vel") == 40.0
+    rig.set(doOvr=True, factor=600.0)
+    rig.scan()
+    assert rig.r("ovr.Error") and rig.r("ovr.ErrorID") == M.ERR_OVERRIDE
+
+
+def test_velocity_above_the_axis_maximum_is_limited_and_flagged(rig):
+    """W507 Details.VelLimit: the command velocity is limited to the axis' maximum velocity (200 mm/s here)."""
+    rig.powered()
+    rig.set(doVel=True, vv=500.0)
+    rig.scan(400)
+    assert rig.ax("Cmd.Vel") == 200.0 and rig.ax("Details.VelLimit")
+
+
+@pytest.mark.parametrize("values,code", [
+    ({"v1": 0.0}, M.ERR_VELOCITY), ({"v1": -1.0}, M.ERR_VELOCITY), ({"a1": -1.0}, M.ERR_ACCELERATION),
+    ({"d1": -5.0}, M.ERR_DECELERATION), ({"jerk": -1.0}, M.ERR_JERK)])
+def test_out_of_range_parameters_end_in_error_in_the_execute_call(rig, values, code):
+    """W508 MC_MoveAbsolute input ranges: Velocity > 0, Acceleration, Deceleration and Jerk >= 0."""
+    rig.powered()
+    rig.set(doAbs1=True, **values)
+    rig.scan()
+    assert rig.outputs("abs1") == (False, False, False, False, True) and rig.r("abs1.ErrorID") == code
+    assert rig.state() == "Standstill"
+    rig.scan()
+    assert rig.r("abs1.Error"), "Error stays TRUE while Execute is TRUE"
+    rig.set(doAbs1=False)
+    rig.scan()
+    assert not rig.r("abs1.Error") and rig.r("abs1.ErrorID") == 0
+
+
+def test_jerk_is_refused_as_not_modelled(rig):
+    """Jerk-limited (S-curve) profiles are not modelled: a Jerk other than 0 stops the controller with a fault
+    naming it instead of running another profile."""
+    rig.powered()
+    rig.set(doAbs1=True, jerk=5000.0)
+    with pytest.raises(PlcFault, match=r"MC_MoveAbsolute: Jerk 5000 is not modelled by vplc"):
+        rig.scan()
+
+
+def test_blending_buffer_modes_are_refused_as_not_modelled(rig):
+    """W508 BufferMode: only _mcAborting and _mcBuffered are modelled; the blending modes fault clearly."""
+    rig.powered()
+    rig.set(doAbs1=True, buf1="_mcBlendingLow")
+    with pytest.raises(PlcFault, match=r"BufferMode _mcBlendingLow is not modelled"):
+        rig.scan()
+
+
+def test_a_second_buffered_command_is_refused(rig):
+    """One buffered command per axis; a further one ends in Error."""
+    rig.powered()
+    rig.set(pos1=50.0, doAbs1=True)
+    rig.scan(2)
+    rig.set(pos2=10.0, buf2="_mcBuffered", doAbs2=True)
+    rig.scan()
+    rig.set(dist=1.0, bufRel="_mcBuffered", doRel=True)
+    rig.scan()
+    assert rig.r("rel.Error") and rig.r("rel.ErrorID") == M.ERR_BUFFER_FULL
