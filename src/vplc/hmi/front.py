@@ -207,8 +207,12 @@ class HttpFront:
                 sock, peer = self.socket.accept()
             except (BlockingIOError, InterruptedError):
                 return
-            except OSError as exc:                    # out of file descriptors: the next wake-up tries again
+            except OSError as exc:
+                # out of file descriptors (the process holds other sockets too): free one, else pause briefly
+                # rather than turn the loop on a listening socket that stays readable
                 log.warning("HMI server cannot accept a connection: %s", exc)
+                if not self._evict(self._connections):
+                    time.sleep(0.05)
                 return
             sock.setblocking(False)
             if not self._make_room(peer[0]):
@@ -224,7 +228,7 @@ class HttpFront:
             self._connections.add(connection)
             self._by_client.setdefault(connection.client, set()).add(connection)
             self._watch(connection, selectors.EVENT_READ)
-            self._receive(connection)         # a request sent with the connection goes to a worker at once
+            self._receive(connection)         # a request sent with the connection is answered at once
 
     def _make_room(self, client: str) -> bool:
         """Close the longest-waiting connection of ``client`` when it has per_client open, and one of the
