@@ -36,6 +36,18 @@ def _axis(fb):
     return axis
 
 
+def _state_error(axis, stop: bool = False) -> int:
+    """The PLCopen state diagram (W507): no motion from ErrorStop or Disabled, and none but another MC_Stop
+    (``stop``) while MC_Stop holds the axis in Stopping."""
+    if axis.state == M.ERRORSTOP:
+        return M.ERR_ERRORSTOP
+    if axis.state == M.DISABLED:
+        return M.ERR_DISABLED
+    if axis.state == M.STOPPING and not stop:
+        return M.ERR_STOPPING
+    return 0
+
+
 def _now(fb) -> float:
     return fb.i__rt.now_ns / 1e9
 
@@ -124,16 +136,6 @@ class _MoveFB(_ExecuteFB):
     def _set_active(self, value: bool) -> None:
         self.Active = value
 
-    def _state_error(self, axis) -> int:
-        """The PLCopen state diagram (W507): no motion from Disabled, ErrorStop or Stopping."""
-        if axis.state == M.ERRORSTOP:
-            return M.ERR_ERRORSTOP
-        if axis.state == M.DISABLED:
-            return M.ERR_DISABLED
-        if axis.state == M.STOPPING:
-            return M.ERR_STOPPING
-        return 0
-
     def _ramps(self, need_velocity: bool, velocity_zero_ok: bool = False) -> int:
         name = type(self).__name__
         v, a, d, j = self.Velocity, self.Acceleration, self.Deceleration, self.Jerk
@@ -187,7 +189,7 @@ class MC_MoveAbsolute(_MoveFB):
         return self.Position
 
     def begin(self, axis) -> int:
-        code = self._state_error(axis) or self._ramps(True)
+        code = _state_error(axis) or self._ramps(True)
         if code:
             return code
         if not 0 <= self.Direction <= 4:
@@ -230,7 +232,7 @@ class MC_MoveVelocity(_MoveFB):
         self.Continuous = False
 
     def begin(self, axis) -> int:
-        code = self._state_error(axis) or self._ramps(True, velocity_zero_ok=True)
+        code = _state_error(axis) or self._ramps(True, velocity_zero_ok=True)
         if code:
             return code
         d = self.Direction
@@ -265,7 +267,7 @@ class MC_Halt(_MoveFB):
     """W508 MC_Halt: decelerates to a stop (Discrete); another instruction may abort it."""
 
     def begin(self, axis) -> int:
-        code = self._state_error(axis) or self._ramps(False)
+        code = _state_error(axis) or self._ramps(False)
         if code:
             return code
         cmd = M.Command("halt", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration))
@@ -277,11 +279,7 @@ class MC_Stop(_MoveFB):
     is TRUE; the axis goes to Standstill when MC_Stop is Done and called with Execute FALSE."""
 
     def begin(self, axis) -> int:
-        if axis.state == M.ERRORSTOP:
-            return M.ERR_ERRORSTOP
-        if axis.state == M.DISABLED:
-            return M.ERR_DISABLED
-        code = self._ramps(False)
+        code = _state_error(axis, stop=True) or self._ramps(False)
         if code:
             return code
         cmd = M.Command("stop", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration))
@@ -317,14 +315,9 @@ class MC_Home(_ExecuteFB):
     """W508 MC_Home with the zero position preset homing method: home = the configured home_position."""
 
     def begin(self, axis) -> int:
-        if axis.state == M.ERRORSTOP:
-            return M.ERR_ERRORSTOP
-        if axis.state == M.DISABLED:
-            return M.ERR_DISABLED
-        if axis.state == M.STOPPING:
-            return M.ERR_STOPPING
-        if axis.state != M.STANDSTILL:
-            return M.ERR_MOVING
+        code = _state_error(axis)
+        if code or axis.state != M.STANDSTILL:
+            return code or M.ERR_MOVING
         cmd = M.Command("home", self, axis.cfg.home_position)
         axis.instant.append(cmd)
         axis._set_state(M.HOMING)
