@@ -27,10 +27,10 @@ TOKENS_MAX = 10_000                         # tokens of one script (an array of 
                                             # call with constant arguments only, e.g. a motion, counts 1)
 DEPTH_MAX = 100                             # nesting of one expression (operands of operands ...)
 STEPS_MAX = 20_000                          # work of one script: statements + expression nodes + array
-                                            # elements copied / 8 + string characters built / 256
+                                            # elements copied / 8 + string characters built or sent / 256
 
 # ---- work of one turn of the scheduler (sim/work.py): one unit is about 4 us of the simulator's time ---------
-TURN_WORK = 1_000                           # units one turn of one robot may do; then its work goes on later
+TURN_WORK = 500                             # units one turn of one robot may do; then its work goes on later
 WORK_CHAR = 1                               # a character of a script line parsed and checked ...
 WORK_LINE = 4                               # ... plus this per line
 WORK_STEP = 1                               # an interpreter step (STEPS_MAX; a ListenSend counts its bytes / 256)
