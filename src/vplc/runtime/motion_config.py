@@ -68,6 +68,8 @@ def load_axes(path) -> tuple[AxisConfig, ...]:
         raise AxisConfigError(f"{path}: the axis configuration is not UTF-8 text") from None
     except tomllib.TOMLDecodeError as exc:
         raise AxisConfigError(f"{path}: not a TOML file: {exc}") from None
+    except (RecursionError, MemoryError):
+        raise AxisConfigError(f"{path}: the axis configuration nests too deeply to be read") from None
     return parse_axes(doc, path)
 
 

@@ -171,6 +171,18 @@ def test_bad_axis_configuration_names_the_file_the_axis_and_the_limit(tmp_path_f
     assert str(cfg) in text and message in text and "Traceback" not in text
 
 
+def test_hostile_axis_configurations_are_refused_without_traceback(tmp_path_factory, tmp_path):
+    """Bad input: a file nested 100,000 levels deep and a file of 2 MB end in a clear load error."""
+    main = str(files(tmp_path_factory) / "Main.st")
+    deep, big = tmp_path / "deep.toml", tmp_path / "big.toml"
+    deep.write_text("a = " + "[" * 100_000 + "]" * 100_000 + "\n")
+    big.write_text("# " + "x" * 2_000_000 + "\n")
+    with pytest.raises(LoadError, match="nests too deeply"):
+        load_plc([main], axes=str(deep))
+    with pytest.raises(LoadError, match="larger than 1,000,000 bytes"):
+        load_plc([main], axes=str(big))
+
+
 def test_a_missing_axis_configuration_file_is_a_load_error(tmp_path_factory, tmp_path):
     with pytest.raises(LoadError, match="cannot read the axis configuration"):
         load_plc([str(files(tmp_path_factory) / "Main.st")], axes=str(tmp_path / "none.toml"))
