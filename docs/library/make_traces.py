@@ -19,8 +19,11 @@ PINS = ("Busy", "Active", "Connected", "Valid", "Done", "CommandAborted", "Error
 EXTRA = {"CBT_Connect": ["Cobot.InListenNode", "RobotReady"], "CBT_Stop": ["Cobot.Stopping"],
          "CBT_ReadActualPosition": ["TcpZ"],
          "CBT_RobotStatus": ["fbStatus.Status.ProjectRunning", "fbStatus.Status.Position.TCP.Z", "RobotFault"],
-         "CBT_ProjectControl": ["Cobot.Status.ProjectRunning"]}
-FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"], "CBT_RobotStatus": ["fbConnect.Connected"]}      # the FB's Enable
+         "CBT_ProjectControl": ["Cobot.Status.ProjectRunning"],
+         "CBT_ReadIO": ["PartPresent"], "CBT_SetOverride": ["SpeedShown"],
+         "CBT_WaitQueue": ["Cobot.Status.Moving", "Cobot.Status.TCPSpeed"]}
+FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"], "CBT_RobotStatus": ["fbConnect.Connected"],
+         "CBT_ReadIO": ["fbConnect.Connected"]}      # the FB's Enable
 HOLD_S = 0.02                   # Execute stays TRUE this long after Done, then falls: both Done cases show
 
 
@@ -46,7 +49,7 @@ def page_trace(page: str, out: Path) -> None:
         read = lambda name: plc.read(f"{program}.{name}")   # noqa: E731
         pump = lambda now_ns: srv.poll(now_ns / 1e9)        # noqa: E731
         steps = STEPS[page]
-        if page not in ("CBT_Connect", "CBT_ReadActualPosition", "CBT_RobotStatus"):   # these show the connect
+        if page not in ("CBT_Connect", "CBT_ReadActualPosition", "CBT_RobotStatus", "CBT_ReadIO"):   # show the connect
             assert plc.run_until(lambda: read("fbConnect.Connected"), 5 * SEC, on_scan=pump)
         paths = list(FIRST.get(page, []))
         for trigger, done in steps:

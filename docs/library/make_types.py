@@ -222,7 +222,7 @@ def render_hmi(ranges: list[Range]) -> str:
 
 def outputs() -> dict[Path, str]:
     types, ranges = read_types(), read_ranges()
-    names = {t.name for t in types} | {"CBT_Connect"}
+    names = {t.name for t in types} | {p.stem for p in TYPES_DIR.parent.glob("CBT_*.st")}      # or an FB input
     for r in ranges:
         if r.struct not in names:
             raise SourceError(f"{TABLE}:{r.line}: no structure named {r.struct}")

@@ -30,6 +30,9 @@ STEPS = {
     "CBT_ReadActualPosition": [(None, "fbReadPos.Valid")],
     "CBT_RobotStatus": [(None, "fbStatus.Valid")],
     "CBT_ProjectControl": [("PlayButton", "fbPlay.Done")],
+    "CBT_ReadIO": [(None, "fbIO.Valid")],
+    "CBT_SetOverride": [("SlowButton", "fbOverride.Done")],
+    "CBT_WaitQueue": [("MoveExec", "fbMove.Done"), ("SyncExec", "fbSync.Done")],
 }
 
 

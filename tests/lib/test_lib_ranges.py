@@ -36,7 +36,9 @@ def load(name):
 
 
 MT = load("make_types")
-ROWS = [r for r in MT.read_ranges() if r.error]
+# CBT_SetOverride's row (an FB input of a program of its own) is run, every value of its type, by
+# tests/lib/test_lib_set_override.py
+ROWS = [r for r in MT.read_ranges() if r.error and r.struct != "CBT_SetOverride"]
 
 
 @pytest.fixture(scope="module")
