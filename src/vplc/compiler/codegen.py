@@ -364,22 +364,27 @@ class CodeGen(ExprGen):
         if len(st.branches) <= CASE_CHAIN:
             self.if_chain(st.branches, st.span, st.else_body)
             return
-        # thousands of ELSIF: consecutive chains of CASE_CHAIN branches, the next one tried only while no
-        # condition has held (the same order and first-match semantics; see st_Case)
+        self.chains(st.branches, lambda part, pending: self.if_chain(part, st.span, None, pending), st.else_body)
+
+    def chains(self, branches, chain, else_body) -> None:
+        """Python nests each elif one level deeper when it compiles, so thousands of branches in one chain (CASE
+        labels, ELSIF) exceed its recursion limit: they become consecutive chains of CASE_CHAIN branches, written
+        by ``chain(part, pending)``, the next one tried only while no branch has matched (``pending`` is set when
+        none did; same order, same first-match semantics), then the ELSE part."""
         pending = self.tmp("_p")
         self.emit(f"{pending} = False")
-        for start in range(0, len(st.branches), CASE_CHAIN):
+        for start in range(0, len(branches), CASE_CHAIN):
             if start:
                 self.emit(f"if {pending}:")
                 self.ind += 1
                 self.emit(f"{pending} = False")
-            self.if_chain(st.branches[start:start + CASE_CHAIN], st.span, None, pending)
+            chain(branches[start:start + CASE_CHAIN], pending)
             if start:
                 self.ind -= 1
-        if st.else_body:
+        if else_body:
             self.emit(f"if {pending}:")
             self.ind += 1
-            self.block(st.else_body)
+            self.block(else_body)
             self.ind -= 1
 
     def if_chain(self, branches, span, else_body, pending: str | None = None) -> None:
@@ -427,26 +432,12 @@ class CodeGen(ExprGen):
                 self.block(st.else_body)
                 self.ind -= 1
             return
-        # Python nests each elif one level deeper when it compiles, so thousands of labels in one chain exceed
-        # its recursion limit: a long CASE becomes consecutive chains of CASE_CHAIN branches, the next one
-        # tried only while no branch has matched (same order, same first-match semantics).
-        pending = self.tmp("_p")
-        self.emit(f"{pending} = False")
-        for start in range(0, len(st.branches), CASE_CHAIN):
-            if start:
-                self.emit(f"if {pending}:")
-                self.ind += 1
-                self.emit(f"{pending} = False")
-            self.case_chain(st.branches[start:start + CASE_CHAIN], sel, st.span)
-            self.emit("else:")
-            self.emit(f"    {pending} = True")
-            if start:
-                self.ind -= 1
-        if st.else_body:
-            self.emit(f"if {pending}:")
-            self.ind += 1
-            self.block(st.else_body)
-            self.ind -= 1
+        self.chains(st.branches, lambda part, pending: self.case_else(part, sel, st.span, pending), st.else_body)
+
+    def case_else(self, branches, sel: str, span, pending: str) -> None:
+        self.case_chain(branches, sel, span)
+        self.emit("else:")
+        self.emit(f"    {pending} = True")
 
     def case_chain(self, branches, sel: str, span) -> None:
         """One if/elif chain over the CASE branches given (no else part)."""
