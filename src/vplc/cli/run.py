@@ -1,12 +1,13 @@
 """``python3 -m vplc run PATHS... [--task Main@1ms] [--virtual-time] [--cycles N | --duration T] [--stats]
 [--watch VAR,...] [--set VAR=VALUE@TIME]... [--scenario FILE] [--trace VAR,... --trace-out FILE.vcd|FILE.svg
-[--trace-window FROM..TO]]``: run ST programs on the virtual controller.
+[--trace-window FROM..TO]] [--max-overruns N]``: run ST programs on the virtual controller.
 
-Real time (default) scans at the task period on the wall clock until Ctrl-C, --cycles, --duration or the end of
-the scenario; --virtual-time scans as fast as possible with the clock advancing one period per scan
-(deterministic). Exit 0 when the run ended as asked and every expectation held; 1 with a one-line reason on a
-major fault (watchdog included), a failed expectation or an operator stop before the scenario was decided;
-2 on usage or load errors.
+Real time (default) scans at the task period on the wall clock until Ctrl-C, SIGTERM, --cycles, --duration or the
+end of the scenario, and reports its overruns in the last line; --virtual-time scans as fast as possible with the
+clock advancing one period per scan (deterministic). Values are shown in PLC notation (16#4006, enumeration
+names, T#1.5s). Exit 0 when the run ended as asked and every expectation held; 1 with a one-line reason on a
+major fault (watchdog included), a failed expectation, an operator stop before the scenario was decided or more
+overruns than --max-overruns; 2 on usage or load errors.
 """
 from __future__ import annotations
 
