@@ -16,14 +16,14 @@ meaning. Spellings written by earlier vplc exports that the schemas refuse (``In
 """
 from __future__ import annotations
 
+import threading
 import xml.etree.ElementTree as ET
 
 from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit
 from .model import EDGES, STORAGES, Conn, Element, LadderBody, Pin, Rung
-from .xmlsafe import text_of, xsi_type
+from .xmlsafe import XSI_TYPE, text_of, xsi_type
 
-POUS = {"Program": "PROGRAM", "FunctionBlock": "FUNCTION_BLOCK", "Function": "FUNCTION",
-        "DebugProgram": "PROGRAM"}
+POUS = {"Program": "PROGRAM", "FunctionBlock": "FUNCTION_BLOCK", "Function": "FUNCTION"}
 PARAMS = {"InputVars": "VAR_INPUT", "OutputVars": "VAR_OUTPUT", "InOutVars": "VAR_IN_OUT", "InoutVars": "VAR_IN_OUT"}
 # Elements of the Sysmac extension (namespace https://www.ia.omron.com/Smc) that may stand in an AddData/Data,
 # and what reading them means. Anything else in an Omron Data block is refused by name.
@@ -40,23 +40,23 @@ FBD_OBJECTS = {"Block": "block", "DataSource": "in_var", "DataSink": "out_var", 
 KNOWN = ", ".join([*LD_OBJECTS, *FBD_OBJECTS])
 
 
-_warnings: list[tuple[str, str]] = []
+_state = threading.local()          # the warnings of the file being read (one reader per thread)
 
 
 def _old(where: str, message: str) -> None:
     """A spelling of an earlier vplc export that Omron's schemas refuse: read with its meaning, and said."""
-    _warnings.append((where, message))
+    warnings = getattr(_state, "warnings", None)
+    if warnings is not None:
+        warnings.append((where, message))
 
 
 def read(root: ET.Element, warnings: list | None = None) -> list[XmlUnit]:
     """The units of the file; ``warnings`` receives (where, message) for each old-export spelling read."""
-    _warnings.clear()
+    _state.warnings = [] if warnings is None else warnings
     try:
         return _read(root)
     finally:
-        if warnings is not None:
-            warnings.extend(_warnings)
-        _warnings.clear()
+        _state.warnings = []
 
 
 def _read(root: ET.Element) -> list[XmlUnit]:
@@ -86,7 +86,7 @@ def _namespace(container: ET.Element, ns: str | None, units: dict) -> None:
         elif item.tag in ("DataTypeDecl", "UserDefinedTypeDecl"):
             unit.types.append(_data_type(item))
         elif item.tag in POUS:
-            using = [(u.text or "").strip() for u in item.iterfind("UsingDirective")]
+            using = [u.text.strip() for u in item.iterfind("UsingDirective") if (u.text or "").strip()]
             if len(using) > 1 or (using and ns is not None):
                 raise FormatError(item.get("name", ""), "UsingDirective " + ", ".join(using) + ": vplc resolves "
                                   "the names of a POU in one namespace only; qualify the names instead")
@@ -111,7 +111,6 @@ def _add_data(el: ET.Element, where: str) -> dict[str, ET.Element]:
 
 def _smc_type(el: ET.Element) -> str:
     """``xsi:type`` with its prefix as written (``smcext:LdSection``)."""
-    from .xmlsafe import XSI_TYPE
     return el.get(XSI_TYPE, "")
 
 
@@ -214,7 +213,8 @@ def _data_type(dt: ET.Element) -> TypeText:
 def _enum_base(base: ET.Element | None, where: str) -> str:
     """The schema's BaseType is the elementary type name as text (ElementaryType: DINT)."""
     if base is None:
-        _old(where, "an enumeration without BaseType; the schema requires it (read as DINT)")
+        _old(where, "an enumeration without BaseType; the schema requires it (read with vplc's default base "
+                    "type, as the earlier export meant)")
         return ""
     if len(base):
         _old(where, "the enumeration's BaseType holds a TypeName element; the schema wants the type name as "
@@ -361,6 +361,8 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
             if not e.var and obj.get("label"):
                 _old(where, "a Jump names its target in targetNetworkLabel, not label")
                 e.var = obj.get("label", "")
+            if not e.var:
+                raise FormatError(where, "a Jump without targetNetworkLabel: name the label of the rung to jump to")
         elif e.kind == "label":
             e.var = obj.get("label", "")
         elif e.kind == "block":

@@ -241,3 +241,22 @@ def test_files_of_earlier_exports_load_with_a_warning_naming_the_rule(tmp_path):
     r.scan(A=True, Skip=True)
     assert (r["Q"], r["Mid"], r["End"]) == (True, False, True), "storage=set is a set coil; the jump skips"
     assert r.scan(A=False, Skip=False)["Q"] is True and r["Mid"] is False
+
+
+def test_malformed_sysmac_attributes_are_errors_with_their_place_never_a_traceback(tmp_path):
+    bad = {
+        "order": (doc(_param_fb("").replace('orderWithinParamSet="0"', 'orderWithinParamSet="x"')),
+                  "the XML does not follow the format"),
+        "latch": (iec10_program({"A": "BOOL", "Q": "BOOL"}, [RAIL + contact("A", 1, 2) + coil("Q", 2, latch="on")]),
+                  'Main:rung 1:coil Q: latch="on" is not one of none, set, reset'),
+        "both": (iec10_program({"A": "BOOL", "Q": "BOOL"},
+                               [RAIL + contact("A", 1, 2) + coil("Q", 2, latch="set", storage="reset")]),
+                 'latch="set" and storage="reset" contradict each other'),
+        "jump": (iec10_program({"A": "BOOL"}, [RAIL + contact("A", 1, 2) + '<FbdObject xsi:type="Jump">' + cin(2)
+                                               + "</FbdObject>"]), "a Jump without targetNetworkLabel"),
+        "using": (doc(FUNCTION_EN.replace("<ResultType>", "<UsingDirective>A</UsingDirective><UsingDirective>B"
+                                          "</UsingDirective><ResultType>")), "UsingDirective A, B"),
+    }
+    for name, (text, message) in bad.items():
+        d = refused(write(tmp_path, text, f"{name}.xml"), message)
+        assert "internal error" not in d.message, name
