@@ -19,7 +19,7 @@ from .motion_config import UNITS, AxisConfig
 # motion-instruction range; the names say what the instruction refused.
 ERR_AXIS_UNUSED = 0x5401       # the axis is not a configured virtual axis
 ERR_DISABLED = 0x5402          # motion command while the servo is OFF (Disabled)
-ERR_ERRORSTOP = 0x5403         # command while the axis is in ErrorStop
+ERR_ERRORSTOP = 0x5403         # MC_SetPosition while the axis is in ErrorStop (motions: CommandAborted)
 ERR_STOPPING = 0x5404          # command while MC_Stop holds the axis in Stopping
 ERR_MOVING = 0x5405            # MC_Home / MC_SetPosition while the axis moves
 ERR_VELOCITY = 0x5410          # Velocity out of range
@@ -146,6 +146,7 @@ class Axis:
         self.stop_cmd: Command | None = None    # MC_Stop holding the axis in Stopping
         self.stop_execute = False               # that MC_Stop's Execute at its last call
         self.error_code = 0
+        self.error_serial = 0                   # counts the resets: an instruction's Error lasts until the next
         self.limit_stop = False                 # decelerating onto a software limit
         self.instant: list[Command] = []        # MC_Home / MC_SetPosition for this period
         self.last_dir = 1.0
@@ -352,9 +353,25 @@ class Axis:
         self.abort_all()
         self._finish(self.stop_cmd, ABORTED)
         self.stop_cmd = None
-        self.error_code = code
-        self.ref.MFaultLvl.Active, self.ref.MFaultLvl.Code = True, code
+        if not self.error_code:
+            self.error_code = code
+            self.ref.MFaultLvl.Active, self.ref.MFaultLvl.Code = True, code
         self._set_state(ERRORSTOP)
+
+    def instruction_error(self, code: int, t: float) -> None:
+        """An instruction refused on this axis: on an NJ/NX it is an error of the axis (the instruction's Error
+        stays TRUE until the error is reset, the running instructions end in CommandAborted: W508, output
+        timing of MC_Power and MC_Stop). A moving axis decelerates to a stop with its maximum deceleration
+        (our choice of the stop method)."""
+        if self.profile is not None:
+            self.pos, self.vel, self.acc, _ = self.profile.at(t)
+        self.error(code)
+        self.limit_stop = False
+        if self.vel:
+            dec = self.cfg.max_deceleration
+            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, dec, dec))
+        elif self.profile is not None:
+            self.profile = Profile(t, self.pos, 0.0, [])
 
     def power(self, on: bool) -> None:
         """Servo ON / OFF (applied in the motion processing after the program, so MC_Power's Status follows
@@ -381,6 +398,7 @@ class Axis:
         if self.profile is not None:
             return False
         self.error_code = 0
+        self.error_serial += 1
         self.ref.MFaultLvl.Active, self.ref.MFaultLvl.Code = False, 0
         self._set_state(STANDSTILL if self.powered else DISABLED)
         return True

@@ -1,15 +1,17 @@
 """The single-axis motion instructions of W508 (declared in prelude/sysmac_motion.st) on virtual axes.
 
-Output timing (PLCopen Part 1 as W508 describes it for every motion instruction; details we chose are in
-docs/toolchain/runtime_sysmac.md section 5):
+Output timing (W508 output timing tables, read in the Chinese edition's MC_Power and MC_Stop pages; details we
+chose are in docs/toolchain/runtime_sysmac.md section 5):
 
 * the rising edge of Execute starts the instruction: Busy TRUE in that call (Active too when the axis takes
   the command at once, i.e. always except a Buffered command waiting for the one before it); a parameter or
   state error sets Error and ErrorID in that call instead;
 * the motion runs in the motion processing after the program (``motion.MotionController.cycle``), so Done,
   InVelocity and CommandAborted appear at the earliest in the next call;
-* Done, CommandAborted and Error stay TRUE while Execute is TRUE and are cleared in the call that sees
-  Execute FALSE; if Execute was already FALSE when they came, they are TRUE for that one call.
+* Done and CommandAborted stay TRUE while Execute is TRUE and are cleared in the call that sees Execute FALSE;
+  if Execute was already FALSE when they came, they are TRUE for that one call;
+* an instruction error is an error of the axis (ErrorStop): Error stays TRUE until MC_Reset has cleared it;
+  an instruction started while the axis has an error ends in CommandAborted.
 
 What vplc does not model is refused as a major fault naming the instruction and the value (Jerk other than 0,
 the blending buffer modes), never run with another meaning.
@@ -36,11 +38,16 @@ def _axis(fb):
     return axis
 
 
+IN_ERROR = -1       # begin(): the axis is in ErrorStop, the instruction ends in CommandAborted (not an ErrorID)
+
+
 def _state_error(axis, stop: bool = False) -> int:
-    """The PLCopen state diagram (W507): no motion from ErrorStop or Disabled, and none but another MC_Stop
-    (``stop``) while MC_Stop holds the axis in Stopping."""
+    """The PLCopen state diagram (W507): no motion from ErrorStop (W508 MC_Stop output timing: an instruction
+    started while the axis has an error ends in CommandAborted) or Disabled (W508 MC_Power: motion instructions
+    on a disabled axis end in error), and none but another MC_Stop (``stop``) while MC_Stop holds the axis in
+    Stopping."""
     if axis.state == M.ERRORSTOP:
-        return M.ERR_ERRORSTOP
+        return IN_ERROR
     if axis.state == M.DISABLED:
         return M.ERR_DISABLED
     if axis.state == M.STOPPING and not stop:
@@ -67,35 +74,50 @@ class _ExecuteFB:
         self.i__prev = False
         self.i__cmd = None
         self.i__final = False
+        self.i__eaxis = None            # the axis whose error this instance's Error reports
+        self.i__eserial = 0
 
     def i__run(self) -> None:
         ex = self.Execute
         if self.i__final and not ex:
             self._clear()
+        eaxis = self.i__eaxis
+        if eaxis is not None and eaxis.error_serial != self.i__eserial:
+            self.Error, self.ErrorID, self.i__eaxis = False, 0, None    # W508: FALSE once the error is reset
         if ex and not self.i__prev:
             self._clear()
+            self.Error, self.ErrorID, self.i__eaxis = False, 0, None
             self.i__cmd = None
             axis = _axis(self)
             if axis is None:
                 self._fail(M.ERR_AXIS_UNUSED)
             else:
                 code = self.begin(axis)
-                if code:
+                if code == IN_ERROR:
+                    self.CommandAborted = True
+                    self._end()
+                elif code:
+                    axis.instruction_error(code, _now(self))
                     self._fail(code)
+                    self.i__eaxis, self.i__eserial = axis, axis.error_serial
         elif self.i__cmd is not None:
             self._poll(self.i__cmd)
         self.i__prev = ex
 
     def _clear(self) -> None:
+        """Done and CommandAborted end with Execute (one call if Execute was already FALSE); so does an Error
+        that is not an error of the axis (an Axis that is not a virtual axis)."""
         setattr(self, self.DONE_OUT, False)
-        self.CommandAborted = self.Error = False
-        self.ErrorID = 0
+        self.CommandAborted = False
+        if self.i__eaxis is None:
+            self.Error, self.ErrorID = False, 0
         self.i__final = False
 
     def _fail(self, code: int) -> None:
         self.Busy = False
         self._set_active(False)
         self.Error, self.ErrorID, self.i__final = True, code, True
+        self.i__cmd = None
 
     def _set_active(self, value: bool) -> None:
         pass
@@ -183,7 +205,7 @@ class MC_MoveAbsolute(_MoveFB):
     def __init__(self, rt, path):
         super().__init__(rt, path)
         self.Position = 0.0
-        self.Direction = 4
+        self.Direction = 0
 
     def target(self, axis) -> float:
         return self.Position
@@ -222,7 +244,11 @@ class MC_MoveRelative(MC_MoveAbsolute):
 
 
 class MC_MoveVelocity(_MoveFB):
-    """W508 MC_MoveVelocity: Direction _mcPositiveDirection, _mcNegativeDirection or _mcCurrentDirection."""
+    """W508 MC_MoveVelocity: Direction _mcPositiveDirection (default), _mcNegativeDirection or
+    _mcCurrentDirection; BufferMode _mcAborting or _mcBuffered (its valid range); Continuous is reserved."""
+
+    def _buffer_mode(self) -> int:
+        return 0 if self.BufferMode in (0, 1) else M.ERR_BUFFER_MODE
 
     DONE_OUT = "InVelocity"
 
@@ -277,6 +303,9 @@ class MC_Halt(_MoveFB):
 class MC_Stop(_MoveFB):
     """W508 MC_Stop: aborts every command, decelerates to a stop and holds the axis in Stopping while Execute
     is TRUE; the axis goes to Standstill when MC_Stop is Done and called with Execute FALSE."""
+
+    def _buffer_mode(self) -> int:
+        return 0                    # reserved for MC_Stop: the stop always aborts
 
     def begin(self, axis) -> int:
         code = _state_error(axis, stop=True) or self._ramps(False)

@@ -201,14 +201,32 @@ def test_stop_holds_the_axis_in_stopping_while_execute_is_true(rig):
         if not rig.r("stp.Done"):
             assert rig.ax("Cmd.Vel") == pytest.approx(max(v0 - 1000.0 * (rig.t - t0), 0.0), abs=1e-9)
     assert rig.ax("Cmd.Vel") == 0.0
-    rig.set(doAbs1=True)
-    rig.scan()
-    assert rig.r("abs1.Error") and rig.r("abs1.ErrorID") == M.ERR_STOPPING
     rig.scan(50)
     assert rig.state() == "Stopping" and rig.r("stp.Done")
-    rig.set(doStop=False, doAbs1=False)
+    rig.set(doStop=False)
     rig.scan()
     assert rig.state() == "Standstill" and not rig.r("stp.Done")
+
+
+def test_a_motion_instruction_while_stopping_is_an_axis_error(rig):
+    """W507 state chart: nothing but MC_Stop is accepted in Stopping; the refused instruction is an error of the
+    axis (ErrorStop, MFaultLvl), its Error stays TRUE until MC_Reset (W508 output timing: Error is FALSE once the
+    error is reset)."""
+    rig.powered()
+    rig.set(doStop=True)
+    rig.scan(3)
+    rig.set(doAbs1=True)
+    rig.scan()
+    assert rig.r("abs1.Error") and rig.r("abs1.ErrorID") == M.ERR_STOPPING and not rig.r("abs1.Busy")
+    assert rig.state() == "ErrorStop" and rig.ax("MFaultLvl.Code") == M.ERR_STOPPING
+    rig.set(doAbs1=False, doStop=False)
+    rig.scan(3)
+    assert rig.r("abs1.Error"), "Error lasts until the axis error is reset, not until Execute is FALSE"
+    rig.set(doReset=True)
+    rig.scan()
+    assert rig.r("rst.Done") and rig.state() == "Standstill"
+    rig.scan()
+    assert not rig.r("abs1.Error") and rig.r("abs1.ErrorID") == 0
 
 
 def test_stop_with_execute_already_false_ends_in_standstill(rig):
@@ -248,11 +266,26 @@ def test_halt_decelerates_in_discrete_and_can_be_taken_over(rig):
 
 @pytest.mark.parametrize("fb,flag", [("abs1", "doAbs1"), ("vel", "doVel"), ("hlt", "doHalt"), ("home", "doHome")])
 def test_motion_from_disabled_is_refused(rig, fb, flag):
-    """W507 state chart: no motion instruction is accepted while the servo is OFF (Disabled)."""
+    """W508 MC_Power: a motion instruction on an axis that is not enabled ends in an error (of the axis)."""
     rig.set(power=False, **{flag: True})
     rig.scan()
     assert rig.r(f"{fb}.Error") and rig.r(f"{fb}.ErrorID") == M.ERR_DISABLED and not rig.r(f"{fb}.Busy")
+    assert rig.state() == "ErrorStop" and not rig.ax("DrvStatus.ServoOn")
+    rig.set(doReset=True)
+    rig.scan()
     assert rig.state() == "Disabled"
+
+
+def test_an_instruction_started_while_the_axis_has_an_error_ends_in_command_aborted(rig):
+    """W508 MC_Stop output timing: CommandAborted when the instruction is started while an error is present."""
+    rig.powered()
+    rig.set(v1=0.0, doAbs1=True)
+    rig.scan()
+    assert rig.state() == "ErrorStop"
+    rig.set(doStop=True, doVel=True)
+    rig.scan()
+    assert rig.outputs("stp") == (False, False, False, True, False)
+    assert rig.outputs("vel", ("Busy", "Active", "CommandAborted", "Error")) == (False, False, True, False)
 
 
 def test_home_defines_home_at_standstill_and_is_refused_while_moving(rig):
@@ -271,7 +304,9 @@ def test_home_defines_home_at_standstill_and_is_refused_while_moving(rig):
     rig.scan(5)
     rig.set(doHome=True)
     rig.scan()
-    assert rig.r("home.Error") and rig.r("home.ErrorID") == M.ERR_MOVING and rig.state() == "Continuous"
+    assert rig.r("home.Error") and rig.r("home.ErrorID") == M.ERR_MOVING and rig.state() == "ErrorStop"
+    rig.scan(100)
+    assert rig.r("vel.CommandAborted") and rig.ax("Cmd.Vel") == 0.0
 
 
 def test_override_scales_the_velocity_and_zero_holds_the_axis_in_motion(rig):
@@ -307,17 +342,29 @@ def test_velocity_above_the_axis_maximum_is_limited_and_flagged(rig):
     ({"v1": 0.0}, M.ERR_VELOCITY), ({"v1": -1.0}, M.ERR_VELOCITY), ({"a1": -1.0}, M.ERR_ACCELERATION),
     ({"d1": -5.0}, M.ERR_DECELERATION), ({"jerk": -1.0}, M.ERR_JERK)])
 def test_out_of_range_parameters_end_in_error_in_the_execute_call(rig, values, code):
-    """W508 MC_MoveAbsolute input ranges: Velocity > 0, Acceleration, Deceleration and Jerk >= 0."""
+    """W508 MC_MoveAbsolute input ranges (Velocity positive — "always set the target velocity", Acceleration,
+    Deceleration and Jerk positive or 0): Error and ErrorID in the call of the Execute edge; the error is the
+    axis' (ErrorStop, MFaultLvl.Code, MC_ReadAxisError) until MC_Reset."""
     rig.powered()
     rig.set(doAbs1=True, **values)
     rig.scan()
     assert rig.outputs("abs1") == (False, False, False, False, True) and rig.r("abs1.ErrorID") == code
-    assert rig.state() == "Standstill"
-    rig.scan()
-    assert rig.r("abs1.Error"), "Error stays TRUE while Execute is TRUE"
+    assert rig.state() == "ErrorStop" and rig.ax("MFaultLvl.Code") == code
     rig.set(doAbs1=False)
     rig.scan()
-    assert not rig.r("abs1.Error") and rig.r("abs1.ErrorID") == 0
+    assert rig.r("abs1.Error") and rig.r("err.AxisErrorID") == code
+    rig.set(doReset=True)
+    rig.scan(2)
+    assert not rig.r("abs1.Error") and rig.r("abs1.ErrorID") == 0 and rig.state() == "Standstill"
+
+
+def test_move_velocity_accepts_only_aborting_and_buffered(rig):
+    """W508 MC_MoveVelocity: the valid BufferMode values are _mcAborting and _mcBuffered."""
+    rig.powered()
+    rig.plc.write("Main.vel.BufferMode", "_mcBlendingLow")
+    rig.set(doVel=True)
+    rig.scan()
+    assert rig.r("vel.Error") and rig.r("vel.ErrorID") == M.ERR_BUFFER_MODE
 
 
 def test_jerk_is_refused_as_not_modelled(rig):
