@@ -10,6 +10,7 @@ Attacks:
 * listen_send one 64,000-character string, then 1,420 x ListenSend(90, s) in scripts of 200 lines
 * frames_64k  scripts of 64 KiB (1,100 float declarations each, the rest refused by the token limit)
 * nested      scripts of lines nested 95 levels deep (each line ~190 tokens), 64 KiB each
+* long_line   scripts of one line of ~10,000 tokens nested 95 levels deep (the parser's largest item)
 * control     15 control-channel clients each writing 64 KiB of state / events requests at a time
 Reported per attack: robot 2's TMSTA 00 round trip median / p99 / worst, the round trips slower than 1 s
 (a PLC's link supervision would count each as a lost link), and the event log file's size.
@@ -80,6 +81,11 @@ def frames_64k_stream():
         lines.append(line)
         size += len(line) + 2
     return _script("F", lines[:-1]), True
+
+
+def long_line_stream():
+    deep = "(" * 95 + "1" + ")" * 95
+    return _script("W", ["int w = " + "+".join([deep] * 52)]), True
 
 
 def nested_stream():
@@ -160,7 +166,7 @@ def main():
                                           values[-1] * 1e3)
 
     attacks = {"pvt": pvt_stream, "listen_send": listen_send_stream, "frames_64k": frames_64k_stream,
-               "nested": nested_stream, "control": None}
+               "nested": nested_stream, "long_line": long_line_stream, "control": None}
     chosen = sys.argv[1:] or list(attacks)
     for name in chosen:
         with tempfile.TemporaryDirectory() as folder:

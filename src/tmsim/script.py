@@ -17,13 +17,17 @@ script (a line that is a call with constant arguments only - a motion line - cou
 levels of nesting per expression, STATEMENTS_MAX statements per script, string constants of at most
 STRING_MAX characters, hexadecimal constants of at most 32 bits. A decimal integer constant beyond the
 int range is a float constant ([MAN 2.24 §2.2]: constants take the smallest type that holds them).
+
+The tokenizer and the parse methods are generators that yield every PARSE_SLICE tokens, so the simulator
+can parse a long line in pieces between its other robots' turns (``iter_lines``); ``split_lines`` and
+``parse_line`` run them through at once.
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
 
-from .limits import DEPTH_MAX, HEX_DIGITS_MAX, INT_MAX, STATEMENTS_MAX, STRING_MAX, TOKENS_MAX
+from .limits import DEPTH_MAX, HEX_DIGITS_MAX, INT_MAX, PARSE_SLICE, STATEMENTS_MAX, STRING_MAX, TOKENS_MAX
 
 TYPES = frozenset({"int", "float", "double", "string", "bool", "byte"})
 
@@ -175,7 +179,16 @@ _TOO_LONG = f"script longer than {TOKENS_MAX} elements (names, numbers, operator
 
 def tokenize(text: str) -> list[tuple[str, object]]:
     """Return (kind, value) tokens: num, str, name, op; raises ScriptSyntaxError."""
-    tokens, pos, n = [], 0, len(text)
+    tokens = []
+    for _ in _tokenize(text, tokens):
+        pass
+    return tokens
+
+
+def _tokenize(text: str, tokens: list):
+    """``tokenize`` as a generator that fills ``tokens`` and yields every PARSE_SLICE tokens (a long line is
+    tokenized in pieces, see ``iter_lines``)."""
+    pos, n, pause_at = 0, len(text), PARSE_SLICE
     match = _TOKEN.match
     while pos < n:
         m = match(text, pos)
@@ -197,8 +210,10 @@ def tokenize(text: str) -> list[tuple[str, object]]:
         pos = end
         if len(tokens) > TOKENS_MAX:
             raise ScriptSyntaxError(_TOO_LONG)
+        if len(tokens) >= pause_at:
+            pause_at += PARSE_SLICE
+            yield len(tokens)
     tokens.append(("end", None))
-    return tokens
 
 
 # ---- parser ---------------------------------------------------------------------------------------
@@ -208,6 +223,8 @@ class _Parser:
         self.pos = 0
         self.last = len(tokens) - 1
         self.nesting = 0                # expressions open right now (parentheses, arguments, unary chains)
+        self.pause_at = PARSE_SLICE     # the parse methods are generators: they yield the token position
+                                        # every PARSE_SLICE tokens, so a long line can be parsed in pieces
 
     def peek(self, offset=0):
         index = self.pos + offset
@@ -228,21 +245,25 @@ class _Parser:
         if not self.accept(value):
             raise ScriptSyntaxError(f"expected '{value}' but found {_describe(self.peek())}")
 
-    # grammar: line = "" | decl | assign | incdec | expr
     def line(self):
+        """The statement of the whole line, parsed at once."""
+        return _finish(self.steps())
+
+    # grammar: line = "" | decl | assign | incdec | expr
+    def steps(self):
         if self.peek()[0] == "end":
             return Empty()
         kind, value = self.peek()
         if kind == "name" and value in TYPES and self.peek(1)[0] in ("name",) or (
                 kind == "name" and value in TYPES and self.peek(1) == ("op", "[") and self.peek(2) == ("op", "]")):
-            stmt = self.decl()
+            stmt = yield from self.decl()
         else:
-            expr = self.expr()
+            expr = yield from self.expr()
             kind, value = self.peek()
             if kind == "op" and value in ("=", "+=", "-=", "*=", "/="):
                 self.next()
                 _check_target(expr)
-                stmt = Assign(expr, value, self.expr())
+                stmt = Assign(expr, value, (yield from self.expr()))
             elif kind == "op" and value in ("++", "--"):
                 self.next()
                 _check_target(expr)
@@ -263,14 +284,14 @@ class _Parser:
         kind, name = self.next()
         if kind != "name" or name in TYPES:
             raise ScriptSyntaxError(f"expected a variable name after '{type_name}'")
-        init = self.expr() if self.accept("=") else None
+        init = (yield from self.expr()) if self.accept("=") else None
         return Decl("float" if type_name == "double" else type_name, is_array, name, init)
 
     def expr(self):
         self.nesting += 1
         if self.nesting > DEPTH_MAX:
             raise ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
-        node = self.binary(1)
+        node = yield from self.binary(1)
         self.nesting -= 1
         return node
 
@@ -280,14 +301,14 @@ class _Parser:
     # grammar: binary operators by precedence climbing, all left-associative:
     #          || < && < comparisons < + - < * / %
     def binary(self, min_prec):
-        left = self.unary()
+        left = yield from self.unary()
         while True:
             kind, op = self.toks[self.pos]
             prec = self._PRECEDENCE.get(op, 0) if kind == "op" else 0
             if prec < min_prec:
                 return left
             self.pos += 1
-            left = Binary(op, left, self.binary(prec + 1))
+            left = Binary(op, left, (yield from self.binary(prec + 1)))
 
     # grammar: unary = ("-"|"!"|"+") unary | postfix
     def unary(self):
@@ -296,19 +317,19 @@ class _Parser:
             self.nesting += 1
             if self.nesting > DEPTH_MAX:
                 raise ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
-            operand = self.unary()
+            operand = yield from self.unary()
             self.nesting -= 1
             if op == "-" and isinstance(operand, Num):
                 return Num(-operand.value, operand.is_float)
             return operand if op == "+" else Unary(op, operand)
-        return self.postfix()
+        return (yield from self.postfix())
 
     # grammar: postfix = primary { "[" expr "]" | "." NAME }
     def postfix(self):
-        node = self.primary()
+        node = yield from self.primary()
         while True:
             if self.accept("["):
-                node = Index(node, self.expr())
+                node = Index(node, (yield from self.expr()))
                 self.expect("]")
             elif self.accept("."):
                 kind, name = self.next()
@@ -320,6 +341,9 @@ class _Parser:
 
     # grammar: primary = NUMBER | STRING | BOOL | NAME [call] | array | "(" expr ")"
     def primary(self):
+        if self.pos >= self.pause_at:            # a long line: let the caller spread it over turns
+            self.pause_at = self.pos + PARSE_SLICE
+            yield self.pos
         kind, value = self.next()
         if kind == "num":
             return Num(value[0], value[1])
@@ -329,12 +353,12 @@ class _Parser:
             if value in ("true", "false"):
                 return Bool(value == "true")
             if self.accept("("):
-                return Call(value, self.items(")"))
+                return Call(value, (yield from self.items(")")))
             return Name(value)
         if (kind, value) == ("op", "{"):
-            return Array(self.items("}"))
+            return Array((yield from self.items("}")))
         if (kind, value) == ("op", "("):
-            node = self.expr()
+            node = yield from self.expr()
             self.expect(")")
             return node
         raise ScriptSyntaxError(f"unexpected {_describe((kind, value))}")
@@ -344,7 +368,7 @@ class _Parser:
         if self.accept(closer):
             return items
         while True:
-            items.append(self.expr())
+            items.append((yield from self.expr()))
             if self.accept(closer):
                 return items
             self.expect(",")
@@ -441,24 +465,40 @@ def _parse(text: str) -> tuple[object, int]:
     """
     cached = _CACHE.get(text)
     if cached is None:
-        cost = 1
-        try:
-            stmt = _simple_call(text)
-            if stmt is None:
-                tokens = tokenize(text)
-                cost = len(tokens)
-                stmt = _Parser(tokens).line()
-                _check_depth(stmt)
-        except ScriptSyntaxError as exc:
-            stmt = exc
-        except RecursionError:
-            stmt = ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
-        cached = (stmt, cost)
+        cached = _finish(_parse_steps(text))
         if len(text) <= _CACHE_LINE:
             if len(_CACHE) >= _CACHE_SIZE:
                 _CACHE.clear()
             _CACHE[text] = cached
     return cached
+
+
+def _finish(steps):
+    """Run a generator of the parser to its end; its return value."""
+    while True:
+        try:
+            next(steps)
+        except StopIteration as done:
+            return done.value
+
+
+def _parse_steps(text: str):
+    """``_parse`` without the cache, as a generator: it yields after every PARSE_SLICE tokens tokenized or
+    parsed and returns (statement node or ScriptSyntaxError, tokens)."""
+    cost = 1
+    try:
+        stmt = _simple_call(text)
+        if stmt is None:
+            tokens = []
+            yield from _tokenize(text, tokens)
+            cost = len(tokens)
+            stmt = yield from _Parser(tokens).steps()
+            _check_depth(stmt)
+    except ScriptSyntaxError as exc:
+        stmt = exc
+    except RecursionError:
+        stmt = ScriptSyntaxError(f"expression nested deeper than {DEPTH_MAX} levels")
+    return stmt, cost
 
 
 def parse_line(text: str) -> object:
@@ -472,12 +512,13 @@ def parse_line(text: str) -> object:
 def split_lines(script: str) -> list[Line]:
     """Split a script on CR LF (the protocol's line separator) and parse each line. The line that goes
     beyond STATEMENTS_MAX statements or TOKENS_MAX tokens is an error; the lines after it are not parsed."""
-    return list(iter_lines(script))
+    return [line for line in iter_lines(script) if type(line) is Line]
 
 
 def iter_lines(script: str):
-    """``split_lines`` one line at a time (a generator), so that a caller can spread the parsing of a long
-    script over several turns of the simulator's scheduler."""
+    """``split_lines`` as a generator, so that a caller can spread the parsing of a long script over
+    several turns of the simulator's scheduler: it yields each Line, and while it parses a line longer
+    than the cache keeps (_CACHE_LINE), the number PARSE_SLICE after every PARSE_SLICE tokens."""
     statements, tokens, full = 0, 0, False
     for number, text in enumerate(script.split("\r\n"), start=1):
         line = Line(number, text)
@@ -489,7 +530,17 @@ def iter_lines(script: str):
             line.error = "lines must be separated by CR LF"
             yield line
             continue
-        stmt, cost = _parse(text)
+        if len(text) <= _CACHE_LINE:
+            stmt, cost = _parse(text)
+        else:
+            steps = _parse_steps(text)
+            while True:
+                try:
+                    next(steps)
+                except StopIteration as done:
+                    stmt, cost = done.value
+                    break
+                yield PARSE_SLICE
         if isinstance(stmt, Empty):
             line.stmt = stmt
             yield line

@@ -18,7 +18,7 @@ from . import codec
 from .checker import ScriptChecker
 from .eventlog import text as _text
 from .interp import Context, ScriptRuntimeError, run_script
-from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE
+from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_TOKEN
 from .profiles import Profile
 from .robot import RobotModel
 from .script import iter_lines
@@ -293,17 +293,23 @@ class ListenSession:
     def _script(self, packet):
         """Check the packet line by line, then run it (a generator, like sim.interp.run_script, whose waits
         it passes on). Returns the reply status and whether ScriptExit() ran. Parsing and checking count
-        WORK_CHAR per character and WORK_LINE per line; when the turn's budget is spent, the rest waits for
-        a later turn (wait "turn"): a 64 KiB script never holds the other robots and clients."""
+        WORK_CHAR per character and WORK_LINE per line, a long line WORK_TOKEN per token as its parsing goes
+        (PARSE_SLICE tokens at a time); when the turn's budget is spent, the rest waits for a later turn
+        (wait "turn"): a 64 KiB script, or one line of 10,000 tokens, never holds the other robots."""
         meter = self.meter
         checker = ScriptChecker(self.types, self.profile.tmflow)
-        lines = []
+        lines, sliced = [], 0
         for line in iter_lines(packet.script):
             if meter.spent:
                 yield ("turn", None, None)
+            if type(line) is int:               # PARSE_SLICE more tokens of a long line parsed
+                meter.add(line * WORK_TOKEN)
+                sliced += line * WORK_TOKEN
+                continue
             checker.check(line)
             lines.append(line)
-            meter.add(WORK_LINE + WORK_CHAR * len(line.text))
+            meter.add(max(0, WORK_LINE + WORK_CHAR * len(line.text) - sliced))
+            sliced = 0
         errors = [line.number for line in lines if line.error]
         for line in lines:
             if line.error:

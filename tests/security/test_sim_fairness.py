@@ -9,8 +9,8 @@ import math
 import socket
 
 from tmsim import eventlog
-from tmsim.limits import (CONTROL_TURN_REQUESTS, STEPS_MAX, TURN_WORK, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES,
-                          WORK_PVT_CARTESIAN)
+from tmsim.limits import (CONTROL_TURN_REQUESTS, PARSE_SLICE, STEPS_MAX, TURN_WORK, WORK_CHAR, WORK_LINE,
+                          WORK_LOG_BYTES, WORK_PVT_CARTESIAN, WORK_TOKEN)
 from tmsim.robot import RobotModel
 from tmsim.session import ListenSession
 
@@ -69,6 +69,28 @@ def test_deeply_nested_lines_are_checked_line_by_line_across_turns():
         assert h.until(lambda: replies(attacker), timeout=10) and replies(attacker) == ["N,OK"]
         assert h.robot.session.meter.deferred >= 48 * (WORK_LINE + len(deep)) // (TURN_WORK + 220)
         assert h.robot.session.variables["n47"] == 1
+    finally:
+        h.close()
+
+
+def test_one_line_of_ten_thousand_nested_tokens_is_parsed_in_slices_across_turns():
+    """Attack: one line of ~10,000 tokens nested 95 levels deep per script (the parser's largest item: ~40 ms
+    at once). The tokenizer and the parser stop every PARSE_SLICE tokens; a spent turn leaves the rest of
+    the line for a later turn."""
+    h = Harness(robots=2)
+    try:
+        attacker, other = h.connect(0), h.connect(1)
+        deep = "(" * 95 + "1" + ")" * 95
+        line = "int w = " + "+".join([deep] * 52)
+        attacker.send(sct("W", line))
+        other.send(sta("00"))
+        h.step()
+        assert other.texts() == [("TMSTA", "00,true,Listen1")] and replies(attacker) == []
+        assert h.until(lambda: replies(attacker), timeout=10) and replies(attacker) == ["W,OK"]
+        meter = h.robot.session.meter
+        assert meter.deferred >= len(line) // (TURN_WORK + PARSE_SLICE * WORK_TOKEN)
+        assert meter.most() <= TURN_WORK + PARSE_SLICE * WORK_TOKEN + len(line) * 2 // WORK_LOG_BYTES + WORK_LINE
+        assert h.robot.session.variables["w"] == 52
     finally:
         h.close()
 
