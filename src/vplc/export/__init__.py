@@ -38,6 +38,9 @@ def register(subparsers) -> None:
     p.add_argument("--only", metavar="NAME[,NAME...]",
                    help="write only these data types and POUs (the other sources are loaded to check them), e.g. "
                         "one program for import into a project that has the library already")
+    p.add_argument("--device", metavar="MODEL[@VERSION]",
+                   help="iec61131-10: name the controller in the file header (smcext:DeviceInfo), e.g. "
+                        "NJ501-1500@1.40; without it the file is not tied to a controller model")
     p.add_argument("--dialect", choices=("sysmac", "iec"), default="sysmac", help="language dialect (default: sysmac)")
     p.set_defaults(handler=run_export)
 
@@ -54,6 +57,12 @@ def run_export(args) -> int:
     from .model import ExportError, collect
     from .paste import PasteTargetError, write as write_paste
 
+    device = None
+    if getattr(args, "device", None):
+        model, _, version = args.device.partition("@")
+        if not model.strip() or "@" in version:
+            return _usage(f"--device `{args.device}`: give MODEL or MODEL@VERSION, e.g. NJ501-1500@1.40")
+        device = (model.strip(), version.strip())
     if args.format not in FORMATS:
         return _usage(f"unknown format `{args.format}`; use {', '.join(FORMATS[:-1])} or {FORMATS[-1]}")
     if not args.output:
@@ -94,7 +103,7 @@ def run_export(args) -> int:
         return _usage("the sources declare no data type and no POU; nothing to export")
     try:
         if args.format == "iec61131-10":
-            data = render(export, proj, flat=args.flat)
+            data = render(export, proj, flat=args.flat, device=device)
             _write_atomic(out, data)
         elif args.format == "plcopen":
             from .plcopen import render as render_plcopen

@@ -314,8 +314,8 @@ def _qualifiers(section: A.VarSection) -> dict:
 
 # ---- document ------------------------------------------------------------------------------------
 
-def build(export: ExportSet, project, *, flat: bool = False) -> ET.Element:
-    """The ``Project`` element of the export."""
+def build(export: ExportSet, project, *, flat: bool = False, device: tuple[str, str] | None = None) -> ET.Element:
+    """The ``Project`` element of the export; ``device`` (model, version) names the controller."""
     root = ET.Element("Project", {
         "xmlns": IEC_NS,
         "xmlns:xsi": XSI_NS,
@@ -326,6 +326,9 @@ def build(export: ExportSet, project, *, flat: bool = False) -> ET.Element:
     _sub(root, "FileHeader", {"companyName": COMPANY, "productName": PRODUCT, "productVersion": __version__})
     ch = _sub(root, "ContentHeader", {"name": export.name, "creationDateTime": creation_time()})
     _sub(_sub(ch, "AddDataInfo"), "Info", {"name": SMC_DATA_NAME, "vendor": SMC_NS})
+    if device is not None:
+        model, version = device
+        _add_data(ch, "DeviceInfo", {"modelName": model, **({"version": version} if version else {})})
     gns = _sub(_sub(root, "Types"), "GlobalNamespace")
     containers: dict[str | None, ET.Element] = {None: gns}
     if not flat:
@@ -359,5 +362,5 @@ def to_bytes(root: ET.Element) -> bytes:
     return ('<?xml version="1.0" encoding="utf-8"?>\n' + body + "\n").encode("utf-8")
 
 
-def render(export: ExportSet, project, *, flat: bool = False) -> bytes:
-    return to_bytes(build(export, project, flat=flat))
+def render(export: ExportSet, project, *, flat: bool = False, device: tuple[str, str] | None = None) -> bytes:
+    return to_bytes(build(export, project, flat=flat, device=device))

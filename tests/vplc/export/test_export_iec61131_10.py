@@ -232,7 +232,8 @@ def test_synthetic_sources_cover_programs_constants_retain_at_and_globals(tmp_pa
     lib.mkdir()
     (lib / "types.st").write_text(
         "TYPE\n    eMode : (Off, Slow := 5, Fast) INT;\n    aTable : ARRAY[0..2] OF INT;\n"
-        "    stPoint : STRUCT\n        X : REAL := 1.5;\n        Tab : aTable := [1, 2(7)];\n    END_STRUCT;\nEND_TYPE\n",
+        "    stPoint : STRUCT\n        X : REAL := 1.5;\n        Tab : aTable := [1, 2(7)];\n    END_STRUCT;\n"
+        "END_TYPE\n",
         encoding="utf-8")
     (lib / "Main.st").write_text(
         "PROGRAM Main\nVAR CONSTANT\n    Limit : INT := 10;\nEND_VAR\nVAR RETAIN\n    Count : DINT;   (* kept *)\n"

@@ -53,6 +53,14 @@ def test_library_and_examples_validate(schema, tmp_path, capsys, paths):
     assert errors(schema, export(capsys, tmp_path / "flat.xml", *paths, "--flat")) == []
 
 
+def test_device_info_names_the_controller_and_validates(schema, tmp_path, capsys):
+    out = export(capsys, tmp_path / "dev.xml", LIB, "--device", "NJ501-1500@1.40")
+    assert errors(schema, out) == []
+    assert '<smcext:DeviceInfo modelName="NJ501-1500" version="1.40" />' in out.read_text(encoding="utf-8")
+    code, _, err = run(capsys, "export", str(LIB), "--device", "@1.40", "-o", str(tmp_path / "x.xml"))
+    assert code == 2 and "--device `@1.40`: give MODEL or MODEL@VERSION" in err
+
+
 def test_the_shipped_ladder_example_validates(schema):
     assert errors(schema, ROOT / "examples" / "Commands_Example.xml") == []
 

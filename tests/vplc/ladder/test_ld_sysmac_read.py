@@ -260,3 +260,22 @@ def test_malformed_sysmac_attributes_are_errors_with_their_place_never_a_traceba
     for name, (text, message) in bad.items():
         d = refused(write(tmp_path, text, f"{name}.xml"), message)
         assert "internal error" not in d.message, name
+
+
+def test_old_export_declarations_load_with_one_warning_per_rule(tmp_path):
+    old = ('<DataTypeDecl name="eOld"><UserDefinedTypeSpec xsi:type="EnumTypeWithNamedValueSpec">'
+           '<Enumerator name="A" value="0"/><Enumerator name="B" value="1"/><BaseType><TypeName>DINT</TypeName>'
+           '</BaseType></UserDefinedTypeSpec></DataTypeDecl>'
+           '<FunctionBlock name="Old"><Parameters><InputVars constant="true"><Variable name="K" orderWithinParamSet="0">'
+           '<Type><TypeName>INT</TypeName></Type><InitialValue><SimpleValue value="3"/></InitialValue></Variable>'
+           '</InputVars><InOutVars><Variable name="Buf" orderWithinParamSet="1"><Type><InstantlyDefinedType '
+           'xsi:type="ArrayTypeSpec"><BaseType><TypeName>BYTE</TypeName></BaseType><DimensionSpec dimensionNumber="1"/>'
+           '</InstantlyDefinedType></Type></Variable></InOutVars></Parameters>'
+           '<MainBody><BodyContent xsi:type="ST"><ST>Buf[0] := INT_TO_BYTE(K);</ST></BodyContent></MainBody>'
+           '</FunctionBlock>')
+    found = diagnostics(write(tmp_path, doc(old)))
+    assert {d.severity for d in found} == {"warning"} and {d.code for d in found} == {"ST2108"}
+    text = " | ".join(d.message for d in found)
+    for rule in ("spelt InoutVars", "per variable", "BaseType>DINT</BaseType>", "IndexRange or VariableLength"):
+        assert rule in text, rule
+    assert len(found) == 4, "one warning per rule"
