@@ -91,6 +91,18 @@ def plant():
     p.close()
 
 
+@pytest.fixture
+def plant_without_ethernet_slave():
+    """The robot's Ethernet Slave not used (Connect_SvrPort 0): positions come from the Listen node, the robot's
+    outputs are not known to the PLC."""
+    p = Plant()
+    p.plc.write("Connect_SvrPort", 0)
+    p.plc.write("Connect_Execute", True)
+    p.until(lambda: p.read("Connect_Connected"), "connected")
+    yield p
+    p.close()
+
+
 def switched(values):
     """The gripper's switching: consecutive equal values collapsed (setting an output to the value it has is no
     switching)."""
@@ -165,10 +177,9 @@ def lose_the_answer_of_the_next(plant, what, predicate):
     return mark
 
 
-def test_gripper_close_with_a_lost_answer_is_resolved_at_the_pick_point_and_the_part_is_picked_once(plant):
-    """Issue 23 item 3: the gripper closed, its answer was lost (16#200B). The next start must not carry the part
-    back to the pick point and close again: the robot is still at the pick point, so the close is sent again
-    there (the output already is 1: no switching), and the cycle goes on with the retreat."""
+def lose_the_gripper_close_answer_then_restart(plant):
+    """The gripper closes at the pick point, its answer is lost (16#200B); the link comes back; the operator
+    resets and starts again. Returns the event index before the close."""
     plant.start()
     mark = lose_the_answer_of_the_next(plant, "the gripper close", lambda: plant.read("PnP.GripperExecute"))
     plant.until(lambda: plant.gripper(mark), "the robot to close the gripper", 2)
@@ -183,17 +194,32 @@ def test_gripper_close_with_a_lost_answer_is_resolved_at_the_pick_point_and_the_
     assert plant.read("PnP_State") == "Faulted"
     plant.reset()
     assert plant.read("PnP_State") == "Idle" and plant.read("PnP_MoveError") is False
-    lost = plant.gripper(mark)[0]
     plant.start()
     plant.until(lambda: plant.read("PnP_CycleCount") == 1, "the cycle to complete", 40)
-    gripper = plant.gripper(mark)
-    assert [e["value"] for e in gripper] == [1, 1, 0]           # sent again at the pick point, then opened at place
-    moves_before_resolved = [e for e in plant.events("motion_start", mark) if e["t"] < gripper[1]["t"]]
-    assert moves_before_resolved == [], "the robot moved before the gripper state was known"
     assert len(plant.arrivals(1)) == 1, "the part was carried back to the pick point"
-    assert switched([e["value"] for e in plant.gripper()]) == [1, 0]
     assert plant.read("PnP_OutcomeUnknown") is False and plant.read("PnP_GripperClosed") is False
-    assert lost["t"] < gripper[1]["t"]
+    return mark
+
+
+def test_gripper_close_with_a_lost_answer_is_resolved_from_the_robots_output_and_the_part_is_picked_once(plant):
+    """Issue 23 item 3: the gripper closed, its answer was lost (16#200B). The next start must not carry the part
+    back to the pick point and close again: the robot is at rest at the pick point and its Ethernet Slave data
+    table shows End_DO0 = 1, so the close had run; the cycle goes on with the dwell and the retreat."""
+    mark = lose_the_gripper_close_answer_then_restart(plant)
+    assert [e["value"] for e in plant.gripper(mark)] == [1, 0]  # closed once (answer lost), opened at place
+    assert [e["value"] for e in plant.gripper()] == [1, 0]
+
+
+def test_without_the_robots_output_the_gripper_close_is_sent_again_at_the_pick_point(plant_without_ethernet_slave):
+    """No Ethernet Slave, so no output reading: the robot is still at the pick point, so the close is sent again
+    there (the output already is 1: no switching) before anything moves."""
+    plant = plant_without_ethernet_slave
+    mark = lose_the_gripper_close_answer_then_restart(plant)
+    gripper = plant.gripper(mark)
+    assert [e["value"] for e in gripper] == [1, 1, 0]           # sent again at the pick point, opened at place
+    assert [e for e in plant.events("motion_start", mark) if e["t"] < gripper[1]["t"]] == [], \
+        "the robot moved before the gripper state was known"
+    assert switched([e["value"] for e in plant.gripper()]) == [1, 0]
 
 
 def test_move_with_a_lost_answer_is_not_sent_again_when_the_robot_has_arrived(plant):
