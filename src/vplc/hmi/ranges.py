@@ -1,7 +1,9 @@
 """Parameter ranges of the HMI taken from the library's one range table (hmi/ranges.json, generated from
 docs/library/ranges.tsv by docs/library/make_types.py), never typed into the variable table a second time.
 
-For every structure member (or FB input) in the table, the variable table's spec gets:
+For every structure member (or FB input) in the table, the variable table's spec gets (an FB of which the
+variable table feeds no input, e.g. CBT_SetOverride while the HMI has no override setting, is left out; one it
+feeds must have every ranged input, so a misspelt name is still an error):
   min / max   the widest range over all conditions: what the server accepts for a single write
   ranges      the conditional ranges ({"when": {"DataFormat": [...]}, "min", "max", "unit", "error"}): the page
               applies the one that matches the selected data format, blending, module ...
@@ -37,7 +39,10 @@ def apply_ranges(document: dict, table: dict, source: str = "ranges") -> dict:
     """Write the table's ranges into the variable table ``document`` (in place; returned for chaining)."""
     types = document.get("types", {})
     inputs = {spec["input"]: spec for spec in document.get("variables", {}).values() if "input" in spec}
+    fed = {name.partition(".")[0] for name in inputs}
     for owner, members in table.items():
+        if owner not in types and owner not in fed and not owner.startswith("st"):
+            continue                                    # an FB the HMI does not drive
         for member, entries in members.items():
             if owner in types:
                 spec = types[owner].get("fields", {}).get(member)
