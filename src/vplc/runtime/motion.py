@@ -19,8 +19,6 @@ from .motion_config import UNITS, AxisConfig
 # motion-instruction range; the names say what the instruction refused.
 ERR_AXIS_UNUSED = 0x5401       # the axis is not a configured virtual axis
 ERR_DISABLED = 0x5402          # motion command while the servo is OFF (Disabled)
-ERR_ERRORSTOP = 0x5403         # MC_SetPosition while the axis is in ErrorStop (motions: CommandAborted)
-ERR_STOPPING = 0x5404          # command while MC_Stop holds the axis in Stopping
 ERR_MOVING = 0x5405            # MC_Home / MC_SetPosition while the axis moves
 ERR_VELOCITY = 0x5410          # Velocity out of range
 ERR_ACCELERATION = 0x5411      # Acceleration negative
@@ -29,7 +27,7 @@ ERR_JERK = 0x5413              # Jerk negative
 ERR_DIRECTION = 0x5414         # Direction not allowed for the instruction
 ERR_BUFFER_MODE = 0x5415       # BufferMode out of range
 ERR_POSITION = 0x5416          # target (or SetPosition value) outside the software limits, or not finite
-ERR_OVERRIDE = 0x5417          # VelFactor outside 0 .. 500 %
+ERR_OVERRIDE = 0x5417          # VelFactor is not a number (NaN)
 ERR_BUFFER_FULL = 0x5418       # a second buffered command while one is already waiting
 AXIS_SW_LIMIT_POS = 0x6440     # axis minor fault: positive software limit reached (MFaultLvl.Code)
 AXIS_SW_LIMIT_NEG = 0x6441     # axis minor fault: negative software limit reached

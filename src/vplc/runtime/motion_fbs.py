@@ -38,20 +38,17 @@ def _axis(fb):
     return axis
 
 
-IN_ERROR = -1       # begin(): the axis is in ErrorStop, the instruction ends in CommandAborted (not an ErrorID)
+REFUSED = -1        # begin(): the instruction ends in CommandAborted (not an ErrorID)
 
 
 def _state_error(axis, stop: bool = False) -> int:
-    """The PLCopen state diagram (W507): no motion from ErrorStop (W508 MC_Stop output timing: an instruction
-    started while the axis has an error ends in CommandAborted) or Disabled (W508 MC_Power: motion instructions
-    on a disabled axis end in error), and none but another MC_Stop (``stop``) while MC_Stop holds the axis in
-    Stopping."""
-    if axis.state == M.ERRORSTOP:
-        return IN_ERROR
+    """The PLCopen state diagram as W508 applies it (output timing of MC_Home, MC_SetPosition, MC_Stop: an
+    instruction started while the axis has an error, or while MC_Stop runs, ends in CommandAborted; MC_Power: a
+    motion instruction on a disabled axis is an error). Another MC_Stop (``stop``) may start while one runs."""
+    if axis.state == M.ERRORSTOP or (axis.state == M.STOPPING and not stop):
+        return REFUSED
     if axis.state == M.DISABLED:
         return M.ERR_DISABLED
-    if axis.state == M.STOPPING and not stop:
-        return M.ERR_STOPPING
     return 0
 
 
@@ -93,7 +90,7 @@ class _ExecuteFB:
                 self._fail(M.ERR_AXIS_UNUSED)
             else:
                 code = self.begin(axis)
-                if code == IN_ERROR:
+                if code == REFUSED:
                     self.CommandAborted = True
                     self._end()
                 elif code:
@@ -356,16 +353,19 @@ class MC_Home(_ExecuteFB):
 
 class MC_SetPosition(_ExecuteFB):
     """W508 MC_SetPosition: the command and actual position become Position (the virtual servo has no following
-    error, so every ReferenceType gives the same result); home becomes defined."""
+    error, so both ReferenceType values give the same result); home becomes defined. Relative and ExecutionMode
+    are reserved."""
 
     def __init__(self, rt, path):
         super().__init__(rt, path)
         self.Position = 0.0
         self.ReferenceType = 0
+        self.Relative = False
+        self.ExecutionMode = 0
 
     def begin(self, axis) -> int:
-        if axis.state == M.ERRORSTOP:
-            return M.ERR_ERRORSTOP
+        if axis.state in (M.ERRORSTOP, M.STOPPING):
+            return REFUSED
         if axis.state not in (M.STANDSTILL, M.DISABLED):
             return M.ERR_MOVING
         x = self.Position
@@ -460,21 +460,26 @@ class MC_ReadAxisError(_EnableFB):
 
 
 class MC_SetOverride(_EnableFB):
-    """W508 MC_SetOverride: while Enable is TRUE the command velocity is VelFactor % (0 .. 500) of what the
-    instructions ask; 0 % holds the axis without ending its motion. AccFactor and JerkFactor are not used."""
+    """W508 MC_SetOverride: while Enable is TRUE the target velocity of the running instruction is VelFactor %
+    of what it asks (at most the axis maximum); VelFactor above 500 counts as 500, below 0.01 (negative included)
+    as 0.01, and only 0 as 0 — which holds the axis without ending its motion. Enabled goes FALSE one period after
+    Enable. AccFactor and JerkFactor are reserved."""
 
     def __init__(self, rt, path):
         super().__init__(rt, path)
         self.VelFactor = self.AccFactor = self.JerkFactor = 100.0
         self.Enabled = False
 
+    i__on = False           # the override is applied (Enabled follows it one call later when Enable drops)
+
     def i__run(self) -> None:
         ctl = getattr(self.i__rt, "motion", None)
         axis = ctl.axis_of(self.Axis) if ctl is not None else None
         if not self.Enable:
-            if self.Enabled and axis is not None:
+            self.Enabled = self.i__on
+            if self.i__on and axis is not None:
                 axis.set_override(1.0, _now(self))
-            self.Enabled = self.Busy = self.Error = False
+            self.i__on = self.Busy = self.Error = False
             self.ErrorID = 0
             return
         if axis is None:
@@ -483,12 +488,15 @@ class MC_SetOverride(_EnableFB):
             self.Enabled, self.Busy, self.Error, self.ErrorID = False, False, True, M.ERR_AXIS_UNUSED
             return
         f = self.VelFactor
-        if not (math.isfinite(f) and 0.0 <= f <= M.MAX_OVERRIDE * 100):
+        if math.isnan(f):
             self.Enabled, self.Busy, self.Error, self.ErrorID = False, False, True, M.ERR_OVERRIDE
+            self.i__on = False
             return
+        if f != 0.0:
+            f = min(max(f, 0.01), M.MAX_OVERRIDE * 100)
         self.Error, self.ErrorID = False, 0
         axis.set_override(f / 100.0, _now(self))
-        self.Enabled = self.Busy = True
+        self.Enabled = self.Busy = self.i__on = True
 
 
 NATIVE_FBS = {c.__name__: c for c in (MC_Power, MC_Home, MC_MoveAbsolute, MC_MoveRelative, MC_MoveVelocity,

@@ -208,60 +208,20 @@ def test_stop_holds_the_axis_in_stopping_while_execute_is_true(rig):
     assert rig.state() == "Standstill" and not rig.r("stp.Done")
 
 
-def test_a_motion_instruction_while_stopping_is_an_axis_error(rig):
-    """W507 state chart: nothing but MC_Stop is accepted in Stopping; the refused instruction is an error of the
-    axis (ErrorStop, MFaultLvl), its Error stays TRUE until MC_Reset (W508 output timing: Error is FALSE once the
-    error is reset)."""
+def test_an_instruction_started_while_mc_stop_runs_ends_in_command_aborted(rig):
+    """W508 MC_Home / MC_SetPosition output timing (CommandAborted "when started while MC_Stop is executed") and
+    the W507 state chart: in Stopping only MC_Stop is accepted; the axis stays in Stopping."""
     rig.powered()
     rig.set(doStop=True)
     rig.scan(3)
-    rig.set(doAbs1=True)
+    rig.set(doAbs1=True, doHome=True, doSetPos=True)
     rig.scan()
-    assert rig.r("abs1.Error") and rig.r("abs1.ErrorID") == M.ERR_STOPPING and not rig.r("abs1.Busy")
-    assert rig.state() == "ErrorStop" and rig.ax("MFaultLvl.Code") == M.ERR_STOPPING
-    rig.set(doAbs1=False, doStop=False)
-    rig.scan(3)
-    assert rig.r("abs1.Error"), "Error lasts until the axis error is reset, not until Execute is FALSE"
-    rig.set(doReset=True)
+    assert rig.outputs("abs1") == (False, False, False, True, False)
+    assert rig.r("home.CommandAborted") and rig.r("setp.CommandAborted") and not rig.r("setp.Error")
+    assert rig.state() == "Stopping"
+    rig.set(doAbs1=False)
     rig.scan()
-    assert rig.r("rst.Done") and rig.state() == "Standstill"
-    rig.scan()
-    assert not rig.r("abs1.Error") and rig.r("abs1.ErrorID") == 0
-
-
-def test_stop_with_execute_already_false_ends_in_standstill(rig):
-    """W507 state chart: Stopping ends when MC_Stop is Done with Execute FALSE."""
-    rig.powered()
-    rig.set(doVel=True)
-    rig.scan(50)
-    rig.set(doStop=True)
-    rig.scan()
-    rig.set(doStop=False)
-    rig.scan(100)
-    assert rig.state() == "Standstill" and rig.ax("Cmd.Vel") == 0.0
-
-
-def test_halt_decelerates_in_discrete_and_can_be_taken_over(rig):
-    """W508 MC_Halt: Discrete while decelerating, Done at velocity 0, then Standstill; unlike MC_Stop another
-    instruction may abort it (MC_Halt then shows CommandAborted)."""
-    rig.powered()
-    rig.set(doVel=True, vv=50.0)
-    rig.scan(100)
-    rig.set(doHalt=True)
-    rig.scan()
-    assert rig.state() == "Discrete" and rig.outputs("hlt") == (True, True, False, False, False)
-    while not rig.r("hlt.Done"):
-        rig.scan()
-    assert rig.state() == "Standstill"
-    rig.set(doHalt=False, doVel=False)
-    rig.scan()
-    rig.set(doVel=True)
-    rig.scan(30)
-    rig.set(doHalt=True)
-    rig.scan(5)
-    rig.set(doAbs1=True)
-    rig.scan(2)
-    assert rig.r("hlt.CommandAborted") and rig.state() == "Discrete" and rig.r("abs1.Active")
+    assert not rig.r("abs1.CommandAborted")
 
 
 @pytest.mark.parametrize("fb,flag", [("abs1", "doAbs1"), ("vel", "doVel"), ("hlt", "doHalt"), ("home", "doHome")])
@@ -310,8 +270,9 @@ def test_home_defines_home_at_standstill_and_is_refused_while_moving(rig):
 
 
 def test_override_scales_the_velocity_and_zero_holds_the_axis_in_motion(rig):
-    """W508 MC_SetOverride: VelFactor % of the commanded velocity while Enabled; 0 % stops the axis without ending
-    the instruction; back to 100 % when Enable is FALSE."""
+    """W508 MC_SetOverride: VelFactor % of the target velocity while Enabled (above 500 counts as 500, below 0.01 as
+    0.01, only 0 as 0, never above the axis maximum); 0 % stops the axis without ending the instruction; back to
+    100 % when Enable is FALSE."""
     rig.powered()
     rig.set(doOvr=True, factor=50.0)
     rig.scan()
@@ -323,11 +284,18 @@ def test_override_scales_the_velocity_and_zero_holds_the_axis_in_motion(rig):
     rig.scan(100)
     assert rig.ax("Cmd.Vel") == 0.0 and rig.state() == "Continuous" and rig.r("vel.Busy")
     rig.set(doOvr=False)
+    rig.scan()
+    assert rig.r("ovr.Enabled") and not rig.r("ovr.Busy"), "Enabled goes FALSE one period after Enable"
+    rig.scan()
+    assert not rig.r("ovr.Enabled")
     rig.scan(100)
     assert rig.ax("Cmd.Vel") == 40.0
-    rig.set(doOvr=True, factor=600.0)
-    rig.scan()
-    assert rig.r("ovr.Error") and rig.r("ovr.ErrorID") == M.ERR_OVERRIDE
+    rig.set(doOvr=True, factor=600.0)             # counts as 500 %, limited by the axis maximum (200 mm/s)
+    rig.scan(200)
+    assert rig.ax("Cmd.Vel") == 200.0 and not rig.r("ovr.Error")
+    rig.set(factor=-5.0)                          # counts as 0.01 %
+    rig.scan(500)
+    assert rig.ax("Cmd.Vel") == pytest.approx(40.0 * 0.0001)
 
 
 def test_velocity_above_the_axis_maximum_is_limited_and_flagged(rig):
