@@ -12,7 +12,9 @@ Limits (per robot unless noted):
   that does not read (the one with most waiting, for the total) is dropped
 * fairness: each client's input is processed in bounded turns, floods after the others (sim/fairness.py);
   CPERR answers to bad packets limited per client (the session, sim/session.py)
-* the event log: bounded by count and bytes (sim/eventlog.py)
+* the event log: bounded by count and bytes in memory, the file rotated at LOG_FILE_BYTES_MAX (sim/eventlog.py)
+* work: every turn of a robot (a client's input, advancing its motions and script) does at most TURN_WORK
+  units; what is left goes on in its next turn, after the others (sim/work.py)
 """
 from __future__ import annotations
 
@@ -38,7 +40,7 @@ from .session import STOPPED, ListenSession
 MAX_CLIENTS = 256
 MAX_OUTBOX = 1 << 20
 RBUF_READ_BELOW = codec.MAX_DATA + 64     # a receive buffer this full holds a complete item: process it first
-EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all), and at
+EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all, rotated), and at
                             # most limits.EVENT_BYTES_MAX bytes (sim/eventlog.py)
 GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
