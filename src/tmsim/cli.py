@@ -44,7 +44,8 @@ def build_parser() -> argparse.ArgumentParser:
     timing.add_argument("--realtime", action="store_true", help="motions take their real duration (default)")
     timing.add_argument("--speedup", type=float, default=1.0, metavar="K",
                         help="run the robot clock K times faster than the wall clock")
-    parser.add_argument("--log", metavar="FILE.jsonl", help="append every event as one JSON line to FILE (renamed to FILE.1 at 64 MiB)")
+    parser.add_argument("--log", metavar="FILE.jsonl",
+                        help="append every event as one JSON line to FILE (renamed to FILE.1 at 64 MiB)")
     parser.add_argument("--no-auto-enter", action="store_true",
                         help="start with the flow outside the Listen node (enter it via the control channel)")
     parser.add_argument("--send-message", default="Listen1", metavar="TEXT", help="the node's Send Message (default Listen1)")

@@ -3,7 +3,8 @@
 The server only schedules: which client's input is processed next and how much of it. One turn lets the
 robot's session (``ListenSession.process``) handle at most SERVE_ITEMS items of one client's input and
 decode at most SERVE_SCAN, and do at most TURN_WORK units of work (sim/work.py: checking and running
-scripts, logging; a script that is not done goes on in the robot's next turn, ``SimServer._advance``); what is left waits in that client's receive buffer in the session
+scripts, logging; a script that is not done goes on in the robot's next turn, ``SimServer._advance``);
+what is left waits in that client's receive buffer in the session
 (``_backlog``), which is not read further meanwhile, while the other clients get their turn, round
 robin. A client whose last read filled the receive size or who has input left over is "greedy":
 ``SimServer._serve`` serves it after the others. The session limits the CPERR answers to bad packets
