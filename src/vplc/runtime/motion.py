@@ -186,9 +186,10 @@ class Axis:
         return not self.limits_active() or self.cfg.limit_negative <= x <= self.cfg.limit_positive
 
     def vmax_of(self, velocity: float) -> tuple[float, bool]:
-        """Command velocity after the axis maximum and the override; True when the maximum limited it."""
-        limited = velocity > self.cfg.max_velocity
-        return min(velocity, self.cfg.max_velocity) * self.override, limited
+        """Target velocity × override, at most the axis maximum (W508 MC_SetOverride); True when the maximum
+        limited it (Details.VelLimit)."""
+        v = velocity * self.override
+        return (self.cfg.max_velocity, True) if v > self.cfg.max_velocity else (v, False)
 
     def ramp(self, value: float, maximum: float) -> float:
         """Acceleration or deceleration actually used: 0 (no limit in W508) and values above the axis maximum

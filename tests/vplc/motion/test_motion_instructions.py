@@ -290,9 +290,18 @@ def test_override_scales_the_velocity_and_zero_holds_the_axis_in_motion(rig):
     assert not rig.r("ovr.Enabled")
     rig.scan(100)
     assert rig.ax("Cmd.Vel") == 40.0
-    rig.set(doOvr=True, factor=600.0)             # counts as 500 %, limited by the axis maximum (200 mm/s)
+    rig.set(doOvr=True, factor=300.0)             # 120 mm/s
     rig.scan(200)
-    assert rig.ax("Cmd.Vel") == 200.0 and not rig.r("ovr.Error")
+    assert rig.ax("Cmd.Vel") == 120.0 and not rig.ax("Details.VelLimit")
+    rig.set(factor=600.0, vv=50.0)                # counts as 500 %: 250 mm/s, limited to the axis maximum
+    rig.set(doVel=False)
+    rig.scan()
+    rig.set(doVel=True)
+    rig.scan(200)
+    assert rig.ax("Cmd.Vel") == 200.0 and rig.ax("Details.VelLimit") and not rig.r("ovr.Error")
+    rig.set(vv=40.0, doVel=False)
+    rig.scan()
+    rig.set(doVel=True)
     rig.set(factor=-5.0)                          # counts as 0.01 %
     rig.scan(500)
     assert rig.ax("Cmd.Vel") == pytest.approx(40.0 * 0.0001)
