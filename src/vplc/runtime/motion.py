@@ -207,9 +207,10 @@ class Axis:
         self._finish(self.queued, ABORTED)
         self.active = self.queued = None
 
-    def start(self, cmd: Command, t: float) -> None:
-        """Make ``cmd`` the axis' motion from now on (Aborting, or a buffered command whose turn came)."""
-        if self.profile is not None and self.profile.t_end != t:     # where the axis is now, in closed form
+    def start(self, cmd: Command, t: float, at_end: bool = False) -> None:
+        """Make ``cmd`` the axis' motion from time t on: Aborting (from where the running motion is at t, in
+        closed form), or a buffered command whose turn came (``at_end``: from where the one before it ended)."""
+        if self.profile is not None and not at_end:
             self.pos, self.vel, self.acc, _ = self.profile.at(t)
         if self.active is not cmd:
             self._finish(self.active, ABORTED)
@@ -275,7 +276,7 @@ class Axis:
                 self.pos, self.vel = prof.x_end, prof.v_end
                 self._finish(cmd, DONE)
                 nxt, self.queued, self.active = self.queued, None, None
-                self.start(nxt, prof.t_end)
+                self.start(nxt, prof.t_end, at_end=True)
                 continue
             self.profile = None
             self.vel = self.acc = 0.0
