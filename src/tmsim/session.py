@@ -18,7 +18,7 @@ from . import codec
 from .checker import ScriptChecker
 from .eventlog import text as _text
 from .interp import Context, ScriptRuntimeError, run_script
-from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_TOKEN
+from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN
 from .profiles import Profile
 from .robot import RobotModel
 from .script import iter_lines
@@ -175,10 +175,14 @@ class ListenSession:
         if client is not None:
             client.outbox.append(frame)
 
-    def push(self, frame: bytes, ip_filter=None):
-        for conn, client in self.clients.items():
+    def push(self, frame: bytes, ip_filter=None) -> int:
+        """Queue ``frame`` for every client (of address ``ip_filter``); returns how many get it."""
+        count = 0
+        for client in self.clients.values():
             if ip_filter is None or client.peer == ip_filter:
                 client.outbox.append(frame)
+                count += 1
+        return count
 
     # ---- input --------------------------------------------------------------------------------
     def handle(self, conn: int, item):
@@ -375,7 +379,9 @@ class ListenSession:
             self._step(result)
 
     def _listen_send(self, ip_filter, sub, payload):
-        self.push(codec.encode("TMSTA", f"{sub},".encode() + payload), ip_filter)
+        frame = codec.encode("TMSTA", f"{sub},".encode() + payload)
+        recipients = self.push(frame, ip_filter)
+        self.meter.add(len(frame) * recipients // WORK_LOG_BYTES)     # sending it and its event, per client
 
     # ---- time ---------------------------------------------------------------------------------
     def advance(self, now: float):

@@ -148,8 +148,24 @@ def test_listen_send_of_a_long_string_is_work_counted_by_its_size():
         assert len(sends) == line - 1
         reason = [e["reason"] for e in h.robot.events if e["kind"] == "runtime_error"]
         assert reason and f"more than {STEPS_MAX} steps" in reason[-1]
-        one_send = 64_000 // 256 + 4 + 2 * (64_000 + 300) // WORK_LOG_BYTES            # steps + its frame's event
+        one_send = 64_000 // 256 + 4 + 3 * (64_000 + 300) // WORK_LOG_BYTES    # steps, sending, the frame's event
         assert h.robot.session.meter.most() <= TURN_WORK + one_send + 70_000 * 2 // WORK_LOG_BYTES
+    finally:
+        h.close()
+
+
+def test_listen_send_to_many_clients_counts_its_work_for_each_of_them():
+    """A ListenSend reaches every client of the robot: its turn counts the frame once per client, so a
+    64,000-character send to 40 clients ends the turn (the script goes on in a later turn)."""
+    h = Harness()
+    try:
+        peers = [h.connect() for _ in range(40)]
+        h.request(peers[0], sct("D", "\r\n".join(['string s = "' + "x" * 125 + '"'] + ["s = s + s"] * 9)))
+        meter = h.robot.session.meter
+        deferred = meter.deferred
+        assert h.request(peers[0], sct("L", "ListenSend(90,s)\r\nListenSend(90,s)"), count=3)[-1] == ("TMSCT", "L,OK")
+        assert meter.deferred > deferred                 # the second send waited for a later turn
+        assert h.until(lambda: all(len([f for f in p.frames if f.header == "TMSTA"]) == 2 for p in peers))
     finally:
         h.close()
 
