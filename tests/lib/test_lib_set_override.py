@@ -9,6 +9,7 @@ import sys
 
 import pytest
 
+from cell import svr  # noqa: F401 - the fixture
 from rig import ROOT, SEC, Rig, move_abs
 
 from docs.library import make_error_tables as tables
@@ -23,15 +24,6 @@ def range_row():
     spec.loader.exec_module(module)
     (row,) = [r for r in module.read_ranges() if r.struct == "CBT_SetOverride" and r.member == "Override"]
     return row
-
-
-@pytest.fixture
-def svr():
-    r = Rig(program="Main_Cell.st", svr_port=0)
-    r.write("StatusEnable", True)
-    assert r.until(lambda: r.read("status.Valid"), 1)
-    yield r
-    r.close()
 
 
 def override(rig, value, seconds=3):

@@ -4,21 +4,11 @@ before it has ended on the robot (the simulator's event log), blended motions of
 a stop ends it CommandAborted; Moving / Standstill from TCP_Speed3D and Joint_Speed (TMflow 2.24 Appendix D)
 and MotionsQueued following what the robot still has to do."""
 
-import pytest
-
+from cell import svr  # noqa: F401 - the fixture
 from rig import SEC, Rig, move_abs
 
 TARGETS = [dict(X=30, Y=0, Z=90, RX=0, RY=90, RZ=0), dict(X=30, Y=20, Z=90, RX=0, RY=90, RZ=0),
            dict(X=0, Y=20, Z=90, RX=0, RY=90, RZ=0), dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=0)]
-
-
-@pytest.fixture
-def svr():
-    r = Rig(program="Main_Cell.st", svr_port=0)
-    r.write("StatusEnable", True)
-    assert r.until(lambda: r.read("status.Valid"), 1)
-    yield r
-    r.close()
 
 
 def motion_ends(rig):
