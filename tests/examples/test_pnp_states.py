@@ -1,90 +1,16 @@
 """PnP_Example's operating states on the virtual PLC (virtual time) against the simulator with its Ethernet Slave:
-a stop latches (issue 25 item 1) and an unknown outcome is resolved from the robot's position before the cycle
-moves again (issue 23 item 3). The simulator's event log is the witness of what the robot did."""
+a stop latches (issue 25 item 1) and an unknown outcome is resolved from the robot's position and outputs before
+the cycle moves again (issue 23 item 3). The simulator's event log is the witness of what the robot did."""
 from __future__ import annotations
 
-import pathlib
-
 import pytest
-
-from tmsim.server import SimServer
-from vplc.api import load_plc
-
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
-SECOND = 1_000_000_000
-GRIPPER = "EndModule.DO[0]"
-HMI_STOP_HOLD_S = 1.5            # the HMI's Stop Motion page releases Stop 1.5 s after Done (hmi.js HOLD_DONE_MS)
-
-
-class Plant:
-    """The examples on the virtual PLC and a simulator robot with its Ethernet Slave, one thread."""
-
-    def __init__(self):
-        self.sim = SimServer(port=0, robots=1, svr_port=0)
-        self.sim.start()
-        self.robot = self.sim.robots[0]
-        self.plc = load_plc(SOURCES)
-        self.plc.write("Connect_AddressIP", "127.0.0.1")
-        self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
-        self.plc.write("Connect_SvrPort", self.robot.svr_port)
-        self.plc.write("PnP_DwellTime", SECOND // 4)
-
-    def close(self):
-        self.plc.close()
-        self.sim.close()
-
-    def read(self, name):
-        return self.plc.read(name)
-
-    def until(self, predicate, what, seconds=10.0):
-        ok = self.plc.run_until(predicate, timeout_ns=int(seconds * SECOND),
-                                on_scan=lambda now_ns: self.sim.poll(now_ns / 1e9))
-        assert ok, f"{what} did not happen within {seconds} s of PLC time (state {self.read('PnP_State')})"
-
-    def run_for(self, seconds):
-        end = self.plc.now_ns + int(seconds * SECOND)
-        self.until(lambda: self.plc.now_ns >= end, f"{seconds} s to pass", seconds + 1)
-
-    def start(self):
-        """The operator's deliberate start: a rising edge of PnP_Example_Execute, held TRUE afterwards."""
-        self.plc.write("PnP_Example_Execute", False)
-        self.run_for(0.002)
-        self.plc.write("PnP_Example_Execute", True)
-
-    def reset(self):
-        self.plc.write("PnP_Reset", True)
-        self.until(lambda: self.read("PnP_State") != "Faulted", "the reset")
-        self.plc.write("PnP_Reset", False)
-
-    def press_stop_like_the_hmi(self):
-        """Stop Motion page: Execute until Done, Done shown for 1.5 s, then Execute released."""
-        self.plc.write("Stop_Execute", True)
-        self.until(lambda: self.read("Stop_Done"), "the stop", 2)
-        self.run_for(HMI_STOP_HOLD_S)
-        self.plc.write("Stop_Execute", False)
-
-    def events(self, kind, since=0):
-        return [e for e in self.robot.events[since:] if e["kind"] == kind]
-
-    def mark(self):
-        return len(self.robot.events)
-
-    def target(self, segment):
-        return [self.read(f"PnP_MoveParameters[{segment}].TargetPosition.{a}") for a in ("X", "Y", "Z")]
-
-    def arrivals(self, segment, since=0):
-        """motion_end events at the target of a segment."""
-        return [e for e in self.events("motion_end", since)
-                if e["pose"][:3] == pytest.approx(self.target(segment), abs=0.5)]
-
-    def gripper(self, since=0):
-        return [e for e in self.events("io", since) if e["point"] == GRIPPER]
+from pnp_plant import ROOT, SECOND, Plant
 
 
 @pytest.fixture
 def plant():
     p = Plant()
+    p.plc.write("PnP_DwellTime", SECOND // 4)
     p.plc.write("Connect_Execute", True)
     p.until(lambda: p.read("Connect_Connected") and p.read("RobotStatus_Valid"), "connected with status")
     yield p
@@ -96,6 +22,7 @@ def plant_without_ethernet_slave():
     """The robot's Ethernet Slave not used (Connect_SvrPort 0): positions come from the Listen node, the robot's
     outputs are not known to the PLC."""
     p = Plant()
+    p.plc.write("PnP_DwellTime", SECOND // 4)
     p.plc.write("Connect_SvrPort", 0)
     p.plc.write("Connect_Execute", True)
     p.until(lambda: p.read("Connect_Connected"), "connected")

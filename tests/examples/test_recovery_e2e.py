@@ -3,7 +3,6 @@ virtual time) against the simulator with its Ethernet Slave over real loopback s
 log is the witness that nothing ran twice."""
 from __future__ import annotations
 
-import pathlib
 import signal
 import socket
 import subprocess
@@ -11,49 +10,11 @@ import sys
 import time
 
 import pytest
+from pnp_plant import SECOND, SOURCES, Plant
 
-from tmsim.server import SimServer
 from vplc.api import load_plc
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
-SECOND = 1_000_000_000
 UNREACHABLE = dict(X=1900.0, Y=0.0, Z=300.0, RX=180.0, RY=0.0, RZ=90.0)
-
-
-class Plant:
-    """The examples on the virtual PLC and a simulator robot with its Ethernet Slave."""
-
-    def __init__(self):
-        self.sim = SimServer(port=0, robots=1, svr_port=0)
-        self.sim.start()
-        self.robot = self.sim.robots[0]
-        self.plc = load_plc(SOURCES)
-        self.plc.write("Connect_AddressIP", "127.0.0.1")
-        self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
-        self.plc.write("Connect_SvrPort", self.robot.svr_port)
-
-    def close(self):
-        self.plc.close()
-        self.sim.close()
-
-    def read(self, name):
-        return self.plc.read(name)
-
-    def until(self, predicate, what, seconds=10.0):
-        ok = self.plc.run_until(predicate, timeout_ns=int(seconds * SECOND),
-                                on_scan=lambda now_ns: self.sim.poll(now_ns / 1e9))
-        assert ok, f"{what} did not happen within {seconds} s of PLC time"
-
-    def pulse(self, name, done, what):
-        self.plc.write(name, False)
-        self.until(lambda: True, "one scan")
-        self.plc.write(name, True)
-        self.until(lambda: self.read(done), what)
-        self.plc.write(name, False)
-
-    def events(self, kind):
-        return [e for e in self.robot.events if e["kind"] == kind]
 
 
 @pytest.fixture
