@@ -187,3 +187,18 @@ def test_a_project_command_pending_on_the_one_write_channel_is_waited_for(svr):
         (svr.read("ovr.ErrorDescrip"), svr.read("proj.ErrorDescrip"))
     assert svr_writes(svr) == [{"Project_Speed": 25}, {"Stick_Pause": 1}]
     assert svr.read("Cobot.Status.ProjectPaused") and svr.read("status.Status.ProjectSpeed") == 25
+
+
+def test_a_rising_edge_while_busy_is_ignored_and_the_first_value_ends(svr):
+    """Execute pulsed twice while the first write waits for its data table: one write, the first value."""
+    svr.write("OvrValue", 40)
+    svr.write("OvrExec", True)
+    svr.scans(2)
+    svr.write("OvrExec", False)
+    svr.scans(1)
+    assert svr.read("ovr.Busy")
+    svr.write("OvrValue", 60)
+    svr.write("OvrExec", True)
+    assert svr.until(lambda: svr.read("ovr.Done") or svr.read("ovr.Error"), 1)
+    assert svr.read("ovr.Done") and svr_writes(svr) == [{"Project_Speed": 40}]
+    assert svr.read("status.Status.ProjectSpeed") == 40
