@@ -130,3 +130,18 @@ def test_moving_and_standstill_stay_false_without_the_speed_items(svr):
     svr.until(lambda: False, 0.25)
     assert svr.read("status.Valid")
     assert not svr.read("status.Status.Moving") and not svr.read("status.Status.Standstill")
+
+
+def test_the_status_follows_a_dropped_frame_and_the_listen_link_between_data_tables(svr):
+    """CBT_RobotStatus copies only when something changed: a damaged data table (counted, no new values) and the
+    Listen-node link (the project stops: the robot closes the Listen node, the Ethernet Slave goes on) still show
+    in the next call."""
+    bad = svr.read("status.Status.BadFrames")
+    svr.srv.svr.inject(svr.robot, "corrupt_checksum", count=1)
+    assert svr.until(lambda: svr.read("status.Status.BadFrames") == bad + 1, 0.2)
+    assert svr.read("status.Valid")
+    assert svr.read("status.Status.ListenLink")
+    svr.robot.stop_project()
+    assert svr.until(lambda: not svr.read("status.Status.ListenLink"), 2)
+    assert svr.read("status.Valid")
+    assert svr.until(lambda: svr.read("status.Status.ProjectStopped"), 0.2)          # the next data table
