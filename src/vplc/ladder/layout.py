@@ -5,6 +5,8 @@ Program page and the PLCopen writer (positions) all use this one layout.
 """
 from __future__ import annotations
 
+import bisect
+import math
 from dataclasses import dataclass, field
 
 from .model import Element, LadderBody, Rung
@@ -161,32 +163,75 @@ def _fit_names(lay: RungLayout) -> None:
     """Give every name room between the rails, column by column. The name above a contact or coil is centred on
     it; near the right rail it moves left (a coil's long name over the wire from the block before it), and where
     the row leaves too little room the symbol itself moves right, under its name. The variables written next to
-    block pins keep to their row. Whatever moves right takes the columns after it and the right rail along."""
-    placed = sorted(lay.placed.values(), key=lambda p: (p.col, p.row))
+    block pins keep to their row. Whatever moves right takes the columns after it and the right rail along.
 
-    def shift(col: int, dx: float) -> None:
-        for q in placed:
-            if q.col >= col:
+    Linear in the rung's size (a rung of 10,000 contacts took 16 s when every element looked at every other): a
+    move always takes the current column or the next along with every column after it, so the columns already
+    passed never move again (their right edges are kept per row), and the columns not reached yet all move by the
+    same amount (``ahead``, added when the column is reached); the first element after a column in a row is the
+    nearest one to its right, since x grows with the column."""
+    placed = sorted(lay.placed.values(), key=lambda p: (p.col, p.row))
+    ahead = 0.0                                   # moved since the start: columns not reached yet
+    current: list[Placed] = []                    # the elements of the column being fitted
+    boxes_right: dict[int, float] = {}            # per row: right edge + PAD of the blocks in passed columns
+    names_right: dict[int, float] = {}            # per row: end + PAD of the contact and coil names passed
+    later_cols: dict[int, list[int]] = {}         # per row: columns of the blocks covering it, ascending
+    later_x: dict[int, list[float]] = {}          # ... and their x before any move
+    any_cols: dict[int, list[int]] = {}           # per row: columns of every element covering it, ascending
+    any_x: dict[int, list[float]] = {}
+    by_col: dict[int, list[Placed]] = {}
+    for q in placed:
+        by_col.setdefault(q.col, []).append(q)
+        for r in range(q.row, q.row + q.rows):
+            any_cols.setdefault(r, []).append(q.col)
+            any_x.setdefault(r, []).append(q.x)
+            if q.element.kind == "block":
+                later_cols.setdefault(r, []).append(q.col)
+                later_x.setdefault(r, []).append(q.x)
+
+    def shift(col: int, dx: float) -> None:       # col is the current column or the next one
+        nonlocal ahead
+        if col == current[0].col:
+            for q in current:
                 q.x += dx
                 q.label_x += dx
+        ahead += dx
         lay.width += dx
 
-    def boxes(p: Placed, later: bool, rows: range):
-        """Blocks in columns before (after) ``p`` whose box reaches into ``rows``."""
-        return [q for q in placed if q.element.kind == "block" and (q.col > p.col if later else q.col < p.col)
-                and q.row <= rows.stop - 1 and rows.start <= q.row + q.rows - 1]
+    def first_after(cols: dict, xs: dict, row: int, col: int) -> float | None:
+        """x now of the first element covering ``row`` in a column after ``col``."""
+        cs = cols.get(row)
+        if not cs:
+            return None
+        i = bisect.bisect_right(cs, col)
+        return xs[row][i] + ahead if i < len(cs) else None
+
+    def leave_column() -> None:
+        for q in current:
+            if q.element.kind == "block":
+                for r in range(q.row, q.row + q.rows):
+                    boxes_right[r] = max(boxes_right.get(r, -math.inf), q.x + q.w + PAD)
+            elif q.element.kind in ("contact", "coil"):
+                names_right[q.row] = max(names_right.get(q.row, -math.inf),
+                                         q.label_x + text_width(q.element.var) / 2 + PAD)
+        current.clear()
 
     for p in placed:
+        if not current or current[0].col != p.col:
+            leave_column()
+            same = by_col[p.col]
+            for q in same:
+                q.x += ahead
+                q.label_x += ahead
+            current.extend(same)
         e = p.element
         if e.kind in ("contact", "coil"):
             tw = text_width(e.var)
-            band = range(p.row, p.row + 1)
-            lo = max([LEFT_RAIL + PAD] + [q.x + q.w + PAD for q in boxes(p, False, band)]
-                     + [q.label_x + text_width(q.element.var) / 2 + PAD for q in placed
-                        if q.col < p.col and q.row == p.row and q.element.kind in ("contact", "coil")])
+            lo = max(LEFT_RAIL + PAD, boxes_right.get(p.row, -math.inf), names_right.get(p.row, -math.inf))
             if p.x + p.w / 2 < lo + tw / 2:          # the symbol moves right, to stay under its name
                 shift(p.col, lo + tw / 2 - p.x - p.w / 2)
-            hi = min([lay.width + RAIL_GAP - PAD] + [q.x - PAD for q in boxes(p, True, band)])
+            nxt = first_after(later_cols, later_x, p.row, p.col)
+            hi = min(lay.width + RAIL_GAP - PAD, nxt - PAD if nxt is not None else math.inf)
             if hi - lo < tw:
                 shift(p.col + 1, tw - (hi - lo))
                 hi = lo + tw
@@ -196,17 +241,15 @@ def _fit_names(lay: RungLayout) -> None:
             for i, name in enumerate(ins):
                 label = lay.pin_labels.get((e.id, name))
                 if label is not None:
-                    row = range(p.row + i, p.row + i + 1)
-                    lo = max([LEFT_RAIL + PAD] + [q.x + q.w + PAD for q in boxes(p, False, row)])
+                    lo = max(LEFT_RAIL + PAD, boxes_right.get(p.row + i, -math.inf))
                     room = p.x - 18 - lo
                     if room < text_width(label):
                         shift(p.col, text_width(label) - room)
             for i, name in enumerate(outs):
                 label = lay.pin_labels.get((e.id, "out:" + name))
                 if label is not None:
-                    r = p.row + i
-                    hi = min([lay.width + RAIL_GAP - PAD] + [q.x - PAD for q in placed if q.col > p.col and (
-                        q.row <= r <= q.row + q.rows - 1)])
+                    nxt = first_after(any_cols, any_x, p.row + i, p.col)
+                    hi = min(lay.width + RAIL_GAP - PAD, nxt - PAD if nxt is not None else math.inf)
                     need = p.x + p.w + 18 + text_width(label) - hi
                     if need > 0:
                         shift(p.col + 1, need)

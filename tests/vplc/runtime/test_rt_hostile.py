@@ -143,3 +143,28 @@ def test_thousands_of_elsif_branches_compile_as_chains_with_first_match_semantic
         plc.scan(scan * 1_000_000)
         assert plc.read("Main.y") == y, x
     assert plc.read("Main.z") == 7
+
+
+def test_drawing_a_long_rung_looks_at_each_element_a_bounded_number_of_times(tmp_path, monkeypatch):
+    # `vplc draw` of 10,000 contacts in series took 16 s: fitting each name looked at every element before it.
+    # Counted here: how often a name is measured while the rung is laid out
+    from vplc.ladder import layout
+    from vplc.project import load_project
+    calls = [0]
+    measure = layout.text_width
+
+    def counting(text, scale=1.0):
+        calls[0] += 1
+        return measure(text, scale)
+    monkeypatch.setattr(layout, "text_width", counting)
+    counts = {}
+    for n in (200, 800):
+        path = tmp_path / f"s{n}.xml"
+        path.write_text(_series_rung_xml(n), encoding="utf-8")
+        rung = load_project([str(path)]).lookup_pou("Main").pou.ladder.rungs[0]
+        calls[0] = 0
+        lay = layout.layout_rung(rung, 1)
+        counts[n] = calls[0]
+        xs = [lay.placed[e.id].x for e in rung.elements if e.kind == "contact"]
+        assert xs == sorted(xs) and len(set(xs)) == n          # one contact after the other, none on another
+    assert counts[800] <= 4 * counts[200] + 50, counts           # linear, not quadratic (16x)
