@@ -145,3 +145,13 @@ def test_the_status_follows_a_dropped_frame_and_the_listen_link_between_data_tab
     assert svr.until(lambda: not svr.read("status.Status.ListenLink"), 2)
     assert svr.read("status.Valid")
     assert svr.until(lambda: svr.read("status.Status.ProjectStopped"), 0.2)          # the next data table
+
+
+def test_while_a_stop_is_held_it_is_done_at_once(svr):
+    """A CBT_Stop with Execute held clears the queue and refuses motions (16#4005); the mark is no motion: it is
+    sent and reached at once, the queue being empty."""
+    svr.write("StopExec", True)
+    assert svr.until(lambda: svr.read("stop.Done"), 1)
+    svr.write("WaitExec", True)
+    assert svr.until(lambda: svr.read("wait.Done") or svr.read("wait.Error"), 0.1)
+    assert svr.read("wait.Done")
