@@ -20,8 +20,9 @@ Every field is checked (type, range, finite numbers, nesting, line length: sim/l
 request gets ``ok: false`` with the reason and the connection stays usable, except after a line
 longer than CONTROL_LINE_MAX (answered, then closed). Answers are written without blocking; a client
 that lets more than CONTROL_OUTBOX_MAX bytes of answers pile up is closed. Each client is served in
-turns bounded in work (CONTROL_TURN_REQUESTS requests, CONTROL_TURN_BYTES of answers); a client is not
-read while its answers wait to be written or requests of it wait for their turn (back-pressure).
+turns bounded in work (CONTROL_TURN_REQUESTS requests, CONTROL_TURN_BYTES of answers; a large ``state``
+is encoded CONTROL_TURN_PIECES pieces a turn); a client is not read while requests of it wait for their
+turn (back-pressure).
 """
 from __future__ import annotations
 
@@ -32,7 +33,8 @@ import selectors
 import socket
 
 from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
-                     CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_BYTES, CONTROL_TURN_REQUESTS)
+                     CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_BYTES, CONTROL_TURN_PIECES,
+                     CONTROL_TURN_REQUESTS)
 from .listener import Listener, receive
 from .session import TransitionError
 
@@ -45,13 +47,24 @@ class RequestError(ValueError):
 
 
 class _Client:
-    __slots__ = ("sock", "rbuf", "wbuf", "closing")
+    __slots__ = ("sock", "rbuf", "wbuf", "closing", "encoding", "pieces")
 
     def __init__(self, sock):
         self.sock = sock
         self.rbuf = bytearray()
         self.wbuf = bytearray()
         self.closing = False
+        self.encoding = None                # the pieces of a large answer still to encode (an iterator)
+        self.pieces: list[str] = []         # ... and those encoded so far
+
+
+class _Streamed(dict):
+    """An answer that is encoded a piece at a time over several turns (``ControlChannel._encode_more``):
+    a ``state`` whose variables hold more than CONTROL_TURN_BYTES (500 arrays of 2,048 numbers encode in
+    ~0.4 s, which no turn may take)."""
+
+
+_PIECES = json.JSONEncoder(allow_nan=False, ensure_ascii=False)
 
 
 class ControlChannel:
@@ -70,7 +83,7 @@ class ControlChannel:
             "ping": lambda robot, req: "pong",
             "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.state,
                                            "svr_port": getattr(r, "svr_port", None)} for r in server.robots],
-            "state": lambda robot, req: robot.state(),
+            "state": lambda robot, req: self._state(robot),
             "events": self._events,
             "enter_listen_node": lambda robot, req: robot.enter_listen_node(),
             "leave_listen_node": lambda robot, req: robot.leave_listen_node(),
@@ -128,6 +141,10 @@ class ControlChannel:
         must not hold the robots' servers); the rest waits in ``backlog`` for the next turn."""
         sock, answered, written = client.sock, 0, 0
         self.backlog.pop(sock, None)
+        if client.encoding is not None and not self._encode_more(client):
+            self.backlog[sock] = client
+            self.turns_deferred += 1
+            return
         while not client.closing:
             end = client.rbuf.find(b"\n")
             if end < 0:
@@ -150,7 +167,15 @@ class ControlChannel:
             else:
                 answer = self.execute(line)
             before = len(client.wbuf)
-            if not self._answer(client, answer):
+            if type(answer) is _Streamed:
+                if not self._outbox_room(client):
+                    return
+                client.encoding = _PIECES.iterencode(answer)
+                if not self._encode_more(client):
+                    self.backlog[sock] = client
+                    self.turns_deferred += 1
+                    return
+            elif not self._answer(client, answer):
                 return
             answered += 1
             written += max(0, len(client.wbuf) - before) or 1
@@ -171,11 +196,39 @@ class ControlChannel:
     def has_backlog(self) -> bool:
         return bool(self.backlog)
 
+    def _outbox_room(self, client) -> bool:
+        """False (and the client closed) when CONTROL_OUTBOX_MAX bytes of earlier answers are still unread."""
+        if len(client.wbuf) > CONTROL_OUTBOX_MAX:
+            self._close(client.sock, f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)")
+            return False
+        return True
+
+    def _encode_more(self, client) -> bool:
+        """Encode the next pieces of a large answer: at most CONTROL_TURN_PIECES pieces and about
+        CONTROL_TURN_BYTES characters a turn. True when the answer is complete (and queued whole: the
+        client never sees part of one), False when the rest waits for the client's next turn."""
+        size = 0
+        try:
+            for _ in range(CONTROL_TURN_PIECES):
+                piece = next(client.encoding, None)
+                if piece is None:
+                    client.wbuf += ("".join(client.pieces) + "\n").encode("utf-8")
+                    break
+                client.pieces.append(piece)
+                size += len(piece)
+                if size >= CONTROL_TURN_BYTES:
+                    return False
+            else:
+                return False
+        except ValueError as exc:           # e.g. a value JSON cannot carry
+            client.wbuf += _encode(_error(f"the answer cannot be written as JSON ({exc})"))
+        client.encoding, client.pieces = None, []
+        return self._write(client)
+
     def _answer(self, client, answer) -> bool:
         """Queue one answer and write what the socket takes; False when the client was closed. A client is
         closed when CONTROL_OUTBOX_MAX bytes of earlier answers are still unread (one answer may be larger)."""
-        if len(client.wbuf) > CONTROL_OUTBOX_MAX:
-            self._close(client.sock, f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)")
+        if not self._outbox_room(client):
             return False
         try:
             client.wbuf += _encode(answer)
@@ -229,11 +282,17 @@ class ControlChannel:
             index = _int_field(request, "robot", 0, 0, count - 1,
                                f"robot {{}} does not exist: this simulator has {count} "
                                f"robot{'s' if count > 1 else ''}; {robot_numbering(count)} of the start-up lines")
-            return {"ok": True, "result": command(self.server.robots[index], request)}
+            result = command(self.server.robots[index], request)
+            return _Streamed(ok=True, result=result) if type(result) is _Streamed else {"ok": True, "result": result}
         except (ValueError, TypeError, TransitionError) as exc:
             return _error(str(exc))
         except Exception as exc:          # noqa: BLE001 - a request never ends the simulator
             return _error(f"internal error of the simulator ({type(exc).__name__}: {exc})")
+
+    @staticmethod
+    def _state(robot):
+        state = robot.state()
+        return _Streamed(state) if robot.session.variable_bytes() > CONTROL_TURN_BYTES else state
 
     def _svr_config(self, robot, request):
         _svr(robot)

@@ -123,6 +123,11 @@ def _size(value) -> int:
     return 8
 
 
+def variable_memory(variables: dict) -> int:
+    """Bytes the variables count against VARIABLE_BYTES_MAX."""
+    return sum(map(_size, variables.values()))
+
+
 def _work(ctx, steps):
     ctx.steps += steps
     ctx.meter.work += steps * WORK_STEP

@@ -53,6 +53,7 @@ CONTROL_ANSWER_BYTES = 1 << 20              # ... and their bytes as the event l
 CONTROL_CLIENTS_MAX = 16
 CONTROL_TURN_REQUESTS = 8                   # requests of one client answered in one turn ...
 CONTROL_TURN_BYTES = 64 << 10               # ... and no more once this turn's answers reach this many bytes
+CONTROL_TURN_PIECES = 1_024                 # pieces (numbers, texts) of one large answer encoded in one turn
 
 # ---- robot servers (per robot unless noted) -----------------------------------------------------
 EVENT_BYTES_MAX = 20 << 20                  # event log kept in memory, all robots together

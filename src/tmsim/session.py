@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from . import codec
 from .checker import ScriptChecker
 from .eventlog import text as _text
-from .interp import Context, ScriptRuntimeError, run_script
+from .interp import Context, ScriptRuntimeError, run_script, variable_memory
 from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN
 from .profiles import Profile
 from .robot import RobotModel
@@ -530,6 +530,10 @@ class ListenSession:
         """Scripts received and not started yet."""
         return len(self.pending)
 
+    def variable_bytes(self) -> int:
+        """The memory the node's variables use, as VARIABLE_BYTES_MAX counts it."""
+        return variable_memory(self.variables)
+
     def waiting_script_bytes(self) -> int:
         return sum(len(p.script) for p in self.pending)
 
@@ -581,7 +585,8 @@ class ListenSession:
         data.update(in_listen_node=self.state in (IN_NODE, EXITING), node_state=self.state,
                     project_running=self.state != STOPPED, exit_path=self.exit_path, last_error=self.last_error,
                     buffered_scripts=len(self.pending) + (1 if self.running else 0),
-                    variables=dict(self.variables))
+                    variables={name: list(value) if isinstance(value, list) else value    # a snapshot: a
+                               for name, value in self.variables.items()})            # large one is sent later
         return data
 
 

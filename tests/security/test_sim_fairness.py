@@ -9,8 +9,8 @@ import math
 import socket
 
 from tmsim import eventlog
-from tmsim.limits import (CONTROL_TURN_REQUESTS, PARSE_SLICE, STEPS_MAX, TURN_WORK, WORK_CHAR, WORK_LINE,
-                          WORK_LOG_BYTES, WORK_PVT_CARTESIAN, WORK_TOKEN)
+from tmsim.limits import (CONTROL_TURN_PIECES, CONTROL_TURN_REQUESTS, PARSE_SLICE, STEPS_MAX, TURN_WORK, WORK_CHAR,
+                          WORK_LINE, WORK_LOG_BYTES, WORK_PVT_CARTESIAN, WORK_TOKEN)
 from tmsim.robot import RobotModel
 from tmsim.session import ListenSession
 
@@ -98,9 +98,9 @@ def test_one_line_of_ten_thousand_nested_tokens_is_parsed_in_slices_across_turns
 
 def test_cartesian_pvt_points_are_planned_one_turn_at_a_time_on_the_same_timeline():
     """Attack: Cartesian PVTPoints of 2 ms (old: each plan ~5 ms, a poll that fell behind planned all the
-    points it owed at once: 7 scripts of 998 stalled robot 2 for 1.1-1.5 s, its PLC lost the link). A turn plans no motion once
-    its work is spent; the robot clock owes the time and the motions keep their timeline: the arm ends
-    where a robot without any budget ends."""
+    points it owed at once: 7 scripts of 998 stalled robot 2 for 1.1-1.5 s, its PLC lost the link). A turn
+    plans no motion once its work is spent; the robot clock owes the time and the motions keep their
+    timeline: the arm ends where a robot without any budget ends."""
     script = pvt_script(200)
     h = Harness(robots=2)
     try:
@@ -208,6 +208,45 @@ def test_a_control_channel_flood_is_answered_in_bounded_turns_between_the_robots
         assert CONTROL_TURN_REQUESTS * h.srv.control.turns_deferred >= 3 * count - 3 * CONTROL_TURN_REQUESTS
         for sock in flooders:
             sock.close()
+    finally:
+        h.close()
+
+
+def test_a_state_with_large_variables_is_encoded_over_several_turns_and_arrives_whole():
+    """Attack: a client of robot 1 fills the variable memory with arrays, a control client asks for the
+    state (100 arrays of 2,048 numbers: ~80 ms of JSON in one go; 500 arrays ~0.4 s). The answer is encoded
+    CONTROL_TURN_PIECES pieces a turn; robot 2 is answered meanwhile; the answer arrives whole, a snapshot
+    of the moment it was asked for."""
+    h = Harness(robots=2, control_port=0)
+    try:
+        other = h.connect(1)
+        variables = h.robot.session.variables
+        for n in range(100):
+            variables[f"a{n}"] = [n + 0.5] * 2048
+            h.robot.session.types[f"a{n}"] = "float[]"
+        asker = socket.create_connection(("127.0.0.1", h.srv.control.port))
+        asker.sendall(json.dumps({"cmd": "state", "robot": 0}).encode() + b"\n")
+        asker.setblocking(False)
+        assert h.until(lambda: h.srv.control.turns_deferred > 0, timeout=1)
+        deferred = h.srv.control.turns_deferred
+        other.send(sta("00"))
+        h.step()
+        assert other.texts() == [("TMSTA", "00,true,Listen1")]
+        variables["a0"][0] = -1.0                      # changed after the request: not in the answer
+        answer = bytearray()
+
+        def whole():
+            try:
+                answer.extend(asker.recv(1 << 20))
+            except BlockingIOError:
+                pass
+            return answer.endswith(b"\n")
+        assert h.until(whole, timeout=30)
+        state = json.loads(answer)
+        assert state["ok"] and state["result"]["variables"]["a0"] == [0.5] * 2048
+        assert state["result"]["variables"]["a99"] == [99.5] * 2048
+        assert h.srv.control.turns_deferred >= deferred + 100 * 2048 // CONTROL_TURN_PIECES - 2
+        asker.close()
     finally:
         h.close()
 
