@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 from .motion_config import UNITS, AxisConfig
+from .motion_profile import Profile, plan_position, plan_velocity
 
 # ---- ErrorIDs and axis error codes (docs/toolchain/runtime_sysmac.md section 5.3) ---------------------------
 # Omron's W508 error table was not readable in the manual corpus: the values are chosen in Omron's 16#54xx
@@ -42,89 +43,15 @@ WAITING, ACTIVE, DONE, ABORTED = "waiting", "active", "done", "aborted"
 MAX_OVERRIDE = 5.0             # MC_SetOverride VelFactor 0 .. 500 %
 
 
-class Profile:
-    """Motion from (t0, x0, v0) as segments of constant acceleration; after the last segment the axis keeps
-    the final velocity (0 for a positioning, the target velocity for velocity control)."""
-
-    __slots__ = ("parts", "i", "t_end", "x_end", "v_end", "hold")
-
-    def __init__(self, t0: float, x0: float, v0: float, segments, target: float | None = None) -> None:
-        parts = []
-        t, x, v = t0, x0, v0
-        for d, a in segments:
-            if d > 0.0:
-                parts.append((t + d, t, x, v, a))
-                x += v * d + 0.5 * a * d * d
-                v += a * d
-                t += d
-        self.parts, self.i, self.t_end = parts, 0, t
-        self.x_end, self.v_end = (target, 0.0) if target is not None else (x, v)
-        self.hold = False           # True: a positioning held at velocity 0 by a 0 % override
-
-    def at(self, t: float) -> tuple[float, float, float, bool]:
-        """(position, velocity, acceleration, finished) at time t (seconds)."""
-        parts, i = self.parts, self.i
-        while i < len(parts) and t >= parts[i][0]:
-            i += 1
-        self.i = i
-        if i == len(parts):
-            return self.x_end + self.v_end * (t - self.t_end), self.v_end, 0.0, True
-        _, ts, x, v, a = parts[i]
-        tau = t - ts
-        return x + v * tau + 0.5 * a * tau * tau, v + a * tau, a, False
-
-
-def plan_position(x0: float, v0: float, xt: float, vmax: float, acc: float, dec: float) -> list:
-    """Segments (duration, acceleration) that take the axis from (x0, v0) to rest at xt: accelerate with acc,
-    cruise at vmax, decelerate with dec (a triangle when the distance is short). Moving away from the target,
-    or too fast to stop before it, the axis first decelerates to a stop and then comes back."""
-    dist = xt - x0
-    s = 1.0 if dist > 0 or (dist == 0 and v0 < 0) else -1.0
-    d, u = abs(dist), v0 * s               # distance and velocity in the direction of the target
-    segs = []
-    if u < 0:                              # moving away: stop first
-        segs.append((-u / dec, s * dec))
-        d += u * u / (2 * dec)
-        u = 0.0
-    elif u * u / (2 * dec) > d * (1 + 1e-12) + 1e-12:       # cannot stop in time: stop beyond, come back
-        segs.append((u / dec, -s * dec))
-        over = u * u / (2 * dec) - d
-        return segs + plan_position(0.0, 0.0, -s * over, vmax, acc, dec)
-    if d <= 0.0 and u <= 0.0:
-        return segs
-    if u > vmax:                           # slower than now (override lowered): decelerate to vmax, cruise, stop
-        cruise = d - u * u / (2 * dec)
-        return segs + [((u - vmax) / dec, -s * dec), (max(cruise, 0.0) / vmax, 0.0), (vmax / dec, -s * dec)]
-    vp = math.sqrt((d + u * u / (2 * acc)) / (1 / (2 * acc) + 1 / (2 * dec)))
-    cruise = 0.0
-    if vp > vmax:
-        vp = vmax
-        cruise = d - (vmax * vmax - u * u) / (2 * acc) - vmax * vmax / (2 * dec)
-    segs.append(((vp - u) / acc, s * acc))
-    if cruise > 0:
-        segs.append((cruise / vp, 0.0))
-    segs.append((vp / dec, -s * dec))
-    return segs
-
-
-def plan_velocity(v0: float, vt: float, acc: float, dec: float) -> list:
-    """Segments from velocity v0 to vt: speeding up with acc, slowing down with dec (through 0 when the
-    direction changes: first dec to 0, then acc)."""
-    if v0 * vt < 0:
-        return [(abs(v0) / dec, math.copysign(dec, -v0)), (abs(vt) / acc, math.copysign(acc, vt))]
-    if abs(vt) >= abs(v0):
-        return [((abs(vt) - abs(v0)) / acc, math.copysign(acc, vt if vt else v0))]
-    return [((abs(v0) - abs(vt)) / dec, math.copysign(dec, -v0))]
-
-
 class Command:
     """One execution of a motion instruction on an axis."""
 
-    __slots__ = ("kind", "fb", "status", "in_velocity", "target", "velocity", "acc", "dec", "direction")
+    __slots__ = ("kind", "fb", "status", "in_velocity", "target", "velocity", "acc", "dec", "jerk", "direction")
 
-    def __init__(self, kind: str, fb, target=0.0, velocity=0.0, acc=0.0, dec=0.0, direction=1.0) -> None:
+    def __init__(self, kind: str, fb, target=0.0, velocity=0.0, acc=0.0, dec=0.0, jerk=0.0, direction=1.0) -> None:
         self.kind, self.fb, self.status, self.in_velocity = kind, fb, WAITING, False
         self.target, self.velocity, self.acc, self.dec, self.direction = target, velocity, acc, dec, direction
+        self.jerk = jerk
 
 
 class Axis:
@@ -191,6 +118,12 @@ class Axis:
         v = velocity * self.override
         return (self.cfg.max_velocity, True) if v > self.cfg.max_velocity else (v, False)
 
+    def jerk(self, value: float) -> float:
+        """Jerk actually used: 0 is a trapezoid (W508: Jerk positive or 0); with `max_jerk` configured, values
+        above it run at it (our choice, like the acceleration)."""
+        top = self.cfg.max_jerk
+        return top if top and value > top else value
+
     def ramp(self, value: float, maximum: float) -> float:
         """Acceleration or deceleration actually used: 0 (no limit in W508) and values above the axis maximum
         run at the axis maximum (our choice: the axis parameter 'Acceleration/Deceleration Over' is not
@@ -224,25 +157,27 @@ class Axis:
             vt, limited = self.vmax_of(cmd.velocity)
             self.ref.Details.VelLimit = limited
             self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, cmd.direction * vt, cmd.acc,
-                                                                        cmd.dec))
+                                                                        cmd.dec, cmd.jerk, self.acc))
             self._set_state(CONTINUOUS)
         elif k == "position":
             self.plan_to(cmd, t)
             self._set_state(DISCRETE)
         elif k in ("halt", "stop"):
-            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.dec, cmd.dec)
-                                   if self.vel else [], None)
+            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.dec, cmd.dec, cmd.jerk,
+                                                                        self.acc))
             self._set_state(DISCRETE if k == "halt" else STOPPING)
 
     def plan_to(self, cmd: Command, t: float) -> None:
         vmax, limited = self.vmax_of(cmd.velocity)
         self.ref.Details.VelLimit = limited
         if vmax <= 0.0:                         # 0 % override: decelerate and hold, still in motion
-            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.acc, cmd.dec))
+            self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.acc, cmd.dec, cmd.jerk,
+                                                                        self.acc))
             self.profile.hold = True
         else:
             self.profile = Profile(t, self.pos, self.vel, plan_position(self.pos, self.vel, cmd.target, vmax,
-                                                                          cmd.acc, cmd.dec), cmd.target)
+                                                                          cmd.acc, cmd.dec, cmd.jerk, self.acc),
+                                   cmd.target)
         if self.vel == 0.0 and cmd.target != self.pos:
             self.last_dir = 1.0 if cmd.target > self.pos else -1.0
 
@@ -339,7 +274,7 @@ class Axis:
             if room <= brake:
                 self._limit_fault(edge, t)
                 dec = v * v / (2 * room) if room > 0 else 0.0
-                segs = [(abs(v) / dec, math.copysign(dec, -v))] if dec > 0 else []
+                segs = [(abs(v) / dec, math.copysign(dec, -v), 0.0)] if dec > 0 else []
                 self.profile = Profile(t, x, v if dec > 0 else 0.0, segs, edge)
                 self.limit_stop = True
                 return (x, v, -math.copysign(dec, v), False) if dec > 0 else (edge, 0.0, 0.0, True)

@@ -9,7 +9,7 @@ A TOML file (read with the standard library's tomllib), one ``[[axis]]`` table p
     max_velocity = 500.0            # units/s
     max_acceleration = 5000.0       # units/s^2
     max_deceleration = 5000.0       # optional, default max_acceleration
-    max_jerk = 0.0                  # optional; jerk-limited profiles are not modelled (0 = none)
+    max_jerk = 0.0                  # optional, units/s^3: an instruction's Jerk above it runs at it (0 = no limit)
     software_limit_negative = -5.0  # optional pair: software limits (active once home is defined)
     software_limit_positive = 1200.0
     home_position = 0.0             # optional: position MC_Home defines (zero position preset)

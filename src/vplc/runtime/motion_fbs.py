@@ -13,8 +13,8 @@ chose are in docs/toolchain/runtime_sysmac.md section 5):
 * an instruction error is an error of the axis (ErrorStop): Error stays TRUE until MC_Reset has cleared it;
   an instruction started while the axis has an error ends in CommandAborted.
 
-What vplc does not model is refused as a major fault naming the instruction and the value (Jerk other than 0,
-the blending buffer modes), never run with another meaning.
+What vplc does not model is refused as a major fault naming the instruction and the value (the blending buffer
+modes), never run with another meaning.
 """
 from __future__ import annotations
 
@@ -166,9 +166,6 @@ class _MoveFB(_ExecuteFB):
             return M.ERR_DECELERATION
         if not (math.isfinite(j) and j >= 0):
             return M.ERR_JERK
-        if j > 0:
-            raise RuntimeFaultError(f"{name}: Jerk {j:g} is not modelled by vplc (trapezoidal profiles only); "
-                                    "use Jerk := 0")
         return self._buffer_mode()
 
     def _buffer_mode(self) -> int:
@@ -218,7 +215,7 @@ class MC_MoveAbsolute(_MoveFB):
             return M.ERR_POSITION
         cfg = axis.cfg
         cmd = M.Command("position", self, x, self.Velocity, axis.ramp(self.Acceleration, cfg.max_acceleration),
-                        axis.ramp(self.Deceleration, cfg.max_deceleration))
+                        axis.ramp(self.Deceleration, cfg.max_deceleration), axis.jerk(self.Jerk))
         return self._give(axis, cmd)
 
 
@@ -269,7 +266,7 @@ class MC_MoveVelocity(_MoveFB):
             return M.ERR_DIRECTION
         cfg = axis.cfg
         cmd = M.Command("velocity", self, 0.0, self.Velocity, axis.ramp(self.Acceleration, cfg.max_acceleration),
-                        axis.ramp(self.Deceleration, cfg.max_deceleration), sign)
+                        axis.ramp(self.Deceleration, cfg.max_deceleration), axis.jerk(self.Jerk), sign)
         return self._give(axis, cmd)
 
     def _poll(self, cmd) -> None:
@@ -293,7 +290,8 @@ class MC_Halt(_MoveFB):
         code = _state_error(axis) or self._ramps(False)
         if code:
             return code
-        cmd = M.Command("halt", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration))
+        cmd = M.Command("halt", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration),
+                        jerk=axis.jerk(self.Jerk))
         return self._give(axis, cmd)
 
 
@@ -308,7 +306,8 @@ class MC_Stop(_MoveFB):
         code = _state_error(axis, stop=True) or self._ramps(False)
         if code:
             return code
-        cmd = M.Command("stop", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration))
+        cmd = M.Command("stop", self, dec=axis.ramp(self.Deceleration, axis.cfg.max_deceleration),
+                        jerk=axis.jerk(self.Jerk))
         axis.abort_all()
         if axis.stop_cmd is not None and axis.stop_cmd.fb is not self:
             axis._finish(axis.stop_cmd, M.ABORTED)

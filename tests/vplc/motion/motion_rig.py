@@ -16,7 +16,7 @@ VAR
     power : BOOL := TRUE;
     doHome, doAbs1, doAbs2, doRel, doVel, doHalt, doStop, doReset, doSetPos, doOvr : BOOL;
     pos1 : LREAL := 100.0; pos2 : LREAL; dist : LREAL; v1 : LREAL := 50.0; v2 : LREAL := 50.0; vv : LREAL := 20.0;
-    a1 : LREAL := 1000.0; d1 : LREAL := 500.0; jerk : LREAL;
+    a1 : LREAL := 1000.0; d1 : LREAL := 500.0; jerk : LREAL; jerkV : LREAL; jerkS : LREAL;
     buf1 : _eMC_BUFFER_MODE; buf2 : _eMC_BUFFER_MODE; bufRel : _eMC_BUFFER_MODE;
     dir : _eMC_DIRECTION := _mcPositiveDirection; stopDec : LREAL := 1000.0; factor : LREAL := 100.0;
     setTo : LREAL;
@@ -29,9 +29,10 @@ abs2(Axis := _MC_AX[0], Execute := doAbs2, Position := pos2, Velocity := v2, Acc
      Deceleration := d1, BufferMode := buf2);
 rel(Axis := _MC_AX[0], Execute := doRel, Distance := dist, Velocity := v1, Acceleration := a1,
     Deceleration := d1, BufferMode := bufRel);
-vel(Axis := _MC_AX[0], Execute := doVel, Velocity := vv, Acceleration := a1, Deceleration := d1, Direction := dir);
+vel(Axis := _MC_AX[0], Execute := doVel, Velocity := vv, Acceleration := a1, Deceleration := d1, Jerk := jerkV,
+    Direction := dir);
 hlt(Axis := _MC_AX[0], Execute := doHalt, Deceleration := d1);
-stp(Axis := _MC_AX[0], Execute := doStop, Deceleration := stopDec);
+stp(Axis := _MC_AX[0], Execute := doStop, Deceleration := stopDec, Jerk := jerkS);
 rst(Axis := _MC_AX[0], Execute := doReset);
 err(Axis := _MC_AX[0], Enable := TRUE);
 setp(Axis := _MC_AX[0], Execute := doSetPos, Position := setTo);
@@ -48,6 +49,8 @@ max_acceleration = 2000.0
 max_deceleration = 2000.0
 """
 
+AXES_JERK = AXES + "max_jerk = 20000.0\n"
+
 AXES_LIMITED = AXES + """software_limit_negative = -10.0
 software_limit_positive = 150.0
 homed = true
@@ -62,6 +65,7 @@ def files(tmp_path_factory):
         (d / "Main.st").write_text(MAIN, encoding="utf-8")
         (d / "axes.toml").write_text(AXES, encoding="utf-8")
         (d / "axes_limited.toml").write_text(AXES_LIMITED, encoding="utf-8")
+        (d / "axes_jerk.toml").write_text(AXES_JERK, encoding="utf-8")
         _DIR["d"] = d
     return _DIR["d"]
 
@@ -131,3 +135,44 @@ def trapezoid(tau: float, dist: float, v: float, a: float, d: float) -> tuple[fl
 def duration(dist: float, v: float, a: float, d: float) -> float:
     vp = min(v, (dist / (1 / (2 * a) + 1 / (2 * d))) ** 0.5)
     return vp / a + vp / d + (dist - vp * vp / (2 * a) - vp * vp / (2 * d)) / vp
+
+
+def s_curve(tau: float, dist: float, v: float, a: float, j: float) -> tuple[float, float]:
+    """Closed-form position and velocity, tau s after the start of a jerk-limited positioning from rest over
+    ``dist`` with velocity v, acceleration = deceleration a and jerk j, for a distance long enough to reach v
+    (v >= a * a / j): jerk phase t1 = a / j, constant acceleration t2, jerk phase t1, cruise, and the mirror
+    image to rest."""
+    t1 = a / j
+    t2 = v / a - t1
+    ta = 2 * t1 + t2
+    da = v * ta / 2
+    tc = (dist - 2 * da) / v
+    total = 2 * ta + tc
+
+    def up(t):                     # distance and velocity after t s of the acceleration phase
+        if t <= 0:
+            return 0.0, 0.0
+        if t < t1:
+            return j * t ** 3 / 6, j * t * t / 2
+        if t < t1 + t2:
+            x1, v1 = j * t1 ** 3 / 6, j * t1 * t1 / 2
+            r = t - t1
+            return x1 + v1 * r + a * r * r / 2, v1 + a * r
+        if t < ta:
+            r = ta - t
+            return da - (v * r - j * r ** 3 / 6), v - j * r * r / 2
+        return da, v
+
+    if tau < ta:
+        return up(tau)
+    if tau < ta + tc:
+        return da + v * (tau - ta), v
+    if tau < total:
+        x, vel = up(total - tau)
+        return dist - x, vel
+    return dist, 0.0
+
+
+def s_curve_duration(dist: float, v: float, a: float, j: float) -> float:
+    ta = v / a + a / j
+    return 2 * ta + (dist - v * ta) / v

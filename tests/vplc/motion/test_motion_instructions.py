@@ -4,7 +4,7 @@ Control Instructions Reference Manual) or the W507 axis-state chart it pins; the
 readable in our manual corpus, see docs/toolchain/runtime_sysmac.md section 5."""
 import pytest
 
-from motion_rig import Rig, duration, files, trapezoid
+from motion_rig import Rig, duration, files, s_curve, s_curve_duration, trapezoid
 from vplc.api import PlcFault
 from vplc.runtime import motion as M
 
@@ -344,13 +344,89 @@ def test_move_velocity_accepts_only_aborting_and_buffered(rig):
     assert rig.r("vel.Error") and rig.r("vel.ErrorID") == M.ERR_BUFFER_MODE
 
 
-def test_jerk_is_refused_as_not_modelled(rig):
-    """Jerk-limited (S-curve) profiles are not modelled: a Jerk other than 0 stops the controller with a fault
-    naming it instead of running another profile."""
+def test_move_absolute_with_jerk_follows_the_closed_form_s_curve(rig):
+    """W508 MC_MoveAbsolute Jerk (positive or 0): with a jerk the acceleration rises and falls at that rate and
+    never exceeds Acceleration; the position is the closed-form S-curve, Done once it is at rest on the target."""
     rig.powered()
-    rig.set(doAbs1=True, jerk=5000.0)
-    with pytest.raises(PlcFault, match=r"MC_MoveAbsolute: Jerk 5000 is not modelled by vplc"):
+    rig.set(d1=1000.0, jerk=50_000.0, doAbs1=True)
+    rig.scan()
+    t0 = rig.t
+    total = s_curve_duration(100.0, 50.0, 1000.0, 50_000.0)
+    prev_a, worst = 0.0, 0.0
+    while not rig.r("abs1.Done"):
+        x, v = s_curve(rig.t - t0, 100.0, 50.0, 1000.0, 50_000.0)
+        worst = max(worst, abs(rig.ax("Cmd.Pos") - x), abs(rig.ax("Cmd.Vel") - v) * 1e-3)
+        a = rig.ax("Cmd.AccDec")
+        assert abs(a) <= 1000.0 + 1e-9 and abs(a - prev_a) <= 50_000.0 * 0.001 + 1e-9
+        prev_a = a
         rig.scan()
+        assert rig.k < 5000
+    assert worst < 1e-9
+    assert rig.t > t0 + total and rig.t == pytest.approx(t0 + total, abs=2.001e-3)
+    assert (rig.ax("Cmd.Pos"), rig.ax("Cmd.Vel")) == (100.0, 0.0)
+
+
+def test_short_jerk_limited_move_lands_on_its_target_with_continuous_acceleration(rig):
+    """A distance too short to reach Velocity or Acceleration: a lower peak, still jerk-limited, exactly on the
+    target; taken over mid-ramp by another jerk-limited move, the acceleration stays continuous."""
+    rig.powered()
+    rig.set(pos1=0.3, d1=1000.0, jerk=50_000.0, doAbs1=True)
+    prev_a, peak = 0.0, 0.0
+    rig.scan()
+    while not rig.r("abs1.Done"):
+        rig.scan()
+        a = rig.ax("Cmd.AccDec")
+        assert abs(a - prev_a) <= 50.0 + 1e-9
+        prev_a, peak = a, max(peak, rig.ax("Cmd.Vel"))
+        assert rig.k < 2000
+    assert rig.ax("Cmd.Pos") == 0.3 and peak < 50.0
+    rig.set(doAbs1=False, pos1=50.0)
+    rig.scan()
+    rig.set(doAbs1=True)
+    rig.scan(15)                                  # in the first jerk phase
+    rig.plc.write("Main.abs2.Jerk", 50_000.0)
+    rig.set(pos2=-20.0, doAbs2=True)
+    prev_a = rig.ax("Cmd.AccDec")
+    while not rig.r("abs2.Done"):
+        rig.scan()
+        a = rig.ax("Cmd.AccDec")
+        assert abs(a - prev_a) <= 50.0 + 1e-9, "acceleration continuous across the takeover"
+        prev_a = a
+        assert rig.k < 5000
+    assert rig.ax("Cmd.Pos") == -20.0
+
+
+def test_velocity_and_stop_with_jerk_are_s_curves(rig):
+    """W508 MC_MoveVelocity and MC_Stop with Jerk: the velocity follows the jerk-limited ramp (v = J t^2 / 2 at
+    first), InVelocity once reached; MC_Stop brings it to 0 the same way."""
+    rig.powered()
+    rig.set(vv=50.0, jerkV=50_000.0, doVel=True)
+    rig.scan()
+    t0 = rig.t
+    rig.scan(10)
+    assert rig.ax("Cmd.Vel") == pytest.approx(50_000.0 * (rig.t - t0) ** 2 / 2, abs=1e-9)
+    while not rig.r("vel.InVelocity"):
+        rig.scan()
+    ramp = 50.0 / 1000.0 + 1000.0 / 50_000.0     # seen in the call after the processing that reached it
+    assert t0 + ramp < rig.t <= t0 + ramp + 0.002 + 1e-9
+    rig.set(doStop=True, stopDec=1000.0, jerkS=50_000.0)
+    rig.scan()
+    t1 = rig.t
+    rig.scan(10)
+    assert rig.ax("Cmd.Vel") == pytest.approx(50.0 - 50_000.0 * (rig.t - t1) ** 2 / 2, abs=1e-9)
+    while not rig.r("stp.Done"):
+        rig.scan()
+    assert rig.ax("Cmd.Vel") == 0.0 and rig.state() == "Stopping"
+
+
+def test_a_jerk_above_the_axis_maximum_runs_at_the_maximum(tmp_path_factory):
+    """Axis configuration `max_jerk`: an instruction's Jerk above it runs at it (like Acceleration)."""
+    rig = Rig(files(tmp_path_factory), "axes_jerk.toml").powered()
+    rig.set(vv=50.0, jerkV=1e9, doVel=True)
+    rig.scan()
+    t0 = rig.t
+    rig.scan(10)
+    assert rig.ax("Cmd.Vel") == pytest.approx(20_000.0 * (rig.t - t0) ** 2 / 2, abs=1e-9)
 
 
 def test_blending_buffer_modes_are_refused_as_not_modelled(rig):
