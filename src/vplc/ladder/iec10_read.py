@@ -66,6 +66,7 @@ def _read(root: ET.Element) -> list[XmlUnit]:
     if header is not None:
         _add_data(header, "ContentHeader")
     if gns is not None:
+        _no_using(gns)
         _namespace(gns, None, units)
     for gl in root.iterfind("Instances/Configuration/Resource/GlobalVars"):
         units[None].globals.append(_list("VAR_GLOBAL", gl, "global variables"))
@@ -92,6 +93,19 @@ def _namespace(container: ET.Element, ns: str | None, units: dict) -> None:
                                   "the names of a POU in one namespace only; qualify the names instead")
             target = units.setdefault(using[0], XmlUnit(using[0])) if using else unit
             target.pous.append(_pou(item))
+
+
+def _no_using(gns: ET.Element) -> None:
+    """A UsingDirective changes how names resolve; vplc reads the one of a POU (see _namespace) and refuses
+    it anywhere else (namespace, variable list, body, variable) rather than resolve names another way."""
+    for el in gns.iter():
+        if el.tag in POUS:
+            continue
+        for c in el:
+            if c.tag == "UsingDirective" and (c.text or "").strip():
+                name = el.get("name")
+                raise FormatError(f"{el.tag}{' ' + name if name else ''}", f"UsingDirective {c.text.strip()} "
+                                  "is read on a POU only; vplc does not model it here: qualify the names instead")
 
 
 def _add_data(el: ET.Element, where: str) -> dict[str, ET.Element]:

@@ -279,3 +279,10 @@ def test_old_export_declarations_load_with_one_warning_per_rule(tmp_path):
     for rule in ("spelt InoutVars", "per variable", "BaseType>DINT</BaseType>", "IndexRange or VariableLength"):
         assert rule in text, rule
     assert len(found) == 4, "one warning per rule"
+
+
+def test_using_directive_outside_a_pou_is_refused(tmp_path):
+    fb = _param_fb("").replace("<Type><TypeName>BOOL</TypeName>",
+                               "<UsingDirective>Other</UsingDirective><Type><TypeName>BOOL</TypeName>", 1)
+    text = doc(fb)
+    refused(write(tmp_path, text), "Variable Go", "UsingDirective Other")
