@@ -54,7 +54,8 @@ def test_scenario_passes_when_all_24_boxes_are_placed_in_order_once_each(robots)
 def test_scenario_fails_with_the_reason_when_one_placement_is_broken(robots):
     r = vplc_run(robots, "--set", "Palletizer.PickPoint[2].Z=2000@0.5s")     # robot 2's next pick: out of reach
     assert r.returncode == 1
-    reason = r.stderr.strip().splitlines()[-1]
+    reason, _, overruns = r.stderr.strip().splitlines()[-1].rpartition("; ")     # a real-time run ends with its
+    assert overruns.endswith(" overrun(s)")                                      # overruns (issue 27)
     assert reason.startswith("vplc run: FAILED: expectation failed at ")
     assert "expect Palletizer.Error = FALSE always (" in reason and reason.endswith("Palletizer.Error is TRUE")
     assert len(placements(robots.robots[1])) < 12
