@@ -253,6 +253,10 @@ def _parameters(el: ET.Element, item: PouItem) -> None:
     ps = _sub(el, "Parameters")
     order = 0
     if pou.kind == "FUNCTION":
+        own = next((d.name for s in sections for d in s.vars if d.name.upper() in ("EN", "ENO")), None)
+        if own:
+            _refuse(item, f"declares its own `{own}`; EN and ENO are the implicit input and output of every "
+                          "Sysmac function: rename the parameter")
         en = _sub(_sub(ps, "InputVars"), "Variable", {"name": "EN", "orderWithinParamSet": "0"})
         _sub(_sub(en, "Type"), "TypeName", text="BOOL")
         _sub(_sub(en, "InitialValue"), "SimpleValue", {"value": "TRUE"})

@@ -80,6 +80,8 @@ REFUSED = {   # what Omron's IEC 61131-10 schemas cannot express is refused, nev
                            "data type `aT` has an initial value of its own"),
     "VAR_TEMP in an FB": ("FUNCTION_BLOCK F\nVAR_TEMP\n    t : INT;\nEND_VAR\nt := 1;\nEND_FUNCTION_BLOCK\n",
                           "FUNCTION_BLOCK `F`: VAR_TEMP has no counterpart"),
+    "own EN": ("FUNCTION F : INT\nVAR_INPUT\n    EN : BOOL;\n    X : INT;\nEND_VAR\nF := X;\nEND_FUNCTION\n",
+               "FUNCTION `F`: declares its own `EN`"),
     "VAR_INPUT in a program": ("PROGRAM P\nVAR_INPUT\n    i : INT;\nEND_VAR\n;\nEND_PROGRAM\n",
                                "PROGRAM `P`: VAR_INPUT in a program has no counterpart"),
 }
