@@ -2,9 +2,10 @@
 the control channel) attacks the simulator.
 
 The simulator runs as its own process (the CLI, real-time clock, two robots, the control channel and the
-event log file on). This process runs the attacker and the measuring client in one thread (a selectors
-loop): the measuring client keeps one TMSTA 00 in flight on robot 2 and records each round trip; the
-attacker writes its byte stream whenever its socket takes more and reads (and drops) what comes back.
+event log file on). The attacker runs in a child process of this one (a selectors loop: it writes its byte
+stream whenever its socket takes more and reads, and drops, what comes back); this process keeps one
+TMSTA 00 in flight on robot 2 and records each round trip. Each attack runs 3 times (a fresh simulator each
+time); the run with the median p99 is shown, as the VM's other jobs make single runs vary.
 Attacks:
 * pvt         7 scripts of PVTEnter(1), 998 Cartesian PVTPoint(...) of 2 ms, PVTExit()
 * listen_send one 64,000-character string, then 1,420 x ListenSend(90, s) in scripts of 200 lines
@@ -18,9 +19,10 @@ Target (issue 23): p99 <= 10 ms under every attack, no round trip near a PLC's l
 """
 from __future__ import annotations
 
+import functools
 import json
 import math
-import os
+import multiprocessing
 import pathlib
 import selectors
 import socket
@@ -119,14 +121,31 @@ class Attack:
             sel.unregister(self.sock)
 
 
-def measure(port, attackers, seconds=4.0, warm_up=0.3):
-    """TMSTA 00 round trips on ``port`` while the attackers run; returns the sorted round-trip times."""
+def run_attack(make_attackers, seconds):
+    """The attack loop (in its own process, so that the attackers' own work never delays the measuring
+    client's reads): write and read the attackers' sockets for ``seconds``."""
+    attackers = make_attackers()
     sel = selectors.DefaultSelector()
     for attack in attackers:
         sel.register(attack.sock, selectors.EVENT_READ | selectors.EVENT_WRITE, attack)
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end and sel.get_map():
+        for key, mask in sel.select(0.05):
+            key.data.on_ready(mask, sel)
+    for key in list(sel.get_map().values()):
+        key.fileobj.close()
+
+
+def measure(port, make_attackers, seconds=4.0, warm_up=0.3):
+    """TMSTA 00 round trips on ``port`` while an attack runs in a child process; the sorted round-trip
+    times (a request still unanswered at the end counts with the time it has waited)."""
+    attack = multiprocessing.get_context("fork").Process(target=run_attack,
+                                                         args=(make_attackers, warm_up + seconds + 0.5))
+    attack.start()
     good = socket.create_connection(("127.0.0.1", port))
     good.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     good.setblocking(False)
+    sel = selectors.DefaultSelector()
     sel.register(good, selectors.EVENT_READ, "good")
     request, expected = codec.encode("TMSTA", "00"), codec.encode("TMSTA", "00,true,Listen1")
     latencies, reply, sent_at = [], b"", time.perf_counter()
@@ -134,22 +153,20 @@ def measure(port, attackers, seconds=4.0, warm_up=0.3):
     counted_from = time.perf_counter() + warm_up
     end = counted_from + seconds
     while time.perf_counter() < end:
-        for key, mask in sel.select(0.05):
-            if key.data != "good":
-                key.data.on_ready(mask, sel)
-                continue
-            reply += good.recv(4096)
-            if len(reply) >= len(expected):
-                if reply != expected:
-                    raise AssertionError(f"unexpected reply {reply!r}")
-                if sent_at >= counted_from:
-                    latencies.append(time.perf_counter() - sent_at)
-                reply, sent_at = b"", time.perf_counter()
-                good.sendall(request)
-    if sent_at < end - seconds and not reply:       # a reply still missing at the end counts as it stands
-        latencies.append(time.perf_counter() - sent_at)
-    for key in list(sel.get_map().values()):
-        key.fileobj.close()
+        if not sel.select(0.05):
+            continue
+        reply += good.recv(4096)
+        if len(reply) >= len(expected):
+            if reply != expected:
+                raise AssertionError(f"unexpected reply {reply!r}")
+            if sent_at >= counted_from:
+                latencies.append(time.perf_counter() - sent_at)
+            reply, sent_at = b"", time.perf_counter()
+            good.sendall(request)
+    if len(reply) < len(expected):
+        latencies.append(time.perf_counter() - max(sent_at, counted_from))
+    good.close()
+    attack.join(timeout=30)
     latencies.sort()
     return latencies
 
@@ -158,6 +175,11 @@ def control_attackers(port):
     lines = [json.dumps({"cmd": "state", "robot": 0}).encode(), json.dumps({"cmd": "events", "robot": 0}).encode()]
     block = b"\n".join(lines[i % 2] for i in range(65536 // 30)) + b"\n"
     return [Attack(socket.create_connection(("127.0.0.1", port)), block, True) for _ in range(15)]
+
+
+def robot_attacker(stream, port):
+    data, repeat = stream()
+    return [Attack(socket.create_connection(("127.0.0.1", port)), data, repeat)]
 
 
 def main():
@@ -169,23 +191,28 @@ def main():
                "nested": nested_stream, "long_line": long_line_stream, "control": None}
     chosen = sys.argv[1:] or list(attacks)
     for name in chosen:
-        with tempfile.TemporaryDirectory() as folder:
-            log_path = pathlib.Path(folder) / "events.jsonl"
-            proc, ports, control = start_cli(log_path)
-            try:
-                if attacks[name] is None:
-                    attackers = control_attackers(control)
-                else:
-                    data, repeat = attacks[name]()
-                    attackers = [Attack(socket.create_connection(("127.0.0.1", ports[0])), data, repeat)]
-                latencies = measure(ports[1], attackers)
-                log_bytes = sum(p.stat().st_size for p in pathlib.Path(folder).iterdir())
-            finally:
-                proc.terminate()
-                proc.communicate(timeout=30)
+        runs = []
+        for _ in range(3):
+            with tempfile.TemporaryDirectory() as folder:
+                log_path = pathlib.Path(folder) / "events.jsonl"
+                proc, ports, control = start_cli(log_path)
+                try:
+                    if attacks[name] is None:
+                        make = functools.partial(control_attackers, control)
+                    else:
+                        make = functools.partial(robot_attacker, attacks[name], ports[0])
+                    latencies = measure(ports[1], make)
+                    log_bytes = sum(p.stat().st_size for p in pathlib.Path(folder).iterdir())
+                finally:
+                    proc.terminate()
+                    proc.communicate(timeout=30)
+            runs.append((latencies[int(len(latencies) * 0.99)], latencies, log_bytes))
+        runs.sort(key=lambda run: run[0])
+        _p99, latencies, log_bytes = runs[1]
         lost = sum(1 for value in latencies if value > 1.0)
-        print(f"{name:12s} robot 2 TMSTA 00 median / p99 / worst {ms(latencies)}; {len(latencies):,d} round trips "
-              f"in 4 s, {lost} slower than 1 s; event log {log_bytes / 1e6:.1f} MB   (target p99 <= 10 ms)")
+        print(f"{name:12s} robot 2 TMSTA 00 median / p99 / worst {ms(latencies)} (median run of 3; p99 of the "
+              f"runs {', '.join(f'{run[0] * 1e3:.1f}' for run in runs)} ms); {len(latencies):,d} round trips in 4 s, "
+              f"{lost} slower than 1 s; event log {log_bytes / 1e6:.1f} MB   (target p99 <= 10 ms)")
     return 0
 
 
