@@ -64,7 +64,8 @@ class Packet:
 class Running:
     packet: Packet
     gen: object
-    wait: tuple | None = None          # ("tag", tag, deadline or None) or ("room", None, None)
+    wait: tuple | None = None          # ("tag", tag, deadline or None), ("delay", None, deadline) or
+                                       # ("room" | "idle" | "turn", None, None): see _resume_waits
 
 
 @dataclass
@@ -351,7 +352,8 @@ class ListenSession:
 
     def _resume_waits(self):
         """Resume the running script if what it waits for has happened. Waits (see sim.interp):
-        room (FIFO full), idle (WaitQueueTag(): every queued motion done), delay (Sleep, tag 0), and
+        turn (the budget of a turn ended its checking or running: a new turn), room (FIFO full), idle
+        (WaitQueueTag(): every queued motion done), delay (Sleep, tag 0), and
         tag: 1 completed / -1 not existed end the wait at once, 0 when the timeout passes (§13.2)."""
         while self.running is not None and self.running.wait is not None:
             kind, tag, deadline = self.running.wait
