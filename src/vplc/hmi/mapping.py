@@ -76,6 +76,9 @@ class Mapping:
         self.roots: dict[str, dict] = {}
         try:
             self.pages = frozenset(document.get("pages", ["index"]))
+            # members that only the engineer may change in every structure that has them (ExitNode: one
+            # command with it leaves the robot outside the Listen node, every later command fails 16#4002)
+            self.engineering_members = frozenset(document.get("engineering_members", []))
             types = document["types"]
             for name, spec in document["variables"].items():
                 self.roots[name] = spec
@@ -124,7 +127,8 @@ class Mapping:
             for field, field_spec in definition["fields"].items():
                 if "min" in spec and "min" not in field_spec:      # e.g. TargetPosition's range on X..RZ
                     field_spec = {**field_spec, "min": spec["min"], "max": spec["max"]}
-                self._expand(f"{path}.{field}", field_spec, access, role, types)
+                member_role = "engineer" if field in self.engineering_members else role
+                self._expand(f"{path}.{field}", field_spec, access, member_role, types)
 
     def why_not_a_leaf(self, path) -> str:
         """Why ``path`` cannot be written as one value: a whole structure/array, an index out of its range,

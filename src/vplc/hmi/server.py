@@ -9,7 +9,10 @@ variables too.
 API (all answers are JSON objects with "ok"):
   GET  /api/mapping                         the variable table (types, ranges, enumerations, roles)
   GET  /api/session                         {"ok", "role"}: the role the request's X-HMI-Key grants
-  GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "plc": "run"|"fault", ["fault",] "values": {...}}
+  GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "clock", "plc": "run"|"fault", ["fault",] "alarms",
+                                            "robot", "values": {...}}: "alarms" changes with the alarm list
+  GET  /api/alarms[?history=N]              the alarm list and the newest N history entries (vplc.hmi.alarms)
+  POST /api/alarms/ack {"alarms": [n, ...]} | {"all": true}   acknowledge (operator or engineer)
   GET  /api/program[/state?pou=NAME]        ladder drawings and their live power flow (vplc.hmi.program)
   POST /api/write   {"values": {path: v}}   validate all, then write all in one scan gap
   POST /api/execute {"execute": "X_Execute", "values": {path: v}}
@@ -37,6 +40,7 @@ from http.server import BaseHTTPRequestHandler
 from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
+from .alarms import HISTORY, AlarmSystem, stamp
 from .front import MAX_BODY, HttpFront, HttpLimits
 from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, validate
 from .trail import Trail
@@ -48,6 +52,7 @@ SCAN_WAIT_S = 1.0
 log = logging.getLogger("vplc.hmi")
 
 _POINT_NUMBER = re.compile(r"[0-9]{1,18}")       # /api/trail?since=N: ASCII digits, within an int64
+_HISTORY_COUNT = re.compile(r"[0-9]{1,6}")        # /api/alarms?history=N
 
 
 def _number_digits(text: str) -> str:
@@ -98,7 +103,8 @@ class HmiServer:
     """HTTP server for one PLC. start() binds (port 0 = ephemeral), serves in a thread; stop() ends it."""
 
     def __init__(self, plc, mapping: Mapping | None = None, host: str = "127.0.0.1", port: int = 8080,
-                 root: pathlib.Path = HMI_DIR, access: AccessPolicy | None = None, limits: HttpLimits | None = None):
+                 root: pathlib.Path = HMI_DIR, access: AccessPolicy | None = None, limits: HttpLimits | None = None,
+                 alarm_log: pathlib.Path | str | None = None, clock=time.time):
         self.plc = plc
         self.limits = limits or HttpLimits()
         self.mapping = mapping or Mapping.load()
@@ -113,6 +119,9 @@ class HmiServer:
         self.program = None            # ProgramMonitor, built at the Program page's first request
         spec = self.mapping.document.get("trail")
         self.trail = Trail(plc, spec["valid"], spec["position"]) if spec else None
+        # the alarm list and its history (alarm_log: a JSON-lines file kept across restarts; None: memory only)
+        self.clock = clock
+        self.alarms = AlarmSystem(plc, self.mapping, alarm_log, clock=clock)
 
     @property
     def port(self) -> int:
@@ -137,10 +146,12 @@ class HmiServer:
         self._thread.start()
         if self.trail is not None:
             self.trail.start()
+        self.alarms.start()
 
     def stop(self) -> None:
         if self.trail is not None:
             self.trail.stop()
+        self.alarms.stop()
         if self._httpd:
             self._httpd.shutdown()
             self._thread.join(timeout=5)
@@ -164,10 +175,22 @@ class HmiServer:
             leaf = self.mapping.leaves.get(name)
             if leaf is not None and leaf.type in ("DATE_AND_TIME", "DT"):
                 values[name] = format_dt(values[name])
-        if fault is None:
-            return {"ok": True, "time_ns": now, "plc": "run", "values": jsonable(values)}
-        # the values are those of the faulted scan's moment: shown, but marked as no longer valid
-        return {"ok": True, "time_ns": now, "plc": "fault", "fault": fault, "values": jsonable(values)}
+        answer = {"ok": True, "time_ns": now, "clock": stamp(self.clock()), "plc": "run",
+                  "alarms": self.alarms.seq, "robot": self.alarms.robot_state, "values": jsonable(values)}
+        if fault is not None:
+            # the values are those of the faulted scan's moment: shown, but marked as no longer valid
+            answer["plc"], answer["fault"] = "fault", fault
+        return answer
+
+    def acknowledge(self, body: dict, role: str) -> dict:
+        numbers = body.get("alarms")
+        if body.get("all") is True and numbers is None:
+            count = self.alarms.acknowledge(None, role)
+        elif isinstance(numbers, list) and numbers and all(type(n) is int for n in numbers):
+            count = self.alarms.acknowledge(numbers, role)
+        else:
+            raise RequestError('give the alarms to acknowledge: {"alarms": [number, ...]} or {"all": true}')
+        return {"ok": True, "acknowledged": count, "seq": self.alarms.seq}
 
     def _refuse_when_faulted(self) -> None:
         fault = plc_fault(self.plc)
@@ -191,8 +214,10 @@ class HmiServer:
         if leaf.access != "rw":
             raise RequestError(f"'{path}' is read-only for the HMI", HTTPStatus.FORBIDDEN)
         if not role_at_least(role, leaf.role):
-            raise RequestError(f"'{path}' is an engineering setting: open the engineer address printed at "
-                               f"start-up to change it", HTTPStatus.FORBIDDEN)
+            member = path.rpartition(".")[2]
+            why = (" (it would make the robot leave its Listen node)" if member == "ExitNode" else "")
+            raise RequestError(f"'{path}' is an engineering setting{why}: the operator may not change it; "
+                               f"open the engineer address printed at start-up", HTTPStatus.FORBIDDEN)
         return leaf
 
     def _write_all(self, checked) -> int:
@@ -337,7 +362,12 @@ class _Handler(BaseHTTPRequestHandler):
                 if not _POINT_NUMBER.fullmatch(since):
                     raise RequestError("since must be a point number: /api/trail?since=0")
                 self._json(HTTPStatus.OK, self.hmi.trail.since(int(since)))
-            elif url.path in ("/api/write", "/api/execute"):
+            elif url.path == "/api/alarms":
+                count = parse_qs(url.query).get("history", ["0"])[0]
+                if not _HISTORY_COUNT.fullmatch(count) or int(count) > HISTORY:
+                    raise RequestError(f"history must be a number of entries, 0 .. {HISTORY}: /api/alarms?history=500")
+                self._json(HTTPStatus.OK, self.hmi.alarms.summary(int(count)))
+            elif url.path in ("/api/write", "/api/execute", "/api/alarms/ack"):
                 raise RequestError(f"{url.path} takes POST with a JSON body", HTTPStatus.METHOD_NOT_ALLOWED)
             elif url.path.startswith("/api/"):
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
@@ -368,7 +398,8 @@ class _Handler(BaseHTTPRequestHandler):
         try:
             self.hmi.access.check_host(self.headers)
             url = self._url()
-            operation = {"/api/write": self.hmi.write, "/api/execute": self.hmi.execute}.get(url.path)
+            operation = {"/api/write": self.hmi.write, "/api/execute": self.hmi.execute,
+                         "/api/alarms/ack": self.hmi.acknowledge}.get(url.path)
             if operation is None:
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
             role = self.hmi.access.check_write(self.headers)
