@@ -14,6 +14,7 @@ Documentation: docs/toolchain/export.md.
 """
 from __future__ import annotations
 
+import errno
 import os
 import sys
 import tempfile
@@ -125,7 +126,15 @@ def run_export(args) -> int:
 
 
 def _write_atomic(path: str, data: bytes) -> None:
-    """Write next to the target and rename, so a failed run never leaves half a file behind."""
+    """Write next to the target and rename, so a failed run never leaves half a file behind. A target that exists
+    and is not a regular file (a device such as /dev/stdout, a pipe) is written in place: renaming over it would
+    replace the device with a file and report success for data nobody received."""
+    if os.path.exists(path) and not os.path.isfile(path):
+        if os.path.isdir(path):
+            raise IsADirectoryError(errno.EISDIR, "is a folder; name the file to write")
+        with open(path, "wb") as fh:
+            fh.write(data)
+        return
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".vplc-export-", suffix=".tmp", dir=folder)
     try:

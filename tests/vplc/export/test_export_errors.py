@@ -1,8 +1,11 @@
 """Error handling: sources with errors, missing paths, bad format, unwritable output. Never a traceback."""
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
+
+import pytest
 
 from tests.vplc.export.conftest import LIB, ROOT, run
 
@@ -122,3 +125,21 @@ def test_only_writes_the_named_objects_and_names_a_missing_one(tmp_path, capsys)
     assert '<ContentHeader name="Commands_Example"' in text
     code, _, err = run(capsys, "export", str(LIB), "--only", "NoSuchThing", "-o", str(out))
     assert code == 2 and "--only: no data type or POU named NOSUCHTHING" in err
+
+
+def test_a_device_target_is_written_in_place_and_a_full_device_is_an_error(tmp_path, capsys):
+    """`-o /dev/full` once renamed a temporary file over the device (as root) and reported success; a target that
+    is not a regular file is now written in place, so the device's own error reaches the user. Reached through a
+    symbolic link, so that a regression replaces the link, never the machine's device."""
+    if not os.path.exists("/dev/full"):
+        pytest.skip("this system has no /dev/full")
+    target = tmp_path / "out.xml"
+    target.symlink_to("/dev/full")
+    code, _out, err = run(capsys, "export", str(LIB), "--format", "iec61131-10", "-o", str(target))
+    assert code != 0 and "No space left on device" in err, err
+    assert target.is_symlink() and not target.is_file()
+
+
+def test_a_folder_target_is_refused(tmp_path, capsys):
+    code, _out, err = run(capsys, "export", str(LIB), "--format", "iec61131-10", "-o", str(tmp_path))
+    assert code == 2 and "is a folder" in err and "Traceback" not in err, err
