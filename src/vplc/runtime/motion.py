@@ -152,19 +152,20 @@ class Axis:
         self.active, cmd.status = cmd, ACTIVE
         self.limit_stop = False
         k = cmd.kind
+        vlim = self.cfg.max_velocity
         if k == "velocity":
             self.last_dir = cmd.direction
             vt, limited = self.vmax_of(cmd.velocity)
             self.ref.Details.VelLimit = limited
             self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, cmd.direction * vt, cmd.acc,
-                                                                        cmd.dec, cmd.jerk, self.acc))
+                                                                        cmd.dec, cmd.jerk, self.acc, vlim))
             self._set_state(CONTINUOUS)
         elif k == "position":
             self.plan_to(cmd, t)
             self._set_state(DISCRETE)
         elif k in ("halt", "stop"):
             self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.dec, cmd.dec, cmd.jerk,
-                                                                        self.acc))
+                                                                        self.acc, vlim))
             self._set_state(DISCRETE if k == "halt" else STOPPING)
 
     def plan_to(self, cmd: Command, t: float) -> None:
@@ -172,11 +173,12 @@ class Axis:
         self.ref.Details.VelLimit = limited
         if vmax <= 0.0:                         # 0 % override: decelerate and hold, still in motion
             self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.acc, cmd.dec, cmd.jerk,
-                                                                        self.acc))
+                                                                        self.acc, self.cfg.max_velocity))
             self.profile.hold = True
         else:
             self.profile = Profile(t, self.pos, self.vel, plan_position(self.pos, self.vel, cmd.target, vmax,
-                                                                          cmd.acc, cmd.dec, cmd.jerk, self.acc),
+                                                                          cmd.acc, cmd.dec, cmd.jerk, self.acc,
+                                                                          self.cfg.max_velocity),
                                    cmd.target)
         if self.vel == 0.0 and cmd.target != self.pos:
             self.last_dir = 1.0 if cmd.target > self.pos else -1.0

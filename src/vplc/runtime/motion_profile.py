@@ -79,15 +79,25 @@ def ramp_distance(u0: float, u1: float, limit: float, jerk: float) -> float:
     return (u0 + u1) / 2 * sum(d for d, _, _ in ramp(u0, u1, limit, jerk))
 
 
-def settle(a0: float, jerk: float) -> list:
-    """With a jerk, the segment that brings a running acceleration a0 to 0 before a new plan starts."""
-    return [(abs(a0) / jerk, a0, -math.copysign(jerk, a0))] if jerk and a0 else []
+def settle(a0: float, jerk: float, v0: float = 0.0, vlimit: float = math.inf) -> list:
+    """With a jerk, the segment that brings a running acceleration a0 to 0 before a new plan starts. While it
+    settles the speed still grows by a0^2 / 2J: a steeper jerk keeps it within ``vlimit`` (the axis maximum; an
+    acceleration that cannot settle in time drops to 0 at once)."""
+    if not (jerk and a0):
+        return []
+    if a0 * v0 > 0:
+        room = vlimit - abs(v0)
+        if room <= 0:
+            return []
+        jerk = max(jerk, a0 * a0 / (2 * room))
+    return [(abs(a0) / jerk, a0, -math.copysign(jerk, a0))]
 
 
-def plan_velocity(v0: float, vt: float, acc: float, dec: float, jerk: float = 0.0, a0: float = 0.0) -> list:
+def plan_velocity(v0: float, vt: float, acc: float, dec: float, jerk: float = 0.0, a0: float = 0.0,
+                  vlimit: float = math.inf) -> list:
     """Segments from velocity v0 (acceleration a0) to vt: speeding up with acc, slowing down with dec (through 0
     when the direction changes: first dec to 0, then acc)."""
-    segs = settle(a0, jerk)
+    segs = settle(a0, jerk, v0, vlimit)
     if segs:
         _, v0 = advance(0.0, v0, segs)
     if v0 * vt < 0:
@@ -96,11 +106,11 @@ def plan_velocity(v0: float, vt: float, acc: float, dec: float, jerk: float = 0.
 
 
 def plan_position(x0: float, v0: float, xt: float, vmax: float, acc: float, dec: float, jerk: float = 0.0,
-                  a0: float = 0.0) -> list:
+                  a0: float = 0.0, vlimit: float = math.inf) -> list:
     """Segments that take the axis from (x0, v0, a0) to rest at xt: speed up with acc to at most vmax, cruise,
     slow down with dec (a lower peak velocity when the distance is short). Moving away from the target, or too
     fast to stop before it, the axis first stops and then comes back."""
-    segs = settle(a0, jerk)
+    segs = settle(a0, jerk, v0, vlimit)
     if segs:
         x0, v0 = advance(x0, v0, segs)
     dist = xt - x0
