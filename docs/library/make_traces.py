@@ -106,12 +106,31 @@ def move_absolute_cases(out: Path) -> None:
     r.close()
 
 
+def move_absolute_aborting(out: Path) -> None:
+    """BufferMode Aborting: a slow PTP runs, a second one waits behind it; an aborting PTP replaces both (they end
+    CommandAborted) and runs to its end."""
+    paths = ["MExec[1]", "movers[1].Active", "movers[1].Done", "movers[1].CommandAborted",
+             "movers[2].Active", "movers[2].CommandAborted",
+             "MExec[3]", "movers[3].Busy", "movers[3].Active", "movers[3].Done"]
+    r = Rig(program="Main_Buffer.st")
+    r.set_struct("MParam[1]", move_abs(TargetPosition=dict(X=90, Y=0, Z=90, RX=0, RY=90, RZ=0), Speed=10))
+    r.set_struct("MParam[2]", move_abs(TargetPosition=dict(X=-90, Y=0, Z=90, RX=0, RY=90, RZ=0), Speed=10))
+    r.set_struct("MParam[3]", move_abs(TargetPosition=dict(X=10, Y=10, Z=90, RX=0, RY=90, RZ=0)))
+    r.write("MMode[3]", "Aborting")
+    steps = [(lambda: (r.write("MExec[1]", True), r.write("MExec[2]", True)), 0.1),
+             (lambda: r.write("MExec[3]", True), 0.32),
+             (lambda: [r.write(f"MExec[{k}]", False) for k in (1, 2, 3)], 0.02)]
+    record(r, paths, steps, out / "move_absolute_aborting.svg")
+    r.close()
+
+
 def main(out: Path = OUT) -> None:
     """Write every diagram into ``out`` (the drift test writes them into a temporary folder and compares)."""
     out.mkdir(exist_ok=True)
     for page in sorted(STEPS):
         page_trace(page, out)
     move_absolute_cases(out)
+    move_absolute_aborting(out)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,9 @@ FB_OF = {"stCBT_MovAbsParam": ("mover", "MoveParam", "MoveExec"), "stCBT_MovRelP
          "stCBT_BaseParam": ("base", "BaseParam", "BaseExec"), "stCBT_TCParam": ("tcp", "TcpParam", "TcpExec"),
          "stCBT_OutputParam": ("dout", "OutParam", "OutExec")}
 CONNECT_INPUT = {"Time_Out": "TimeOut", "IPPort": "Port"}
+# an FB input of a motion FB: written on the instance itself (Main_Lib.st does not pass it, so it keeps the value)
+FB_INPUT = {"CBT_MoveAbsolute": "stCBT_MovAbsParam", "CBT_MoveRelative": "stCBT_MovRelParam",
+            "CBT_MoveCircle": "stCBT_MovCircleParam"}
 POSE = {"stCBT_Transformation": "X", "stCBT_MomentOfInertia": "Ixx"}      # the member written for a structure
 VALID = {"stCBT_MovAbsParam": dict(MovementCommand="Line", DataFormat="CPP_Abs", Speed=50, AccelTime=200),
          "stCBT_MovRelParam": dict(MovementCommand="Line", DataFormat="CPP_Rel", Speed=50, AccelTime=200),
@@ -52,6 +55,9 @@ def member_path(rig, row) -> tuple[str, str]:
     """(variable path written, its ST type) of the row's member."""
     if row.struct == "CBT_Connect":
         return CONNECT_INPUT[row.member], rig.plc.var_type(f"Main.{CONNECT_INPUT[row.member]}")
+    if row.struct in FB_INPUT:
+        path = f"{FB_OF[FB_INPUT[row.struct]][0]}.{row.member}"
+        return path, rig.plc.var_type(f"Main.{path}").rsplit("\\", 1)[-1]
     _, param, _ = FB_OF[row.struct]
     path = f"{param}.{row.member}"
     ty = rig.plc.var_type(f"Main.{path}").rsplit("\\", 1)[-1]
@@ -91,8 +97,9 @@ def outcome_when(rig, row, value, when: dict) -> int:
         rig.write("ConnExec", False)
         rig.scans(3)
         return err if 0x1000 <= err < 0x2000 else NOT_CONNECTED
-    fb, param, execute = FB_OF[row.struct]
-    rig.set_struct(param, VALID.get(row.struct, {}))
+    struct_name = FB_INPUT.get(row.struct, row.struct)
+    fb, param, execute = FB_OF[struct_name]
+    rig.set_struct(param, VALID.get(struct_name, {}))
     for key, text in when.items():
         rig.write(f"{param}.{key}", {"TRUE": True, "FALSE": False}.get(text, text))
     rig.write(member_path(rig, row)[0], value)
