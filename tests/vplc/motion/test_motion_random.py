@@ -11,9 +11,11 @@ VMAX, AMAX, DT = 200.0, 2000.0, 0.001
 
 
 @pytest.mark.parametrize("seed", range(int(__import__("os").environ.get("MOTION_SEEDS", "6"))))
-def test_random_instruction_sequences_keep_the_motion_physical(tmp_path_factory, seed):
+@pytest.mark.parametrize("axes", ["axes.toml", "axes_limited.toml"])
+def test_random_instruction_sequences_keep_the_motion_physical(tmp_path_factory, seed, axes):
     rnd = random.Random(seed)
-    rig = Rig(files(tmp_path_factory)).powered()
+    rig = Rig(files(tmp_path_factory), axes).powered()
+    limited = axes == "axes_limited.toml"
     flags = ["doAbs1", "doAbs2", "doRel", "doVel", "doHalt", "doStop", "doOvr"]
     prev_x, prev_v = rig.ax("Cmd.Pos"), rig.ax("Cmd.Vel")
     travelled = 0.0
@@ -37,6 +39,7 @@ def test_random_instruction_sequences_keep_the_motion_physical(tmp_path_factory,
             rig.scan()
             x, v = rig.ax("Cmd.Pos"), rig.ax("Cmd.Vel")
             assert abs(v) <= VMAX * (1 + 1e-12), (seed, step, v)
+            assert not limited or -10.0 <= x <= 150.0, (seed, step, x)
             assert abs(x - prev_x) <= VMAX * DT * (1 + 1e-9) + 1e-9, (seed, step, prev_x, x)
             assert abs(v - prev_v) <= AMAX * DT * (1 + 1e-9) + 1e-9 or rig.state() in ("ErrorStop", "Disabled"), \
                 (seed, step, prev_v, v)
