@@ -4,14 +4,18 @@
     python3 docs/library/make_error_tables.py --check   # exit 1 and name the files that are out of date
 
 errors.tsv has one row per ErrorID: id (16#XXXX), raised_by, text (the ErrorDescrip, <= 79 characters), cause,
-remedy. Generated from it:
+remedy (for the engineer: the FB pages and errors.md), operator (what the operator does at the panel; it names
+screens and buttons, never a function block) and hmi ("alarm": the HMI server raises an alarm when a command
+ends with it, unless a cause it already shows explains it; "message": a refused start, nothing happened, the
+page's message line says it). Generated from it:
   lib/CBT_Commands_Lib/core/CBT_ErrorText.st   the ST text function (decimal CASE labels, IEC 61131-3 Ed. 2
                                                has no based-number CASE labels; the hex ID in a comment)
   docs/library/errors.md                       the table between the BEGIN / END markers
   docs/library/CBT_*.md                        the "## ErrorIDs" section of every FB page; which IDs an FB
                                                raises is read from its page (ranges such as 16#3011..16#3015
                                                are expanded)
-  hmi/errors.json                              text, cause and remedy for the HMI's alarm history
+  hmi/errors.json                              text, cause, remedy, operator remedy and alarm/message for
+                                               the HMI (pages and the server's alarm system)
 """
 from __future__ import annotations
 
@@ -25,7 +29,9 @@ ROOT = HERE.parents[1]
 TABLE = HERE / "errors.tsv"
 ST_FILE = ROOT / "lib" / "CBT_Commands_Lib" / "core" / "CBT_ErrorText.st"
 HMI_FILE = ROOT / "hmi" / "errors.json"
-COLUMNS = ["id", "raised_by", "text", "cause", "remedy"]
+COLUMNS = ["id", "raised_by", "text", "cause", "remedy", "operator", "hmi"]
+HMI_KINDS = ("alarm", "message")
+FB_NAME = re.compile(r"\bCBT_\w+|\b(?:MoveAbsolute|MoveRelative|MoveCircle|ProgramControl|ProjectControl)\b")
 ID = re.compile(r"16#[0-9A-F]{4}")
 CODE = re.compile(r"16#([0-9A-F]{4})(?:\.\.16#([0-9A-F]{4}))?")
 BEGIN = "<!-- BEGIN table generated from errors.tsv by make_error_tables.py -->"
@@ -63,6 +69,12 @@ def load(path: Path = TABLE) -> dict[str, dict[str, str]]:
                 raise TableError(f"{where}: ErrorID {code} has no {column}")
             if "|" in row[column]:
                 raise TableError(f"{where}: ErrorID {code}: '|' in {column} would break the docs table")
+        if row["hmi"] not in HMI_KINDS:
+            raise TableError(f"{where}: ErrorID {code}: hmi is {row['hmi']!r}, expected alarm or message")
+        named = FB_NAME.search(row["operator"])
+        if named:
+            raise TableError(f"{where}: ErrorID {code}: the operator text names the function block "
+                             f"{named.group()}: say what to do at the panel instead")
         if len(row["text"]) > 79:
             raise TableError(f"{where}: ErrorID {code}: text is {len(row['text'])} characters, ErrorDescrip "
                              "holds 79 (STRING[80])")
@@ -121,8 +133,8 @@ def fb_page(page: Path, text: str, rows: dict) -> str:
 
 
 def hmi_json(rows: dict) -> str:
-    table = {code: {"layer": LAYERS[code[3]], "text": r["text"], "cause": r["cause"], "remedy": r["remedy"]}
-             for code, r in rows.items()}
+    table = {code: {"layer": LAYERS[code[3]], "text": r["text"], "cause": r["cause"], "remedy": r["remedy"],
+                    "operator": r["operator"], "hmi": r["hmi"]} for code, r in rows.items()}
     return json.dumps(table, indent=1, ensure_ascii=False) + "\n"
 
 

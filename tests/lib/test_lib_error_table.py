@@ -87,12 +87,20 @@ END_PROGRAM
         assert plc.read("Main.Unknown") == "Unknown ErrorID 16#4fff"
 
 
+OPERATOR = "\tPress Execute again.\tmessage"
+
+
 @pytest.mark.parametrize("line,message", [
-    ("16#1001\tCBT_Connect\tText\t\tRemedy", "has no cause"),
-    ("16#0001\tCBT_Connect\tText\tCause\tRemedy", "is not 16#1xxx..16#4xxx"),
-    ("16#1001\tCBT_Connect\t" + "x" * 80 + "\tCause\tRemedy", "text is 80 characters"),
-    ("16#1001\tCBT_Connect\tText\tCause", "4 fields, expected 5"),
-    ("16#1001\tCBT_Connect\tA | B\tCause\tRemedy", "'|' in text"),
+    ("16#1001\tCBT_Connect\tText\t\tRemedy" + OPERATOR, "has no cause"),
+    ("16#0001\tCBT_Connect\tText\tCause\tRemedy" + OPERATOR, "is not 16#1xxx..16#4xxx"),
+    ("16#1001\tCBT_Connect\t" + "x" * 80 + "\tCause\tRemedy" + OPERATOR, "text is 80 characters"),
+    ("16#1001\tCBT_Connect\tText\tCause", "4 fields, expected 7"),
+    ("16#1001\tCBT_Connect\tA | B\tCause\tRemedy" + OPERATOR, "'|' in text"),
+    ("16#1001\tCBT_Connect\tText\tCause\tRemedy\tPress Execute again.\tevent", "hmi is 'event', expected alarm or "
+     "message"),
+    ("16#1001\tCBT_Connect\tText\tCause\tRemedy\tExecute CBT_Connect again.\tmessage",
+     "the operator text names the function block CBT_Connect"),
+    ("16#1001\tCBT_Connect\tText\tCause\tRemedy\t\tmessage", "has no operator"),
 ])
 def test_a_malformed_table_is_named_with_its_line(tmp_path, line, message):
     bad = tmp_path / "errors.tsv"

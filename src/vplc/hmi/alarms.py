@@ -7,7 +7,7 @@ turns what it reads into alarms:
   its Listen node, link to the robot lost, a command that failed. A condition that comes while a higher-ranked
   alarm is active is a consequence: it becomes a detail of that alarm, not an alarm of its own. Consequences wait
   ON_DELAY_S before they are raised (ISA-18.2 on-delay), so a cause seen a moment later still takes them; the
-  first alarm of an episode (no other alarm active) is marked first-out.
+  first alarm of an episode (raised while no other alarm is listed) is marked first-out.
 * states: active-unacknowledged, active-acknowledged, returned-unacknowledged, normal (acknowledged and gone:
   off the list, in the history). A condition alarm follows the process: it returns when its cause is gone,
   whatever the pages do with a command's Execute. A failed command is an event: it is raised returned (its
@@ -321,7 +321,7 @@ class AlarmSystem:
         self.alarm_number += 1
         alarm = Alarm(self.alarm_number, key, c["rank"], c["priority"], c["source"], c["text"], c["remedy"], now,
                       c["error_id"], active=active, returned=None if active else now,
-                      first_out=not any(a.active for a in self.alarms.values()))
+                      first_out=not self.alarms)     # the first of an episode: nothing else listed
         self.alarms[alarm.number] = alarm
         self._record(now, "raised" if active else "event", alarm, first_out=alarm.first_out)
         return alarm
@@ -379,7 +379,7 @@ class AlarmSystem:
             if not error or not error_id or before == (True, error_id):
                 continue
             row = self.errors.get(id_text(error_id), {})
-            if row.get("alarm", "alarm") != "alarm":
+            if row.get("hmi", "alarm") != "alarm":
                 continue                                  # a refused start: the page's message line says it
             text = v.get(f"{group}_ErrorDescrip") or row.get("text", "")
             self._events.append((mono, {"rank": COMMAND_RANK, "priority": COMMAND_PRIORITY, "source": source,

@@ -1,0 +1,267 @@
+"""The alarm system the server owns (issue 25, item 4; ISA-18.2), sample by sample on a clock the test turns:
+states, one alarm per cause with its consequences as details, first-out, priority, alarms that follow the process
+condition, refused starts that are no alarms, acknowledge through the API, and a history that survives a
+restart and never makes a sample wait for the disk."""
+from __future__ import annotations
+
+import json
+import threading
+
+import pytest
+
+from fake_plc import FakePlc, command_program
+from hmi_http import Client
+from vplc.hmi import alarms as alarm_module
+from vplc.hmi.alarms import HISTORY, ON_DELAY_S, AlarmSystem
+
+START = 1_900_000_000.0          # 2030-03-17, whatever the test machine's clock says
+
+
+class Clock:
+    def __init__(self):
+        self.now = START
+
+    def __call__(self):
+        return self.now
+
+
+@pytest.fixture
+def plant(mapping, tmp_path):
+    """A connected robot in its Listen node with its project running; the alarm system sampling on demand. No
+    program: the variables hold what the test sets."""
+    plc = FakePlc(mapping)
+    plc.vars.update(Connect_Execute=True, Connect_Connected=True, Robot_InListenNode=True, RobotStatus_Valid=True)
+    plc.vars["RobotStatus"].update(ProjectRunning=True, AutoMode=True)
+    clock = Clock()
+    system = AlarmSystem(plc, mapping, tmp_path / "alarms.jsonl", clock=clock, monotonic=clock)
+    return plc, system, clock
+
+
+def step(plant, seconds=0.1, times=1):
+    plc, system, clock = plant
+    for _ in range(times):
+        plc.scan()
+        clock.now += seconds
+        system.sample()
+    return system.summary(history=HISTORY)
+
+
+def listed(summary):
+    return [(a["key"], a["state"]) for a in summary["alarms"]]
+
+
+def test_a_healthy_robot_has_no_alarm_and_reads_ready(plant):
+    summary = step(plant, times=20)
+    assert summary["alarms"] == [] and summary["robot"] == "ready"
+
+
+def test_an_alarm_goes_through_the_isa_18_2_states(plant):
+    plc, system, _ = plant
+    plc.vars["RobotStatus"]["EStop"] = True
+    assert listed(step(plant)) == [("estop", "active-unacknowledged")]
+    number = step(plant)["alarms"][0]["number"]
+    assert system.acknowledge([number], "operator") == 1
+    assert listed(step(plant)) == [("estop", "active-acknowledged")]
+    plc.vars["RobotStatus"]["EStop"] = False
+    summary = step(plant)
+    assert summary["alarms"] == []                               # acknowledged and gone: normal
+    assert [e["event"] for e in summary["history"]][:4] == ["normal", "returned", "acknowledged", "raised"]
+
+
+def test_an_alarm_that_returns_unacknowledged_waits_for_its_acknowledge_and_comes_back_as_the_same(plant):
+    plc, system, _ = plant
+    plc.vars["RobotStatus"]["EStop"] = True
+    number = step(plant)["alarms"][0]["number"]
+    plc.vars["RobotStatus"]["EStop"] = False
+    assert listed(step(plant)) == [("estop", "returned-unacknowledged")]
+    plc.vars["RobotStatus"]["EStop"] = True
+    summary = step(plant)
+    assert listed(summary) == [("estop", "active-unacknowledged")] and summary["alarms"][0]["number"] == number
+    plc.vars["RobotStatus"]["EStop"] = False
+    step(plant)
+    system.acknowledge(None, "operator")
+    assert step(plant)["alarms"] == []
+
+
+def test_an_e_stop_is_one_alarm_with_its_consequences_as_details(plant):
+    """The E-stop stops the project with a robot error, the link closes and the running motion fails 16#4006:
+    one alarm (the E-stop, high priority, first-out), the rest are its details."""
+    plc, _, _ = plant
+    plc.vars["RobotStatus"]["EStop"] = True
+    step(plant)
+    plc.vars["RobotStatus"].update(RobotError=True, ErrorCode=0x10001, ErrorText="Emergency stop",
+                                   ProjectRunning=False, ProjectStopped=True)
+    plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=0x4006, MoveAbs_ErrorDescrip="Robot error stopped the project",
+                    Connect_Connected=False, Connect_Reconnecting=True, Connect_ErrorID=0x4006)
+    summary = step(plant, times=int(2 * ON_DELAY_S / 0.1) + 2)
+    assert listed(summary) == [("estop", "active-unacknowledged")]
+    alarm = summary["alarms"][0]
+    assert alarm["priority"] == "high" and alarm["first_out"] is True
+    details = [d["text"] for d in alarm["details"]]
+    assert details == ["Robot: Robot error 16#00010001: Emergency stop",
+                       "Connection: Connection to the robot lost, reconnecting — Robot error stopped the project: "
+                       "code and text in CBT_RobotStatus",
+                       "Move Absolute 16#4006: Robot error stopped the project"]
+    assert summary["robot"] == "E-stop"
+
+
+def test_a_consequence_seen_before_its_cause_waits_for_it(plant):
+    """The motion's 16#4006 reaches the PLC a sample before the Ethernet Slave shows the robot error: the on-delay
+    lets the robot error take it as a detail instead of raising two alarms."""
+    plc, _, _ = plant
+    plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=0x4006, MoveAbs_ErrorDescrip="Robot error stopped the project")
+    step(plant)
+    plc.vars["RobotStatus"].update(RobotError=True, ErrorCode=0x10001, ErrorText="Line: target pose is out of reach")
+    summary = step(plant, times=int(2 * ON_DELAY_S / 0.1) + 2)
+    assert listed(summary) == [("robot", "active-unacknowledged")]
+    assert [d["text"] for d in summary["alarms"][0]["details"]] == [
+        "Move Absolute 16#4006: Robot error stopped the project"]
+
+
+def test_alarms_are_listed_by_priority_and_the_first_out_is_marked(plant):
+    plc, _, _ = plant
+    plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001, MoveAbs_ErrorDescrip="No reply from robot")
+    step(plant, times=int(ON_DELAY_S / 0.1) + 2)
+    plc.vars["RobotStatus"]["EStop"] = True
+    summary = step(plant)
+    assert [(a["key"], a["priority"], a["first_out"]) for a in summary["alarms"]] == [
+        ("estop", "high", False), ("command:Move Absolute", "low", True)]
+
+
+def test_a_failed_command_is_an_event_that_does_not_stay_active_while_execute_is_held(plant):
+    """The page keeps Execute TRUE so Error stays visible; the alarm must not stay active for that."""
+    plc, system, _ = plant
+    plc.vars.update(MoveAbs_Execute=True, MoveAbs_Error=True, MoveAbs_ErrorID=0x3001,
+                    MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")
+    summary = step(plant, times=int(ON_DELAY_S / 0.1) + 2)
+    assert listed(summary) == [("command:Move Absolute", "returned-unacknowledged")]
+    assert summary["alarms"][0]["id"] == "16#3001"
+    system.acknowledge(None, "operator")
+    assert step(plant, times=30)["alarms"] == []                # Error still TRUE: no new alarm for it
+
+
+@pytest.mark.parametrize("error_id", [0x1013, 0x2001, 0x4005])
+def test_a_refused_start_is_a_message_not_an_alarm(plant, error_id):
+    plc, _, _ = plant
+    plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=error_id, MoveAbs_ErrorDescrip="refused")
+    assert step(plant, times=20)["alarms"] == []
+
+
+def test_leaving_the_listen_node_is_an_alarm_that_returns_when_the_robot_is_back(plant):
+    plc, _, _ = plant
+    plc.vars["Robot_InListenNode"] = False
+    summary = step(plant, times=int(ON_DELAY_S / 0.1) + 2)
+    assert listed(summary) == [("listen", "active-unacknowledged")] and summary["robot"] == "left the Listen node"
+    assert summary["alarms"][0]["remedy"].startswith("Press Back to Listen Node on the Main screen")
+    plc.vars["Robot_InListenNode"] = True
+    summary = step(plant)
+    assert listed(summary) == [("listen", "returned-unacknowledged")] and summary["robot"] == "ready"
+
+
+def test_a_first_connect_retried_is_not_called_a_lost_link(plant):
+    plc, _, _ = plant
+    plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=1, Connect_Error=True,
+                    Connect_ErrorID=0x2004, Connect_ErrorDescrip="Robot not reachable")
+    plant[1]._was_connected = False
+    alarm = step(plant, times=int(ON_DELAY_S / 0.1) + 2)["alarms"][0]
+    assert alarm["text"] == "Not connected to the robot, retrying (attempt 1) — Robot not reachable"
+
+
+def test_a_stalled_or_faulted_plc_is_a_high_alarm(plant, mapping):
+    plc, system, clock = plant
+    for _ in range(15):                                          # the PLC stops scanning
+        clock.now += 0.1
+        system.sample()
+    alarm = system.summary()["alarms"][0]
+    assert (alarm["key"], alarm["priority"]) == ("plc", "high")
+    assert alarm["text"] == "PLC stopped: its tasks completed no cycle for 1 s"
+
+
+def test_timestamps_are_the_servers_date_and_24_hour_time(plant):
+    plc, _, clock = plant
+    clock.now = 1_900_000_000.25 + 13 * 3600                    # whatever hour, shown 0..23
+    plc.vars["RobotStatus"]["EStop"] = True
+    alarm = step(plant, seconds=0)["alarms"][0]
+    import time
+    assert alarm["time"] == time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(clock.now)) + ".250"
+
+
+def test_the_history_survives_a_restart_and_keeps_the_newest_entries(mapping, tmp_path):
+    path = tmp_path / "alarms.jsonl"
+    plc = FakePlc(mapping, command_program)
+    plc.vars.update(Connect_Execute=True, Connect_Connected=True, Robot_InListenNode=True)
+    clock = Clock()
+    system = AlarmSystem(plc, mapping, path, clock=clock, monotonic=clock)
+    system.history.start()
+    for n in range(700):                                        # 2100 entries: raised, acknowledged... normal
+        plc.vars["RobotStatus_Valid"] = True
+        plc.vars["RobotStatus"]["EStop"] = n % 2 == 0
+        plc.scan(); clock.now += 0.1; system.sample()
+        system.acknowledge(None, "operator")
+    system.history.stop()
+    kept = [json.loads(line) for line in path.read_text().splitlines()]
+    assert 500 <= len(kept) <= 2 * HISTORY
+    again = AlarmSystem(plc, mapping, path, clock=clock, monotonic=clock)
+    entries = again.summary(history=HISTORY)["history"]
+    assert len(entries) == HISTORY and entries[0]["n"] == system.entry_number
+    assert again.alarm_number == system.alarm_number             # numbering goes on after a restart
+
+
+def test_a_sample_never_waits_for_the_disk(plant, monkeypatch):
+    """The writer thread is held (a disk that does not answer): sampling and acknowledging go on."""
+    plc, system, _ = plant
+    held = threading.Event()
+    writing = threading.Event()
+
+    def stuck(self):
+        writing.set()
+        held.wait(30)
+    monkeypatch.setattr(alarm_module.History, "_write", stuck)
+    system.history.start()
+    writing.wait(5)
+
+    def work():
+        for n in range(200):
+            plc.vars["RobotStatus"]["EStop"] = n % 2 == 0
+            step(plant)
+            system.acknowledge(None, "operator")
+    worker = threading.Thread(target=work)
+    worker.start()
+    worker.join(timeout=20)
+    stuck_thread = worker.is_alive()
+    held.set()
+    assert not stuck_thread, "a sample waited for the history file"
+    assert system.summary(history=5)["history"][0]["n"] == system.entry_number
+
+
+def test_a_history_file_with_a_damaged_line_is_read_without_it(mapping, tmp_path):
+    path = tmp_path / "alarms.jsonl"
+    path.write_text('{"n": 1, "alarm": 1, "event": "raised"}\nnot json\n{"n": 2, "alarm": 1, "event": "normal"}\n')
+    system = AlarmSystem(FakePlc(mapping), mapping, path)
+    assert [e["n"] for e in system.summary(history=10)["history"]] == [2, 1]
+
+
+# --- the API ---------------------------------------------------------------------------------------------------
+def test_acknowledge_over_the_api_needs_an_operator_key_and_a_list_of_alarms(server, fake_plc):
+    base = f"http://127.0.0.1:{server.port}"
+    with fake_plc.lock:
+        fake_plc.vars.update(RobotStatus_Valid=True)
+        fake_plc.vars["RobotStatus"]["EStop"] = True
+    operator = Client(base, server.access.keys["operator"])
+    deadline_reads = 0
+    while not operator.json("/api/alarms")[1]["alarms"] and deadline_reads < 200:
+        threading.Event().wait(0.05)
+        deadline_reads += 1
+    status, summary = operator.json("/api/alarms")
+    number = summary["alarms"][0]["number"]
+    assert Client(base).json("/api/alarms/ack", {"all": True})[0] == 401
+    assert operator.json("/api/alarms/ack", {"alarms": "all"}) == (
+        400, {"ok": False, "error": 'give the alarms to acknowledge: {"alarms": [number, ...]} or {"all": true}'})
+    status, answer = operator.json("/api/alarms/ack", {"alarms": [number]})
+    assert status == 200 and answer["acknowledged"] == 1
+    status, summary = Client(base).json("/api/alarms")             # every panel, even a monitor, sees it
+    assert summary["alarms"][0]["state"] == "active-acknowledged"
+    status, read = operator.json("/api/read?names=Connect_Connected")
+    assert read["alarms"] == summary["seq"] and read["robot"] == "E-stop"
+    assert operator.json("/api/alarms?history=x")[0] == 400
+    assert operator.json(f"/api/alarms?history={HISTORY + 1}")[0] == 400
