@@ -39,9 +39,7 @@ def test_library_and_examples_export_is_valid_tc6(schema, tmp_path, capsys):
 
 
 def test_every_ladder_element_kind_is_valid_tc6(schema, tmp_path, capsys):
-    import sys
-    sys.path.insert(0, str(ROOT / "tests" / "vplc" / "ladder"))     # test_ld_export imports its helpers by name
-    from test_ld_export import ALL_BODY, ALL_KINDS
+    from tests.vplc.ladder.ld_xml import ALL_BODY, ALL_KINDS
     src = program(tmp_path, ALL_KINDS, ALL_BODY)
     assert valid(schema, src) == [], "the test's own input is valid TC6"
     out = tmp_path / "out.xml"

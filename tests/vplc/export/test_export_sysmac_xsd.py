@@ -67,9 +67,7 @@ def test_the_shipped_ladder_example_validates(schema):
 
 def _ladder_fixtures(tmp_path):
     """(name, PLCopen source) of every ladder fixture of tests/vplc/ladder that exports to IEC 61131-10."""
-    import sys
-    sys.path.insert(0, str(ROOT / "tests" / "vplc" / "ladder"))     # test_ld_export imports its helpers by name
-    from test_ld_export import ALL_BODY, ALL_KINDS
+    from tests.vplc.ladder.ld_xml import ALL_BODY, ALL_KINDS
     out = []
     for kind in ("program", "functionBlock"):
         path = tmp_path / f"all_{kind}.xml"

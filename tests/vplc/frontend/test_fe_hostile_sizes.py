@@ -8,18 +8,17 @@ import json
 import subprocess
 import sys
 
-from fe_helpers import ROOT, check_text, codes, program
+from fe_helpers import check_text, codes, program
 
 from vplc.frontend import lexer
 
 _MEASURE = r"""
 import json, sys, tracemalloc
-sys.path.insert(0, sys.argv[1])
 from vplc.frontend.diagnostics import DiagnosticBag
 from vplc.frontend.lexer import tokenize
 from vplc.frontend.source import SourceFile
-n, quote = int(sys.argv[2]), sys.argv[3]
-body = sys.argv[4] * (n // len(sys.argv[4]))
+n, quote = int(sys.argv[1]), sys.argv[2]
+body = sys.argv[3] * (n // len(sys.argv[3]))
 text = "PROGRAM Main VAR s : STRING[10]; END_VAR s := " + quote + body + quote + "; END_PROGRAM"
 tracemalloc.start()
 tokens = tokenize(SourceFile("x.st", text), DiagnosticBag())
@@ -29,7 +28,7 @@ print(json.dumps({"peak": peak, "n": len(body), "kinds": [t.kind for t in tokens
 
 
 def _lex_peak(n: int, quote: str, unit: str) -> dict:
-    out = subprocess.run([sys.executable, "-c", _MEASURE, str(ROOT / "src"), str(n), quote, unit],
+    out = subprocess.run([sys.executable, "-c", _MEASURE, str(n), quote, unit],
                          capture_output=True, text=True, check=True, timeout=120)
     return json.loads(out.stdout)
 
@@ -44,11 +43,10 @@ def test_a_long_string_literal_is_lexed_in_memory_proportional_to_nothing_but_it
 
 _MEASURE_TEXT = r"""
 import json, sys, tracemalloc
-sys.path.insert(0, sys.argv[1])
 from vplc.frontend.diagnostics import DiagnosticBag
 from vplc.frontend.lexer import tokenize
 from vplc.frontend.source import SourceFile
-text = sys.argv[2] + sys.argv[3] * int(sys.argv[4]) + sys.argv[5]
+text = sys.argv[1] + sys.argv[2] * int(sys.argv[3]) + sys.argv[4]
 tracemalloc.start()
 tokens = tokenize(SourceFile("x.st", text), DiagnosticBag())
 print(json.dumps({"peak": tracemalloc.get_traced_memory()[1], "n": len(text), "kinds": [t.kind for t in tokens]}))
@@ -58,7 +56,7 @@ print(json.dumps({"peak": tracemalloc.get_traced_memory()[1], "n": len(text), "k
 def test_long_duration_and_address_literals_are_lexed_in_memory_proportional_to_their_text():
     # a T# literal of 200,000 units took ~500 bytes per character, a %IX address of 200,000 parts ~330
     for head, unit, tail, kind in (("T#", "1s", ";", "TIME"), ("%IX1", ".1", ";", "ADDRESS")):
-        out = subprocess.run([sys.executable, "-c", _MEASURE_TEXT, str(ROOT / "src"), head, unit, "200000", tail],
+        out = subprocess.run([sys.executable, "-c", _MEASURE_TEXT, head, unit, "200000", tail],
                              capture_output=True, text=True, check=True, timeout=120)
         r = json.loads(out.stdout)
         assert r["kinds"][0] == kind and r["peak"] < 4 * r["n"] + 200_000, (kind, r["peak"])

@@ -118,3 +118,25 @@ def iec10_program(variables: dict, rungs: list[str], name="Main") -> str:
     return (IEC10_HEAD + f'<Program name="{name}"><Vars accessSpecifier="private">{vars_xml}</Vars><MainBody>'
             f'<BodyContent xsi:type="smcext:LdSection" name="S" evaluationOrder="1">{body}</BodyContent>'
             '</MainBody></Program></GlobalNamespace></Types><Instances/></Project>\n')
+
+
+# One program holding every ladder element kind (the round-trip and schema tests of the LD readers and writers)
+ALL_KINDS = {"A": "BOOL", "B": "BOOL", "C": "BOOL", "Q1": "BOOL", "Q2": "BOOL", "Latch": "BOOL", "Pulse": "BOOL",
+             "Up": "BOOL", "Down": "BOOL", "Run": "BOOL", "T": "TON", "Et": "TIME", "N": "INT", "Sum": "INT",
+             "Skip": "BOOL", "Mid": "BOOL", "Stop": "BOOL", "Last": "BOOL", "Eno": "BOOL"}
+ALL_BODY = [comment(90, "series, parallel, NC", y=-20), rail(1), contact(2, "A", 1), contact(3, "B", 1, y=20),
+            contact(4, "C", 2, 3, negated="true"), coil(5, "Q1", 4), coil(6, "Q2", 4, y=20, negated="true"),
+            right(7, 5, 6),
+            contact(10, "A", 1, y=100, edge="rising"), coil(11, "Latch", 10, y=100, storage="set"),
+            contact(12, "B", 1, y=120, edge="falling"), coil(13, "Latch", 12, y=120, storage="reset"),
+            contact(14, "C", 1, y=140), coil(15, "Pulse", 14, y=140, edge="rising"),
+            contact(20, "Run", 1, y=200), contact(21, "C", 1, y=220),
+            block(22, "TON", {"EN": 20, "IN": 21, "PT": 23}, ["ENO", "Q", "ET"], instance="T", y=200),
+            invar(23, "T#2ms", y=240), coil(24, "Eno", (22, "ENO"), y=200), coil(25, "Up", (22, "Q"), y=220),
+            outvar(26, "Et", (22, "ET"), y=240),
+            invar(30, "N", y=300), invar(31, "7", y=310), block(32, "ADD", {"IN1": 30, "IN2": 31}, ["OUT"], y=300),
+            outvar(33, "Sum", (32, "OUT"), y=300),
+            contact(40, "Skip", 1, y=400), jump(41, "After", 40, y=400),
+            contact(42, "A", 1, y=420), coil(43, "Mid", 42, y=420),
+            label(44, "After", y=440), contact(45, "Stop", 1, y=460), ret(46, 45, y=460),
+            contact(47, "B", 1, y=480), coil(48, "Last", 47, y=480), coil(49, "Down", 47, y=490, negated="true")]

@@ -205,7 +205,7 @@ def test_damaged_files_give_diagnostics_never_a_traceback(tmp_path):
     import re
 
     from ld_xml import document
-    from test_ld_export import ALL_BODY, ALL_KINDS
+    from ld_xml import ALL_BODY, ALL_KINDS
     base = document(ALL_KINDS, ALL_BODY)
     rnd = random.Random(16)
 
