@@ -93,6 +93,10 @@ def _skip_args(ck, e: A.Call) -> T.Type:
 def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
     ctx = ck.ctx
     positional = [p for p in pt.params if p.direction in ("in", "inout")]
+    if kind == "fb" and ctx.dialect == "sysmac":
+        # a function block called with non-formal arguments takes its outputs after its inputs, in declaration
+        # order (W502 2-116 `TON_instance(In, PT, Q, ET);`, 2-134 `CTD_instance(CD, Load, PV, Q, CV);`)
+        positional += [p for p in pt.params if p.direction == "out"]
     bound: dict[int, BoundArg] = {}
     pos = 0
     formal_seen = False
@@ -104,7 +108,8 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
                 ck.expr(arg.value)
                 continue
             if pos >= len(positional):
-                ctx.diags.error("ST1204", f"too many arguments: {pt.name} takes {len(positional)} input(s)",
+                ctx.diags.error("ST1204", f"too many arguments: {pt.name} takes {len(positional)} "
+                                f"{'inputs and outputs' if kind == 'fb' and ctx.dialect == 'sysmac' else 'input(s)'}",
                                 arg.span)
                 ck.expr(arg.value)
                 continue
@@ -112,7 +117,7 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
             pos += 1
         else:
             formal_seen = True
-            p = pt.param(arg.name)
+            p = pt.param(arg.name) or _iec_alias(pt, arg.name)
             if p is None:
                 _unknown_param(ck, arg, pt)
                 continue
@@ -136,6 +141,15 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
     e.binding = CallBinding(kind, pt.ret if kind == "function" else T.VOID, pou=pt, instance=instance,
                             args=[bound[i] for i in sorted(bound)])
     return e.binding.ty
+
+
+# IEC 61131-3 names of inputs that Sysmac names otherwise (W502 2-134: CTD's load input is `Load`, IEC's `LD`)
+IEC_PARAM_NAMES = {("CTD", "LD"): "Load"}
+
+
+def _iec_alias(pt: T.PouType, name: str):
+    sysmac = IEC_PARAM_NAMES.get((pt.name.upper(), name.upper()))
+    return pt.param(sysmac) if sysmac and pt.namespace in (None, "") else None
 
 
 def _unknown_param(ck, arg: A.Arg, pt: T.PouType) -> None:

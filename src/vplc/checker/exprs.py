@@ -320,6 +320,8 @@ class ExprChecker:
 
     def comparison(self, e, lt, rt):
         a, b = T.base_of(lt), T.base_of(rt)
+        if e.op in ("=", "<>") and (self.bool_digit(e.right, a, b) or self.bool_digit(e.left, b, a)):
+            return T.BOOL
         if isinstance(a, T.StringType) and isinstance(b, T.StringType) and a.wide == b.wide:
             return T.BOOL
         if isinstance(a, T.EnumType) or isinstance(b, T.EnumType):
@@ -332,6 +334,17 @@ class ExprChecker:
                 self.widen_both(e, lt, rt, c)
                 return T.BOOL
         return self.op_error(e, lt, rt, "comparable values of the same type")
+
+    @staticmethod
+    def bool_digit(lit, other: T.Type, this: T.Type) -> bool:
+        """`Flag = 1`, `Flag <> 0`: a plain 0 or 1 compared with a BOOL is a BOOL literal (IEC 61131-3
+        boolean_literal; Sysmac accepts it). The literal becomes FALSE / TRUE."""
+        if not (isinstance(lit, A.Literal) and lit.kind == "int" and lit.type_prefix is None and lit.value in (0, 1)
+                and isinstance(other, T.ElementaryType) and other.kind == "bool" and T.is_int(this)):
+            return False
+        lit.ty = T.BOOL
+        lit.kind, lit.value = "bool", bool(lit.value)
+        return True
 
     def numeric_common(self, e, a: T.Type, b: T.Type) -> T.Type | None:
         """Common type of two operands. Sysmac (W501 6-106): the operand of highest rank, unsigned at equal

@@ -143,6 +143,24 @@ def _not(args, dialect):
     return T.base_of(args[0]), [None]
 
 
+def _compare(args, dialect):
+    """LT, LE, GT, GE, EQ, NE as functions (IEC 61131-3 comparison functions; Sysmac accepts them in ST like ADD):
+    operands of one comparable type, the result BOOL. LT/LE/GT/GE/EQ are extensible, `LT(a, b, c)` meaning
+    `a < b AND b < c`."""
+    if all(T.is_string(a) or T.is_error(a) for a in args):
+        return T.BOOL, [None] * len(args)
+    for i, a in enumerate(args):
+        _need(lambda t: T.is_elementary(t) or isinstance(T.base_of(t), T.EnumType), a, i, "a comparable value")
+    if any(isinstance(T.base_of(a), T.EnumType) for a in args):
+        first = T.base_of(args[0])
+        for i, a in enumerate(args):
+            if not T.is_error(a) and T.base_of(a) is not first:
+                raise SignatureError(f"argument {i + 1} must be a value of {first.name}, not {a.name}", i)
+        return T.BOOL, [None] * len(args)
+    c = _common(list(args))
+    return T.BOOL, _convs(args, c)
+
+
 def _move(args, dialect):
     return args[0], [None]
 
@@ -302,6 +320,8 @@ BUILTINS: dict[str, Builtin] = {b.name: b for b in [
     _b("AND", 2, None, _bitwise), _b("OR", 2, None, _bitwise), _b("XOR", 2, None, _bitwise),
     _b("NOT", 1, 1, _not, ("IN",)),
     _b("MOVE", 1, 1, _move, ("IN",)),
+    *[_b(n, 2, None, _compare) for n in ("LT", "LE", "GT", "GE", "EQ")],
+    _b("NE", 2, 2, _compare, ("IN1", "IN2")),
     _b("LEN", 1, 1, _len, ("IN",)),
     _b("LEFT", 2, 2, _string_fn("si"), ("IN", "L")),
     _b("RIGHT", 2, 2, _string_fn("si"), ("IN", "L")),

@@ -225,6 +225,9 @@ def conversion(src, dst, dialect: str = "sysmac"):
 
 # ---- builtin call generation -----------------------------------------------------------------------
 
+COMPARE_FUNCTIONS = {"LT": " < ", "LE": " <= ", "GT": " > ", "GE": " >= ", "EQ": " == ", "NE": " != "}
+
+
 def gen_builtin(gen, b) -> str:
     name = b.builtin.name.upper()
     args = [gen.expr(ba.expr) for ba in b.args]
@@ -292,6 +295,8 @@ def gen_builtin(gen, b) -> str:
         return fix(f"~({args[0]})")
     if name == "MOVE":
         return args[0]
+    if name in COMPARE_FUNCTIONS:            # Python's chained comparison: LT(a, b, c) = a < b AND b < c
+        return "(" + COMPARE_FUNCTIONS[name].join(f"({a})" for a in args) + ")"
     if name == "LEN":
         return f"len({args[0]})"
     cap = rt.capacity if isinstance(rt, T.StringType) else 1985

@@ -1,0 +1,49 @@
+"""Sysmac's ST where it differs from plain IEC 61131-3 (docs/toolchain/dialects.md), run on the virtual PLC with
+the values the manuals document."""
+from rt_helpers import plc_from, run1
+
+
+def test_comparison_functions_give_the_operators_results(tmp_path):
+    plc = run1(tmp_path, """a := LT(i, 5); b := LE(i, 3); c := GT(i, 3); d := GE(5, i, 3);
+        e := EQ(s, 'ab'); f := NE(r, 1.5); g := LT(1, i, 2);""",
+               "i : INT := 3; s : STRING[8] := 'ab'; r : REAL := 1.5; a, b, c, d, e, f, g : BOOL;")
+    assert [plc.read(f"Main.{v}") for v in "abcdefg"] == [True, True, False, True, True, False, False]
+
+
+def test_bool_compared_with_0_and_1_is_compared_with_false_and_true(tmp_path):
+    plc = run1(tmp_path, "a := On = 1; b := On <> 0; c := Off = 1; d := 0 = Off;",
+               "On : BOOL := TRUE; Off : BOOL; a, b, c, d : BOOL;")
+    assert [plc.read(f"Main.{v}") for v in "abcd"] == [True, True, False, True]
+
+
+def test_fb_called_positionally_with_outputs_fills_them_in_declaration_order(tmp_path):
+    """W502 2-116: TON_instance(In, PT, Q, ET);"""
+    plc = plc_from(tmp_path, "Timer1(Go, T#100ms, Up, Elapsed);",
+                   "Timer1 : TON; Go : BOOL := TRUE; Up : BOOL; Elapsed : TIME;")
+    plc.scan(0)
+    plc.scan(60_000_000)
+    assert plc.read("Main.Up") is False and plc.read("Main.Elapsed") == 60_000_000
+    plc.scan(100_000_000)
+    assert plc.read("Main.Up") is True and plc.read("Main.Elapsed") == 100_000_000
+
+
+def test_ctd_load_sets_cv_and_counting_stops_at_zero(tmp_path):
+    """W502 2-134: CTD_instance(CD, Load, PV, Q, CV); Load TRUE sets CV to PV and CD is ignored; after CV reaches 0
+    or less it does not change when CD changes to TRUE; Q is TRUE when CV is 0 or less."""
+    plc = plc_from(tmp_path, "Down(Pulse, Ld, 2, Q, CV);",
+                   "Down : CTD; Pulse, Ld, Q : BOOL; CV : INT;")
+    plc.write("Main.Ld", True)
+    plc.scan(0)
+    assert plc.read("Main.CV") == 2 and plc.read("Main.Q") is False
+    plc.write("Main.Ld", False)
+    values = []
+    for n in range(1, 9):
+        plc.write("Main.Pulse", n % 2 == 1)
+        plc.scan(n * 1_000_000)
+        values.append(plc.read("Main.CV"))
+    assert values == [1, 1, 0, 0, 0, 0, 0, 0] and plc.read("Main.Q") is True
+
+
+def test_ctd_accepts_the_iec_name_ld_for_load(tmp_path):
+    plc = run1(tmp_path, "Down(CD := FALSE, LD := TRUE, PV := 7);", "Down : CTD;")
+    assert plc.read("Main.Down.CV") == 7
