@@ -156,7 +156,8 @@ class _MoveFB(_ExecuteFB):
         self.Active = value
 
     def _ramps(self, need_velocity: bool, velocity_zero_ok: bool = False) -> int:
-        name = type(self).__name__
+        """W508 input ranges: Velocity positive (MC_MoveVelocity: or 0), Acceleration, Deceleration and Jerk
+        positive or 0."""
         v, a, d, j = self.Velocity, self.Acceleration, self.Deceleration, self.Jerk
         if need_velocity and not (math.isfinite(v) and (v > 0 or (velocity_zero_ok and v == 0))):
             return M.ERR_VELOCITY

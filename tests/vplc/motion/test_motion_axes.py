@@ -1,6 +1,7 @@
 """Virtual axes: software limits and axis errors (MC_Reset, MC_ReadAxisError), the axis configuration file and
 its errors, axes that are not configured, axis names, and tracing _MC_AX members. W507/W508 sections as named in
-each test (page numbers not readable in our manual corpus: docs/toolchain/runtime_sysmac.md section 5)."""
+each test (the English pages were not readable in our manual corpus; W508's Chinese edition pages are linked in
+docs/toolchain/runtime_sysmac.md section 5)."""
 import pytest
 
 from motion_rig import Rig, files
@@ -202,6 +203,6 @@ def test_the_errorid_table_of_the_docs_is_the_one_the_runtime_uses():
     import re
     doc = (pathlib.Path(__file__).resolve().parents[3] / "docs" / "toolchain" / "runtime_sysmac.md").read_text()
     section = doc[doc.index("## 5. Virtual servo axes"):]
-    listed = {int(m, 16) for m in re.findall(r"^\| 16#([0-9A-F]{4}) \|", section, re.M)}
+    listed = {int(m, 16) for m in re.findall(r"^\| 16#([0-9A-F]{4}) \|", section, re.MULTILINE)}
     assert listed == {v for k, v in vars(M).items() if k.startswith("ERR_")}
     assert f"16#{M.AXIS_SW_LIMIT_POS:04X} positive and 16#{M.AXIS_SW_LIMIT_NEG:04X} negative" in section

@@ -1,7 +1,8 @@
 """Single-axis motion instructions on a virtual axis: documented outputs scan by scan, profiles against the closed
-form, state transitions and refused transitions. Each test names the W508 instruction section (NJ/NX-series Motion
-Control Instructions Reference Manual) or the W507 axis-state chart it pins; the manual's page numbers were not
-readable in our manual corpus, see docs/toolchain/runtime_sysmac.md section 5."""
+form, state transitions and refused transitions. Each test names the W508 instruction (NJ/NX-series Motion Control
+Instructions Reference Manual) or the W507 axis-state chart it pins. The English pages were not readable in our
+manual corpus; the instruction pages of W508's Chinese edition were (links in docs/toolchain/runtime_sysmac.md
+section 5, "W508 (zh)"), so the citations name the instruction and its table (input ranges, output timing)."""
 import pytest
 
 from motion_rig import Rig, duration, files, s_curve, s_curve_duration, trapezoid
@@ -65,6 +66,7 @@ def test_short_move_is_a_triangle_below_the_velocity(rig):
         rig.scan()
         x, v = trapezoid(rig.t - t0, 1.0, 50.0, 1000.0, 500.0)
         assert rig.ax("Cmd.Pos") == pytest.approx(x, abs=1e-9)
+        assert rig.ax("Cmd.Vel") == pytest.approx(v, abs=1e-9)
         peak = max(peak, rig.ax("Cmd.Vel"))
     assert peak < 50.0 and peak == pytest.approx((1.0 / (1 / 2000 + 1 / 1000)) ** 0.5, rel=0.05)
 
