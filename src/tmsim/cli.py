@@ -8,6 +8,7 @@
                       [--data-timeout S] [--connection-timeout S]
                       [--svr-port PORT | --no-svr] [--svr-period S]
                       [--svr-format binary|string|json] [--svr-items A,B,...]
+                      [--svr-var NAME:TYPE[:ACCESS][=VALUE] ...]
 
 Also `python3 -m tmsim` and, from a checkout, `python3 sim/tmflow_listener.py` (the launcher kept for existing
 users). Every number is range-checked before anything starts; a bad one is one line on stderr, exit code 2.
@@ -26,7 +27,7 @@ from tmsim.control import robot_numbering
 from tmsim.profiles import STOP_TAGS, VERSIONS, Profile
 from tmsim.server import SimServer
 from tmsim.svr_session import DEFAULT_STREAM
-from tmsim.svr_table import ITEMS
+from tmsim.svr_table import ITEMS, SvrValueError, parse_variable
 
 SVR_FORMATS = {"binary": 1, "string": 2, "json": 3}
 
@@ -78,7 +79,28 @@ def build_parser() -> argparse.ArgumentParser:
     svr.add_argument("--svr-items", metavar="A,B,...", default=",".join(DEFAULT_STREAM),
                      help="items of the periodic data table, comma separated (default: the ROS driver's items "
                           "plus the status items; see docs/simulator.md)")
+    svr.add_argument("--svr-var", action="append", default=[], metavar="NAME:TYPE[:ACCESS][=VALUE]",
+                     help="a global variable of the robot's project, readable and writable through the Ethernet "
+                          "Slave (repeat for more): TYPE bool, byte, int, float or string, an array as int[4]; "
+                          "ACCESS rw (default), auto (written in auto mode only) or ro; VALUE as written in string "
+                          "mode, e.g. g_count:int=5, g_pos:float[3]={1,2,3}, g_name:string=\"abc\"")
     return parser
+
+
+def check_variables(args) -> tuple[list[str], list]:
+    """(one line per --svr-var that cannot be declared, the declared (Item, value) pairs)."""
+    problems, variables, seen = [], [], set()
+    for spec in args.svr_var:
+        try:
+            item, value = parse_variable(spec)
+        except SvrValueError as exc:
+            problems.append(f"--svr-var {spec[:60]}: {exc}")
+            continue
+        if item.name in seen:
+            problems.append(f"--svr-var {spec[:60]}: variable {item.name} is declared twice")
+        seen.add(item.name)
+        variables.append((item, value))
+    return problems, variables
 
 
 MAX_SPEEDUP = 1000.0
@@ -115,7 +137,8 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
     if not (math.isfinite(args.svr_period) and 0 <= args.svr_period <= 3600):
         problems.append(f"--svr-period must be 0 (off) .. 3600 s (got {args.svr_period:g})")
     svr_items = [name.strip() for name in args.svr_items.split(",") if name.strip()]
-    unknown = [name for name in svr_items if name not in ITEMS]
+    declared = {spec.partition(":")[0].strip() for spec in getattr(args, "svr_var", [])}
+    unknown = [name for name in svr_items if name not in ITEMS and name not in declared]
     if unknown:
         problems.append(f"--svr-items: unknown data table item(s): {', '.join(unknown)} (see docs/simulator.md)")
     return problems, svr_port, svr_items
@@ -142,6 +165,8 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     problems, svr_port, svr_items = check_args(args)
+    variable_problems, variables = check_variables(args)
+    problems += variable_problems
     if problems:
         for problem in problems:
             print(f"tmflow_listener: error: {problem}", file=sys.stderr)
@@ -157,7 +182,7 @@ def main(argv=None) -> int:
                            connection_timeout=args.connection_timeout if args.connection_timeout > 0 else None,
                            manage_gc=True, control_host=args.control_host, svr_port=svr_port,
                            svr_options=dict(period=args.svr_period, mode=SVR_FORMATS[args.svr_format],
-                                            items=svr_items))
+                                            items=svr_items, variables=variables))
         server.start()
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)

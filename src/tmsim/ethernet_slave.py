@@ -35,7 +35,7 @@ class _Conn:
 class EthernetSlave:
     """Ethernet Slave of every robot of ``server``; ``port`` 0 = ephemeral ports."""
 
-    def __init__(self, server, port=0, period=0.1, mode=1, items=DEFAULT_STREAM):
+    def __init__(self, server, port=0, period=0.1, mode=1, items=DEFAULT_STREAM, variables=()):
         self.server = server
         self.listeners = []
         self._next_conn = 1
@@ -44,7 +44,7 @@ class EthernetSlave:
         try:
             for robot in server.robots:
                 robot.svr_source = RobotDataSource(robot, robot._log)
-                robot.svr = SvrSession(robot.svr_source, robot._log, items, mode, period)
+                robot.svr = SvrSession(robot.svr_source, robot._log, items, mode, period, variables=variables)
                 robot.svr_conns = {}
                 self._listen(robot, port + robot.index if port else 0)
         except OSError:

@@ -12,7 +12,8 @@ Confirmation": mode, write permission, content vs mode, item exists, not read on
 and performed only when every item passes.
 
 ``source`` gives the values and performs writes (``sim.svr_source.RobotDataSource``): ``values(names)``
--> {name: value}, ``write({name: value})``, ``auto_mode``.
+-> {name: value}, ``write({name: value})``, ``auto_mode``. The global variables of the robot's project (§17.2
+"Global Variable") are items of the session itself: ``declare`` adds one, ``variables`` holds their values.
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from dataclasses import dataclass, field
 
 from . import codec
 from . import svr_table as table
-from .svr_table import ITEMS, SvrContentError, SvrValueError
+from .svr_table import ITEMS, Item, SvrContentError, SvrValueError
 
 HEADERS = frozenset({"TMSVR"})
 
@@ -59,9 +60,13 @@ class Client:
 
 class SvrSession:
     def __init__(self, source, log=None, stream_items=DEFAULT_STREAM, stream_mode=1, period=0.1,
-                 write_permission=True):
+                 write_permission=True, variables=()):
         self.source = source
         self.log = log or (lambda kind, **fields: None)
+        self.items: dict[str, Item] = dict(ITEMS)   # the predefined items and the declared global variables
+        self.variables: dict[str, object] = {}      # value of every declared global variable
+        for variable in variables:
+            self.declare(*((variable,) if isinstance(variable, Item) else variable))
         self.clients: dict[int, Client] = {}
         self.now = 0.0
         self.write_permission = write_permission   # §17.1 IP filter "Write Permission" of the clients
@@ -77,7 +82,7 @@ class SvrSession:
         items = list(self.stream_items if items is None else items)
         mode = self.stream_mode if mode is None else mode
         period = self.period if period is None else period
-        unknown = [name for name in items if name not in ITEMS]
+        unknown = [name for name in items if name not in self.items]
         if unknown:
             raise SvrConfigError(f"unknown data table item(s): {', '.join(unknown)}")
         if mode not in WRITE_MODES:
@@ -88,6 +93,19 @@ class SvrSession:
             items.remove("Robot_Link")
         self.stream_items = ["Robot_Link", *dict.fromkeys(items)]
         self.stream_mode, self.period = mode, period
+
+    def declare(self, item: Item, value=None):
+        """Add (or redeclare) a global variable of the robot's project (``svr_table.variable_item`` /
+        ``parse_variable``); ``value`` None = zeros / empty texts. SvrConfigError names what is wrong."""
+        if not isinstance(item, Item) or item.name in ITEMS:
+            raise SvrConfigError(f"not a global variable: {getattr(item, 'name', item)!r}")
+        try:
+            value = table.check_value(item, table.default_value(item) if value is None else value)
+        except SvrValueError as exc:
+            raise SvrConfigError(f"global variable {item.name}: {exc}") from None
+        self.items[item.name] = item
+        self.variables[item.name] = value
+        self.log("svr_variable", name=item.name, type=item.type, size=item.size, writable=item.writable)
 
     # ---- connections --------------------------------------------------------------------------
     def connect(self, conn: int, peer="127.0.0.1"):
@@ -134,8 +152,10 @@ class SvrSession:
             self._out(conn, frame)
 
     def _content(self, mode, names) -> bytes:
-        values = self.source.values(names)
-        pairs = [(ITEMS[name], values[name]) for name in names]
+        variables = self.variables
+        values = self.source.values([name for name in names if name not in variables]) if variables else \
+            self.source.values(names)
+        pairs = [(self.items[name], variables[name] if name in variables else values[name]) for name in names]
         kind = WRITE_MODES.get(mode) or READ_MODES[mode]
         if kind == "binary":
             return table.encode_binary(pairs)
@@ -193,7 +213,7 @@ class SvrSession:
             self._status(conn, ident, INVALID_DATA)
             return
         for name in names:
-            if name not in ITEMS:
+            if name not in self.items:
                 self._status(conn, ident, NOT_EXIST, name)
                 return
         self.log("svr_read", conn=conn, id=ident, mode=mode, items=names)
@@ -218,12 +238,12 @@ class SvrSession:
                   (MODE_ERROR, lambda item: item.writable == "A" and not self.source.auto_mode))
         for code, failed in checks:
             for name, _ in pairs:
-                if failed(ITEMS.get(name)):
+                if failed(self.items.get(name)):
                     self._status(conn, ident, code, name)
                     return
         values = {}
         for name, raw in pairs:
-            item = ITEMS[name]
+            item = self.items[name]
             try:
                 if kind == "binary":
                     value = table.decode_binary_value(item, raw)
@@ -238,4 +258,7 @@ class SvrSession:
                 return
         self.log("svr_write", conn=conn, id=ident, mode=mode, items=values)
         self._status(conn, ident, OK)
-        self.source.write(values)
+        for name in [name for name in values if name in self.variables]:
+            self.variables[name] = values.pop(name)
+        if values:
+            self.source.write(values)

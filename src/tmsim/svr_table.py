@@ -136,10 +136,22 @@ def _scalar(item, value):
 
 
 # ---- binary (mode 1 / 11) --------------------------------------------------------------------------
+def _packer(item: Item):
+    """(length-prefixed name, value packer) of an item: precomputed for the table, built for a declared variable."""
+    known = _PACKERS.get(item.name)
+    if known is not None and ITEMS.get(item.name) is item:
+        return known
+    name = item.name.encode("utf-8")
+    return (_U16.pack(len(name)) + name,
+            None if item.type == "string" else struct.Struct("<%d%s" % (item.size, _PACK[item.type])))
+
+
 def binary_value(item: Item, value) -> bytes:
     if item.type == "string":
+        if item.size > 1:                      # §17.4.2: "two bytes, 0x00 0x00, are inserted between the elements"
+            return b"\x00\x00".join(v.encode("utf-8") for v in value)
         return value.encode("utf-8")
-    packer = _PACKERS[item.name][1]
+    packer = _packer(item)[1]
     if item.size > 1:
         return packer.pack(*value)
     return packer.pack(value)
@@ -150,7 +162,7 @@ def encode_binary(pairs) -> bytes:
     out = []
     for item, value in pairs:
         data = binary_value(item, value)
-        out.append(_PACKERS[item.name][0])
+        out.append(_packer(item)[0])
         out.append(_U16.pack(len(data)))
         out.append(data)
     return b"".join(out)
@@ -187,6 +199,8 @@ def _chunk(content, pos):
 def decode_binary_value(item: Item, data: bytes):
     if item.type == "string":
         try:
+            if item.size > 1:
+                return [part.decode("utf-8") for part in data.split(b"\x00\x00")]
             return data.decode("utf-8")
         except UnicodeDecodeError:
             raise SvrValueError(f"{item.name} is not UTF-8 text") from None
@@ -317,3 +331,54 @@ def split_json(content: str, with_values: bool) -> list[tuple[str, object]]:
             raise SvrContentError(f'item {entry["Item"]!r} has no "Value"')
         out.append((entry["Item"], entry.get("Value") if with_values else None))
     return out
+
+
+# ---- global variables of the robot's project (TMscript 2.24 §17.2 "Global Variable") ---------------------
+# "the external communication devices can read / write global variables with the communication protocol"; like
+# user-defined items they must be in the communication file to be read or written (§17.4), so the simulator
+# knows only the variables declared to it (start-up option --svr-var, SvrSession.declare). TMflow names them
+# g_<name> (the manual's example item g_ss, string[]); the simulator does not insist on the prefix.
+VARIABLE_TYPES = ("bool", "byte", "int", "float", "string")
+VARIABLE_SIZE_MAX = 1024                 # elements of an array variable (our limit, the manual gives none)
+VARIABLE_ACCESS = {"rw": "MA", "auto": "A", "ro": ""}   # write in manual and auto mode / auto only / read only
+
+
+def variable_item(name: str, kind: str, size: int = 1, access: str = "rw") -> Item:
+    """The Item of a global variable; SvrValueError names what is wrong."""
+    if not (isinstance(name, str) and 0 < len(name) <= 64 and name.isascii()
+            and (name[0].isalpha() or name[0] == "_") and all(c.isalnum() or c == "_" for c in name)):
+        raise SvrValueError(f"variable name {str(name)[:70]!r}: 1..64 letters, digits or '_', not starting with a digit")
+    if name in ITEMS:
+        raise SvrValueError(f"variable name {name!r} is a predefined item of the data table")
+    if kind not in VARIABLE_TYPES:
+        raise SvrValueError(f"variable {name}: type {str(kind)[:20]!r} is not one of {', '.join(VARIABLE_TYPES)}")
+    if isinstance(size, bool) or not isinstance(size, int) or not 1 <= size <= VARIABLE_SIZE_MAX:
+        raise SvrValueError(f"variable {name}: array size must be 1..{VARIABLE_SIZE_MAX}, got {size!r}")
+    if access not in VARIABLE_ACCESS:
+        raise SvrValueError(f"variable {name}: access {str(access)[:20]!r} is not one of {', '.join(VARIABLE_ACCESS)}")
+    return Item(name, kind, size, VARIABLE_ACCESS[access])
+
+
+def default_value(item: Item):
+    zero = "" if item.type == "string" else 0.0 if item.type == "float" else 0
+    return [zero] * item.size if item.size > 1 else zero
+
+
+def parse_variable(spec: str) -> tuple[Item, object]:
+    """``NAME:TYPE[:ACCESS][=VALUE]`` (TYPE ``int``, ``float[6]`` ...; ACCESS rw, auto or ro; VALUE as in a mode 2
+    write: ``5``, ``{1,2,3}``, ``"text"``) -> (Item, value); SvrValueError names what is wrong."""
+    head, eq, text = spec.partition("=")
+    parts = head.split(":")
+    if len(parts) not in (2, 3):
+        raise SvrValueError(f"variable {spec[:60]!r}: expected NAME:TYPE[:ACCESS][=VALUE]")
+    name, kind = parts[0].strip(), parts[1].strip()
+    size = 1
+    if kind.endswith("]") and "[" in kind:
+        kind, _, count = kind[:-1].partition("[")
+        if not count.isdigit():
+            raise SvrValueError(f"variable {name}: array size {count[:10]!r} is not a number")
+        size = int(count)
+    item = variable_item(name, kind, size, parts[2].strip() if len(parts) == 3 else "rw")
+    value = check_value(item, parse_string_value(item, text.strip())) if eq else default_value(item)
+    return item, value
+
