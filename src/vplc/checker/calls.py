@@ -184,7 +184,8 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
     have = ck.expr(value, None if isinstance(pty, T.ArrayType) or is_generic(pty) else p.type)
     if isinstance(pty, T.ArrayType) and isinstance(value, A.Index) and not isinstance(T.unalias(have), T.ArrayType) \
             and not T.is_error(have):
-        if _compatible(have, pty.element) and T.same_type(T.base_of(have), T.base_of(pty.element)):
+        if (is_generic(pty.element) and pty.element.accepts(have)) or (
+                _compatible(have, pty.element) and T.same_type(T.base_of(have), T.base_of(pty.element))):
             ba.from_element = True
             array_bounds.check_slice(ck, value, pty, p.name)
             if p.direction == "inout":
@@ -220,6 +221,8 @@ def _inout_compatible(have: T.Type, want: T.Type) -> bool:
     if isinstance(h, T.StringType) and isinstance(w, T.StringType):
         return h.wide == w.wide
     if isinstance(h, T.ArrayType) and isinstance(w, T.ArrayType):
+        if is_generic(w.element):       # ARRAY[*] OF ANY: Sysmac's array instructions (W502 AryMove, SizeOfAry)
+            return w.open and w.element.accepts(h.element)
         return _compatible(h, w) and T.same_type(T.base_of(h.element), T.base_of(w.element))
     return T.same_type(h, w)
 

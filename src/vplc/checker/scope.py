@@ -34,6 +34,8 @@ _generic("ANY_REAL", T.is_real)
 _generic("ANY_BIT", T.is_bits)
 _generic("ANY_STRING", T.is_string)
 _generic("ANY_DATE", T.is_date_like)
+# EnumToNum's In: a value of any enumeration (W502, Data Type Conversion Instructions)
+_generic("ANY_ENUM", lambda t: isinstance(T.base_of(t), T.EnumType), "an enumeration")
 
 
 def is_generic(t: T.Type) -> bool:

@@ -1,4 +1,5 @@
-"""ST1001 / ST1003 / ST1004 — a name or type that is not declared, or is ambiguous between namespaces.
+"""ST1001 / ST1003 / ST1004 / ST1007 — a name or type that is not declared, is ambiguous between namespaces, or
+is a real Omron Sysmac name vplc does not model.
 
 Passing::
 
@@ -9,10 +10,14 @@ Failing::
 
     Cuont := Count + 1;        (* ST1001: `Cuont` is not declared; did you mean `Count`? *)
     x : stUnknown;             (* ST1004: unknown data type *)
+    Tune(Run := Go);           (* with Tune : PIDAT;  ST1007: Sysmac instruction `PIDAT` (W502, Control
+                                  Instructions) is not modelled by vplc *)
 """
 from __future__ import annotations
 
 import difflib
+
+from ..frontend import sysmac_names
 
 
 def _suggest(name: str, candidates) -> list[str]:
@@ -25,11 +30,27 @@ def _suggest(name: str, candidates) -> list[str]:
 
 
 def report(ctx, name: str, span, candidates=()) -> None:
+    if _not_modelled(ctx, name, span):
+        return
     ctx.diags.error("ST1001", f"`{name}` is not declared; declare it in a VAR section or check the spelling",
                     span, _suggest(name, candidates))
 
 
+def _not_modelled(ctx, name: str, span) -> bool:
+    """ST1007: a real Omron name (frontend/sysmac_names.py) that vplc does not model, in the Sysmac dialect."""
+    if ctx.dialect != "sysmac":
+        return False
+    text = sysmac_names.describe(name)
+    if text is None:
+        return False
+    ctx.diags.error("ST1007", text, span, ["write the POU without it, or model it in vplc's prelude "
+                                           "(src/vplc/prelude) and runtime"])
+    return True
+
+
 def report_type(ctx, name: str, span) -> None:
+    if _not_modelled(ctx, name, span):
+        return
     known = [k[1] for k in ctx.tables.types.entries] + [k[1] for k in ctx.tables.pous.entries]
     notes = _suggest(name.rsplit("\\", 1)[-1], known)
     if "\\" in name:

@@ -75,6 +75,7 @@ class Engine:
         self.now_cell = module.namespace["_NOW"]          # what VPLC_ScanTime() returns in generated code
         self.system_vars = None           # (globals dict, first-run attrs, [(attr, period ns)]): see bind_system_vars
         self.system_vars_next = 0         # scan time at which a clock pulse changes next
+        self.current_time = None          # (globals dict, attr) of _CurrentTime, set before every task execution
         self.instruction_errors: collections.deque[str] = collections.deque(maxlen=100)   # the latest, located
         self.instruction_error_count = 0
 
@@ -111,6 +112,8 @@ class Engine:
                                                          ("P_1MIN", 60_000_000_000)) if n in info]
         if first or clocks:
             self.system_vars = (globals_obj.__dict__, first, clocks)
+        if "_CURRENTTIME" in info:
+            self.current_time = (globals_obj.__dict__, info["_CURRENTTIME"][0])
 
     def update_system_vars(self, task: Task, now_ns: int) -> None:
         """First-run flags for the task's first cycle; clock pulses (half period on, half off). The next call is
@@ -169,6 +172,9 @@ class Engine:
                     continue
                 if self.system_vars is not None and (task.cycles < 2 or now_ns >= self.system_vars_next):
                     self.update_system_vars(task, now_ns)
+                self.current_task = task          # GetMyTaskInterval (W502) reads the period of the running task
+                if self.current_time is not None:  # _CurrentTime (W501 system-defined variables): the clock
+                    self.current_time[0][self.current_time[1]] = self.clock_dt_ns()
                 for inst, body in task.programs:
                     body(inst)
                 task.cycles += 1

@@ -4,6 +4,7 @@ Choices where the documentation available to us is silent are listed in docs/too
 """
 from __future__ import annotations
 
+import math
 import struct
 
 from ..frontend import types as T
@@ -195,6 +196,104 @@ def VPLC_ScanTime(rt) -> int:
     return rt.now_ns
 
 
+def SecToTime(rt, In) -> int:
+    return In * _NS
+
+
+def TimeToSec(rt, In) -> int:
+    return int(In / _NS)                         # toward zero: the fraction of a second is cut off
+
+
+def CopyDwordToReal(rt, In) -> float:
+    return struct.unpack("<f", struct.pack("<I", In & 0xFFFF_FFFF))[0]
+
+
+def CopyRealToDword(rt, In) -> int:
+    return struct.unpack("<I", struct.pack("<f", In))[0]
+
+
+def CopyLwordToLreal(rt, In) -> float:
+    return struct.unpack("<d", struct.pack("<Q", In & 0xFFFF_FFFF_FFFF_FFFF))[0]
+
+
+def CopyLrealToLword(rt, In) -> int:
+    return struct.unpack("<Q", struct.pack("<d", In))[0]
+
+
+def EnumToNum(rt, In, In_t) -> int:
+    return int(In)                               # an enumeration value is held as its number
+
+
+def ModReal(rt, In1, In2) -> float:
+    if In2 == 0:
+        rt.instruction_error("ModReal: In2 is 0; Out is 0")
+        return 0.0
+    return math.fmod(In1, In2)                   # the sign of In1, as the division's remainder
+
+
+def _step(ref, t, delta: int) -> bool:
+    container, key = ref
+    b = _elementary(t)
+    value = container[key] + delta
+    if b.kind != "real":
+        bits = b.bits
+        value &= (1 << bits) - 1
+        if b.kind == "int" and value >= 1 << (bits - 1):
+            value -= 1 << bits
+    container[key] = value
+    return True
+
+
+def Inc(rt, InOut, InOut_t) -> bool:
+    return _step(InOut, InOut_t, 1)
+
+
+def Dec(rt, InOut, InOut_t) -> bool:
+    return _step(InOut, InOut_t, -1)
+
+
+def AryMove(rt, In, AryOut, Size) -> bool:
+    """Size elements from In to AryOut; a structure element is copied into the existing one (other references to
+    it see the new value)."""
+    if Size > len(In) or Size > len(AryOut):
+        rt.instruction_error(f"AryMove: Size {Size} exceeds the {min(len(In), len(AryOut))} elements the arrays "
+                             "hold from the elements given; nothing is copied")
+        return False
+    values = [In[i] for i in range(Size)]
+    for i, v in enumerate(values):
+        if type(v) in (int, float, bool, str):
+            AryOut[i] = v
+        else:
+            iec.assign_into(AryOut[i], iec.copy_value(v))
+    return True
+
+
+def SizeOfAry(rt, In) -> int:
+    return len(In)
+
+
+def ClearString(rt, InOut) -> bool:
+    container, key = InOut
+    container[key] = ""
+    return True
+
+
+def GetMyTaskInterval(rt) -> int:
+    task = getattr(rt, "current_task", None)
+    return task.period_ns if task is not None else rt.period_ns
+
+
+def Get1sClk(rt) -> bool:
+    return rt.now_ns % 1_000_000_000 < 500_000_000
+
+
+def Get100msClk(rt) -> bool:
+    return rt.now_ns % 100_000_000 < 50_000_000
+
+
 FUNCTIONS = {f.__name__: f for f in (ToAryByte, AryByteTo, StringToAry, AryToString, RealToFormatString,
                                      LrealToFormatString, GetTime, SecToDt, DtToSec, NanoSecToTime,
-                                     TimeToNanoSec, VPLC_ScanTime)}
+                                     TimeToNanoSec, VPLC_ScanTime, SecToTime, TimeToSec, CopyDwordToReal,
+                                     CopyRealToDword, CopyLwordToLreal, CopyLrealToLword, EnumToNum, ModReal,
+                                     Inc, Dec, AryMove, SizeOfAry, ClearString, GetMyTaskInterval, Get1sClk,
+                                     Get100msClk)}

@@ -1,0 +1,45 @@
+"""ST1007: a real Omron name vplc does not model is reported as such, never as an undeclared name."""
+import pathlib
+import re
+
+from fe_helpers import check_text, codes, program
+from vplc.frontend.sysmac_names import SYSMAC_NAMES
+from vplc.project import PRELUDE_DIR
+
+
+def test_unmodelled_instruction_type_and_function_are_st1007_with_the_manual(tmp_path):
+    proj = check_text(tmp_path, program("x := CheckReal(1.0); SetAlarm(Code := 1); Tune(); e := _PLC_ErrSta;",
+                                        "Tune : PIDAT; x : BOOL; e : WORD;"))
+    errors = [d for d in proj.diagnostics if d.severity == "error"]
+    assert [d.code for d in errors] == ["ST1007"] * 4
+    assert "Sysmac instruction `PIDAT` (W502, Control Instructions) is not modelled by vplc" in errors[0].message
+
+
+def test_a_misspelt_name_is_still_st1001(tmp_path):
+    assert codes(check_text(tmp_path, program("Cuont := 1;", "Count : INT;")), "error") == ["ST1001"]
+
+
+def test_a_users_own_pou_with_an_omron_name_is_used(tmp_path):
+    proj = check_text(tmp_path, program("x := CheckReal(1.0);", "x : BOOL;")
+                      + "FUNCTION CheckReal : BOOL\nVAR_INPUT In : REAL; END_VAR\nCheckReal := TRUE;\nEND_FUNCTION\n")
+    assert codes(proj, "error") == []
+
+
+def test_iec_dialect_reports_them_as_undeclared(tmp_path):
+    proj = check_text(tmp_path, program("x := CheckReal(1.0);", "x : BOOL;"), dialect="iec")
+    assert codes(proj, "error") == ["ST1001"]
+
+
+def test_names_of_the_table_that_the_prelude_declares_are_used_not_reported():
+    """The motion prelude declares MC_Power and _sAXIS_REF's axis table: the table is only consulted for names
+    nothing declares."""
+    declared = set()
+    for f in pathlib.Path(PRELUDE_DIR).glob("*.st"):
+        declared |= {m.upper() for m in re.findall(r"^\s*(?:FUNCTION_BLOCK|FUNCTION)\s+(\w+)", f.read_text(), re.M)}
+    both = sorted(set(SYSMAC_NAMES) & declared)
+    assert "MC_POWER" in both
+
+
+def test_a_declared_motion_instruction_checks(tmp_path):
+    proj = check_text(tmp_path, program("Pwr(Axis := _MC_AX[0], Enable := TRUE);", "Pwr : MC_Power;"))
+    assert "ST1007" not in codes(proj)
