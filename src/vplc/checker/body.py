@@ -44,7 +44,10 @@ class BodyChecker(ExprChecker):
                         if not T.same_type(g.type, sym.type) and not T.is_error(g.type):
                             self.ctx.diags.error("ST1101", f"VAR_EXTERNAL `{decl.name}` is declared {sym.type.name} "
                                                  f"but the global is {g.type.name}", decl.name_span)
-                if section.constant and decl.init is None and section.kind != "VAR_EXTERNAL":
+                # a CONSTANT input or in-out is a parameter the POU only reads: its value comes from the caller
+                # (W501, variable attributes: Constant for input and in-out variables)
+                if section.constant and decl.init is None and section.kind not in ("VAR_EXTERNAL", "VAR_INPUT",
+                                                                                   "VAR_IN_OUT"):
                     self.ctx.diags.error("ST1301", f"CONSTANT `{decl.name}` needs an initial value", decl.name_span)
                 if decl.init is not None:
                     self.initial_value(decl.init, sym.type, f"initial value of {decl.name}")

@@ -15,6 +15,18 @@ from .symbols import VarSymbol
 PARAM_DIRECTION = {"VAR_INPUT": "in", "VAR_OUTPUT": "out", "VAR_IN_OUT": "inout"}
 
 
+class NamespaceView:
+    """The items of one NAMESPACE block of a file, seen as a compilation unit of that namespace (names are looked
+    up from it as from a library folder's file)."""
+
+    def __init__(self, unit: A.CompilationUnit, namespace: str) -> None:
+        self.unit = unit
+        self.namespace = namespace
+
+    def __getattr__(self, name):
+        return getattr(self.unit, name)
+
+
 class Declarer:
     def __init__(self, ctx) -> None:
         self.ctx = ctx
@@ -23,8 +35,17 @@ class Declarer:
 
     # ---- pass 1: names --------------------------------------------------------------------------
     def register(self, unit: A.CompilationUnit) -> None:
-        ns = unit.namespace
-        for item in unit.items:
+        file_unit = unit
+        views: dict[str, NamespaceView] = {}
+        for item in file_unit.items:
+            inner = getattr(item, "declared_namespace", None)
+            if inner:
+                # an item of a NAMESPACE block: its namespace is nested in the file's (a library folder's)
+                full = f"{file_unit.namespace}\\{inner}" if file_unit.namespace else inner
+                unit = views.get(full) or views.setdefault(full, NamespaceView(file_unit, full))
+            else:
+                unit = file_unit
+            ns = unit.namespace
             if isinstance(item, A.TypeBlock):
                 for decl in item.decls:
                     decl.namespace = ns

@@ -68,10 +68,15 @@ class NamedTable:
         up = name.upper()
         if namespace:
             return self.entries.get(("\\".join(namespace).upper(), up))
-        if from_ns:
-            hit = self.entries.get((from_ns.upper(), up))
-            if hit is not None:
-                return hit
+        if from_ns:                     # the namespace itself, then the namespaces it is nested in
+            ns = from_ns.upper()
+            while True:
+                hit = self.entries.get((ns, up))
+                if hit is not None:
+                    return hit
+                if "\\" not in ns:
+                    break
+                ns = ns.rsplit("\\", 1)[0]
         hit = self.entries.get(("", up))
         if hit is not None:
             return hit

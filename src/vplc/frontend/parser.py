@@ -20,38 +20,69 @@ POU_END = {"FUNCTION": "END_FUNCTION", "FUNCTION_BLOCK": "END_FUNCTION_BLOCK", "
 
 
 class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
-    # grammar: unit := { type_block | pou | global_var_list | configuration }
+    # grammar: unit := { type_block | pou | global_var_list | configuration | namespace_block }
+    # grammar: namespace_block := NAMESPACE ident { '\' ident } { type_block | pou | namespace_block } END_NAMESPACE
     def unit(self) -> A.CompilationUnit:
         items: list[A.Item] = []
         globals_sections: list[A.VarSection] = []
         gstart = None
+        spaces: list[str] = []          # the NAMESPACE blocks open here, outermost first
         while self.tok.kind != "EOF":
             t = self.tok
             start_i = self.i
             try:
                 if t.kind == "IDENT" and t.up == "VAR_GLOBAL":
+                    if spaces:
+                        self.fail("global variables belong to no namespace; declare VAR_GLOBAL outside NAMESPACE",
+                                  "ST0206")
                     gstart = t.start if gstart is None else gstart
                     globals_sections.append(self.var_section())
+                    continue
+                if t.kind == "IDENT" and t.up == "NAMESPACE":
+                    spaces.append(self.namespace_name())
+                    continue
+                if t.kind == "IDENT" and t.up == "END_NAMESPACE":
+                    self.advance()
+                    self.accept_op(";")
+                    if not spaces:
+                        self.diags.error("ST0206", "`END_NAMESPACE` without NAMESPACE", self.tok_span(t))
+                    else:
+                        spaces.pop()
                     continue
                 if t.kind == "IDENT" and t.up in POU_END:
                     items.append(self.pou())
                 elif t.kind == "IDENT" and t.up == "TYPE":
                     items.append(self.type_block())
                 elif t.kind == "IDENT" and t.up == "CONFIGURATION":
+                    if spaces:
+                        self.fail("a CONFIGURATION belongs to no namespace; declare it outside NAMESPACE", "ST0206")
                     items.append(self.configuration())
                 else:
                     self.fail(f"expected FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE, VAR_GLOBAL or CONFIGURATION, "
                               f"found {self.describe(t)}", "ST0206")
+                if spaces:
+                    items[-1].declared_namespace = "\\".join(spaces)
             except (ParseError, DepthExceeded):
                 self.depth = 0
                 if self.i == start_i:
                     self.advance()
                 self.sync_item()
+        if spaces:
+            self.diags.error("ST0202", f"missing `END_NAMESPACE` of `{spaces[-1]}`", self.tok_span())
         if globals_sections:
             stem = self.src.path.replace("\\", "/").rsplit("/", 1)[-1].rsplit(".", 1)[0]
             items.append(A.GlobalVarList(globals_sections, stem, span=Span(self.src, gstart, self.tok.start)))
         self.report_pragmas()
         return A.CompilationUnit(items, span=Span(self.src, 0, len(self.src.text)))
+
+    def namespace_name(self) -> str:
+        """NAMESPACE A or NAMESPACE A\\B (IEC 61131-3 3rd edition; Sysmac's namespaces, W501): the name of a
+        namespace nested in the enclosing one."""
+        self.advance()
+        parts = [self.ident("a namespace name").text]
+        while self.accept_op("\\") or self.accept_op("\\\\"):
+            parts.append(self.ident("a namespace name").text)
+        return "\\".join(parts)
 
     def report_pragmas(self) -> None:
         for p in self.pragmas:

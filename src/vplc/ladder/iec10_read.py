@@ -81,8 +81,7 @@ def _namespace(container: ET.Element, ns: str | None, units: dict) -> None:
         if item.tag == "NamespaceDecl":
             inner = item.get("name") or None
             if ns is not None and inner is not None:
-                raise FormatError(f"namespace {ns}\\{inner}", "nested namespaces are not modelled by vplc; "
-                                  "declare the objects in one namespace")
+                inner = f"{ns}\\{inner}"      # a nested namespace (Sysmac: Namespace1\Namespace1): its full name
             _namespace(item, inner, units)
         elif item.tag in ("DataTypeDecl", "UserDefinedTypeDecl"):
             unit.types.append(_data_type(item))

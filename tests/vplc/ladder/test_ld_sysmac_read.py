@@ -197,11 +197,20 @@ def test_unknown_sysmac_extension_element_is_an_error_naming_it(tmp_path):
     assert diagnostics(write(tmp_path, doc(other), "other.xml")) == [], "another vendor's data is discarded"
 
 
-def test_nested_namespaces_are_refused(tmp_path):
+def test_nested_namespaces_are_read_with_their_full_name(tmp_path):
+    """Sysmac nests namespaces (Omron's sample: Namespace1\\Namespace1); a type of the inner one is Outer\\Inner\\eX."""
     t = ('<NamespaceDecl name="Outer"><NamespaceDecl name="Inner"><DataTypeDecl name="eX">'
          '<UserDefinedTypeSpec xsi:type="EnumTypeWithNamedValueSpec"><Enumerator name="A" value="0"/>'
+         '<Enumerator name="B" value="7"/>'
          '<BaseType>DINT</BaseType></UserDefinedTypeSpec></DataTypeDecl></NamespaceDecl></NamespaceDecl>')
-    refused(write(tmp_path, doc(t)), "Outer", "Inner", "nested namespaces")
+    st = tmp_path / "use.st"
+    st.write_text("PROGRAM Main\nVAR x : Outer\\Inner\\eX := Outer\\Inner\\eX#B; n : DINT; END_VAR\n"
+                  "n := EnumToNum(x);\nEND_PROGRAM\n")
+    xml = write(tmp_path, doc(t))
+    assert diagnostics(xml, st) == []
+    plc = load_plc([str(xml), str(st)], task="Main@1ms")
+    plc.scan(0)
+    assert plc.read("Main.n") == 7
 
 
 def test_enumeration_base_type_is_the_schemas_text_and_dint(tmp_path):

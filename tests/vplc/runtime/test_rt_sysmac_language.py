@@ -47,3 +47,49 @@ def test_ctd_load_sets_cv_and_counting_stops_at_zero(tmp_path):
 def test_ctd_accepts_the_iec_name_ld_for_load(tmp_path):
     plc = run1(tmp_path, "Down(CD := FALSE, LD := TRUE, PV := 7);", "Down : CTD;")
     assert plc.read("Main.Down.CV") == 7
+
+
+NAMESPACED = """NAMESPACE nsAxisControl
+TYPE
+    eCurveType : (Linear, SCurve);
+END_TYPE
+NAMESPACE Profiles
+FUNCTION_BLOCK Ramp
+VAR_INPUT Curve : eCurveType; END_VAR
+VAR_OUTPUT IsS : BOOL; END_VAR
+    IsS := Curve = SCurve;
+END_FUNCTION_BLOCK
+END_NAMESPACE
+END_NAMESPACE
+"""
+
+
+def test_namespaces_of_any_name_nest_and_resolve_as_sysmac_does(tmp_path):
+    """nsAxisControl\\eCurveType; a name is looked up in its own namespace, then in the enclosing ones."""
+    plc = run1(tmp_path, "r(Curve := c, IsS => q);",
+               "c : nsAxisControl\\eCurveType := nsAxisControl\\eCurveType#SCurve; r : nsAxisControl\\Profiles\\Ramp; "
+               "q : BOOL;", NAMESPACED)
+    assert plc.read("Main.q") is True
+
+
+def test_a_name_of_a_namespace_is_not_visible_unqualified_when_two_namespaces_have_it(tmp_path):
+    from vplc.project import load_project
+    (tmp_path / "t.st").write_text(NAMESPACED + NAMESPACED.replace("nsAxisControl", "nsOther")
+                                   + "PROGRAM Main\nVAR r : Ramp; END_VAR\nr();\nEND_PROGRAM\n")
+    assert [d.code for d in load_project([str(tmp_path / "t.st")]).diagnostics if d.severity == "error"] == ["ST1003"]
+
+
+def test_constant_inputs_and_in_outs_need_no_initial_value_and_stay_read_only(tmp_path):
+    """W501: CONSTANT on an input or in-out means the POU only reads it; the caller gives the value."""
+    fb = """FUNCTION_BLOCK Over
+VAR_INPUT CONSTANT Limit : INT; END_VAR
+VAR_IN_OUT CONSTANT Buf : ARRAY[0..3] OF BYTE; END_VAR
+VAR_OUTPUT Q : BOOL; END_VAR
+    Q := BYTE_TO_INT(Buf[0]) > Limit;
+END_FUNCTION_BLOCK
+"""
+    plc = run1(tmp_path, "f(Limit := 3, Buf := b);", "f : Over; b : ARRAY[0..3] OF BYTE := [5, 0, 0, 0];", fb)
+    assert plc.read("Main.f.Q") is True
+    from vplc.project import load_project
+    (tmp_path / "w.st").write_text(fb.replace("    Q := ", "    Limit := 1;\n    Q := "))
+    assert [d.code for d in load_project([str(tmp_path / "w.st")]).diagnostics if d.severity == "error"] == ["ST1301"]
