@@ -15,6 +15,8 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "operation_mode", "robot": 0, "mode": "manual"}
     {"cmd": "svr_config", "robot": 0, "period": 0.1, "mode": 1, "items": [...], "write_permission": true}
     {"cmd": "svr_inject", "robot": 0, "fault": "stall", "params": {"enabled": true}}   / "svr_clear_faults"
+Any request may carry "plc_time": the client's controller time in seconds, logged as event ``control`` (with
+``cmd``) next to the robot clock's ``t``.
 
 Every field is checked (type, range, finite numbers, nesting, line length: sim/limits.py); a bad
 request gets ``ok: false`` with the reason and the connection stays usable, except after a line
@@ -38,7 +40,8 @@ from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MA
 from .listener import Listener, receive
 from .session import TransitionError
 
-_FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission"}
+_FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission",
+           "plc_time"}
 _BRACKETS = re.compile(rb'"(?:[^"\\]|\\.)*"|[\[\]{}]')
 
 
@@ -282,7 +285,10 @@ class ControlChannel:
             index = _int_field(request, "robot", 0, 0, count - 1,
                                f"robot {{}} does not exist: this simulator has {count} "
                                f"robot{'s' if count > 1 else ''}; {robot_numbering(count)} of the start-up lines")
-            result = command(self.server.robots[index], request)
+            robot = self.server.robots[index]
+            if "plc_time" in request:
+                robot._log("control", cmd=name, plc_time=_plc_time(request))
+            result = command(robot, request)
             return _Streamed(ok=True, result=result) if type(result) is _Streamed else {"ok": True, "result": result}
         except (ValueError, TypeError, TransitionError) as exc:
             return _error(str(exc))
@@ -359,6 +365,15 @@ def _decode(line: bytes) -> dict:
     if unknown:
         raise RequestError(f"unknown field {unknown[0]!r}; known: {', '.join(sorted(_FIELDS))}")
     return request
+
+
+def _plc_time(request) -> float:
+    """The controller's time (s) a client such as ``vplc run --scenario`` sends with its request, logged next to
+    the robot clock's ``t`` so that both logs line up."""
+    value = request["plc_time"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e9:
+        raise RequestError(f"'plc_time' must be the controller time in seconds (0 .. 1e9), got {_show(value)}")
+    return value
 
 
 def _small_int(text):

@@ -1,6 +1,6 @@
 """``python3 -m vplc run PATHS... [--task Main@1ms] [--virtual-time] [--cycles N | --duration T] [--stats]
 [--watch VAR,...] [--set VAR=VALUE@TIME]... [--scenario FILE] [--trace VAR,... --trace-out FILE.vcd|FILE.svg
-[--trace-window FROM..TO]] [--max-overruns N]``: run ST programs on the virtual controller.
+[--trace-window FROM..TO]] [--max-overruns N] [--sim-control HOST:PORT]``: run ST programs on the virtual controller.
 
 Real time (default) scans at the task period on the wall clock until Ctrl-C, SIGTERM, --cycles, --duration or the
 end of the scenario, and reports its overruns in the last line; --virtual-time scans as fast as possible with the
@@ -17,8 +17,9 @@ import sys
 import threading
 import time
 
-from . import scenario as scn
 from ..runtime.values import parse_duration
+from . import scenario as scn
+from . import simlink
 
 
 def register(subparsers) -> None:
@@ -45,6 +46,9 @@ def register(subparsers) -> None:
     p.add_argument("--scenario", metavar="FILE",
                    help="timed writes and expectations (`at 2s set Main.Start TRUE`, `expect Main.Placed = 24 "
                         "within 60s`); the run ends when every expectation is decided")
+    p.add_argument("--sim-control", metavar="HOST:PORT",
+                   help="the robot simulator's control channel, for the scenario's `robot N ...` lines "
+                        "(e.g. 127.0.0.1:5889)")
     p.add_argument("--trace", metavar="VAR,...", help="variables to record every scan")
     p.add_argument("--trace-out", metavar="FILE", help="trace file: .vcd (GTKWave) or .svg (timing diagram)")
     p.add_argument("--trace-window", metavar="FROM..TO",
@@ -70,10 +74,6 @@ MAX_SPIN_US = 10_000
 
 
 def run_cmd(args) -> int:
-    from ..api import LoadError, PlcFault, load_plc, parse_task
-    from ..runtime.stats import OverrunCount, ScanStats
-    from ..runtime.values import PathError
-    from ..trace import Recorder, write_trace
     if bool(args.trace) != bool(args.trace_out):
         return _err("--trace and --trace-out go together")
     for option, text in (("--trace", args.trace), ("--watch", args.watch)):
@@ -114,6 +114,31 @@ def run_cmd(args) -> int:
             scn.add_set_option(text, scenario)
     except scn.ScenarioError as exc:
         return _err(str(exc))
+    link = None
+    if scenario.robots and not args.sim_control:
+        return _err(f"{scenario.robots[0].where}: `robot` lines act on the simulator: give its control channel "
+                    "with --sim-control HOST:PORT (e.g. 127.0.0.1:5889)")
+    if args.sim_control:
+        try:
+            host, port = simlink.parse_address(args.sim_control)
+            link = simlink.SimControl(host, port)
+            scn.check_robots(scenario, link.robot_count(), link.where)
+        except (ValueError, simlink.LinkError) as exc:
+            if link is not None:
+                link.close()
+            return _err(str(exc))
+    try:
+        return _load_and_run(args, scenario, link, duration, wd, window)
+    finally:
+        if link is not None:
+            link.close()
+
+
+def _load_and_run(args, scenario, link, duration, wd, window) -> int:
+    from ..api import LoadError, PlcFault, load_plc, parse_task
+    from ..runtime.stats import OverrunCount, ScanStats
+    from ..runtime.values import PathError
+    from ..trace import Recorder, write_trace
     try:
         if args.task is not None:
             parse_task(args.task)
@@ -138,7 +163,7 @@ def run_cmd(args) -> int:
     except (PathError, ValueError) as exc:
         plc.close()
         return _err(str(exc))
-    runner = scn.Runner(plc, scenario)
+    runner = scn.Runner(plc, scenario, link, wait=args.virtual_time)
     stats = ScanStats() if args.stats else None
     if stats is None and not args.virtual_time:
         stats = OverrunCount()                 # every real-time run reports its overruns in its final line
@@ -162,6 +187,8 @@ def run_cmd(args) -> int:
     finally:
         _on_sigterm(previous)
         plc.close()
+    if link is not None:
+        link.drain()                           # the answers to the last requests decide the run too
     if reason is None:
         reason = runner.end_check(hooks.last_ns)
     overruns = None if args.virtual_time else stats.overruns
@@ -188,6 +215,9 @@ def run_cmd(args) -> int:
     held = sum(1 for e in scenario.expects if e.state == "held")
     late = f"; {overruns} overrun(s)" if overruns is not None else ""
     if reason is not None:
+        unmet = runner.unmet(hooks.last_ns)
+        if unmet:
+            print(f"vplc run: {len(unmet)} expectation(s) not met:", *unmet, sep="\n", file=sys.stderr)
         print(f"vplc run: FAILED: {reason}{late if 'overrun' not in reason else ''}", file=sys.stderr)
         return 1
     summary = f"{hooks.scans} scan(s), {scn.seconds(hooks.last_ns)} of controller time{late}"

@@ -1,4 +1,4 @@
-"""Commissioning scenarios for ``vplc run``: timed writes and expectations, one per line.
+"""Commissioning scenarios for ``vplc run``: timed writes, reactions, simulator actions and expectations.
 
     # comment (a `#` at the start of a line or after a blank)
     at 2s set Main.Start TRUE              write a variable when the run reaches 2 s
@@ -7,8 +7,15 @@
     at 5s expect Main.Error = FALSE within 1s
     expect Main.Error = FALSE always       must hold at every scan from its time to the end of the run
     at 90s stop                            end the run (without it: when every line has been decided)
+    at 5s robot 1 cut_link                 a request on the simulator's control channel (--sim-control)
+    when Main.Moves >= 80 robot 1 estop    ... when a condition becomes true
+    when Main.Alarm = TRUE for 1s then set Main.Reset TRUE after 200ms every time
+                                           a reaction: the operator or a machine, without PLC code
 
-Times count from the first scan. Operators: = <> < <= > >=. Values are ST literals of the variable's type
+Times count from the first scan. A condition is one or more `VAR OP VALUE` joined by `and`; `time` is the
+controller time (`when time >= 5s and Main.Busy = FALSE ...`). A reaction fires on the scan its condition becomes
+true (held for `for T` when given), once, or again each time it becomes true with `every time`; its action runs
+`after T` later (before that scan). Operators: = <> < <= > >=. Values are ST literals of the variable's type
 (TRUE, 12, -3.5, 16#FF, 'text', T#250ms, an enumeration value's name). ``--set VAR=VALUE@TIME`` on the command
 line is the same as ``at TIME set VAR VALUE``.
 """
@@ -19,6 +26,7 @@ from dataclasses import dataclass, field
 
 from ..frontend import types as T
 from ..runtime.values import PathError, parse_duration
+from . import simlink
 
 
 class ScenarioError(ValueError):
@@ -32,6 +40,7 @@ class Write:
     text: str
     where: str
     done: bool = False
+    value: object = None
 
 
 @dataclass
@@ -47,17 +56,60 @@ class Expect:
     value: object = None
     state: str = "open"           # open, held, failed
     last: object = None
+    since_ns: int = 0             # when ``last`` became the variable's value
+    decided_ns: int | None = None
+
+
+@dataclass
+class Term:
+    """`VAR OP VALUE` of a condition; ``path`` None is the controller time (`time >= 5s`)."""
+    path: str | None
+    op: str
+    text: str
+    value: object = None
+
+
+@dataclass
+class Action:
+    path: str | None = None       # `set VAR VALUE`
+    text: str = ""
+    value: object = None
+    robot: int | None = None      # `robot N COMMAND ...`: N counted from 1, and the control request
+    request: dict | None = None
+
+
+@dataclass
+class Reaction:
+    """An `at TIME robot ...` line (timed: its condition is `time >= TIME`) or a `when` line."""
+    terms: list[Term]
+    hold_ns: int                  # `for T`: the condition must stay true this long
+    delay_ns: int                 # `after T`: the action runs this long after the reaction fired
+    every: bool                   # `every time`: fires again each time the condition becomes true
+    action: Action
+    where: str
+    source: str
+    timed: bool = False
+    armed: bool = True            # the condition was false since the last firing (edge)
+    true_since: int | None = None
+    fired: int = 0
+    due: list[int] = field(default_factory=list)
 
 
 @dataclass
 class Scenario:
     writes: list[Write] = field(default_factory=list)
     expects: list[Expect] = field(default_factory=list)
+    reactions: list[Reaction] = field(default_factory=list)
     stop_ns: int | None = None
 
     @property
     def empty(self) -> bool:
-        return not self.writes and not self.expects and self.stop_ns is None
+        return not self.writes and not self.expects and not self.reactions and self.stop_ns is None
+
+    @property
+    def robots(self) -> list[Reaction]:
+        """The lines that act on the simulator, in file order."""
+        return [r for r in self.reactions if r.action.robot is not None]
 
 
 _OPS = ("<>", "<=", ">=", "=", "<", ">")
@@ -65,6 +117,13 @@ _AT = re.compile(r"^at\s+(\S+)\s+(.*)$", re.IGNORECASE)
 _SET = re.compile(r"^set\s+(\S+?)\s*(?::=|=|\s)\s*(.+)$", re.IGNORECASE)
 _EXPECT = re.compile(r"^expect\s+(\S+?)\s*(<>|<=|>=|=|<|>)\s*(.+?)(?:\s+within\s+(\S+)|\s+(always))?$",
                      re.IGNORECASE)
+_WHEN = re.compile(r"^when\s+(.+?)(?:\s+for\s+(\S+))?\s+(?:then\s+)?((?:set|robot)\s.+)$", re.IGNORECASE)
+_TERM = re.compile(r"^(\S+?)\s*(<>|<=|>=|=|<|>)\s*(.+)$")
+_ROBOT = re.compile(r"^robot\s+(\S+)\s*(.*)$", re.IGNORECASE)
+_EVERY = re.compile(r"^(.*?)\s+every\s+time$", re.IGNORECASE)
+_AFTER = re.compile(r"^(.*?)\s+after\s+(\S+)$", re.IGNORECASE)
+_AND = re.compile(r"\s+and\s+", re.IGNORECASE)
+MAX_REACTIONS = 10_000          # lines that act or react, per scenario (each is evaluated every scan)
 
 
 def _time(text: str, where: str, what: str) -> int:
@@ -98,11 +157,21 @@ def parse_line(line: str, where: str, sc: Scenario) -> None:
             raise ScenarioError(f"{where}: `stop` needs a time: `at 60s stop`")
         sc.stop_ns = at_ns if sc.stop_ns is None else min(sc.stop_ns, at_ns)
         return
+    if rest.lower().startswith("when ") and not timed:
+        _add_reaction(sc, _when(rest, where))
+        return
     m = _SET.match(rest)
     if m:
         if not timed:
             raise ScenarioError(f"{where}: `set` needs a time: `at 0s {rest}`")
         sc.writes.append(Write(at_ns, m.group(1), m.group(2).strip(), where))
+        return
+    if _ROBOT.match(rest):
+        if not timed:
+            raise ScenarioError(f"{where}: `robot` needs a time or a condition: `at 5s {rest}` or "
+                                f"`when Main.Moves >= 80 {rest}`")
+        _add_reaction(sc, Reaction([Term(None, ">=", "", at_ns)], 0, 0, False, _robot(rest, where), where, text,
+                                   timed=True))
         return
     m = _EXPECT.match(rest)
     if m:
@@ -111,7 +180,65 @@ def parse_line(line: str, where: str, sc: Scenario) -> None:
                                  where, rest))
         return
     raise ScenarioError(f"{where}: cannot read `{text}`; expected `at TIME set VAR VALUE`, "
-                        f"`[at TIME] expect VAR = VALUE [within TIME | always]` or `at TIME stop`")
+                        f"`at TIME robot N COMMAND`, `when CONDITION [for TIME] then ACTION [after TIME] "
+                        f"[every time]`, `[at TIME] expect VAR = VALUE [within TIME | always]` or `at TIME stop`")
+
+
+def _add_reaction(sc: Scenario, reaction: Reaction) -> None:
+    if len(sc.reactions) >= MAX_REACTIONS:
+        raise ScenarioError(f"{reaction.where}: more than {MAX_REACTIONS:,} `when` and `robot` lines")
+    sc.reactions.append(reaction)
+
+
+def _when(text: str, where: str) -> Reaction:
+    """# grammar: when COND {and COND} [for TIME] [then] (set VAR VALUE | robot N CMD ...) [after TIME] [every time]"""
+    m = _WHEN.match(text)
+    if not m:
+        raise ScenarioError(f"{where}: cannot read `{text}`; expected `when VAR OP VALUE [for TIME] then "
+                            f"set VAR VALUE [after TIME] [every time]` or `when VAR OP VALUE robot N COMMAND`")
+    cond, hold, action = m.group(1), m.group(2), m.group(3).strip()
+    every, delay = False, None
+    for _ in range(2):                       # `after T` and `every time`, in either order
+        e = _EVERY.match(action)
+        if e and not every:
+            every, action = True, e.group(1)
+            continue
+        a = _AFTER.match(action)
+        if a and delay is None:
+            delay, action = _time(a.group(2), where, "delay"), a.group(1)
+    terms = []
+    for part in _AND.split(cond):
+        t = _TERM.match(part.strip())
+        if not t:
+            raise ScenarioError(f"{where}: condition `{part.strip()}` is not `VAR OP VALUE` (OP one of "
+                                f"{' '.join(_OPS)}), e.g. `Main.Alarm = TRUE` or `time >= 5s`")
+        if t.group(1).lower() == "time":
+            terms.append(Term(None, t.group(2), t.group(3).strip(), _time(t.group(3).strip(), where, "time")))
+        else:
+            terms.append(Term(t.group(1), t.group(2), t.group(3).strip()))
+    hold_ns = _time(hold, where, "hold time") if hold else 0
+    if action.lower().startswith("robot"):
+        act = _robot(action, where)
+    else:
+        s = _SET.match(action)
+        if not s:
+            raise ScenarioError(f"{where}: cannot read the action `{action}`; expected `set VAR VALUE` or "
+                                f"`robot N COMMAND`")
+        act = Action(path=s.group(1), text=s.group(2).strip())
+    return Reaction(terms, hold_ns, delay or 0, every, act, where, text)
+
+
+def _robot(text: str, where: str) -> Action:
+    m = _ROBOT.match(text)
+    number = m.group(1) if m else ""
+    if not number.isdigit() or int(number) < 1:
+        raise ScenarioError(f"{where}: `robot {number}`: robots are numbered from 1, as the simulator's "
+                            f"start-up lines count them")
+    try:
+        request = simlink.build_request(m.group(2).split())
+    except simlink.CommandError as exc:
+        raise ScenarioError(f"{where}: {exc}") from None
+    return Action(robot=int(number), request=request)
 
 
 def load(filename: str, sc: Scenario | None = None) -> Scenario:
@@ -135,6 +262,14 @@ def add_set_option(text: str, sc: Scenario) -> None:
         raise ScenarioError(f"--set {text!r} is not of the form VAR=VALUE@TIME (e.g. Main.Start=TRUE@2s)")
     at = _time(m.group(3).strip(), "--set", "time") if m.group(3) else 0
     sc.writes.append(Write(at, m.group(1), m.group(2), f"--set {text}"))
+
+
+def check_robots(sc: Scenario, count: int, where: str) -> None:
+    """Every `robot N` line names one of the ``count`` robots of the simulator at ``where``."""
+    for r in sc.robots:
+        if r.action.robot > count:
+            raise ScenarioError(f"{r.where}: robot {r.action.robot} does not exist: the simulator at {where} "
+                                f"has {count} robot{'s' if count != 1 else ''} (robot 1 to {count})")
 
 
 # ---- values -------------------------------------------------------------------------------------
@@ -210,46 +345,156 @@ def resolve(plc, sc: Scenario) -> None:
         except PathError as exc:
             raise ScenarioError(f"{w.where}: {exc}") from None
     for e in sc.expects:
-        try:
-            e.value = parse_value(plc, e.path, e.text)
-        except PathError as exc:
-            raise ScenarioError(f"{e.where}: {exc}") from None
-        if e.op not in ("=", "<>") and isinstance(e.value, (bool, str)):
-            raise ScenarioError(f"{e.where}: `{e.op}` compares numbers; {e.path} is a {plc.var_type(e.path)}")
+        _resolve_term(plc, e, e.where)
+    for r in sc.reactions:
+        for term in r.terms:
+            if term.path is not None:
+                _resolve_term(plc, term, r.where)
+        if r.action.path is not None:
+            try:
+                r.action.value = parse_value(plc, r.action.path, r.action.text)
+                plc.read(r.action.path)
+            except PathError as exc:
+                raise ScenarioError(f"{r.where}: {exc}") from None
+
+
+def _resolve_term(plc, term, where: str) -> None:
+    try:
+        term.value = parse_value(plc, term.path, term.text)
+    except PathError as exc:
+        raise ScenarioError(f"{where}: {exc}") from None
+    if term.op not in ("=", "<>") and isinstance(term.value, (bool, str)):
+        raise ScenarioError(f"{where}: `{term.op}` compares numbers; {term.path} is a {plc.var_type(term.path)}")
+
+
+_UNSEEN = object()
 
 
 class Runner:
-    """Applies the writes due before a scan and judges the expectations after it."""
+    """Applies the writes and reactions due before a scan and judges the expectations after it. ``link`` is the
+    simulator's control channel (``simlink.SimControl``) for `robot` lines; ``wait`` sends each request and waits
+    for its answer (virtual time), otherwise requests leave from a sender thread and the scan never waits."""
 
-    def __init__(self, plc, sc: Scenario) -> None:
-        self.plc, self.sc = plc, sc
+    def __init__(self, plc, sc: Scenario, link=None, wait: bool = False, say=print) -> None:
+        self.plc, self.sc, self.link, self.wait, self.say = plc, sc, link, wait, say
         self.failure: str | None = None
+        self.first: Expect | None = None
+        self.active = list(sc.reactions)
+        self.started = False
 
     def before_scan(self, t_ns: int) -> None:
+        if not self.started:
+            self.started = True
+            self._mark_start(t_ns)
         for w in self.sc.writes:
             if not w.done and w.at_ns <= t_ns:
-                try:
-                    self.plc.write(w.path, w.value)
-                except PathError as exc:
-                    self.failure = f"{w.where}: {exc}"
+                self._write(w.path, w.value, w.where)
                 w.done = True
+        if self.active:
+            self._react(t_ns)
+        self.collect_refusals()
+
+    def _react(self, t_ns: int) -> None:
+        """Evaluate the conditions on the values the last scan left (each variable read once) and run what is due."""
+        values: dict[str, object] = {}
+        read = self.plc.read
+        finished = False
+        todo = []                            # acted on after every condition was judged on the same values
+        for r in self.active:
+            while r.due and r.due[0] <= t_ns:
+                r.due.pop(0)
+                todo.append(r)
+            if r.fired and not r.every:
+                finished = finished or not r.due
+                continue
+            for term in r.terms:
+                if term.path is None:
+                    v = t_ns
+                else:
+                    v = values.get(term.path, _UNSEEN)
+                    if v is _UNSEEN:
+                        v = values[term.path] = read(term.path)
+                if not compare(v, term.op, term.value):
+                    r.armed, r.true_since = True, None
+                    break
+            else:
+                if not r.armed:
+                    continue
+                if r.true_since is None:
+                    r.true_since = t_ns
+                if t_ns - r.true_since < r.hold_ns:
+                    continue
+                r.armed, r.true_since = False, None
+                r.fired += 1
+                if r.delay_ns:
+                    r.due.append(t_ns + r.delay_ns)
+                else:
+                    todo.append(r)
+                finished = finished or (not r.every and not r.due)
+        for r in todo:
+            self._act(r, t_ns)
+        if finished:
+            self.active = [r for r in self.active if r.every or not r.fired or r.due]
+
+    def _mark_start(self, t_ns: int) -> None:
+        """A `ping` carrying the controller time of the first scan to every robot the scenario drives: the
+        simulator's log then lines up both clocks from the start, before the first action."""
+        if self.link is None:
+            return
+        for robot in sorted({r.action.robot for r in self.sc.robots}):
+            request = {"cmd": "ping", "robot": robot - 1, "plc_time": round(t_ns / 1e9, 6)}
+            if self.wait:
+                self.link.send_now(request, "start of the run")
+            else:
+                self.link.post(request, "start of the run")
+
+    def _act(self, r: Reaction, t_ns: int) -> None:
+        a = r.action
+        if a.path is not None:
+            self._write(a.path, a.value, r.where)
+            return
+        request = {**a.request, "robot": a.robot - 1, "plc_time": round(t_ns / 1e9, 6)}
+        self.say(f"{t_ns / 1e9:10.3f} s  robot {a.robot}: {simlink.describe(a.request)} ({r.where})", flush=True)
+        if self.wait:
+            self.link.send_now(request, r.where)
+        else:
+            self.link.post(request, r.where)
+
+    def _write(self, path, value, where) -> None:
+        try:
+            self.plc.write(path, value)
+        except PathError as exc:
+            if self.failure is None:
+                self.failure = f"{where}: {exc}"
+
+    def collect_refusals(self) -> None:
+        if self.link is None:
+            return
+        for text in self.link.refusals():
+            if self.failure is None:
+                self.failure = text
 
     def after_scan(self, t_ns: int) -> None:
+        read = self.plc.read
         for e in self.sc.expects:
             if e.state != "open" or t_ns < e.from_ns:
                 continue
-            e.last = self.plc.read(e.path)
-            ok = compare(e.last, e.op, e.value)
+            v = read(e.path)
+            if e.last is None or v != e.last:
+                e.last, e.since_ns = v, t_ns
+            ok = compare(v, e.op, e.value)
             if ok and not e.always:
-                e.state = "held"
+                e.state, e.decided_ns = "held", t_ns
             elif not ok and (e.always or e.until_ns is None or t_ns >= e.until_ns):
-                e.state = "failed"
+                e.state, e.decided_ns = "failed", t_ns
                 if self.failure is None:
+                    self.first = e
                     self.failure = (f"expectation failed at {seconds(t_ns)}: {e.source} ({e.where}); "
-                                    f"{e.path} is {fmt(e.last)}")
+                                    f"{e.path} is {fmt(v)}")
 
     def finished(self, t_ns: int) -> bool:
-        """The run ends at a failure, at `stop`, or when every write is done and every expectation decided."""
+        """The run ends at a failure, at `stop`, or when every write and timed robot action is done and every
+        expectation decided."""
         if self.failure is not None:
             return True
         if self.sc.stop_ns is not None:
@@ -257,11 +502,13 @@ class Runner:
         if not self.sc.expects:
             return False
         return all(w.done for w in self.sc.writes) and \
+            all(r.fired and not r.due for r in self.sc.reactions if r.timed) and \
             all(e.state != "open" for e in self.sc.expects if not e.always) and \
             any(not e.always for e in self.sc.expects)
 
     def end_check(self, t_ns: int) -> str | None:
         """After the last scan: the reason the run did not do what the scenario asked, or None."""
+        self.collect_refusals()
         if self.failure is not None:
             return self.failure
         for e in self.sc.expects:
@@ -271,6 +518,23 @@ class Runner:
                 return (f"expectation not decided: the run ended at {seconds(t_ns)} before `{e.source}` "
                         f"({e.where}) was reached; {e.path} is {fmt(self.plc.read(e.path))}")
         return None
+
+    def unmet(self, t_ns: int) -> list[str]:
+        """Every expectation that failed or was left open, with the value it last had and since when; the first
+        failure marked. Empty when fewer than two (the last line then says all there is)."""
+        lines = []
+        for e in self.sc.expects:
+            if e.state == "failed":
+                mark = " (first)" if e is self.first else ""
+                head = f"failed at {seconds(e.decided_ns)}{mark}"
+            elif e.state == "open" and not (e.always and e.from_ns <= t_ns):
+                head = "not decided"
+            else:
+                continue
+            last = (f"{e.path} was {fmt(e.last)} since {seconds(e.since_ns)}" if e.last is not None
+                    else f"{e.path} was never checked (from {seconds(e.from_ns)})")
+            lines.append(f"  {head}: {e.source} ({e.where}); {last}")
+        return lines if len(lines) > 1 else []
 
 
 def seconds(t_ns: int) -> str:
