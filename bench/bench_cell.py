@@ -1,5 +1,5 @@
 """Statements per scan of the issue 26 function blocks (CBT_ReadIO, CBT_SetOverride, CBT_WaitQueue, the motion
-status of CBT_RobotStatus) against an idle CBT_MoveAbsolute, on the virtual PLC (1 ms task) with the simulator's
+status of CBT_RobotStatus, CBT_ReadVariable, CBT_WriteVariable, an aborting CBT_MoveAbsolute) against an idle CBT_MoveAbsolute, on the virtual PLC (1 ms task) with the simulator's
 Listen node and Ethernet Slave (data table every 100 ms).
 
     PYTHONPATH=tests/lib .venv/bin/python bench/bench_cell.py
@@ -23,6 +23,7 @@ VAR
     conn : CBT_Connect;
     On : BOOL;
     MoveParam : stCBT_MovAbsParam;
+    Variable : stCBT_Variable;
     fb : {fb};
 END_VAR
 """
@@ -32,6 +33,10 @@ CALLS = {
     "CBT_SetOverride": "fb(CBT := Cobot, Execute := On, Override := 50);",
     "CBT_ReadIO": "fb(CBT := Cobot, Enable := On);",
     "CBT_RobotStatus": "fb(CBT := Cobot, Enable := On);",
+    "CBT_ReadVariable": "fb(CBT := Cobot, Variable := Variable, Execute := On);",
+    "CBT_WriteVariable": "fb(CBT := Cobot, Variable := Variable, Execute := On);",
+    "CBT_MoveAbsolute Aborting": "fb(CBT := Cobot, Execute := On, Parameters := MoveParam, "
+                                 "BufferMode := eCBT_BufferMode#Aborting);",
 }
 TAIL = """conn(CBT := Cobot, Execute := ConnExec, IPAddress := '127.0.0.1', IPPort := Port, Time_Out := 10,
      SvrPort := SvrPort);
@@ -40,11 +45,11 @@ END_PROGRAM
 
 
 def program(folder: Path, fb: str | None) -> str:
-    path = folder / f"Main_{fb or 'Connect'}.st"
+    path = folder / f"Main_{(fb or 'Connect').replace(' ', '_')}.st"
     if fb is None:
         text = HEAD.replace("    fb : {fb};\n", "") + TAIL
     else:
-        text = HEAD.format(fb=fb) + CALLS[fb] + "\n" + TAIL
+        text = HEAD.format(fb=fb.split()[0]) + CALLS[fb] + "\n" + TAIL
     path.write_text(text, encoding="utf-8")
     return str(path)
 
@@ -76,7 +81,8 @@ def main():
         folder = Path(tmp)
         base = measure(program(folder, None), False)
         rows = [("CBT_MoveAbsolute", "idle (Execute FALSE)", measure(program(folder, "CBT_MoveAbsolute"), False))]
-        for fb in ("CBT_WaitQueue", "CBT_SetOverride"):
+        for fb in ("CBT_MoveAbsolute Aborting", "CBT_WaitQueue", "CBT_SetOverride", "CBT_ReadVariable",
+                   "CBT_WriteVariable"):
             rows.append((fb, "idle (Execute FALSE)", measure(program(folder, fb), False)))
         for fb in ("CBT_ReadIO", "CBT_RobotStatus"):
             rows.append((fb, "Enable FALSE", measure(program(folder, fb), False)))
@@ -87,7 +93,7 @@ def main():
     for fb, state, total in rows:
         own = total - base
         mark = "ok " if own <= target + 1e-9 else "-- "
-        print(f"  {fb:<18}{state:<24}{own:6.2f}  {mark}(target <= idle CBT_MoveAbsolute {target:.2f})")
+        print(f"  {fb:<27}{state:<24}{own:6.2f}  {mark}(target <= idle CBT_MoveAbsolute {target:.2f})")
 
 
 if __name__ == "__main__":

@@ -7,8 +7,7 @@ import re
 from pathlib import Path
 
 from rig import LIB, SEC, Rig, move_abs
-from tmsim.server import SimServer
-from test_lib_doc_examples import STEPS, example_of, on_simulator
+from test_lib_doc_examples import STEPS, example_of, on_simulator, simulator
 from vplc.api import PathError, load_plc
 from vplc.trace.recorder import Recorder, write_trace
 
@@ -21,7 +20,8 @@ EXTRA = {"CBT_Connect": ["Cobot.InListenNode", "RobotReady"], "CBT_Stop": ["Cobo
          "CBT_RobotStatus": ["fbStatus.Status.ProjectRunning", "fbStatus.Status.Position.TCP.Z", "RobotFault"],
          "CBT_ProjectControl": ["Cobot.Status.ProjectRunning"],
          "CBT_ReadIO": ["PartPresent"], "CBT_SetOverride": ["SpeedShown"],
-         "CBT_WaitQueue": ["Cobot.Status.Moving", "Cobot.Status.TCPSpeed"]}
+         "CBT_WaitQueue": ["Cobot.Status.Moving", "Cobot.Status.TCPSpeed"],
+         "CBT_ReadVariable": ["PartCount"]}
 FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"], "CBT_RobotStatus": ["fbConnect.Connected"],
          "CBT_ReadIO": ["fbConnect.Connected"]}      # the FB's Enable
 HOLD_S = 0.02                   # Execute stays TRUE this long after Done, then falls: both Done cases show
@@ -40,7 +40,7 @@ def page_trace(page: str, out: Path) -> None:
     """Run the page's example as the library tests do and record its trigger inputs and the FB's pins."""
     code, _ = example_of(page)
     program = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
-    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0)
+    srv = simulator()
     srv.start()
     source = out / f".{page}_example.st"
     try:

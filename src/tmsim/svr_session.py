@@ -258,7 +258,11 @@ class SvrSession:
                 return
         self.log("svr_write", conn=conn, id=ident, mode=mode, items=values)
         self._status(conn, ident, OK)
-        for name in [name for name in values if name in self.variables]:
-            self.variables[name] = values.pop(name)
-        if values:
-            self.source.write(values)
+        items = {}
+        for name, value in values.items():
+            if name in self.variables:
+                self.variables[name] = value
+            else:
+                items[name] = value
+        if items:
+            self.source.write(items)

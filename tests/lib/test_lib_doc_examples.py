@@ -10,6 +10,7 @@ import pytest
 
 from rig import LIB, ROOT, SEC
 from tmsim.server import SimServer
+from tmsim.svr_table import parse_variable
 from vplc.api import load_plc
 
 DOCS = ROOT / "docs" / "library"
@@ -33,7 +34,19 @@ STEPS = {
     "CBT_ReadIO": [(None, "fbIO.Valid")],
     "CBT_SetOverride": [("SlowButton", "fbOverride.Done")],
     "CBT_WaitQueue": [("MoveExec", "fbMove.Done"), ("SyncExec", "fbSync.Done")],
+    "CBT_ReadVariable": [("ReadExec", "fbRead.Done")],
+    "CBT_WriteVariable": [("WriteExec", "fbWrite.Done")],
 }
+
+
+# the global variables of the robot's project that the pages' examples read and write (simulator: --svr-var)
+SVR_VARIABLES = ("g_PartCount:int=17", "g_Recipe:string=\"Flange\"", "g_Offset:float[3]={0.5,-1.25,0}")
+
+
+def simulator() -> SimServer:
+    """The robot the examples run against: Listen node, Ethernet Slave and the variables above."""
+    return SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0,
+                     svr_options={"variables": [parse_variable(spec) for spec in SVR_VARIABLES]})
 
 
 def example_of(page: str) -> tuple[str, list[str]]:
@@ -58,7 +71,7 @@ def on_simulator(code: str, srv) -> str:
 def test_page_example_runs_against_the_simulator(page, tmp_path):
     code, promised = example_of(page)
     program = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
-    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0)
+    srv = simulator()
     srv.start()
     try:
         source = tmp_path / f"{page}_example.st"

@@ -40,8 +40,10 @@ def load(name):
 
 MT = load("make_types")
 # CBT_SetOverride's row (an FB input of a program of its own) is run, every value of its type, by
-# tests/lib/test_lib_set_override.py
-ROWS = [r for r in MT.read_ranges() if r.error and r.struct != "CBT_SetOverride"]
+# tests/lib/test_lib_set_override.py; the rows of CBT_ReadVariable / CBT_WriteVariable (members of their in-out
+# Variable) by tests/lib/test_lib_variables.py
+OWN_TESTS = ("CBT_SetOverride", "CBT_ReadVariable", "CBT_WriteVariable")
+ROWS = [r for r in MT.read_ranges() if r.error and r.struct not in OWN_TESTS]
 
 
 @pytest.fixture(scope="module")
