@@ -1,140 +1,129 @@
-/* CBT HMI – alarms, the Robot tile and FB results (issue 14).
-   - Alarm banner on every page: the newest unacknowledged alarm with its ErrorID, text and remedy.
-   - Alarm history on the main page (time, source, ErrorID or robot code, text, active / gone, acknowledged;
-     a tapped row shows whole on the message line), kept for the browser tab while pages change; Acknowledge marks alarms seen (it does not reset the PLC).
-   - Robot tile on the main page: project state, robot error (the robot's code and text), E-stop, mode, link;
-     Play and Stop press the robot's stick buttons through CBT_ProjectControl (Project_Command/Project_Execute).
-   - watchResult: the message line reports what the FB answered (Done, Error with ErrorID and text,
-     CommandAborted), never "sent" as a success.
-   ErrorID texts, causes and remedies come from errors.json, generated from docs/library/errors.tsv. */
+/* CBT HMI – alarms, the Robot tile and FB results.
+   The alarm list belongs to the server (src/vplc/hmi/alarms.py, ISA-18.2): one alarm per cause with its
+   consequences as details, priority, states, timestamps of the controller's clock, acknowledge shared by every
+   panel, a history of 1000 entries. The pages only show it: every /api/read answer carries the alarm list's
+   change count, and the page asks /api/alarms when it changed.
+   - Alarm banner on every page: the unacknowledged alarm of the highest priority, with its operator remedy.
+   - Alarm list on the main page (time, priority, alarm, state; first-out marked; a tapped row shows the whole
+     alarm, its remedy and its consequences on the message line); History opens the last 500 entries.
+   - The panel's own communication alarm when the HMI server does not answer (it cannot be in the server's list).
+   - Robot tile on the main page: project state, robot error, E-stop, mode, link; Play and Stop Project press
+     the robot's stick buttons through CBT_ProjectControl; Back to Listen Node stops and plays the project.
+   - watchResult: the message line reports what the FB answered, with the operator's remedy for an ErrorID.
+   Operator remedies of the ErrorIDs come from errors.json, generated from docs/library/errors.tsv. */
 "use strict";
 
-/* [key, source shown, error flag, ErrorID variable, text variable] */
-const ALARM_SOURCES = [
-  ["connect", "Connection", "Connect_Error", "Connect_ErrorID", "Connect_ErrorDescrip"],
-  ["pnp", "PnP sequence", "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip"],
-  ["project", "Project control", "Project_Error", "Project_ErrorID", "Project_ErrorDescrip"],
-  ...["ChangeBase", "ChangeTCP", "MoveRel", "MoveAbs", "MoveCircle", "ProgramControl", "SetOutput", "Stop"]
-    .map((g) => [g.toLowerCase(), (Object.values(PAGES).find((p) => p.group === g) || { title: g }).title,
-      `${g}_Error`, `${g}_ErrorID`, `${g}_ErrorDescrip`]),
-];
 const PROJECT_CMD = { play: 0, pause: 1, stop: 2 };      // eCBT_ProjectCmd
-const alarms = { list: [], active: {}, texts: {}, sawConnected: false };
-
-function alarmVariables() {
-  return [...ALARM_SOURCES.flatMap((s) => s.slice(2)), "RobotStatus_Valid", "RobotStatus", "Connect_Reconnecting",
-    "Connect_RetryCount", "Robot_LastErrorID", "Connect_Connected", "Project_Busy", "Project_Done"]
-    .filter((n) => MAP.variables[n]);
-}
+const alarms = { seq: null, list: [], history: [], texts: {}, asking: false, historyWanted: 0 };
 
 function idText(id) { return "16#" + Number(id).toString(16).toUpperCase().padStart(4, "0"); }
 function robotCode(code) { return "16#" + (Number(code) >>> 0).toString(16).toUpperCase().padStart(8, "0"); }
+function operatorRemedy(id) { const row = alarms.texts[idText(id)]; return row ? row.operator || "" : ""; }
 
 async function loadAlarms() {
   try { alarms.texts = await (await fetch("errors.json")).json(); } catch (e) { alarms.texts = {}; }
+}
+
+/* called by every poll with the /api/read answer (null: no answer) */
+function alarmsAfterRead(data) {
+  if (data && data.alarms !== alarms.seq && !alarms.asking) fetchAlarms();
+  drawBanner();
+}
+
+async function fetchAlarms() {
+  alarms.asking = true;
   try {
-    const kept = JSON.parse(sessionStorage.getItem("cbt-alarms") || "[]");
-    alarms.list = kept.map((a) => ({ ...a, time: new Date(a.time), gone: a.gone && new Date(a.gone) }));
-    for (const a of alarms.list) if (!a.gone) alarms.active[a.key] = a;
-  } catch (e) { alarms.list = []; }
+    const data = await api(`/api/alarms?history=${alarms.historyWanted}`);
+    alarms.seq = data.seq;
+    alarms.list = data.alarms;
+    if (data.history) alarms.history = data.history;
+    drawAlarms();
+  } catch (e) { /* the next poll asks again: the read answer still carries the new count */ }
+  finally { alarms.asking = false; }
 }
 
-function saveAlarms() { sessionStorage.setItem("cbt-alarms", JSON.stringify(alarms.list)); }
-
-/* One alarm for a whole outage: CBT_Connect shows Error only during its back-off waits (FALSE during each
-   attempt), so its own Error would raise and clear an alarm on every retry. While Connect_Reconnecting is TRUE
-   the connection alarm stays active under one key; its ErrorID is the latest reason seen (Connect_ErrorID of
-   the loss or of the last failed attempt, else the connection's Robot_LastErrorID), updated in place. A first
-   connect that failed at Time_Out is retried the same way (Execute held): "not connected" unless this tab saw
-   the link up before. */
-function reconnectingAlarm(v) {
-  const held = alarms.active["connect:reconnecting"], lost = held ? held.lost : alarms.sawConnected;
-  const id = v.Connect_ErrorID || (held && held.id) || v.Robot_LastErrorID || 0;
-  const known = alarms.texts[idText(id)];
-  const reason = v.Connect_Error === true && v.Connect_ErrorID === id && v.Connect_ErrorDescrip ? v.Connect_ErrorDescrip
-    : held && held.id === id ? held.reason : known ? known.text : "";
-  const attempt = v.Connect_RetryCount ? ` (attempt ${v.Connect_RetryCount})` : "";
-  return { source: "Connection", id, reason, lost,
-    text: `${lost ? "Connection lost, reconnecting" : "Not connected, retrying"}${attempt}${reason ? " — " + reason : ""}` };
+async function acknowledge(body) {
+  try {
+    await api("/api/alarms/ack", body);
+    await fetchAlarms();
+  } catch (e) { message("Acknowledge: " + e.message, "error"); }
 }
 
-/* what is in alarm now: {key: {source, id | code, text}} */
-function currentAlarms() {
-  const v = live.values, now = {}, reconnecting = v.Connect_Reconnecting === true;
-  if (reconnecting) now["connect:reconnecting"] = reconnectingAlarm(v);
-  for (const [key, source, flag, idVar, textVar] of ALARM_SOURCES)
-    if (v[flag] === true && v[idVar] && !(reconnecting && key === "connect"))
-      now[`${key}:${v[idVar]}`] = { source, id: v[idVar], text: v[textVar] || "" };
-  const rs = v.RobotStatus;
-  if (v.RobotStatus_Valid === true && rs) {
-    if (rs.RobotError) now[`robot:${rs.ErrorCode}`] = { source: "Robot", code: rs.ErrorCode, text: rs.ErrorText || "Robot error" };
-    if (rs.EStop) now.estop = { source: "Robot", text: "Emergency stop pressed" };
-  }
-  return now;
-}
-
-function checkAlarms() {
-  if (!live.online) return;
-  if (live.values.Connect_Connected === true) alarms.sawConnected = true;
-  const now = currentAlarms(), stamp = new Date();
-  let changed = false;
-  for (const [key, a] of Object.entries(now)) {
-    const held = alarms.active[key];
-    if (held) {                     // still active: its reason may change, it stays one (acknowledged) entry
-      if (held.id !== a.id || held.text !== a.text) { Object.assign(held, a); changed = true; }
-      continue;
-    }
-    const entry = { ...a, key, time: stamp, ack: false, gone: null };
-    alarms.list.unshift(entry);
-    alarms.active[key] = entry;
-    changed = true;
-  }
-  for (const [key, entry] of Object.entries(alarms.active)) {
-    if (now[key]) continue;
-    entry.gone = stamp;
-    delete alarms.active[key];
-    changed = true;
-  }
-  if (!changed) return;
-  alarms.list.length = Math.min(alarms.list.length, 100);
-  saveAlarms();
-  drawAlarms();
-}
+const PRIORITY_SHOWN = { high: "High", medium: "Medium", low: "Low" };
+const STATE_SHOWN = { "active-unacknowledged": "active, unacknowledged", "active-acknowledged": "active, acknowledged",
+  "returned-unacknowledged": "returned, unacknowledged", normal: "normal" };
 
 function alarmLine(a) {
-  const what = a.id ? idText(a.id) : a.code !== undefined ? `code ${robotCode(a.code)}` : "";
-  return `${a.source}${what ? " " + what : ""}: ${a.text}`;
+  return `${a.source}${a.id ? " " + a.id : ""}: ${a.text}`;
 }
 
-function remedyOf(a) { return a.id && alarms.texts[idText(a.id)] ? alarms.texts[idText(a.id)].remedy : ""; }
+function alarmWhole(a) {
+  const more = a.details.length ? `  Consequences: ${a.details.map((d) => d.text).join("; ")}.` : "";
+  return `${a.time}  ${PRIORITY_SHOWN[a.priority]}  ${alarmLine(a)}${a.remedy ? " — " + a.remedy : ""}` +
+    `${a.first_out ? "  (first out)" : ""}${more}`;
+}
 
-function acknowledge(entries) {
-  for (const a of entries) a.ack = true;
-  saveAlarms();
-  drawAlarms();
+/* The banner: the panel's own communication alarm while the server does not answer, else the unacknowledged
+   alarm of the highest priority (the server lists them highest priority first, newest first). */
+function drawBanner() {
+  const banner = document.getElementById("alarm-banner");
+  if (!banner) return;
+  const text = banner.querySelector(".text"), ack = banner.querySelector("button");
+  if (!live.online && !live.fault && live.lostAt) {
+    banner.hidden = false;
+    banner.dataset.priority = "high";
+    ack.hidden = true;
+    const shown = `${live.clock ? live.clock.slice(0, 19) : "—"}  High  PLC communication lost: no answer from the PLC ` +
+      "— check the PLC and the network cable; the values shown as #### are not valid.";
+    if (text.textContent !== shown) text.textContent = shown;
+    return;
+  }
+  const open = alarms.list.filter((a) => a.state.endsWith("unacknowledged"));
+  banner.hidden = open.length === 0;
+  ack.hidden = false;
+  if (!open.length) return;
+  const a = open[0];
+  banner.dataset.priority = a.priority;
+  banner.dataset.number = a.number;
+  const shown = `${a.time.slice(0, 19)}  ${PRIORITY_SHOWN[a.priority]}  ${alarmLine(a)}` +
+    (a.remedy ? ` — ${a.remedy}` : "") + (a.details.length ? `  [${a.details.length} consequence` +
+    `${a.details.length > 1 ? "s" : ""}]` : "") + (open.length > 1 ? `  (+${open.length - 1} more)` : "");
+  if (text.textContent !== shown) text.textContent = shown;
 }
 
 function drawAlarms() {
-  const banner = document.getElementById("alarm-banner");
-  if (banner) {
-    const open = alarms.list.filter((a) => !a.ack);
-    banner.hidden = open.length === 0;
-    if (open.length) {
-      const a = open[0], remedy = remedyOf(a);
-      banner.querySelector(".text").textContent = `${a.time.toLocaleTimeString()}  ${alarmLine(a)}` +
-        (remedy ? ` — ${remedy}` : "") + (open.length > 1 ? `  (+${open.length - 1} more)` : "");
-    }
-  }
+  drawBanner();
   const table = document.getElementById("alarm-history");
   if (!table) return;
-  table.innerHTML = "<tr><th>Time</th><th>Alarm</th><th>State</th></tr>";
-  for (const a of alarms.list.slice(0, 30)) {
+  table.innerHTML = "<tr><th>Time</th><th>Prio</th><th>Alarm</th><th>State</th></tr>";
+  if (!alarms.list.length) {
+    table.insertRow().insertCell().textContent = "No alarms.";
+    table.rows[1].cells[0].colSpan = 4;
+  }
+  for (const a of alarms.list) {
     const tr = table.insertRow();
-    tr.className = (a.gone ? "gone" : "active") + (a.ack ? " ack" : "");
-    tr.insertCell().textContent = a.time.toLocaleTimeString();
-    tr.insertCell().textContent = alarmLine(a);
-    tr.insertCell().textContent = (a.gone ? "gone" : "active") + (a.ack ? ", acknowledged" : "");
-    tr.onclick = () => message(`${a.time.toLocaleTimeString()}  ${alarmLine(a)}` + (remedyOf(a) ? ` — ${remedyOf(a)}` : ""));
+    tr.className = a.state + " " + a.priority;
+    tr.dataset.number = a.number;
+    tr.insertCell().textContent = a.time.slice(11, 19);
+    tr.insertCell().textContent = PRIORITY_SHOWN[a.priority];
+    tr.insertCell().textContent = (a.first_out ? "① " : "") + alarmLine(a) +
+      (a.details.length ? ` (+${a.details.length})` : "");
+    tr.insertCell().textContent = STATE_SHOWN[a.state];
+    tr.onclick = () => message(alarmWhole(a));
+  }
+  drawHistory();
+}
+
+function drawHistory() {
+  const table = document.getElementById("alarm-log");
+  if (!table) return;
+  table.innerHTML = "<tr><th>Date and time</th><th>Event</th><th>Alarm</th></tr>";
+  for (const e of alarms.history) {
+    const tr = table.insertRow();
+    tr.insertCell().textContent = e.time;
+    tr.insertCell().textContent = e.event + (e.by ? ` (${e.by})` : "");
+    tr.insertCell().textContent = `#${e.alarm} ${PRIORITY_SHOWN[e.priority] || ""} ${e.source}${e.id ? " " + e.id : ""}: ` +
+      (e.detail ? `consequence: ${e.detail}` : e.text);
   }
 }
 
@@ -145,41 +134,86 @@ function alarmBanner(panel) {
   banner.className = "alarm-banner";
   banner.hidden = true;
   banner.innerHTML = '<span class="text"></span><button id="btn-alarm-ack">Acknowledge</button>';
-  banner.querySelector("button").onclick = () => {
-    const open = alarms.list.filter((a) => !a.ack);
-    if (open.length) acknowledge([open[0]]);
+  const button = banner.querySelector("button");
+  button.disabled = ACCESS.role === "monitor";
+  button.onclick = () => { if (banner.dataset.number) acknowledge({ alarms: [Number(banner.dataset.number)] }); };
+  banner.querySelector(".text").onclick = () => {
+    const a = alarms.list.find((x) => String(x.number) === banner.dataset.number);
+    if (a) message(alarmWhole(a));
   };
   panel.querySelector("header").after(banner);
-  drawAlarms();
 }
 
 /* ---------- Robot tile (main page) ---------- */
 function robotTile(container) {
+  alarms.historyWanted = 500;
   const area = document.createElement("div");
   area.className = "robot-tile";
   area.innerHTML = `<div class="row"><table class="robot-state">
-      <tr><td>Project</td><td id="robot-project"></td></tr>
-      <tr><td>Robot error</td><td id="robot-error"></td></tr>
-      <tr><td>Safety / mode</td><td id="robot-safety"></td></tr>
-      <tr><td>Link</td><td id="robot-link"></td></tr></table>
-    <div class="buttons"><button class="primary" id="btn-project-play">Play</button>
-      <button class="danger" id="btn-project-stop">Stop Project</button></div></div>
-    <div class="alarms-head">Alarms <button id="btn-alarm-ack-all">Acknowledge all</button></div>
-    <div class="alarm-list"><table id="alarm-history"></table></div>`;
+      <tr><td>Project</td><td id="robot-project" data-invalid></td></tr>
+      <tr><td>Robot error</td><td id="robot-error" data-invalid></td></tr>
+      <tr><td>Safety / mode</td><td id="robot-safety" data-invalid></td></tr>
+      <tr><td>Link</td><td id="robot-link" data-invalid></td></tr></table>
+    <div class="buttons"><button id="btn-project-play">Play</button>
+      <button id="btn-project-stop">Stop Project</button>
+      <button id="btn-back-to-node" hidden>Back to Listen Node</button></div></div>
+    <div class="alarms-head">Alarms <button id="btn-alarm-ack-all">Acknowledge all</button>
+      <button id="btn-alarm-history">History</button></div>
+    <div class="alarm-list"><table id="alarm-history"></table></div>
+    <dialog id="alarm-log-dialog"><header><h1>Alarm history (controller time, newest first)</h1></header>
+      <div class="body"><table id="alarm-log"></table></div>
+      <div class="actions"><button id="btn-alarm-history-close">Close</button></div></dialog>`;
   container.append(area);
-  const press = (command, what) => {
-    executeCommand("Project_Execute", { Project_Command: PROJECT_CMD[command] }, what).then((sent) => {
-      if (sent) releaseWhenFinished("Project", what);
-    });
-  };
-  for (const [id, command, what] of [["btn-project-play", "play", "Project Play"], ["btn-project-stop", "stop", "Project Stop"]]) {
+  const texts = { play: ["Play", "the robot project runs."], stop: ["Stop Project", "the robot project stopped."] };
+  const press = (command) => executeCommand("Project_Execute", { Project_Command: PROJECT_CMD[command] }, texts[command][0])
+    .then((sent) => sent && releaseWhenFinished("Project", texts[command][0], texts[command][1]));
+  for (const [id, command] of [["btn-project-play", "play"], ["btn-project-stop", "stop"]]) {
     const b = area.querySelector("#" + id);
     b.disabled = !mayWrite("Project_Execute");
-    b.onclick = () => press(command, what);
+    b.onclick = () => press(command);
   }
-  area.querySelector("#btn-alarm-ack-all").onclick = () => acknowledge(alarms.list);
+  const back = area.querySelector("#btn-back-to-node");
+  back.disabled = !mayWrite("Project_Execute");
+  back.onclick = () => backToListenNode();
+  const ackAll = area.querySelector("#btn-alarm-ack-all");
+  ackAll.disabled = ACCESS.role === "monitor";
+  ackAll.onclick = () => acknowledge({ all: true });
+  const dialog = area.querySelector("#alarm-log-dialog");
+  area.querySelector("#btn-alarm-history").onclick = () => { drawHistory(); dialog.showModal(); };
+  area.querySelector("#btn-alarm-history-close").onclick = () => dialog.close();
   live.listeners.push(drawRobotTile);
   drawAlarms();
+}
+
+/* The robot left its Listen node (an Exit Listen Node, a flow path): Play alone does not bring it back while its
+   project runs, so the project is stopped and played again through CBT_ProjectControl; TMflow's project then
+   enters the Listen node and CBT_Connect reconnects by itself. */
+async function backToListenNode() {
+  const what = "Back to Listen Node";
+  if (!(await executeCommand("Project_Execute", { Project_Command: PROJECT_CMD.stop }, what))) return;
+  if (!(await projectFinished(what))) return;
+  if (!(await executeCommand("Project_Execute", { Project_Command: PROJECT_CMD.play }, what))) return;
+  if (await projectFinished(what)) message(`${what}: Done – the robot project runs again; the PLC reconnects to its Listen node.`, "ok");
+}
+
+function projectFinished(what) {
+  const firstPoll = live.polls + 2, deadline = Date.now() + 10000;
+  return new Promise((resolve) => {
+    const check = async () => {
+      const v = live.values;
+      if (live.polls >= firstPoll && (v.Project_Done === true || v.Project_Error === true)) {
+        const ok = v.Project_Done === true;
+        if (!ok) message(`${what}: Error ${idText(v.Project_ErrorID)} – ${v.Project_ErrorDescrip || ""}. ` +
+          operatorRemedy(v.Project_ErrorID), "error");
+        try { await api("/api/write", { values: { Project_Execute: false } }); } catch (e) { /* reported below */ }
+        resolve(ok);
+      } else if (Date.now() > deadline) {
+        message(`${what}: the robot did not answer within 10 s.`, "error");
+        resolve(false);
+      } else setTimeout(check, POLL_MS);
+    };
+    setTimeout(check, POLL_MS);
+  });
 }
 
 function drawRobotTile() {
@@ -189,6 +223,11 @@ function drawRobotTile() {
     if (el.textContent !== text) el.textContent = text;
     el.className = bad ? "bad" : "";
   };
+  document.getElementById("btn-back-to-node").hidden = live.robot !== "left the Listen node";
+  if (!live.online && !live.fault) {
+    for (const id of ["robot-project", "robot-error", "robot-safety", "robot-link"]) set(id, "####", false);
+    return;
+  }
   set("robot-project", !valid ? "unknown (no Ethernet Slave data)" :
     rs.ProjectRunning ? (rs.ProjectPaused ? "paused" : "running") + ` at ${rs.ProjectSpeed} %` : "stopped",
   valid && !rs.ProjectRunning);
@@ -196,20 +235,25 @@ function drawRobotTile() {
     valid && rs.RobotError);
   set("robot-safety", !valid ? "—" : `${rs.EStop ? "E-STOP pressed" : "E-stop released"}, ${rs.AutoMode ? "auto" : "manual"} mode`,
     valid && rs.EStop);
-  set("robot-link", v.Connect_Connected ? "Listen node connected" :
-    v.Connect_Reconnecting ? "reconnecting …" : "Listen node not connected", !v.Connect_Connected);
+  set("robot-link", !v.Connect_Connected ? (v.Connect_Reconnecting ? "reconnecting …" : "Listen node not connected") :
+    v.Robot_InListenNode === false ? "connected, robot outside its Listen node" : "Listen node connected",
+  !v.Connect_Connected || v.Robot_InListenNode === false);
 }
+const ROBOT_TILE_VARS = ["RobotStatus_Valid", "RobotStatus", "Connect_Reconnecting", "Connect_Connected",
+  "Robot_InListenNode", "Project_Busy", "Project_Done", "Project_Error", "Project_ErrorID", "Project_ErrorDescrip"];
 
 /* ---------- the FB's answer on the message line ---------- */
+function errorMessage(what, v, group) {
+  const id = v[`${group}_ErrorID`], remedy = operatorRemedy(id);
+  return `${what}: Error ${idText(id)} – ${v[`${group}_ErrorDescrip`] || ""}.${remedy ? " " + remedy : ""}`;
+}
+
 function watchResult(group, what, doneText) {      // doneText: what Done means for this command
   const firstPoll = live.polls + 2, deadline = Date.now() + 30000;
   const check = () => {
     const v = live.values;
     if (live.polls >= firstPoll) {
-      if (v[`${group}_Error`] === true) {
-        message(`${what}: Error ${idText(v[`${group}_ErrorID`])} – ${v[`${group}_ErrorDescrip`] || ""}`, "error");
-        return;
-      }
+      if (v[`${group}_Error`] === true) { message(errorMessage(what, v, group), "error"); return; }
       if (v[`${group}_CommandAborted`] === true) {
         message(`${what}: aborted (CommandAborted) – a stop cleared it, or a new command replaced it.`, "error");
         return;
@@ -220,7 +264,7 @@ function watchResult(group, what, doneText) {      // doneText: what Done means 
       }
     }
     if (Date.now() < deadline) setTimeout(check, POLL_MS);
-    else message(`${what}: sent; no result within 30 s (the FB is still busy).`);
+    else message(`${what}: sent; no result within 30 s (the robot is still busy with it).`);
   };
   setTimeout(check, POLL_MS);
 }

@@ -20,7 +20,7 @@ const LABELS = {
 const HOME = { X: 400, Y: 0, Z: 400, RX: 180, RY: 0, RZ: 90 };
 const T = (x, y, z, rx = 180, ry = 0, rz = 90) => ({ X: x, Y: y, Z: z, RX: rx, RY: ry, RZ: rz });
 const MOTION = { MovementCommand: 1, DataFormat: 1, Speed: 50, AccelTime: 200, BlendingEnable: false,
-  BlendingValue: 0, PrecisePositioning: false, RobotPoseEnable: false, ExitNode: false };
+  BlendingValue: 0, PrecisePositioning: false, RobotPoseEnable: false };   // ExitNode: engineer only, left as it is
 const PNP_SEGMENTS = ["Approach pick", "Pick", "Retreat", "Approach place", "Place", "Retreat"];
 const PNP_PRESET = [        // same cycle as the initial values in examples/GlobalVariables.st
   { ...MOTION, TargetPosition: T(350, -200, 400), BlendingEnable: true, BlendingValue: 50 },
@@ -64,14 +64,18 @@ const PAGES = {
       "Open Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: false, Immediate: false,
       WaitUntilSet: true, ExitNode: false } } },
   stop: { title: "Stop Motion", group: "Stop", param: "Stop_Param", legend: "Stop Settings", execLabel: "Stop",
-    release: true,           // a push button: Execute is reset once the stop is done, which releases the robot
+    release: "the robot stopped and its queue is cleared",   // a push button: Execute is reset once the stop is
+                             // done, which releases the robot
     presets: { "Stop Immediately": { Mode: 1 }, "Stop and Discard All": { Mode: 3 } } },
 };
 const DEFAULT_STATUS = ["Busy", "Done", "CommandAborted", "Error", "ErrorID", "ErrorDescrip", "CmdID_Ack"];
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
 let MAP = null;
-const live = { values: {}, online: false, fault: null, listeners: [], kick: null, polls: 0 };
+/* online: the last read was answered; robot: the server's summary of the robot (connected, Listen node, project);
+   clock: the controller's date and time of the last answer; lostAt: when the answers stopped (browser time) */
+const live = { values: {}, online: false, fault: null, listeners: [], kick: null, polls: 0, robot: "", clock: "",
+  lostAt: 0 };
 
 /* ---------- server access ---------- */
 /* The access key comes in the address printed at start-up (…/#key=…): kept for this browser tab only and
@@ -89,13 +93,17 @@ function takeAccessKey() {
 const ROLE_RANK = { monitor: 0, operator: 1, engineer: 2 };
 function mayWrite(path) {
   const spec = MAP.variables[path.split(/[.[]/)[0]];
-  return Boolean(spec) && ROLE_RANK[ACCESS.role] >= ROLE_RANK[spec.role || "operator"];
+  if (!spec) return false;
+  const member = path.split(".").pop();           // ExitNode: engineer only in every structure (server checks too)
+  const needed = (MAP.engineering_members || []).includes(member) ? "engineer" : spec.role || "operator";
+  return ROLE_RANK[ACCESS.role] >= ROLE_RANK[needed];
 }
 
-async function api(path, body) {
+async function api(path, body, timeoutMs) {
   const headers = ACCESS.key ? { "X-HMI-Key": ACCESS.key } : {};
   const options = body === undefined ? { headers } :
     { method: "POST", headers: { ...headers, "Content-Type": "application/json" }, body: JSON.stringify(body) };
+  if (timeoutMs) options.signal = AbortSignal.timeout(timeoutMs);
   let response;
   try { response = await fetch(path, options); }
   catch (e) { throw new Error("No answer from the PLC web server: check that the demo is running"); }
@@ -103,7 +111,9 @@ async function api(path, body) {
   if (!data.ok) throw new Error(data.error || `HTTP ${response.status}`);
   return data;
 }
-const readVars = (names) => api("/api/read?names=" + names.map(encodeURIComponent).join(","));
+/* A poll not answered within READ_TIMEOUT_MS counts as "no answer": the values turn invalid within a second. */
+const READ_TIMEOUT_MS = 800;
+const readVars = (names) => api("/api/read?names=" + names.map(encodeURIComponent).join(","), undefined, READ_TIMEOUT_MS);
 
 function message(text, kind = "") {
   const el = document.getElementById("message");
@@ -307,8 +317,19 @@ function statusTable(title, rows) {
   return div;
 }
 
+/* Without answers from the PLC no value is shown as if it were valid: texts read ####, lamps go grey
+   (data-value "invalid"), and the panel is hatched (style.css, .plc-offline). */
 function showStatus() {
+  const invalid = !live.online && !live.fault;
   for (const cell of document.querySelectorAll("[data-status]")) {
+    if (invalid) {
+      if (cell.classList.contains("lamp") || cell.querySelector(".led")) {
+        cell.dataset.value = "invalid";
+        const led = cell.querySelector(".led");
+        if (led) led.classList.remove("on");
+      } else if (cell.textContent !== "####") cell.textContent = "####";
+      continue;
+    }
     const v = live.values[cell.dataset.status];
     if (cell.classList.contains("lamp")) { cell.dataset.value = String(v === true); continue; }
     const led = cell.querySelector(".led");
@@ -325,16 +346,29 @@ function showStatus() {
 /* ---------- PLC state in the header ---------- */
 /* After a major fault the PLC stops scanning and closes its sockets; the server stays up and says so
    (docs/hmi.md, "PLC fault"): the header names the fault, the page is greyed out as no longer valid. */
+/* The robot pill says the robot's real state, as the server sums it up from CBT_Connect, the Listen-node flag
+   and CBT_RobotStatus: grey when it can take commands (connected, in its Listen node, project running), amber or
+   red when not. Without answers from the PLC it is unknown. */
+const ROBOT_PILL = { ready: ["Robot ready", ""], connected: ["Robot connected", ""],
+  "not connected": ["Robot not connected", "warn"], "left the Listen node": ["Robot left Listen node", "alarm"],
+  "project stopped": ["Robot project stopped", "warn"], "E-stop": ["Robot E-stop", "alarm"],
+  "robot error": ["Robot error", "alarm"], unknown: ["Robot …", ""] };
 function showPlcState(pillPlc, pillRobot) {
-  const fault = live.fault;
+  const fault = live.fault, lost = !live.online && !fault;
   const what = fault ? (fault.what.length > 40 ? fault.what.slice(0, 39) + "…" : fault.what) : "";
   pillPlc.textContent = fault ? `PLC fault — ${what}` : live.online ? "PLC online" : "PLC offline";
   pillPlc.title = fault ? fault.message : "";
-  pillPlc.className = "pill " + (live.online ? "on" : "off");
-  const connected = !fault && live.values.Connect_Connected === true;
-  pillRobot.textContent = fault ? "Robot link closed" : connected ? "Robot connected" : "Robot not connected";
-  pillRobot.className = "pill " + (connected ? "on" : "off");
+  pillPlc.className = "pill " + (live.online ? "" : "alarm");
+  const [text, kind] = fault ? ["Robot link closed", "alarm"] : lost ? ["Robot ####", ""] :
+    ROBOT_PILL[live.robot] || ROBOT_PILL.unknown;
+  if (pillRobot.textContent !== text) pillRobot.textContent = text;
+  pillRobot.className = "pill " + kind;
   const panel = document.querySelector(".panel");
+  if (lost !== panel.classList.contains("plc-offline")) {
+    panel.classList.toggle("plc-offline", lost);
+    message(lost ? "No answer from the PLC: the values shown as #### are not valid; nothing can be sent." :
+      "The PLC answers again.", lost ? "error" : "");
+  }
   if (Boolean(fault) !== panel.classList.contains("plc-fault")) {
     panel.classList.toggle("plc-fault", Boolean(fault));
     if (fault) message(`PLC major fault: ${fault.message}. The PLC has stopped: the values shown are the last `
@@ -344,7 +378,7 @@ function showPlcState(pillPlc, pillRobot) {
 
 /* ---------- polling ---------- */
 function startPolling(names) {
-  names = [...new Set([...names, ...alarmVariables()].filter((n) => MAP.variables[n]))];
+  names = [...new Set(names.filter((n) => MAP.variables[n]))];
   const pillPlc = document.getElementById("pill-plc"), pillRobot = document.getElementById("pill-robot");
   async function tick() {
     try {
@@ -353,10 +387,17 @@ function startPolling(names) {
       live.polls += 1;
       live.fault = data.plc === "fault" ? data.fault : null;
       live.online = !live.fault;          // after a major fault the values are the last ones, no longer valid
-    } catch (e) { live.online = false; live.fault = null; }
+      live.robot = data.robot;
+      live.clock = data.clock;
+      live.lostAt = 0;
+      alarmsAfterRead(data);
+    } catch (e) {
+      live.online = false; live.fault = null;
+      live.lostAt = live.lostAt || Date.now();
+      alarmsAfterRead(null);
+    }
     showPlcState(pillPlc, pillRobot);
     showStatus();
-    checkAlarms();
     for (const f of live.listeners) f();
     const timer = setTimeout(next, POLL_MS);
     live.kick = () => { clearTimeout(timer); next(); };   // poll at once after a command was sent
@@ -392,7 +433,7 @@ function mainPage() {
   robotTile(document.getElementById("robotview"));
   document.querySelector("header h1").insertAdjacentHTML("afterend",
     '<a class="menu" id="nav-program" href="program.html">Program (Ladder)</a>');
-  startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", ...ROBOT_STATUS]);
+  startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", ...ROBOT_STATUS, ...ROBOT_TILE_VARS]);
 }
 
 /* the robot's state on every page: In Listen node, Paused, Stopping, queue depth, last ErrorID */
@@ -429,21 +470,20 @@ async function executeCommand(execVar, values, what) {
 /* Push-button commands (CBT_Stop): reset Execute once Done or Error shows (within 10 s), after holding it
    HOLD_DONE_MS so the operator sees Done on the page before the FB clears it. */
 const HOLD_DONE_MS = 1500;
-function releaseWhenFinished(group, what) {
+function releaseWhenFinished(group, what, doneText) {
   const deadline = Date.now() + 10000, firstPoll = live.polls + 2;   // values read after the command was sent
   const check = async () => {
     const v = live.values;
     const finished = live.polls >= firstPoll && (v[`${group}_Done`] === true || v[`${group}_Error`] === true);
     if (!finished && Date.now() < deadline) { setTimeout(check, POLL_MS); return; }
     if (finished && v[`${group}_Done`] === true) {
-      message(`${what}: Done – the robot stopped and its queue is cleared; releasing the robot …`, "ok");
+      message(`${what}: Done – ${doneText}; releasing …`, "ok");
       await new Promise((resume) => setTimeout(resume, HOLD_DONE_MS));
     }
     try {
       await api("/api/write", { values: { [`${group}_Execute`]: false } });
-      if (finished && v[`${group}_Error`] === true)
-        message(`${what}: Error ${idText(v[`${group}_ErrorID`])} – ${v[`${group}_ErrorDescrip`] || ""}; Execute reset.`, "error");
-      else if (finished) message(`${what}: done, Execute reset.`, "ok");
+      if (finished && v[`${group}_Error`] === true) message(errorMessage(what, v, group), "error");
+      else if (finished) message(`${what}: Done – ${doneText}.`, "ok");
       else message(`${what}: no answer within 10 s; Execute reset.`, "error");
     } catch (e) { message(`${what}: cannot reset Execute: ${e.message}`, "error"); }
   };
@@ -477,7 +517,8 @@ async function fbPage(key) {
       if (page.param) fillFrom(params, page.param, page.presets[name]);
       else for (const [v, val] of Object.entries(page.presets[name])) setInput(params.querySelector(`[data-path="${v}"]`), val);
       refreshLimits(params, page.param || "");
-      message(`${name}: fields filled, press ${page.execLabel || "Execute"} to send.`);
+      message(exec.disabled ? `${name}: fields filled; sending them needs ${ACCESS.role === "monitor" ?
+        "the operator address" : "the engineer address"}.` : `${name}: fields filled, press ${page.execLabel || "Execute"} to send.`);
     };
     buttons.append(b);
   });
@@ -489,7 +530,7 @@ async function fbPage(key) {
     const result = collect(params, page.param || "");
     if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
     executeCommand(`${group}_Execute`, result.values, page.title).then((sent) => {
-      if (sent && page.release) releaseWhenFinished(group, page.title);
+      if (sent && page.release) releaseWhenFinished(group, page.title, page.release);
       else if (sent) watchResult(group, page.title, page.done && page.done(formContext(params, page.param)));
     });
   };

@@ -117,6 +117,8 @@ def test_preset_and_execute_show_done(page):
 
 def test_connect_and_disconnect_update_the_connection_status(page):
     plc, open_page = page
+    with plc.lock:
+        plc.vars["Robot_InListenNode"] = True           # the header says connected only with the robot in its node
     browser = open_page("connect")
     browser.click("btn-preset")
     browser.click("btn-execute")
@@ -124,6 +126,7 @@ def test_connect_and_disconnect_update_the_connection_status(page):
     browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the header pill")
     browser.click("btn-disconnect")
     browser.wait_status("Connect_Connected", "false")
+    browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot not connected", "the header pill")
 
 
 def test_pnp_segment_edit_writes_only_that_segment(page):
@@ -142,21 +145,25 @@ def test_pnp_segment_edit_writes_only_that_segment(page):
     assert {path.split("]")[0] for path, _ in plc.writes} == {"PnP_MoveParameters[4"}
 
 
-def test_alarm_history_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
-    """Six alarms raised one after the other (a command FB's Error with a new ErrorID each time): the history on the
-    main page shows at least five of them whole, one line each, scrolls only vertically, the page still fits the
-    panel, and a tapped row shows its whole text on the message line."""
+def alarm_rows(browser):
+    rows = browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
+    return [] if rows == ["No alarms."] else rows
+
+
+def test_alarm_list_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
+    """Six alarms raised one after the other (a command FB's Error with a new ErrorID each time, each an alarm of the
+    server's list): the list on the main page shows at least five of them whole, one line each, scrolls only
+    vertically, the page still fits the panel, and a tapped row shows its whole text on the message line."""
     plc, open_page = page
     browser = open_page("index")
-    browser.driver.execute_script("alarms.list.length = 0; alarms.active = {}; saveAlarms(); drawAlarms();")
-    texts = ["Speed out of range: 1..100 % for a PTP format, 1..4500 mm/s for a line or a circle",
-             "Connection lost: the robot did not answer the status query within 1 s"] * 3
+    ids = [0x3001, 0x3002, 0x3003, 0x3005, 0x3006, 0x3007]
+    texts = ["No reply from the robot within ReplyTimeout: check the robot before repeating the command",
+             "Malformed frame received from the robot (skipped): check the network between PLC and robot"] * 3
     try:
-        for n, text in enumerate(texts, 1):
+        for n, (error_id, text) in enumerate(zip(ids, texts), 1):
             with plc.lock:
-                plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=0x1010 + n, MoveAbs_ErrorDescrip=text)
-            browser.wait_for(lambda d: len(d.find_element(By.ID, "alarm-history").find_elements(By.TAG_NAME, "tr"))
-                             == n + 1, f"alarm {n} in the history")
+                plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=error_id, MoveAbs_ErrorDescrip=text)
+            browser.wait_for(lambda d: len(alarm_rows(browser)) == n, f"alarm {n} in the list")
         whole, one_line, box_scrolls_sideways = browser.driver.execute_script("""
             const table = document.getElementById('alarm-history');
             let box = table;
@@ -164,50 +171,53 @@ def test_alarm_history_shows_five_whole_rows_without_a_horizontal_scrollbar(page
             const b = box.getBoundingClientRect(), rows = [...table.rows].slice(1);
             const whole = rows.filter((r) => { const q = r.getBoundingClientRect();
               return q.top >= b.top - 0.5 && q.bottom <= b.bottom + 0.5; }).length;
-            const line = parseFloat(getComputedStyle(rows[0].cells[1]).lineHeight);
+            const line = parseFloat(getComputedStyle(rows[0].cells[2]).lineHeight);
             return [whole, rows.every((r) => r.getBoundingClientRect().height <= line + 2),
                     box.scrollWidth > box.clientWidth];""")
         assert whole >= 5 and one_line and not box_scrolls_sideways, (whole, one_line, box_scrolls_sideways)
         assert browser.viewport_overflow() == []
-        browser.screenshot("fake_index_alarm_history")
+        browser.screenshot("fake_index_alarm_list")
         browser.driver.find_element(By.ID, "alarm-history").find_elements(By.TAG_NAME, "tr")[2].click()
         browser.wait_for(lambda d: texts[4] in browser.message(), "the tapped alarm on the message line")
-        assert "16#1015" in browser.message()
+        assert "16#3006" in browser.message() and "Check the robot (position, gripper)" in browser.message()
     finally:
         with plc.lock:
             plc.vars.update(MoveAbs_Error=False, MoveAbs_ErrorID=0, MoveAbs_ErrorDescrip="")
         browser.click("btn-alarm-ack-all")
+        browser.wait_for(lambda d: alarm_rows(browser) == [], "the list empty")
 
 
-def test_a_first_connect_retried_is_not_called_a_lost_connection(page):
+def test_a_first_connect_retried_is_not_called_a_lost_connection(page, stack):
     """CBT_Connect retries a first connect that failed at Time_Out (Execute held, Reconnecting TRUE, never
-    connected): the one connection alarm says "Not connected, retrying"; after the link was up, a loss says
-    "Connection lost, reconnecting"."""
+    connected): the one connection alarm says "Not connected to the robot, retrying"; after the link was up, a loss
+    says "Connection to the robot lost, reconnecting" (in the same alarm while it waits for its acknowledge)."""
     plc, open_page = page
     with plc.lock:
-        plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=1,
-                        Connect_Error=True, Connect_ErrorID=0x2004, Connect_ErrorDescrip="Robot not reachable")
+        plc.vars.update(Connect_Execute=True, Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=1,
+                        Connect_Error=True, Connect_ErrorID=0x2004, Connect_ErrorDescrip="Robot not reachable",
+                        Robot_InListenNode=True)
+        plc._edges = {"Connect": True}                # the fake program must not connect it: Execute is "held"
+    stack[1].alarms._was_connected = False            # as after a start: the tests before connected
     browser = open_page("index")
-    browser.driver.execute_script("alarms.list.length = 0; alarms.active = {}; alarms.sawConnected = false; "
-                                  "saveAlarms(); drawAlarms();")
-
-    def rows():
-        return browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
     try:
-        browser.wait_for(lambda d: any("Not connected, retrying (attempt 1)" in r for r in rows()), "the retry alarm")
-        with plc.lock:                  # the fake PLC connects on the Execute edge and holds it while Execute
-            plc.vars.update(Connect_Execute=True, Connect_Reconnecting=False, Connect_Error=False,
+        browser.wait_for(lambda d: any("Not connected to the robot, retrying (attempt 1)" in r
+                                       for r in alarm_rows(browser)), "the retry alarm")
+        with plc.lock:
+            plc.vars.update(Connect_Connected=True, Connect_Reconnecting=False, Connect_Error=False,
                             Connect_ErrorID=0, Connect_ErrorDescrip="")
         browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the link up")
-        browser.wait_for(lambda d: rows() and rows()[0].endswith("gone"), "the retry alarm gone")
+        browser.wait_for(lambda d: alarm_rows(browser)[0].endswith("returned, unacknowledged"), "the retry alarm back")
         with plc.lock:
             plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=0,
                             Connect_Error=True, Connect_ErrorID=0x2006, Connect_ErrorDescrip="Link lost")
-        browser.wait_for(lambda d: any("Connection lost, reconnecting — Link lost" in r for r in rows()),
-                         "the outage alarm")
-        assert len(rows()) == 2, rows()
+        browser.wait_for(lambda d: any("Connection to the robot lost, reconnecting — Link lost" in r
+                                       for r in alarm_rows(browser)), "the outage alarm")
+        rows = alarm_rows(browser)            # not acknowledged yet: the same alarm is active again (ISA-18.2)
+        assert len(rows) == 1 and rows[0].endswith("active, unacknowledged"), rows
     finally:
         with plc.lock:
             plc.vars.update(Connect_Execute=False, Connect_Reconnecting=False, Connect_Error=False, Connect_ErrorID=0,
-                            Connect_ErrorDescrip="", Connect_RetryCount=0)
+                            Connect_ErrorDescrip="", Connect_RetryCount=0, Connect_Connected=False)
+        browser.wait_for(lambda d: all("returned" in r for r in alarm_rows(browser)), "the alarms returned")
         browser.click("btn-alarm-ack-all")
+        browser.wait_for(lambda d: alarm_rows(browser) == [], "the list empty")
