@@ -9,6 +9,7 @@ from ..frontend import types as T
 from ..frontend.builtins import default_string
 from . import data_size, duplicates, undeclared
 from .consteval import const_int
+from . import union_member
 from .scope import GENERIC_TYPES, Ambiguous
 from .symbols import VarSymbol
 
@@ -75,7 +76,7 @@ class Declarer:
     def shell_type(self, decl: A.TypeDecl, ns: str | None) -> T.Type:
         spec = decl.spec
         if isinstance(spec, A.StructTypeRef):
-            return T.StructType(decl.name, decl=decl, namespace=ns)
+            return T.StructType(decl.name, decl=decl, namespace=ns, kind="union" if spec.union else "struct")
         if isinstance(spec, A.EnumTypeRef):
             return T.EnumType(decl.name, decl=decl, namespace=ns)
         return T.AliasType(decl.name, decl=decl, namespace=ns)
@@ -171,6 +172,8 @@ class Declarer:
                 duplicates.report(self.ctx, "member", f.name, f.span, None)
                 continue
             st.fields[f.name.upper()] = T.StructField(f.name, ftype, f.init, f)
+            if st.kind == "union":
+                union_member.check(self.ctx, st, f, ftype)
 
     # ---- type references ----------------------------------------------------------------------
     def resolve(self, ref: A.TypeRef, unit, scope) -> T.Type:
@@ -240,7 +243,7 @@ class Declarer:
             self.fill_enum(enum, ref, unit)
             return enum
         if isinstance(ref, A.StructTypeRef):
-            st = T.StructType("STRUCT")
+            st = T.StructType("UNION" if ref.union else "STRUCT", kind="union" if ref.union else "struct")
             self.fill_struct(st, ref, unit)
             return st
         return T.ERROR

@@ -121,6 +121,9 @@ class CodeGen(ExprGen):
 
     # ---- structures ---------------------------------------------------------------------------
     def gen_struct(self, t: T.StructType) -> None:
+        if t.kind == "union":
+            self.gen_union(t)
+            return
         name = self.struct_name(t)
         self.emit(f"class {name}:")
         self.ind += 1
@@ -149,6 +152,34 @@ class CodeGen(ExprGen):
         for f in t.fields.values():
             a = attr(f.name)
             self.emit(self.field_assign(f"o.{a}", f"v.{a}", f.type))
+        self.ind -= 1
+
+    def gen_union(self, t: T.StructType) -> None:
+        """A Sysmac union: one memory image (the cell ``i__m``), each member a property reading and writing its
+        bits of it (runtime/unions.py; W501 6-3-6)."""
+        name = self.struct_name(t)
+        self.emit("from vplc.runtime.unions import member_property as _uprop, members as _umembers")
+        self.emit(f"class {name}:")
+        self.ind += 1
+        self.emit("def __init__(s):")
+        self.ind += 1
+        self.emit("s.i__m = [0]")
+        self.ind -= 1
+        self.emit("i__members = _umembers")
+        self.ind -= 1
+        for f in t.fields.values():
+            layout = T.union_layout(f.type)
+            if layout is not None:
+                self.emit(f"{name}.{attr(f.name)} = _uprop{layout!r}")
+        self.emit(f"def C{name[1:]}(v):")
+        self.ind += 1
+        self.emit(f"o = _new({name})")
+        self.emit("o.i__m = [v.i__m[0]]")
+        self.emit("return o")
+        self.ind -= 1
+        self.emit(f"def A{name[1:]}(o, v):")
+        self.ind += 1
+        self.emit("o.i__m[0] = v.i__m[0]")
         self.ind -= 1
 
     def assign_code(self, dst: str, src: str, t) -> str:

@@ -156,7 +156,8 @@ def _data_type(parent: ET.Element, item: TypeItem, project) -> None:
     _doc(el, item.comment)
     spec = decl.spec
     if isinstance(spec, A.StructTypeRef):
-        ts = _sub(el, "UserDefinedTypeSpec", {"xsi:type": "StructTypeSpec"})
+        ts = _sub(el, "UserDefinedTypeSpec", {"xsi:type": "StructTypeSpec", **({"overlap": "true"} if spec.union
+                                                                               else {})})
         for f in spec.fields:
             _variable(ts, "Member", f, item.member_comments.get(id(f), ""))
     elif isinstance(spec, A.EnumTypeRef):

@@ -110,8 +110,10 @@ class EnumTypeRef(TypeRef):
 
 @dataclass(eq=True)
 class StructTypeRef(TypeRef):
+    """STRUCT ... END_STRUCT, or UNION ... END_UNION (``union``: the members share one memory image, W501)."""
     fields: list["VarDecl"]
     span: Span = _ann()
+    union: bool = False
 
 
 # ----------------------------------------------------------------------------------------------

@@ -229,21 +229,23 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                 length = self.expression()
                 self.expect_op(")", "to close the string length")
             return A.StringTypeRef(t.up == "WSTRING", length, span=self.span_from(start))
-        if t.kind == "IDENT" and t.up == "STRUCT":
+        if t.kind == "IDENT" and t.up in ("STRUCT", "UNION"):
             self.advance()
+            union = t.up == "UNION"          # Sysmac union (W501 6-3-6): the members overlap in memory
+            end = "END_UNION" if union else "END_STRUCT"
             fields: list[A.VarDecl] = []
-            while not self.at_kw("END_STRUCT"):
+            while not self.at_kw(end):
                 if self.tok.kind == "EOF" or self.at_kw("END_TYPE"):
-                    self.diags.error("ST0202", f"missing `END_STRUCT`; found {self.describe(self.tok)}",
+                    self.diags.error("ST0202", f"missing `{end}`; found {self.describe(self.tok)}",
                                      self.tok_span())
-                    return A.StructTypeRef(fields, span=self.span_from(start))
+                    return A.StructTypeRef(fields, span=self.span_from(start), union=union)
                 before = self.i
                 try:
                     fields.extend(self.var_decl())
                 except ParseError:
-                    self.skip_declaration("END_STRUCT", before)
+                    self.skip_declaration(end, before)
             self.advance()
-            return A.StructTypeRef(fields, span=self.span_from(start))
+            return A.StructTypeRef(fields, span=self.span_from(start), union=union)
         if t.kind == "OP" and t.text == "(":
             values = self.enum_values()
             base = None

@@ -97,7 +97,8 @@ def type_ref(t: A.TypeRef, level: int = 0) -> str:
         return f"({vals})" + (f" {type_ref(t.base)}" if t.base is not None else "")
     if isinstance(t, A.StructTypeRef):
         pad = IND * (level + 1)
-        lines = ["STRUCT"] + [pad + IND + var_decl(f, level + 1) for f in t.fields] + [pad + "END_STRUCT"]
+        word = "UNION" if t.union else "STRUCT"
+        lines = [word] + [pad + IND + var_decl(f, level + 1) for f in t.fields] + [pad + "END_" + word]
         return "\n".join(lines)
     raise TypeError(f"cannot print {type(t).__name__}")
 

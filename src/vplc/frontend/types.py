@@ -447,3 +447,24 @@ def literal_fits(value: int, t: Type) -> bool:
     if isinstance(t, ElementaryType) and t.kind in ("int", "uint", "bit"):
         return t.lo <= value <= t.hi
     return True
+
+
+UNION_KINDS = ("bool", "bit", "int", "uint", "real", "time")
+
+
+def union_layout(t: Type) -> tuple[str, int, int | None] | None:
+    """How a member of a Sysmac UNION lies in the union's memory image (W501 6-3-6): (kind read back — bool,
+    int, uint or real —, bits per element, element count of a one-dimensional array member or None), or None
+    for a type vplc cannot overlay (STRING, structures, enumerations, dates, multi-dimensional arrays)."""
+    u = unalias(t)
+    count = None
+    if isinstance(u, ArrayType):
+        if u.open or len(u.dims) != 1:
+            return None
+        count = u.count()
+        u = unalias(u.element)
+    b = base_of(u)
+    if not isinstance(b, ElementaryType) or b.kind not in UNION_KINDS:
+        return None
+    kind = {"time": "int", "bit": "uint"}.get(b.kind, b.kind)
+    return kind, b.bits, count

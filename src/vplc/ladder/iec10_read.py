@@ -205,12 +205,11 @@ def _data_type(dt: ET.Element) -> TypeText:
                               "other than the NJ layout are not modelled by vplc (its structures have no memory "
                               "layout); use offsetType NJ")
     _add_data(dt, where)
-    if kind == "StructTypeSpec" and spec.get("overlap", "false") in ("true", "1"):
-        raise FormatError(where, 'StructTypeSpec overlap="true" (a UNION: members sharing memory) is not modelled '
-                          "by this reader; declare it in ST as UNION or use a structure")
     if kind == "StructTypeSpec":
+        # overlap="true": Sysmac's union, the members sharing one memory image (W501 6-3-6)
+        word = "UNION" if spec.get("overlap", "false") in ("true", "1") else "STRUCT"
         fields = "".join(f"    {_line(_var(m, where))}\n" for m in spec.iterfind("Member"))
-        text = f"STRUCT\n{fields}END_STRUCT"
+        text = f"{word}\n{fields}END_{word}"
     elif kind == "EnumTypeWithNamedValueSpec":
         values = ", ".join(f"{e.get('name')} := {e.get('value')}" for e in spec.iterfind("Enumerator"))
         text = f"({values})" + _enum_base(spec.find("BaseType"), where)

@@ -110,7 +110,8 @@ class Resolver:
                 where = getattr(value, "i__path", None) or getattr(getattr(value, "i__type", None), "name", "value")
                 raise PathError(f"`{shown}` is not a variable of {where} (in {path!r})")
             attr, cur_t = ent
-            container, key = value.__dict__, attr
+            # a union's members live in its memory image: it lends a mapping view of them (runtime/unions.py)
+            container, key = getattr(value, "i__members", None) or value.__dict__, attr
             if key + "__r" in container:                 # scalar VAR_IN_OUT: follow the reference
                 container, key = container[key + "__r"], container[key + "__k"]
             for idx in indexes:

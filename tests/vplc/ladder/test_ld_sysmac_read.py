@@ -109,11 +109,18 @@ def test_negated_with_a_value_that_is_not_a_boolean_is_refused(tmp_path):
     refused(write(tmp_path, iec10_program({"A": "BOOL", "Q": "BOOL"}, rungs)), "contact A", 'negated="yes"')
 
 
-def test_a_union_is_refused_not_read_as_a_structure(tmp_path):
+def test_a_union_is_read_as_a_union_its_members_sharing_memory(tmp_path):
+    """overlap="true" is Sysmac's union (W501 6-3-6): writing W changes B, its low byte."""
     t = ('<DataTypeDecl name="uWord"><UserDefinedTypeSpec xsi:type="StructTypeSpec" overlap="true">'
          '<Member name="W"><Type><TypeName>WORD</TypeName></Type></Member>'
          '<Member name="B"><Type><TypeName>BYTE</TypeName></Type></Member></UserDefinedTypeSpec></DataTypeDecl>')
-    refused(write(tmp_path, doc(t)), "data type uWord", 'overlap="true"', "UNION")
+    st = tmp_path / "use.st"
+    st.write_text("PROGRAM Main\nVAR u : uWord; b : BYTE; END_VAR\nu.W := 16#1234; b := u.B;\nEND_PROGRAM\n")
+    xml = write(tmp_path, doc(t))
+    assert diagnostics(xml, st) == []
+    plc = load_plc([str(xml), str(st)], task="Main@1ms")
+    plc.scan(0)
+    assert plc.read("Main.b") == 0x34
 
 
 @pytest.mark.parametrize("offset, ok", [("NJ", True), ("CJ", False), ("User", False)])

@@ -93,3 +93,42 @@ END_FUNCTION_BLOCK
     from vplc.project import load_project
     (tmp_path / "w.st").write_text(fb.replace("    Q := ", "    Limit := 1;\n    Q := "))
     assert [d.code for d in load_project([str(tmp_path / "w.st")]).diagnostics if d.severity == "error"] == ["ST1301"]
+
+
+UNIONS = """TYPE
+    uWord : UNION
+        W : WORD;
+        Bits : ARRAY[0..15] OF BOOL;
+        Bytes : ARRAY[0..1] OF BYTE;
+        I : INT;
+    END_UNION;
+    uReal : UNION
+        R : REAL;
+        D : DWORD;
+    END_UNION;
+END_TYPE
+"""
+
+
+def test_union_members_share_one_memory_image(tmp_path):
+    """W501 6-3-6 / W506 A-5-1: the members of a union overlap in the same memory locations."""
+    plc = run1(tmp_path, """u.W := 16#8001; a := u.Bits[0]; b := u.Bits[15]; n := u.I;
+        u.Bits[1] := TRUE; v := u; lo := v.Bytes[0]; hi := v.Bytes[1];
+        r.R := 1.0; d := r.D; r.D := 16#40490FDB; x := r.R;""",
+               "u, v : uWord; r : uReal; a, b : BOOL; n : INT; lo, hi : BYTE; d : DWORD; x : REAL;", UNIONS)
+    assert plc.read("Main.a") is True and plc.read("Main.b") is True and plc.read("Main.n") == -32767
+    assert (plc.read("Main.lo"), plc.read("Main.hi")) == (0x03, 0x80)
+    assert plc.read("Main.d") == 0x3F800000 and abs(plc.read("Main.x") - 3.14159265) < 1e-6
+
+
+def test_a_union_written_by_name_updates_every_member(tmp_path):
+    plc = plc_from(tmp_path, "w := u.W;", "u : uWord; w : WORD;", UNIONS)
+    plc.write("Main.u.Bits[2]", True)
+    plc.scan(0)
+    assert plc.read("Main.w") == 4 and plc.read("Main.u.I") == 4
+
+
+def test_union_members_without_a_memory_image_or_with_initial_values_are_st1109(tmp_path):
+    from vplc.project import load_project
+    (tmp_path / "u.st").write_text("TYPE uText : UNION\n    S : STRING[8];\n    W : WORD := 1;\nEND_UNION;\nEND_TYPE\n")
+    assert [d.code for d in load_project([str(tmp_path / "u.st")]).diagnostics] == ["ST1109", "ST1109"]
