@@ -114,33 +114,29 @@ def test_a_wait_queue_mark_behind_the_replaced_motions_ends_command_aborted(buf)
     assert buf.read("wait.CommandAborted") and not buf.read("wait.Done")
 
 
-def test_move_relative_aborting_replaces_a_running_move(buf):
-    buf.set_struct("MParam[1]", move_abs(TargetPosition=FAR, Speed=10))
-    buf.write("MExec[1]", True)
-    assert buf.until(lambda: buf.read("movers[1].Active"), 1)
-    buf.until(lambda: False, 0.3)
-    buf.set_struct("RelParam", rel(MovementCommand=1, DataFormat=0,
-                                   TargetPosition=dict(X=5, Y=0, Z=0, RX=0, RY=0, RZ=0)))
-    buf.write("RelMode", "Aborting")
-    buf.write("RelExec", True)
-    assert buf.until(lambda: buf.read("rel.Done") or buf.read("rel.Error"), 20)
-    assert buf.read("rel.Done"), buf.read("rel.ErrorDescrip")
-    assert buf.read("movers[1].CommandAborted")
-    assert buf.scripts_in()[-1][1].startswith('StopAndClearBuffer()\r\nMove_PTP("JPP",5,0,0,0,0,0,50,200,0,false)\r\n')
-
-
-def test_move_circle_aborting_replaces_a_running_move(buf):
-    buf.set_struct("RelParam", rel(Speed=1))                 # a slow 20.5 mm line down
-    buf.write("RelExec", True)
-    assert buf.until(lambda: buf.read("rel.Active"), 1)
+@pytest.mark.parametrize("running,aborting,script", [
+    (("movers[1]", "MExec[1]", "MParam[1]", move_abs(TargetPosition=FAR, Speed=10)),
+     ("rel", "RelExec", "RelParam", "RelMode",
+      rel(MovementCommand=1, DataFormat=0, TargetPosition=dict(X=5, Y=0, Z=0, RX=0, RY=0, RZ=0))),
+     'StopAndClearBuffer()\r\nMove_PTP("JPP",5,0,0,0,0,0,50,200,0,false)\r\nQueueTag('),
+    (("rel", "RelExec", "RelParam", rel(Speed=1)),                   # a slow 20.5 mm line down
+     ("circ", "CircExec", "CircParam", "CircMode", circ()),
+     'StopAndClearBuffer()\r\nCircle("CAP",417.5,-72.3,359.7,'),
+], ids=["MoveRelative", "MoveCircle"])
+def test_move_relative_and_circle_aborting_replace_a_running_move(buf, running, aborting, script):
+    fb, execute, param, values = running
+    buf.set_struct(param, values)
+    buf.write(execute, True)
+    assert buf.until(lambda: buf.read(f"{fb}.Active"), 1)
     buf.until(lambda: False, 0.2)
-    buf.set_struct("CircParam", circ())
-    buf.write("CircMode", "Aborting")
-    buf.write("CircExec", True)
-    assert buf.until(lambda: buf.read("circ.Done") or buf.read("circ.Error"), 20)
-    assert buf.read("circ.Done"), buf.read("circ.ErrorDescrip")
-    assert buf.read("rel.CommandAborted")
-    assert buf.scripts_in()[-1][1].startswith('StopAndClearBuffer()\r\nCircle("CAP",417.5,-72.3,359.7,')
+    new_fb, new_execute, new_param, mode, new_values = aborting
+    buf.set_struct(new_param, new_values)
+    buf.write(mode, "Aborting")
+    buf.write(new_execute, True)
+    assert buf.until(lambda: buf.read(f"{new_fb}.Done") or buf.read(f"{new_fb}.Error"), 20)
+    assert buf.read(f"{new_fb}.Done"), buf.read(f"{new_fb}.ErrorDescrip")
+    assert buf.read(f"{fb}.CommandAborted")
+    assert buf.scripts_in()[-1][1].startswith(script)
 
 
 @pytest.mark.parametrize("fb,exec_,mode,param,values", [
