@@ -27,6 +27,10 @@ from .model import Conn, Element, LadderBody, Pin, Rung
 TRUE = "TRUE"
 SERIES_MARKS = 128        # marked ranges in one series expression before a helper variable carries its power on
 COMPARE = {"GT": ">", "GE": ">=", "EQ": "=", "LT": "<", "LE": "<=", "NE": "<>"}   # IEC comparison blocks
+# Sysmac names its comparison and arithmetic blocks by their symbols (W502 2-87, 2-89: `=`, `<>`, `<`, `<=`, `>`,
+# `>=`; `+`, `-`, `*`, `/`): the same instructions as IEC's EQ ... DIV
+SYMBOL_BLOCKS = {"=": "EQ", "<>": "NE", "<": "LT", "<=": "LE", ">": "GT", ">=": "GE", "+": "ADD", "-": "SUB",
+                 "*": "MUL", "/": "DIV"}
 
 
 class LadderSource(SourceFile):
@@ -486,6 +490,7 @@ class RungCompiler:
 
     def el_block(self, e: Element) -> None:
         lab = self.label(e)
+        e.type_name = SYMBOL_BLOCKS.get(e.type_name.strip(), e.type_name)
         en = None
         args: list[Txt] = []
         values: list[Txt] = []

@@ -1,0 +1,19 @@
+"""Ladder blocks Sysmac names by their symbols (W502 2-87, 2-89): `<`, `=`, `+` ... run as LT, EQ, ADD ..."""
+from ld_xml import block, coil, invar, outvar, rail, right
+from test_ld_semantics import Run
+
+
+def test_symbol_blocks_compare_and_add_like_their_iec_names(tmp_path):
+    body = [rail(1), invar(2, "A"), invar(3, "B", y=10), block(4, "&lt;", {"In1": 2, "In2": 3}, ["Out"]),
+            coil(5, "Less", (4, "Out")), right(6, 5),
+            invar(7, "A", y=40), invar(8, "B", y=50), block(9, "=", {"In1": 7, "In2": 8}, ["Out"], y=40),
+            coil(10, "Same", (9, "Out"), y=40),
+            invar(11, "A", y=80), invar(12, "B", y=90), block(13, "+", {"In1": 11, "In2": 12}, ["Out"], y=80),
+            outvar(14, "Sum", (13, "Out"), y=80),
+            invar(15, "A", y=120), invar(16, "B", y=130), block(17, "-", {"In1": 15, "In2": 16}, ["Out"], y=120),
+            outvar(18, "Diff", (17, "Out"), y=120)]
+    r = Run(tmp_path, {"A": "INT", "B": "INT", "Less": "BOOL", "Same": "BOOL", "Sum": "INT", "Diff": "INT"}, body)
+    r.scan(A=3, B=4)
+    assert (r["Less"], r["Same"], r["Sum"], r["Diff"]) == (True, False, 7, -1)
+    r.scan(A=4, B=4)
+    assert (r["Less"], r["Same"], r["Sum"], r["Diff"]) == (False, True, 8, 0)
