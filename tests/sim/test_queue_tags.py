@@ -200,3 +200,16 @@ def test_manual_13_18_to_13_21_pvt_exit_pause_resume_outside_pvt_mode_are_reject
     assert answer("PVTResume()") == "false"
     node.send(1, sct("P", "PVTEnter(0)"))
     assert answer("PVTExit()") == "true"                               # PVTEnter still queued: accepted
+
+
+def test_manual_13_4_stop_and_clear_buffer_then_a_motion_in_one_script_runs_the_motion_and_pushes_its_tag(node):
+    """§13.4: StopAndClearBuffer() stops the robot and clears the commands already in its buffer; the lines after
+    it in the same script run as usual (CBT_Move* BufferMode Aborting): the new motion and its tag are queued after
+    the clear, the cleared tags never push and answer 'none' (our choice, 'forget')."""
+    node.send(1, sct("A", PTP_LONG + "\r\nQueueTag(1)\r\n" + PTP_LONG + "\r\nQueueTag(2)"))
+    node.advance(0.5)
+    assert node.send(1, sct("B", "StopAndClearBuffer()\r\n" + PTP_SHORT + "\r\nQueueTag(3)")) == [reply("B", "OK")]
+    assert status(node, 1) == "none" and status(node, 2) == "none" and status(node, 3) == "false"
+    node.advance(6.0)
+    pushes = [f.split(",")[3] for f in node.out(1) if ",01," in f]
+    assert pushes == ["03"] and status(node, 3) == "true"
