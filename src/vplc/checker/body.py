@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..frontend import ast as A
 from ..frontend import types as T
-from . import assign_target, calls, case_labels, duplicates, function_result, unused
+from . import assign_target, calls, case_labels, duplicates, external_globals, function_result, unused
 from .exprs import ExprChecker
 from .symbols import VarSymbol
 
@@ -17,6 +17,7 @@ class BodyChecker(ExprChecker):
         self.in_prelude = getattr(unit, "in_prelude", False)
         self.scope = scope if scope is not None else {}
         self.result_sym = None
+        self.implicit_globals: dict = {}
         self.for_vars: list[VarSymbol] = []
         self.loop_depth = 0
         self.calls_made: list = []
@@ -57,6 +58,7 @@ class BodyChecker(ExprChecker):
         self.block(pou.body)
         function_result.check(self, pou)
         unused.check(self, pou)
+        external_globals.check(self, pou)
 
     # ---- statements -----------------------------------------------------------------------------
     def block(self, stmts: list[A.Stmt]) -> None:

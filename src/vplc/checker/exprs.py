@@ -58,7 +58,10 @@ class ExprChecker:
             return sym
         if self.result_sym is not None and up == self.result_sym.name.upper():
             return self.result_sym
-        return self.ctx.tables.globals.get(up)
+        g = self.ctx.tables.globals.get(up)
+        if g is not None and self.pou is not None:
+            self.implicit_globals.setdefault(up, g)      # used without VAR_EXTERNAL (external_globals.py)
+        return g
 
     def mark_used(self, sym) -> None:
         if isinstance(sym, VarSymbol):
@@ -204,6 +207,8 @@ class ExprChecker:
             p = bt.param(e.member)
             if p is not None and p.direction in ("in", "out"):
                 e.sym = p.decl.sym if p.decl is not None else VarSymbol(p.name, p.type, "VAR_INPUT", bt)
+                if p.direction == "out" and isinstance(T.unalias(p.type), T.ArrayType):
+                    e.fb_array_output = f"{bt.name}.{p.name}"      # see x_Index (ST1008)
                 return p.type
             what = "an in-out parameter" if p is not None else "not an input or output"
             inner = bt.pou is not None and any(d.name.upper() == e.member.upper()
@@ -246,6 +251,12 @@ class ExprChecker:
                                  f"{len(e.indices)} index(es) were given", e.span)
             return bt.element
         array_bounds.check(self, e, bt)
+        output = getattr(e.base, "fb_array_output", None)
+        if output is not None and self.ctx.dialect == "sysmac":
+            # Sysmac Studio: "Cannot use an element of array" output of a function block instance
+            self.ctx.diags.error("ST1008", f"`{self.text(e)}`: Sysmac Studio does not allow an element of the array "
+                                 f"output {output} of a function block instance; copy the whole output into an "
+                                 f"array variable (`Buf := {self.text(e.base)};`) and index that", e.span)
         return bt.element
 
     def x_Unary(self, e: A.Unary, expected):

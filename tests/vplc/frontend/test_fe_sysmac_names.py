@@ -43,3 +43,27 @@ def test_names_of_the_table_that_the_prelude_declares_are_used_not_reported():
 def test_a_declared_motion_instruction_checks(tmp_path):
     proj = check_text(tmp_path, program("Pwr(Axis := _MC_AX[0], Enable := TRUE);", "Pwr : MC_Power;"))
     assert "ST1007" not in codes(proj)
+
+
+FB_ARRAY_OUT = """FUNCTION_BLOCK Rd
+VAR_OUTPUT Data : ARRAY[0..3] OF INT; END_VAR
+Data[1] := 5;
+END_FUNCTION_BLOCK
+"""
+
+
+def test_an_element_of_an_fb_array_output_is_st1008_in_sysmac_and_accepted_in_iec(tmp_path):
+    src = program("r(); x := r.Data[1]; Buf := r.Data; x := Buf[1];",
+                  "r : Rd; x : INT; Buf : ARRAY[0..3] OF INT;") + FB_ARRAY_OUT
+    assert codes(check_text(tmp_path, src), "error") == ["ST1008"]
+    assert codes(check_text(tmp_path, src, dialect="iec"), "error") == []
+
+
+def test_globals_used_without_var_external_are_one_st1009_warning_per_pou(tmp_path):
+    glob = "VAR_GLOBAL Count, Limit : INT; END_VAR\n"
+    proj = check_text(tmp_path, glob + program("Count := Count + Limit; Ok := P_On;", "Ok : BOOL;"))
+    warnings = [d for d in proj.diagnostics if d.code == "ST1009"]
+    assert len(warnings) == 1 and "`Count`, `Limit`" in warnings[0].message and "P_On" not in warnings[0].message
+    fixed = glob + "PROGRAM Main\nVAR_EXTERNAL Count, Limit : INT; END_VAR\nCount := Count + Limit;\nEND_PROGRAM\n"
+    assert codes(check_text(tmp_path, fixed)) == []
+    assert "ST1009" not in codes(check_text(tmp_path, glob + program("Count := 1;"), dialect="iec"))
