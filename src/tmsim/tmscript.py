@@ -47,7 +47,9 @@ FUNCTIONS: dict[str, tuple[bool, list[tuple[tuple[str, ...], str, tuple[str, ...
     "StopAndClearBuffer": (False, [((), B, ALL)]),
     "Pause": (False, [((), B, ALL)]),
     "Resume": (False, [((), B, ALL)]),
-    "ScriptExit": (False, [((), B, ALL), ((I,), B, ALL)]),                                   # §15
+    # §15.7 defines no parameter; ScriptExit(0|1) are priority commands (§15.8), taken by the session from a line that
+    # is literally one of them. ScriptExit(var) or any other argument is invalid, as StopAndClearBuffer(var) is
+    "ScriptExit": (False, [((), B, ALL)]),
     "ListenSend": (False, [((I, ANY), I, ALL), ((S, I, ANY), I, ALL)]),
     "ListenPacket": (False, [((S,), S, ALL), ((S, S), S, ALL)]),
     "GetString": (False, [((ANY,), S, ALL), ((ANY, I), S, ALL), ((ANY, I, I), S, ALL)]),

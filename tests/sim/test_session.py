@@ -219,9 +219,11 @@ def test_priority_command_mixed_with_normal_lines_runs_alone_and_script_exit_win
 
 
 def test_priority_command_needs_a_literal_argument(node):
+    """TMscript 2.24 §15.8: priority commands take no variables ("StopAndClearBuffer(var_st)" answers ERROR;2);
+    §15.7 defines ScriptExit() without a parameter, so ScriptExit(m) is an invalid line and the node stays."""
     node.send(1, sct("1", "int m = 0"))
-    assert node.send(1, sct("2", "ScriptExit(m)")) == [codec.encode("TMSCT", "2,OK").decode()]
-    assert node.s.state == EXITING or node.s.state == IDLE
+    assert node.send(1, sct("2", "ScriptExit(m)")) == [codec.encode("TMSCT", "2,ERROR;1").decode()]
+    assert node.s.state == IN_NODE
 
 
 def test_script_exit_drains_queue_and_rejects_scripts_meanwhile(node):
