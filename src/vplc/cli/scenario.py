@@ -74,7 +74,8 @@ class Action:
     path: str | None = None       # `set VAR VALUE`
     text: str = ""
     value: object = None
-    robot: int | None = None      # `robot N COMMAND ...`: N counted from 1, and the control request
+    robot: int | None = None      # `robot N COMMAND ...`: N counted from 1, the words and the control request
+    words: str = ""
     request: dict | None = None
 
 
@@ -238,7 +239,7 @@ def _robot(text: str, where: str) -> Action:
         request = simlink.build_request(m.group(2).split())
     except simlink.CommandError as exc:
         raise ScenarioError(f"{where}: {exc}") from None
-    return Action(robot=int(number), request=request)
+    return Action(robot=int(number), words=" ".join(m.group(2).split()), request=request)
 
 
 def load(filename: str, sc: Scenario | None = None) -> Scenario:
@@ -454,7 +455,7 @@ class Runner:
             self._write(a.path, a.value, r.where)
             return
         request = {**a.request, "robot": a.robot - 1, "plc_time": round(t_ns / 1e9, 6)}
-        self.say(f"{t_ns / 1e9:10.3f} s  robot {a.robot}: {simlink.describe(a.request)} ({r.where})", flush=True)
+        self.say(f"{t_ns / 1e9:10.3f} s  robot {a.robot}: {a.words} ({r.where})", flush=True)
         if self.wait:
             self.link.send_now(request, r.where)
         else:
