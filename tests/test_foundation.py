@@ -1,14 +1,20 @@
-"""Standing promises of the repository: two README commands, CI = `make test`, stdlib-only runtime."""
+"""Standing promises of the repository: two README commands, CI = `make test`, stdlib-only runtime, and the three
+packages under src/ (docs/toolchain/layout.md): which may import which, their console scripts, no sys.path edits."""
 from __future__ import annotations
 
 import ast
+import importlib
 import pathlib
 import re
 import sys
+import tomllib
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-RUNTIME_TREES = [ROOT / "src" / "vplc", ROOT / "sim"]
-OWN_PACKAGES = {"vplc", "sim"}
+SRC = ROOT / "src"
+# package -> the project packages it may import (layout.md's table)
+MAY_IMPORT = {"vplc": set(), "tmsim": set(), "cbt_hmi": {"vplc", "tmsim"}}
+RUNTIME_TREES = [SRC / package for package in MAY_IMPORT] + [ROOT / "sim", ROOT / "examples"]
+OWN_PACKAGES = set(MAY_IMPORT)
 
 
 def _imported_top_level_modules(path: pathlib.Path) -> set[str]:
@@ -69,3 +75,37 @@ def test_the_vplc_launcher_runs_the_toolchain_from_the_checkout():
     done = subprocess.run([str(root / "vplc"), "check", "lib/CBT_Commands_Lib"], cwd=root, env=env,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "0 error(s)" in done.stdout, done.stdout + done.stderr
+
+
+def test_the_three_packages_are_all_there_is_under_src():
+    packages = {p.name for p in SRC.iterdir() if (p / "__init__.py").is_file()}
+    assert packages == set(MAY_IMPORT)
+
+
+def test_toolchain_and_simulator_import_neither_each_other_nor_the_application():
+    wrong = []
+    for package, allowed in MAY_IMPORT.items():
+        for path in sorted((SRC / package).rglob("*.py")):
+            for name in _imported_top_level_modules(path) & (set(MAY_IMPORT) - {package} - allowed):
+                wrong.append(f"{path.relative_to(ROOT)} imports {name}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_every_console_script_names_a_function_that_exists():
+    scripts = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["scripts"]
+    assert set(scripts) == {"vplc", "tmflow-sim", "cbt-demo"}
+    for name, target in scripts.items():
+        module, function = target.split(":")
+        assert callable(getattr(importlib.import_module(module), function)), name
+
+
+def test_no_code_edits_sys_path():
+    """Packages are found through the install (or pytest's pythonpath), never by a module editing sys.path."""
+    offenders = []
+    for folder in ("src", "sim", "examples", "bench", "tests", "docs"):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Attribute) and node.attr == "path" and \
+                        isinstance(node.value, ast.Name) and node.value.id == "sys":
+                    offenders.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    assert not offenders, "\n".join(offenders)
