@@ -9,7 +9,7 @@ from ..frontend import types as T
 from ..frontend.builtins import default_string
 from . import data_size, duplicates, undeclared
 from .consteval import const_int
-from . import union_member
+from . import at_address, union_member
 from .scope import GENERIC_TYPES, Ambiguous
 from .symbols import VarSymbol
 
@@ -265,6 +265,7 @@ class Declarer:
                     vt = self.resolve(decl.type, unit, consts)
                     sym = VarSymbol(decl.name, vt, section.kind, pt, decl, section.constant, section.retain)
                     decl.sym = sym
+                    at_address.check_local(self.ctx, decl)
                     if direction:
                         pt.params.append(T.Param(decl.name, direction, vt, index, decl.init, decl))
                         index += 1
@@ -281,6 +282,7 @@ class Declarer:
                 sym = VarSymbol(decl.name, vt, "VAR_GLOBAL", None, decl, section.constant, section.retain,
                                 global_list=list_name)
                 decl.sym = sym
+                sym.at_address = at_address.check_global(self.ctx, decl, vt)
                 self.meter.check_global(decl, sym)
                 if getattr(unit, "vendor", False):           # Sysmac system-defined variables (P_On ...)
                     self.ctx.vendor_objects.add(id(sym))

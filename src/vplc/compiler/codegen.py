@@ -218,11 +218,26 @@ class CodeGen(ExprGen):
         self.ind += 1
         self.emit("s.i__path = 'GLOBAL'")
         self.emit("G = s")
+        placed = [sym for sym in self.proj.globals.values() if getattr(sym, "at_address", None) is not None]
+        if placed:
+            self.emit("s.i__mem = _AreaMemory()")
         for sym in self.proj.globals.values():
             init = sym.decl.init if sym.decl is not None else None
+            if getattr(sym, "at_address", None) is not None and init is None:
+                continue                        # its value is the memory area's (all bits 0 at start)
             self.at(sym.decl.span if sym.decl is not None else None)
             self.emit(f"s.{attr(sym.name)} = {self.default(sym.type, init, repr(sym.name))}")
         self.ind -= 2
+        if placed:
+            # a global AT a Sysmac memory area (%W, %H, %D, %E, CIO) reads and writes the area's words
+            # (runtime/at_memory.py, checker/at_address.py)
+            self.emit("from vplc.runtime.at_memory import AreaMemory as _AreaMemory, area_property as _aprop")
+            self.emit("from vplc.runtime.unions import members as _umembers")
+            self.emit("Globals.i__members = _umembers")
+            for sym in placed:
+                area, bank, word, bit, layout, words = sym.at_address
+                self.emit(f"Globals.{attr(sym.name)} = _aprop({area!r}, {bank}, {words}, {word}, {bit}, "
+                          f"{layout[0]!r}, {layout[1]}, {layout[2]!r})")
 
     # ---- POUs ---------------------------------------------------------------------------------
     def gen_pou(self, pt: T.PouType) -> None:

@@ -183,9 +183,16 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
             names.append(self.ident("a variable name"))
         at = None
         if self.accept_kw("AT"):
-            if self.tok.kind != "ADDRESS":
-                self.fail_expected("a direct address such as `%MW10` after AT")
-            at = self.advance().text
+            if self.tok.kind == "IOPORT":
+                # W501 AT specification of an I/O port (ECAT://node#1/..., IOBus://...): vplc has no I/O ports
+                port = self.advance()
+                self.diags.error("ST1007", f"AT `{port.text.strip()}`: Sysmac I/O ports are not modelled by vplc; "
+                                 "declare the variable without AT (vplc models the memory areas %W, %H, %D, %E "
+                                 "and CIO)", self.tok_span(port))
+            elif self.tok.kind != "ADDRESS":
+                self.fail_expected("a direct address such as `%MW10` or `%W480.00` after AT")
+            else:
+                at = self.advance().text
         self.expect_op(":", "after the variable name (declarations read `Name : TYPE;`)")
         spec = self.type_spec()
         init = self.initializer() if self.accept_op(":=") else None
