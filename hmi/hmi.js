@@ -292,6 +292,7 @@ function collect(root, prefix) {
     if (error && !first) first = error;
     if (!error) values[el.dataset.path] = value;
   }
+  if (!first) first = physicalRefusal(root, prefix);   // limits.js: angle and joint ranges, the TM5-700's reach
   return first ? { error: first } : { values };
 }
 

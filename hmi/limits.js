@@ -64,9 +64,77 @@ function refreshLimits(root, prefix) {
       if (hint) hint.textContent = bad ? `not for ${Object.values(rule.when)[0]}` : "";     // ErrorID in the title
     }
   }
+  refreshPoseLimits(root, prefix);
 }
 
 function watchLimits(root, prefix) {
   root.addEventListener("change", (e) => { if (e.target.tagName === "SELECT" || e.target.type === "checkbox") refreshLimits(root, prefix); });
   refreshLimits(root, prefix);
+  armReady.then(() => refreshLimits(root, prefix));          // the joint ranges come with the arm data
+}
+
+/* ---- per-unit limits and the reach check: what the TM5-700 can do, beyond the FB's own ranges ----
+   The FB checks every pose member against one range (±100000, docs/library/ranges.tsv) whatever its unit; the
+   page also knows the unit: an angle (RX, RY, RZ) beyond one turn, ±360°, is a typing slip (our choice: TMflow
+   shows orientations within ±180°); in a joint format the six values are J1..J6, each within its joint range
+   from the arm data (hmi/tm5_700.json, ±2 × the range for joint offsets); millimetres are judged by the reach
+   check on the whole pose (robotview.js reachCheck). */
+const POSE_KEYS = ["X", "Y", "Z", "RX", "RY", "RZ"];
+const ANGLE_LIMIT = 360;
+const poseLabel = (member) => (LABELS[member] || member).replace(/ \(.*\)$/, "");
+
+/* {min, max, unit, what} for a pose member in the selected data format, null where only the FB's range holds */
+function unitLimit(member, key, context) {
+  if (!["TargetPosition", "ArcPoint", "EndPoint"].includes(member)) return null;
+  const fmt = context.DataFormat || "";
+  if (fmt.startsWith("J")) {
+    if (!ARM.data) return null;
+    const j = ARM.data.joints[POSE_KEYS.indexOf(key)], lim = fmt.endsWith("_Rel") ? 2 * j.limit : j.limit;
+    return { min: -lim, max: lim, unit: "°", what: `${j.name}${fmt.endsWith("_Rel") ? " offset" : ""}` };
+  }
+  if (key.startsWith("R")) return { min: -ANGLE_LIMIT, max: ANGLE_LIMIT, unit: "°", what: key };
+  return null;
+}
+
+/* the legend of each pose row says what its six values are and their limits in the selected format */
+function refreshPoseLimits(root, prefix) {
+  const context = formContext(root, prefix);
+  for (const fs of root.querySelectorAll("fieldset.pose")) {
+    const member = fs.dataset.member, span = fs.querySelector("legend .range");
+    const joint = (context.DataFormat || "").startsWith("J");
+    const limits = POSE_KEYS.map((k) => unitLimit(member, k, context));
+    for (const [i, k] of POSE_KEYS.entries()) {
+      const el = fs.querySelector(`[data-path$=".${member}.${k}"]`), box = el && el.parentElement;
+      const label = box && box.querySelector("label");
+      if (label) label.textContent = joint && limits[i] ? limits[i].what.split(" ")[0] : k;
+      if (el) el.title = limits[i] ? `${limits[i].what}: ${limits[i].min}..${limits[i].max}${limits[i].unit}` : `${k}: mm, reach-checked`;
+    }
+    if (!span || !limits[0] && !limits[3]) continue;
+    span.textContent = joint ? `joints, ° (${limits.map((l) => "±" + l.max).join(" ")})` :
+      `mm (reach-checked) · RX RY RZ ±${ANGLE_LIMIT}°`;
+  }
+}
+
+/* Everything the robot itself would refuse in a motion form that the FB's ranges let through: an angle or joint
+   out of its range, a target the TM5-700 cannot reach. The text (null when all is well); marks the fields. */
+function physicalRefusal(root, prefix) {
+  if (typeof motionTargets !== "function" || !prefix) return null;
+  const context = formContext(root, prefix);
+  for (const el of inputsUnder(root, prefix)) {
+    const parts = el.dataset.path.split("."), key = parts.pop(), member = parts.pop();
+    if (!POSE_KEYS.includes(key)) continue;
+    const lim = unitLimit(member, key, context), v = Number(el.value);
+    if (lim && Number.isFinite(v) && (v < lim.min || v > lim.max)) {
+      el.classList.add("invalid");
+      return `${poseLabel(member)} ${lim.what}: ${v}${lim.unit} is out of range ` +
+        `${lim.min}..${lim.max}${lim.unit} for the ${ARM.data ? ARM.data.model : "robot"}`;
+    }
+  }
+  const refused = reachRefusal(motionTargets(root, prefix));
+  if (!refused) return null;
+  for (const k of ["X", "Y", "Z"]) {
+    const el = root.querySelector(`[data-path="${prefix}.${refused.member}.${k}"]`);
+    if (el) el.classList.add("invalid");
+  }
+  return `${poseLabel(refused.member)}: ${refused.reason}`;
 }

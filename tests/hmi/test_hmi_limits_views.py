@@ -74,6 +74,8 @@ def test_a_value_refused_for_one_format_is_sent_for_another(page):
     assert "Speed: 150 is out of range 1..100 % (the FB would refuse it with 16#1013)" in b.message()
     assert plc.writes == []
     select(b, "MoveAbs_Param.DataFormat", "CAP_Abs")
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 180, 0, 90)):   # a target it can reach
+        b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     b.click("btn-execute")
     b.wait_for(lambda d: ("MoveAbs_Execute", True) in plc.writes, "the command to be sent")
     assert ("MoveAbs_Param.Speed", 150) in plc.writes
