@@ -7,6 +7,7 @@ import threading
 
 import pytest
 from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import Select
 
 from browser import chromium_paths
 from hmi_http import Client
@@ -90,3 +91,87 @@ def test_program_api_refuses_an_unknown_program(system):
     client = Client(f"http://127.0.0.1:{hmi.port}")
     status, body = client.json("/api/program/state?pou=Nope")
     assert status == 404 and "no ladder program named `Nope`" in body["error"]
+
+
+def text_overlaps(browser) -> list:
+    """Pairs of drawn texts whose boxes overlap, measured in the browser (values included)."""
+    return browser.driver.execute_script("""
+        const boxes = [...document.querySelectorAll('#ladder text')].filter(t => t.textContent.trim())
+          .map(t => [t.textContent, t.getBoundingClientRect()]);
+        const out = [];
+        for (let i = 0; i < boxes.length; i++) for (let j = i + 1; j < boxes.length; j++) {
+          const [a, r] = boxes[i], [b, s] = boxes[j];
+          if (r.left < s.right - 1 && s.left < r.right - 1 && r.top < s.bottom - 1 && s.top < r.bottom - 1) out.push([a, b]);
+        }
+        return out;""")
+
+
+@pytest.mark.parametrize("size", [(800, 480), (1280, 800)], ids=["800x480", "1280x800"])
+def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(system, size):
+    plc, hmi, browser = system
+    d = browser.driver
+    dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
+    d.set_window_size(size[0] + dw, size[1] + dh)
+    try:
+        browser.open(f"{hmi.url}program.html")
+        browser.wait_for(lambda _d: int(d.find_element(By.CSS_SELECTOR, "section[data-pou]").get_attribute("data-polls")
+                                        or 0) > 2, "the ladder to be polled")
+        with plc.lock:
+            plc.write("Connect_Execute", True)
+        browser.wait_for(lambda _d: any(t.startswith("16#") for t in d.execute_script(
+            "return [...document.querySelectorAll('text.val')].map(t => t.textContent)")), "a WORD value")
+        values = d.execute_script("return Object.fromEntries([...document.querySelectorAll('text.val')]"
+                                  ".filter(t => t.textContent).map(t => [t.dataset.var, t.dataset.full]))")
+        words = {k: v for k, v in values.items() if k.endswith("ErrorID")}
+        assert words and all(v.startswith("16#") and len(v) == 7 for v in words.values()), words
+        # every rung in the list; choosing one scrolls it to the top of the view
+        options = d.execute_script("return [...document.querySelectorAll('#rung-jump option')].map(o => o.text)")
+        assert len(options) == 11 and options[0].startswith("Commands_Example 1") is False and options[0].startswith("1")
+        Select(d.find_element(By.ID, "rung-jump")).select_by_index(7)
+        top = d.execute_script("""const h = document.getElementById('ladder').getBoundingClientRect().top;
+            return document.querySelector('g.rung[data-rung="8"]').getBoundingClientRect().top - h;""")
+        assert 0 <= top <= 60
+        # the whole comments, wrapped (the drawing alone cuts them with an ellipsis)
+        api = Client(f"http://127.0.0.1:{hmi.port}").json("/api/program")[1]
+        comments = [r["comment"] for r in api["programs"][0]["rungs"]]
+        drawn = d.execute_script("return [...document.querySelectorAll('g.rung')].map(g => { const c = g.querySelector("
+                                 "'text.cmt'); return c ? [...c.querySelectorAll('tspan')].map(t => t.textContent)"
+                                 ".join(' ') : ''; })")
+        assert drawn == [" ".join(c.split()) for c in comments]
+        assert not any("…" in t for t in drawn)
+        assert text_overlaps(browser) == [], "no text covers another"
+        for control in ("rung-jump", "ladder-in", "ladder-out"):
+            r = d.find_element(By.ID, control).rect
+            assert r["height"] >= 34 and r["width"] >= 34
+        width = float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width"))
+        d.find_element(By.ID, "ladder-in").click()
+        assert float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width")) == pytest.approx(width * 1.25, abs=1)
+        browser.wait_for(lambda _d: text_overlaps(browser) == [], "the values refitted")
+        browser.screenshot(f"program_zoomed_{size[0]}x{size[1]}")
+        d.find_element(By.ID, "ladder-out").click()
+        browser.screenshot(f"program_rung8_{size[0]}x{size[1]}")
+    finally:
+        with plc.lock:
+            plc.write("Connect_Execute", False)
+        browser._fit()
+
+
+def test_the_coils_of_a_rung_stand_in_one_column_at_the_right_rail(system):
+    _plc, hmi, browser = system
+    browser.open(f"{hmi.url}program.html")
+    gaps = browser.driver.execute_script("""
+        const out = [];
+        for (const g of document.querySelectorAll('g.rung')) {
+          const rails = [...g.querySelectorAll('path.rail')].map(p => p.getBoundingClientRect().left);
+          const right = Math.max(...rails);
+          const row = [];
+          for (const c of g.querySelectorAll('g.el.coil')) {
+            const sym = [...c.querySelectorAll('path.sym')].map(p => p.getBoundingClientRect());
+            row.push(Math.round(right - Math.max(...sym.map(r => r.right))));
+          }
+          if (row.length) out.push(row);
+        }
+        return out;""")
+    assert len(gaps) >= 9
+    for row in gaps:                      # one column of coils per rung, its wires reaching the right rail
+        assert max(row) - min(row) < 2, gaps

@@ -1,12 +1,16 @@
 """Live ladder monitoring for the HMI's Program page, as Sysmac Studio's online monitoring shows it.
 
-    GET /api/program                  {"ok", "programs": [{"pou", "instance", "svg"}]}  the drawings (once)
+    GET /api/program                  {"ok", "programs": [{"pou", "instance", "svg", "rungs"}]}  the drawings (once);
+                                      rungs: [{"number", "label", "comment"}], the whole comments
+                                      (the drawing cuts long ones; the page wraps them and lists the rungs)
     GET /api/program/state?pou=NAME   {"ok", "on": [ids], "values": {variable text: value text}}
 
 ``on`` lists the drawn elements and wires that carry power in the current scan state: power is worked
 out from the variable values the same way the translation does (contacts ``in AND var``, NC ``AND NOT``,
 coils pass power on, a block's outputs are the instance's outputs, ENO follows EN). Edge contacts show
-their variable, as Sysmac's monitor does. Only variables drawn in the ladder are read.
+their variable, as Sysmac's monitor does. Only variables drawn in the ladder are read. Bit strings
+(BYTE, WORD, DWORD, LWORD) are written in 16# notation, as Sysmac Studio's monitor and every other HMI page
+show them (16390 reads 16#4006).
 """
 from __future__ import annotations
 
@@ -124,9 +128,14 @@ class LadderView:
         return on
 
 
+HEX_DIGITS = {"BYTE": 2, "WORD": 4, "DWORD": 8, "LWORD": 16}
+
+
 def _text(v, type_name: str | None = None):
     if type_name in ("DATE_AND_TIME", "DT") and isinstance(v, int):
         return format_dt(v)
+    if type_name in HEX_DIGITS and isinstance(v, int) and not isinstance(v, bool):
+        return f"16#{v:0{HEX_DIGITS[type_name]}X}"
     if isinstance(v, bool):
         return "TRUE" if v else "FALSE"
     if isinstance(v, (int, float)):
@@ -149,7 +158,9 @@ class ProgramMonitor:
                     self.views[item.name.upper()] = LadderView(plc, item, instance)
 
     def page(self) -> dict:
-        return {"ok": True, "programs": [{"pou": v.pou.name, "instance": v.instance, "svg": v.svg}
+        return {"ok": True, "programs": [{"pou": v.pou.name, "instance": v.instance, "svg": v.svg,
+                                          "rungs": [{"number": n, "label": r.label, "comment": r.comment}
+                                                    for n, r in enumerate(v.ladder.rungs, start=1)]}
                                          for v in self.views.values()]}
 
     def state(self, pou: str) -> dict:
