@@ -9,6 +9,7 @@
                       [--svr-port PORT | --no-svr] [--svr-period S]
                       [--svr-format binary|string|json] [--svr-items A,B,...]
                       [--svr-var NAME:TYPE[:ACCESS][=VALUE] ...]
+                      [--vision-job NAME=POSE;POSE...[@S][!fail] ...]
 
 Also `python3 -m tmsim` and, from a checkout, `python3 sim/tmflow_listener.py` (the launcher kept for existing
 users). Every number is range-checked before anything starts; a bad one is one line on stderr, exit code 2.
@@ -23,6 +24,7 @@ import socket
 import sys
 import threading
 
+from tmsim.camera import Camera, camera_of, parse_option
 from tmsim.control import robot_numbering
 from tmsim.profiles import STOP_TAGS, VERSIONS, Profile
 from tmsim.server import SimServer
@@ -84,7 +86,26 @@ def build_parser() -> argparse.ArgumentParser:
                           "Slave (repeat for more): TYPE bool, byte, int, float or string, an array as int[4]; "
                           "ACCESS rw (default), auto (written in auto mode only) or ro; VALUE as written in string "
                           "mode, e.g. g_count:int=5, g_pos:float[3]={1,2,3}, g_name:string=\"abc\"")
+    vision = parser.add_argument_group("virtual camera (TMscript manual §13.32-13.34, chapter 14)")
+    vision.add_argument("--vision-job", action="append", default=[], metavar="NAME=POSE;POSE...[@S][!fail]",
+                        help="a vision job of every robot's project and the objects it finds, each pose X,Y,Z,RX,RY,RZ "
+                             "relative to RobotBase; @S the time it takes (default 0.2 s), !fail a failing job, e.g. "
+                             "job1=300,0,5,0,0,0;300,60,5,0,0,90@0.5 (more: control command vision_job)")
     return parser
+
+
+def check_vision_jobs(args) -> tuple[list[str], list[dict]]:
+    """(one line per --vision-job that cannot be defined, the jobs as camera.define arguments)."""
+    problems, jobs = [], []
+    for spec in getattr(args, "vision_job", []):
+        try:
+            job = parse_option(spec)
+            Camera().define(**job)
+        except ValueError as exc:
+            problems.append(f"--vision-job {spec[:60]}: {exc}")
+            continue
+        jobs.append(job)
+    return problems, jobs
 
 
 def check_variables(args) -> tuple[list[str], list]:
@@ -167,6 +188,8 @@ def main(argv=None) -> int:
     problems, svr_port, svr_items = check_args(args)
     variable_problems, variables = check_variables(args)
     problems += variable_problems
+    vision_problems, vision_jobs = check_vision_jobs(args)
+    problems += vision_problems
     if problems:
         for problem in problems:
             print(f"tmflow_listener: error: {problem}", file=sys.stderr)
@@ -183,6 +206,9 @@ def main(argv=None) -> int:
                            manage_gc=True, control_host=args.control_host, svr_port=svr_port,
                            svr_options=dict(period=args.svr_period, mode=SVR_FORMATS[args.svr_format],
                                             items=svr_items, variables=variables))
+        for robot in server.robots:
+            for job in vision_jobs:
+                camera_of(robot.session.robot).define(**job)
         server.start()
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)

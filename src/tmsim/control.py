@@ -15,6 +15,9 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "operation_mode", "robot": 0, "mode": "manual"}
     {"cmd": "svr_config", "robot": 0, "period": 0.1, "mode": 1, "items": [...], "write_permission": true}
     {"cmd": "svr_inject", "robot": 0, "fault": "stall", "params": {"enabled": true}}   / "svr_clear_faults"
+    {"cmd": "vision_job", "robot": 0, "job": "job1", "objects": [[x, y, z, rx, ry, rz], ...], "pass": true,
+     "seconds": 0.2, "capture": [j1, ..., j6], "variable": "job1_Base_TM"}   a vision job (sim/camera.py)
+    {"cmd": "vision_remove", "robot": 0, "job": "job1"} / {"cmd": "vision", "robot": 0}   remove / show
 Any request may carry "plc_time": the client's controller time in seconds, logged as event ``control`` (with
 ``cmd``) next to the robot clock's ``t``.
 
@@ -37,11 +40,14 @@ import socket
 from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
                      CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_BYTES, CONTROL_TURN_PIECES,
                      CONTROL_TURN_REQUESTS)
+from .camera import camera_of
 from .listener import Listener, receive
 from .session import TransitionError
 
 _FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission",
            "plc_time"}
+_VISION_FIELDS = {"job", "objects", "pass", "seconds", "capture", "variable"}
+_FIELDS |= _VISION_FIELDS
 _BRACKETS = re.compile(rb'"(?:[^"\\]|\\.)*"|[\[\]{}]')
 
 
@@ -99,6 +105,9 @@ class ControlChannel:
             "svr_config": self._svr_config,
             "svr_inject": self._svr_inject,
             "svr_clear_faults": self._svr_clear_faults,
+            "vision_job": self._vision_job,
+            "vision_remove": self._vision_remove,
+            "vision": self._vision,
         }
 
     # ---- sockets ------------------------------------------------------------------------------
@@ -326,6 +335,20 @@ class ControlChannel:
     def _svr_clear_faults(self, robot, _request):
         _svr(robot)
         self.server.svr.clear_faults(robot)
+
+    def _vision_job(self, robot, request):
+        """A vision job of the robot's project and what it finds (sim/camera.py checks every value)."""
+        with self.server.lock:
+            return camera_of(robot.session.robot).define(
+                name=request.get("job"), objects=request.get("objects", []), passed=request.get("pass", True),
+                seconds=request.get("seconds", 0.2), capture=request.get("capture"), variable=request.get("variable"))
+
+    def _vision_remove(self, robot, request):
+        with self.server.lock:
+            return camera_of(robot.session.robot).remove(_text_field(request, "job"))
+
+    def _vision(self, robot, _request):
+        return camera_of(robot.session.robot).state()
 
     def _events(self, robot, request):
         since = _int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")

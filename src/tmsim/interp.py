@@ -30,6 +30,7 @@ from decimal import Decimal
 
 from . import script as ast
 from . import tmscript as table
+from .camera import camera_of
 from .codec import encode as encode_frame
 from .limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
                      VARIABLES_MAX, WORK_STEP)
@@ -534,7 +535,60 @@ def _call(node, args, ctx, line):
         return encode_frame(header, data).decode("utf-8")[:-2]
     if name == "GetString":
         return _text_of(args[0], ctx)
+    if name.startswith("Vision_"):
+        return (yield from _vision(name, args, ctx, line))
     raise ScriptRuntimeError(f"function {name} cannot run here")
+
+
+def _vision(name, args, ctx, line):
+    """The vision functions against the robot's virtual camera (sim/camera.py). A job runs in order with the
+    motions: Vision_DoJob* first wait until the motions queued before them are done (§13.33, §13.34 "queue with
+    the motion commands"), _PTP / _Line then move to the job's capture point and wait for that motion, and the
+    job takes its time; the script goes on with the job's result. An unknown job returns False, "fail to
+    execute" (§13.32-13.34 False case 2)."""
+    camera = camera_of(ctx.robot)
+    if name == "Vision_IsJobAvailable":                   # §14.1
+        return camera.available(args[0])
+    try:
+        if name == "Vision_GetOutputArraySize":           # §14.2.1
+            return camera.array_size(*args)
+        if name == "Vision_GetOutputArrayValue":          # §14.2.2
+            return camera.array_value(*args)
+    except ValueError as exc:                              # the manual's "Return error. Exceeding the access range."
+        raise ScriptRuntimeError(str(exc)) from None
+    job = camera.jobs.get(args[0])
+    if job is None:
+        ctx.log_event("vision_job", job=args[0][:48], result="unknown")
+        return False
+    if name == "Vision_DoJob" and job.capture is not None:
+        ctx.log_event("vision_job", job=job.name, result="has a capture point")
+        return False                                      # §13.32 False case 3
+    robot = ctx.robot
+    yield ("idle", None, None)
+    if name != "Vision_DoJob" and job.capture is not None:
+        if name == "Vision_DoJob_PTP":                    # §13.33: speed %, time to top speed (ms)
+            if args[1] < 0:
+                raise ScriptRuntimeError("Vision_DoJob_PTP speed must be 0..100 %")
+            motion = ("PTP", ["JPP", list(job.capture), args[1], args[2], 0, False])
+        else:                                             # §13.34: syntax 1 speed %, syntax 2/3 mm/s and ms
+            target = robot.tcp_pose(list(job.capture))
+            if args[1] < 0:
+                raise ScriptRuntimeError("Vision_DoJob_Line speed must not be negative")
+            if len(args) == 2:
+                motion = ("Line", ["CPP", target, args[1], 200, 0, False])
+            else:
+                linked = args[3] if len(args) > 3 else True
+                motion = ("Line", ["CAP" if linked else "CDP", target, args[1], args[2], 0, False])
+        if not robot.has_room:
+            yield ("room", None, None)
+        robot.enqueue_motion(_motion(motion[0], motion[1], line))
+        yield ("idle", None, None)
+    if job.seconds > 0:
+        yield ("delay", None, job.seconds)
+    result = camera.finish(job)
+    ctx.log_event("vision_job", job=job.name, result="pass" if result else "fail",
+                  objects=len(job.objects) if result else 0)
+    return result
 
 
 def _wait_queue_tag(args, robot):

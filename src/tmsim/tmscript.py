@@ -54,6 +54,15 @@ FUNCTIONS: dict[str, tuple[bool, list[tuple[tuple[str, ...], str, tuple[str, ...
     "ListenPacket": (False, [((S,), S, ALL), ((S, S), S, ALL)]),
     "GetString": (False, [((ANY,), S, ALL), ((ANY, I), S, ALL), ((ANY, I, I), S, ALL)]),
     "Sleep": (False, [((I,), VOID, NEW)]),
+    # vision (sim/camera.py). The jobs run in order with the motions (§13.33, §13.34 "queue with the motion
+    # commands"); the script waits for the result, the bool they return. Not queued here: the interpreter
+    # waits for the queue itself. Flying Trigger / Inspection forms (§14.2 second halves) are not simulated
+    "Vision_DoJob": (False, [((S,), B, ALL)]),                                               # §13.32
+    "Vision_DoJob_PTP": (False, [((S, I, I, B), B, ALL), ((S, I, I), B, ALL)]),             # §13.33
+    "Vision_DoJob_Line": (False, [((S, I), B, ALL), ((S, I, I, B), B, ALL), ((S, I, I), B, ALL)]),  # §13.34
+    "Vision_IsJobAvailable": (False, [((S,), B, ALL)]),                                      # §14.1
+    "Vision_GetOutputArraySize": (False, [((S,), I, NEW), ((S, I), I, NEW)]),                # §14.2.1
+    "Vision_GetOutputArrayValue": (False, [((S, I), "string[]", NEW), ((S, I, I), S, NEW)]),  # §14.2.2
 }
 
 # data format (first argument) of the motion functions -> versions. "D": absolute speed not scaled by the

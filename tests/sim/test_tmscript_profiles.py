@@ -4,6 +4,7 @@ name) where it does not; values print as a 32-bit TM float does."""
 import pytest
 
 from tmsim import codec, tmscript
+from tmsim.camera import camera_of
 from tmsim.interp import float_text
 from tmsim.profiles import Profile
 from test_session import S, sct
@@ -37,6 +38,13 @@ EXAMPLES = {
     "ListenPacket": ('ListenPacket("x")', "ListenPacket(1,2,3)"),
     "GetString": ("GetString(1.5)", "GetString()"),
     "Sleep": ("Sleep(0)", 'Sleep("1")'),
+    "Vision_DoJob": ('Vision_DoJob("job1")', "Vision_DoJob(1)"),
+    "Vision_DoJob_PTP": ('Vision_DoJob_PTP("job1",100,500)', 'Vision_DoJob_PTP("job1")'),
+    "Vision_DoJob_Line": ('Vision_DoJob_Line("job1",100)', 'Vision_DoJob_Line("job1","x")'),
+    "Vision_IsJobAvailable": ('Vision_IsJobAvailable("job1")', "Vision_IsJobAvailable()"),
+    "Vision_GetOutputArraySize": ('Vision_GetOutputArraySize("job1_Base_TM")', "Vision_GetOutputArraySize(1)"),
+    "Vision_GetOutputArrayValue": ('Vision_GetOutputArrayValue("job1_Base_TM",0,1)',
+                                   'Vision_GetOutputArrayValue("job1_Base_TM")'),
 }
 
 
@@ -48,6 +56,9 @@ def node_of(version):
     n = S(profile=Profile(tmflow=version))
     n.connect(1)
     n.out(1)
+    camera = camera_of(n.s.robot)             # a vision job that has run: the vision examples have its output
+    camera.define("job1", objects=[[1, 2, 3, 4, 5, 6]], seconds=0)
+    camera.finish(camera.jobs["job1"])
     return n
 
 
