@@ -157,6 +157,60 @@ def versus_baseline(rev: str) -> None:
               f"variables after each of 2000 scans: {'identical' if row['identical'] else 'DIFFERENT'}")
 
 
+CELL_SIGNALS = ("Cell.Parts >= 2", "Cell.Connected = FALSE", "Cell.Alarm = TRUE", "Cell.CncBusy = TRUE",
+                "Cell.ConveyorRun = TRUE", "Cell.ShuttleAtLoad = TRUE", "Cell.MovesDone > 12", "Cell.RobotInCnc = TRUE",
+                "Cell.Segment = 7", "Cell.RobotError = TRUE")
+
+
+def scenario_cost(when_lines: int = 100, scans: int = 4000) -> None:
+    """Issue 27: what a scenario's `when` lines add to a scan of the cell example (examples/cell): the cell runs
+    its batch against the simulator in this process (polled between scans, not timed) on virtual time, driven by
+    its commissioning scenario's reactions plus ``when_lines`` more (each on one of ten cell signals, `every
+    time`); the scenario's work before and after each scan is timed apart from the scan."""
+    from tmsim.server import SimServer
+    from vplc.cli import scenario as scn
+    cell = os.path.join(ROOT, "examples", "cell")
+    sim = SimServer(port=0, robots=1, svr_port=0, speedup=1)
+    sim.start()
+    try:
+        plc = load_plc([os.path.join(ROOT, "lib", "CBT_Commands_Lib"), cell],
+                       axes=os.path.join(cell, "cell_axes.toml"))
+        sc = scn.Scenario()
+        with open(os.path.join(cell, "commissioning.scn"), encoding="utf-8") as f:
+            for n, line in enumerate(f, 1):
+                if " robot " not in line:                   # the faults need the control channel: left out
+                    scn.parse_line(line, f"commissioning.scn:{n}", sc)
+        own = len(sc.reactions)
+        for k in range(when_lines):
+            scn.parse_line(f"when {CELL_SIGNALS[k % 10]} for {k % 5}ms then set Cell.Batch 3 every time",
+                           f"bench:{k}", sc)
+        for path, value in (("Cell.Port", sim.ports[0]), ("Cell.SvrPort", sim.robots[0].svr_port)):
+            plc.write(path, value)
+        scn.resolve(plc, sc)
+        runner = scn.Runner(plc, sc)
+        scan_ns, hooks_ns, t = [], [], 0
+        for _ in range(scans):
+            sim.poll(t / 1e9)
+            h0 = time.perf_counter_ns()
+            runner.before_scan(t)
+            s0 = time.perf_counter_ns()
+            plc.scan(t)
+            s1 = time.perf_counter_ns()
+            runner.after_scan(t)
+            h1 = time.perf_counter_ns()
+            scan_ns.append(s1 - s0)
+            hooks_ns.append((s0 - h0) + (h1 - s1))
+            t += plc.period_ns
+        parts = plc.read("Cell.Parts")
+        plc.close()
+    finally:
+        sim.close()
+    scan, hooks = percentile(scan_ns, .5) / 1000, percentile(hooks_ns, .5) / 1000
+    print(f"  cell example with a scenario of {own} + {when_lines} `when` lines ({parts} parts in {scans} scans): "
+          f"scan median {scan:6.1f} us, scenario median {hooks:5.1f} us = {hooks / scan * 100:4.1f} % of the scan "
+          f"(target <= 10 %)")
+
+
 def main() -> int:
     print("vplc runtime benchmark (Python %s)" % sys.version.split()[0])
     rev = sys.argv[sys.argv.index("--against") + 1] if "--against" in sys.argv else engine_compare.BASELINE
@@ -169,6 +223,7 @@ def main() -> int:
         print(f"  (sequence program: {seq_text.count(chr(10))} lines)")
         plc = per_scan(tmp, "300-line CASE sequence", seq_text)
         axes_cost(tmp)
+        scenario_cost()
 
         n, t0 = 20000, time.perf_counter()
         plc.run_until(lambda: False, n * plc.period_ns)

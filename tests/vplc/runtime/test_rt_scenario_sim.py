@@ -218,3 +218,16 @@ def test_the_simulator_refuses_a_controller_time_that_is_not_a_time(sim):
         assert answer["ok"] is False and "'plc_time' must be the controller time in seconds" in answer["error"]
     assert request(sim.control.port, {"cmd": "ping", "robot": 1, "plc_time": 2.5}) == {"ok": True, "result": "pong"}
     assert [e["plc_time"] for e in sim.robots[1].events if e["kind"] == "control"] == [2.5]
+
+
+def test_members_and_unchanged_values_are_judged_like_any_other(tmp_path):
+    """A reaction on an FB member (read through the API each scan) and expectations whose variable never changes
+    (judged at their time and at their deadline, not only on a change)."""
+    r = run(tmp_path, "at 0s set Main.Start TRUE\n"
+                      "when Main.t.Q = TRUE then set Main.Reset TRUE\n"
+                      "at 30ms expect Main.Resets = 0\n"
+                      "expect Main.Level = 99 within 50ms\n", "--virtual-time", "--watch", "Main.Reset")
+    assert r.returncode == 1
+    assert "     0.011 s  Main.Reset = TRUE" in r.stdout.splitlines()       # t.Q after the scan at 10 ms
+    assert r.stderr.strip().splitlines()[-1].startswith("vplc run: FAILED: expectation failed at 0.050 s: "
+                                                        "expect Main.Level = 99 within 50ms")
