@@ -160,6 +160,8 @@ def _data_type(parent: ET.Element, item: TypeItem, project) -> None:
                                                                                else {})})
         for f in spec.fields:
             _variable(ts, "Member", f, item.member_comments.get(id(f), ""))
+        if getattr(decl, "offset_type", None) in ("CJ", "User"):       # kept from the file it was read from
+            _add_data(ts, "StructTypeSpecAdditionalProperties", {"offsetType": decl.offset_type})
     elif isinstance(spec, A.EnumTypeRef):
         ts = _sub(el, "UserDefinedTypeSpec", {"xsi:type": "EnumTypeWithNamedValueSpec"})
         values = enum_values(project, item)

@@ -34,6 +34,7 @@ class TypeText:
     spec: str                       # ST text after ``Name :``
     init: str | None = None
     comment: str = ""
+    offset_type: str = "NJ"         # Sysmac's member layout of a structure (StructTypeSpecAdditionalProperties)
 
 
 @dataclass

@@ -19,6 +19,10 @@ from __future__ import annotations
 import threading
 import xml.etree.ElementTree as ET
 
+from ..frontend import ast as A
+from ..frontend.diagnostics import DiagnosticBag
+from ..frontend.parser import parse
+from ..frontend.source import SourceFile
 from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit
 from .model import EDGES, STORAGES, Conn, Element, LadderBody, Pin, Rung
 from .xmlsafe import XSI_TYPE, text_of, xsi_type
@@ -197,13 +201,16 @@ def _data_type(dt: ET.Element) -> TypeText:
     where = f"data type {name}"
     spec = dt.find("UserDefinedTypeSpec")
     kind = xsi_type(spec) if spec is not None else ""
+    offset = "NJ"
     if spec is not None:
         props = _add_data(spec, where).get("StructTypeSpecAdditionalProperties")
         offset = props.get("offsetType", "NJ") if props is not None else "NJ"
-        if offset != "NJ":
-            raise FormatError(where, f'StructTypeSpecAdditionalProperties offsetType="{offset}": member offsets '
-                              "other than the NJ layout are not modelled by vplc (its structures have no memory "
-                              "layout); use offsetType NJ")
+        # W501 6-43 (member offsets, offset type CJ or User): the memory layout of the structure's members. No
+        # behaviour of vplc depends on it (a structure is refused wherever its memory image would be read: AT,
+        # union members, ToAryByte); it is kept and written back by the export
+        if offset not in ("NJ", "CJ", "User"):
+            raise FormatError(where, f'StructTypeSpecAdditionalProperties offsetType="{offset}": the schema allows '
+                              "NJ, CJ and User")
     _add_data(dt, where)
     if kind == "StructTypeSpec":
         # overlap="true": Sysmac's union, the members sharing one memory image (W501 6-3-6)
@@ -219,7 +226,7 @@ def _data_type(dt: ET.Element) -> TypeText:
         text = _array(spec, where)
     else:
         raise FormatError(where, f"data type specification `{kind or '?'}` is not supported")
-    return TypeText(name, text, value_text(dt.find("InitialValue")), _doc(dt))
+    return TypeText(name, text, value_text(dt.find("InitialValue")), _doc(dt), offset)
 
 
 def _enum_base(base: ET.Element | None, where: str) -> str:
@@ -318,6 +325,24 @@ def _point_ins(el: ET.Element, outs: dict) -> list[Conn]:
             for pt in el.iterfind("ConnectionPointIn") for c in pt.iterfind("Connection")]
 
 
+def _inline_st(obj: ET.Element, where: str) -> str:
+    """The statements of Sysmac's smcext:InlineST (ST inside a rung, run while the rung gives it power). They
+    must be statements only, whole: they are checked alone before they join the POU's generated text, so a
+    fragment cannot close the POU around it or leave a block open."""
+    st = obj.find("ST")
+    if st is None:
+        raise FormatError(where, "smcext:InlineST without its ST element")
+    text = text_of(st)
+    diags = DiagnosticBag()
+    unit = parse(SourceFile(where, f"PROGRAM InlineST\n{text}\nEND_PROGRAM\n"), diags)
+    errors = [d for d in diags.items if d.severity == "error"]
+    items = unit.items
+    if errors or len(items) != 1 or not isinstance(items[0], A.Pou) or items[0].sections:
+        why = errors[0].message if errors else "it must hold statements only (no declarations, no POUs)"
+        raise FormatError(where, f"smcext:InlineST: {why}")
+    return text
+
+
 def _rung(r: ET.Element, pou: str, number: int) -> Rung:
     rung = Rung([], label=r.get("label", "") or "")
     objects = []
@@ -328,11 +353,10 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
             rung.comment = f"{rung.comment}\n{text_of(obj.find('Content'))}".strip()
             continue
         place = f"{pou}:rung {number}:element {index}"
-        if _smc_type(obj) == "smcext:InlineST":
-            raise FormatError(place, f"unknown element <{obj.tag} xsi:type=\"InlineST\"> in a rung: Sysmac's "
-                              "smcext:InlineST (Structured Text inside a rung) is not modelled by vplc; move the ST "
-                              "into an ST POU or a function called from the rung")
+        inline = obj.tag == "LdObject" and _smc_type(obj) == "smcext:InlineST"
         table = LD_OBJECTS if obj.tag == "LdObject" else FBD_OBJECTS if obj.tag == "FbdObject" else {}
+        if inline:
+            table = {kind: "inline_st"}
         if kind not in table:
             if obj.tag in ("AddData", "Documentation"):
                 continue
@@ -377,6 +401,8 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
                 raise FormatError(where, "a Jump without targetNetworkLabel: name the label of the rung to jump to")
         elif e.kind == "label":
             e.var = obj.get("label", "")
+        elif e.kind == "inline_st":
+            e.var = _inline_st(obj, f"{pou}:rung {number}:inline ST")
         elif e.kind == "block":
             e.type_name = obj.get("typeName", "")
             e.instance = obj.get("instanceName", "") or ""

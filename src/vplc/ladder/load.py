@@ -94,9 +94,13 @@ def attach_ladders(unit: A.CompilationUnit) -> None:
     export read it."""
     src = unit.span.file if unit.span is not None else None
     ladders = {lad.pou.upper(): lad for lad in getattr(src, "ladders", ())}
+    layouts = getattr(src, "layouts", None) or {}
     for item in unit.items:
         if isinstance(item, A.Pou) and item.name.upper() in ladders:
             item.ladder = ladders[item.name.upper()]
+        elif isinstance(item, A.TypeBlock) and layouts:
+            for decl in item.decls:             # Sysmac's member layout (CJ, User), written back by the export
+                decl.offset_type = layouts.get(decl.name.upper())
 
 
 def _raw_text(path: str) -> str:

@@ -68,6 +68,8 @@ class Element:
         """How diagnostics and the drawing name the element: ``contact Start``, ``block CBT_MoveAbsolute``."""
         if self.kind == "block":
             return f"block {self.type_name.split(chr(92))[-1]}"
+        if self.kind == "inline_st":
+            return "inline ST"
         noun = {"left_rail": "left power rail", "right_rail": "right power rail", "in_var": "variable",
                 "out_var": "variable", "inout_var": "variable"}.get(self.kind, self.kind)
         return f"{noun} {self.var}".strip()

@@ -164,7 +164,7 @@ def _element(p, y: float, lay: RungLayout) -> str:
                 g.append(_t(x + w + 18, py + 4, label, "", "start"))
                 g.append(_t(x + w + 18, py + 18, "", "val", "start", var=label))
     else:
-        text = {"jump": f">> {e.var}", "return": "RETURN"}.get(e.kind, e.var)
+        text = {"jump": f">> {e.var}", "return": "RETURN", "inline_st": "ST"}.get(e.kind, e.var)
         g.append(f'<rect class="box" x="{x + 4:.0f}" y="{cy - 12:.0f}" width="{w - 8:.0f}" height="24" rx="10"/>')
         g.append(_t(x + w / 2, cy + 4, text, "", "middle"))
         if e.kind in ("in_var", "out_var", "inout_var"):

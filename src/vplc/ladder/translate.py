@@ -36,11 +36,12 @@ SYMBOL_BLOCKS = {"=": "EQ", "<>": "NE", "<": "LT", "<=": "LE", ">": "GT", ">=": 
 class LadderSource(SourceFile):
     """The ST text generated from an XML file; ``where(offset)`` names the XML element behind it."""
 
-    __slots__ = ("regions", "statements", "checks", "ladders", "errors")
+    __slots__ = ("regions", "statements", "checks", "ladders", "errors", "layouts")
 
     def __init__(self, path: str, text: str, regions=(), statements=(), checks=(), ladders=(), errors=()) -> None:
         super().__init__(path, text)
         self.errors = errors            # FormatError of each rung that could not be translated (reported by load)
+        self.layouts: dict = {}         # structure name (upper) -> Sysmac offsetType other than NJ, kept for export
         self.regions = regions          # (start, end, label), any order
         self.statements = statements    # (start, end) of each generated statement
         self.checks = checks            # (start, end, label, operand): contact operands that must be BOOL
@@ -143,7 +144,9 @@ def unit_source(path: str, unit: XmlUnit) -> LadderSource:
         if pou.ladder is not None:
             pou.ladder.path = path
             ladders.append(pou.ladder)
-    return LadderSource(path, w.text(), w.regions, w.statements, w.checks, ladders, errors)
+    src = LadderSource(path, w.text(), w.regions, w.statements, w.checks, ladders, errors)
+    src.layouts = {t.name.upper(): t.offset_type for t in unit.types if t.offset_type != "NJ"}
+    return src
 
 
 def _comment(text: str) -> str:
@@ -467,6 +470,17 @@ class RungCompiler:
             self.el_out_var(e)
         else:
             self.el_in_var(e)
+
+    def el_inline_st(self, e: Element) -> None:
+        """Sysmac's inline ST: its statements run while the rung gives the element power; the power goes on
+        unchanged to what is wired after it."""
+        lab = self.label(e)
+        inp = self.power(e, e.power_in)
+        if self.consumers.get((e.id, None), 0):
+            inp = self.materialize(inp)
+        body = Txt(e.var).marked(lab)
+        self.stmt(body if inp.text == TRUE else "IF " + inp + " THEN\n" + body + "\nEND_IF;", lab)
+        self.out[(e.id, None)] = inp
 
     def el_jump(self, e: Element) -> None:
         lab = self.label(e)

@@ -176,12 +176,12 @@ def test_other_xml_files_in_a_source_folder_are_not_sources(tmp_path):
 def test_unknown_object_in_a_sysmac_rung(tmp_path):
     from ld_xml import iec10_program
     rung = ('<LdObject xsi:type="LeftPowerRail"><ConnectionPointOut connectionPointOutId="1"/></LdObject>'
-            '<LdObject xsi:type="smcext:InlineST"><ConnectionPointIn><Connection refConnectionPointOutId="1"/>'
+            '<LdObject xsi:type="smcext:InlineFBD"><ConnectionPointIn><Connection refConnectionPointOutId="1"/>'
             '</ConnectionPointIn></LdObject>')
     path = write(tmp_path, iec10_program({"A": "BOOL"}, [rung]))
     d = one(path)
     assert d.code == "ST2102" and d.location().endswith("x.xml:Main:rung 1:element 2")
-    assert 'unknown element <LdObject xsi:type="InlineST"> in a rung' in d.message
+    assert 'unknown element <LdObject xsi:type="smcext:InlineFBD"> in a rung' in d.message
 
 
 def test_sysmac_rung_wire_to_a_missing_point(tmp_path):

@@ -123,23 +123,50 @@ def test_a_union_is_read_as_a_union_its_members_sharing_memory(tmp_path):
     assert plc.read("Main.b") == 0x34
 
 
-@pytest.mark.parametrize("offset, ok", [("NJ", True), ("CJ", False), ("User", False)])
-def test_struct_member_offsets_other_than_nj_are_refused(tmp_path, offset, ok):
+@pytest.mark.parametrize("offset, ok", [("NJ", True), ("CJ", True), ("User", True), ("PLC", False)])
+def test_struct_member_offsets_are_read_and_kept_by_the_export(tmp_path, offset, ok):
+    """W501 6-43: offset type CJ or User changes the members' memory layout; no behaviour of vplc depends on it
+    (a structure is refused wherever its memory image is read), so it is read and written back on export."""
     t = ('<DataTypeDecl name="stPair"><UserDefinedTypeSpec xsi:type="StructTypeSpec">'
          '<Member name="A"><Type><TypeName>INT</TypeName></Type></Member>'
          f'<AddData><Data {SMC}><smcext:StructTypeSpecAdditionalProperties offsetType="{offset}"/></Data></AddData>'
          '</UserDefinedTypeSpec></DataTypeDecl>')
     path = write(tmp_path, doc(t))
-    if ok:
-        assert diagnostics(path) == []
-    else:
-        refused(path, "data type stPair", f'offsetType="{offset}"', "not modelled")
+    if not ok:
+        refused(path, "data type stPair", f'offsetType="{offset}"')
+        return
+    assert diagnostics(path) == []
+    from vplc.cli.main import main
+    out = tmp_path / "again.xml"
+    assert main(["export", str(path), "--format", "iec61131-10", "-o", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert (f'offsetType="{offset}"' in text) is (offset != "NJ")
+    assert diagnostics(out) == []
 
 
-def test_inline_st_in_a_rung_is_refused_by_name(tmp_path):
-    inline = ('<LdObject xsi:type="smcext:InlineST">' + cin(1) + '<ConnectionPointOut connectionPointOutId="2"/>'
-              "<ST>Q := TRUE;</ST></LdObject>")
-    refused(write(tmp_path, iec10_program({"Q": "BOOL"}, [RAIL + inline])), "Main:rung 1", "smcext:InlineST")
+def _inline(st: str, src=1, out=None) -> str:
+    """smcext:InlineST as Sysmac Studio writes it: its connection points and ST in the Omron namespace."""
+    cout = f'<smcext:ConnectionPointOut connectionPointOutId="{out}"/>' if out else ""
+    return (f'<LdObject xsi:type="smcext:InlineST" xmlns:smcext="https://www.ia.omron.com/Smc">'
+            f'<smcext:ConnectionPointIn><Connection refConnectionPointOutId="{src}"/></smcext:ConnectionPointIn>'
+            f'{cout}<smcext:ST><ST>{st}</ST></smcext:ST></LdObject>')
+
+
+def test_inline_st_runs_while_the_rung_gives_it_power_and_passes_the_power_on(tmp_path):
+    rungs = [RAIL + contact("Go", 1, 2) + _inline("N := N + 1;\nIF N &gt; 2 THEN Big := TRUE; END_IF;", 2, 3)
+             + coil("After", 3)]
+    r = Run(write(tmp_path, iec10_program({"Go": "BOOL", "N": "INT", "Big": "BOOL", "After": "BOOL"}, rungs)))
+    assert r.scan(Go=False)["N"] == 0 and r.scan(Go=False)["After"] is False
+    r.scan(Go=True)
+    r.scan(Go=True)
+    out = r.scan(Go=True)
+    assert out["N"] == 3 and out["Big"] is True and out["After"] is True
+
+
+@pytest.mark.parametrize("st", ["END_PROGRAM PROGRAM Evil", "IF Go THEN", "VAR X : INT; END_VAR", "Q := ;"])
+def test_inline_st_that_is_not_whole_statements_is_refused_at_its_rung(tmp_path, st):
+    rungs = [RAIL + _inline(st)]
+    refused(write(tmp_path, iec10_program({"Q": "BOOL", "Go": "BOOL"}, rungs)), "Main:rung 1", "smcext:InlineST")
 
 
 def test_jump_with_target_network_label_skips_to_the_labelled_rung(tmp_path):
