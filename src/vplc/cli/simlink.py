@@ -14,6 +14,7 @@ checks it against docs/simulator.md so that a command or a fault added there is 
 from __future__ import annotations
 
 import json
+import math
 import queue
 import socket
 import threading
@@ -133,11 +134,14 @@ def _value(text: str, kind: str, key: str):
     except ValueError:
         pass
     try:
-        return float(text)
+        number = float(text)
     except ValueError:
         if kind == "number":
             raise CommandError(f"`{key}` is a number, got `{text}`") from None
-    return text
+        return text
+    if not math.isfinite(number):
+        raise CommandError(f"`{key}` must be a finite number, got `{text}`")
+    return number
 
 
 def describe(request: dict) -> str:

@@ -102,6 +102,8 @@ def test_scenario_mistakes_about_the_simulator_are_usage_errors_with_file_and_li
              "at 1s robot 1 inject slow\n": ":1: `slow` is not a fault of `inject`; known: reply_delay",
              "at 1s robot 1 inject reply_delay secs=2\n": ":1: `secs` is not a parameter of `reply_delay`; known: "
                                                           "seconds, count",
+             "at 1s robot 1 inject reply_delay seconds=1e400\n": ":1: `seconds` must be a finite number, got `1e400`",
+             "at 1s robot 1 svr_config period=soon\n": ":1: `period` is a number, got `soon`",
              "at 1s robot 1 operation_mode\n": ":1: `operation_mode` needs its mode: one of auto, manual",
              "at 1s robot 1 svr_config\n": ":1: `svr_config` needs at least one of period, mode, items",
              "at 1s robot 1 state\n": ":1: `state` asks the simulator for something; a scenario line acts",
