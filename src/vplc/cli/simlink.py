@@ -56,11 +56,15 @@ COMMANDS = {
                                     "write_permission": "bool"}, needs_one_key=True),
     "svr_inject": Command({}, positional="fault", choices=tuple(SVR_FAULTS), keys={}, into_params=True),
     "svr_clear_faults": Command({}),
+    # the robot's camera: a vision job of its project and what it finds (docs/simulator.md, Virtual camera)
+    "vision_job": Command({}, positional="job", keys={"objects": "poses", "pass": "bool", "seconds": "number",
+                                                      "capture": "pose", "variable": "text"}),
+    "vision_remove": Command({}, positional="job"),
 }
 # Words of the commissioning engineer for the commonest actions, each one request of the table above.
 ALIASES = {"cut_link": ("inject", {"fault": "disconnect"}),        # every client connection closed now
            "release_estop": ("estop", {"pressed": False})}
-QUERIES = ("ping", "robots", "state", "events")                    # answers, not actions
+QUERIES = ("ping", "robots", "state", "events", "vision")                    # answers, not actions
 
 
 def build_request(words: list[str]) -> dict:
@@ -83,7 +87,8 @@ def build_request(words: list[str]) -> dict:
     request = {"cmd": name, **command.fixed}
     if command.positional is not None:
         if not args or "=" in args[0]:
-            raise CommandError(f"`{name}` needs its {command.positional}: one of {', '.join(command.choices)}")
+            choices = f": one of {', '.join(command.choices)}" if command.choices else f", e.g. `{name} job1`"
+            raise CommandError(f"`{name}` needs its {command.positional}{choices}")
         value = args.pop(0)
         if command.choices and value not in command.choices:
             raise CommandError(f"`{value}` is not a {command.positional} of `{name}`; known: "
@@ -124,6 +129,12 @@ def _example(name, allowed) -> str:
 def _value(text: str, kind: str, key: str):
     if kind == "list":
         return [item for item in text.split(",") if item]
+    if kind == "text":
+        return text
+    if kind == "pose":
+        return _pose(text, key)
+    if kind == "poses":
+        return [_pose(pose, key) for pose in text.split(";") if pose]
     low = text.lower()
     if low in ("true", "false"):
         return low == "true"
@@ -144,11 +155,23 @@ def _value(text: str, kind: str, key: str):
     return number
 
 
+def _pose(text: str, key: str) -> list[float]:
+    """``300,0,5,0,0,90`` -> six finite numbers (a pose in mm and deg, or six joint angles)."""
+    try:
+        numbers = [float(v) for v in text.split(",")]
+    except ValueError:
+        numbers = []
+    if len(numbers) != 6 or not all(math.isfinite(v) for v in numbers):
+        raise CommandError(f"`{key}`: `{text}` is not six numbers like 300,0,5,0,0,90"
+                           + (" (poses separated by `;`)" if key == "objects" else ""))
+    return numbers
+
+
 def describe(request: dict) -> str:
     """The request as a scenario writes it (``inject reply_delay seconds=0.5``, ``estop pressed=false``)."""
-    words = [request["cmd"]] + [request[k] for k in ("fault", "mode") if k in request]
+    words = [request["cmd"]] + [request[k] for k in ("fault", "mode", "job") if k in request]
     for key, value in [*request.items(), *request.get("params", {}).items()]:
-        if key not in ("cmd", "fault", "mode", "params", "robot", "plc_time"):
+        if key not in ("cmd", "fault", "mode", "job", "params", "robot", "plc_time"):
             words.append(f"{key}={_word(value)}")
     return " ".join(words)
 
@@ -157,7 +180,9 @@ def _word(value) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, list):
-        return ",".join(value)
+        return (";" if value and isinstance(value[0], list) else ",").join(_word(v) for v in value)
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
     return str(value)
 
 

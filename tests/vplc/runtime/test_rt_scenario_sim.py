@@ -91,6 +91,13 @@ def test_robot_words_become_the_documented_requests():
         == {"cmd": "svr_config", "period": 0.05, "items": ["Robot_Link", "ESTOP"], "write_permission": False}
     assert simlink.build_request(["svr_inject", "refuse_writes", "status=6"]) == \
         {"cmd": "svr_inject", "fault": "refuse_writes", "params": {"status": 6}}
+    job = simlink.build_request(["vision_job", "job1", "objects=300,0,5,0,0,0;310,60,5,0,0,90", "pass=false",
+                                 "seconds=0.5", "capture=0,0,90,0,90,0", "variable=job1_Out"])
+    assert job == {"cmd": "vision_job", "job": "job1", "objects": [[300, 0, 5, 0, 0, 0], [310, 60, 5, 0, 0, 90]],
+                   "pass": False, "seconds": 0.5, "capture": [0, 0, 90, 0, 90, 0], "variable": "job1_Out"}
+    assert simlink.describe(job) == ("vision_job job1 objects=300,0,5,0,0,0;310,60,5,0,0,90 pass=false "
+                                     "seconds=0.5 capture=0,0,90,0,90,0 variable=job1_Out")
+    assert simlink.build_request(["vision_remove", "job1"]) == {"cmd": "vision_remove", "job": "job1"}
 
 
 # ---- usage errors before the run -------------------------------------------------------------------------
@@ -104,6 +111,8 @@ def test_scenario_mistakes_about_the_simulator_are_usage_errors_with_file_and_li
                                                           "seconds, count",
              "at 1s robot 1 inject reply_delay seconds=1e400\n": ":1: `seconds` must be a finite number, got `1e400`",
              "at 1s robot 1 svr_config period=soon\n": ":1: `period` is a number, got `soon`",
+             "at 1s robot 1 vision_job job1 capture=0,0,90\n": ":1: `capture`: `0,0,90` is not six numbers",
+             "at 1s robot 1 vision_remove\n": ":1: `vision_remove` needs its job, e.g. `vision_remove job1`",
              "at 1s robot 1 operation_mode\n": ":1: `operation_mode` needs its mode: one of auto, manual",
              "at 1s robot 1 svr_config\n": ":1: `svr_config` needs at least one of period, mode, items",
              "at 1s robot 1 state\n": ":1: `state` asks the simulator for something; a scenario line acts",
@@ -233,3 +242,14 @@ def test_members_and_unchanged_values_are_judged_like_any_other(tmp_path):
     assert "     0.011 s  Main.Reset = TRUE" in r.stdout.splitlines()       # t.Q after the scan at 10 ms
     assert r.stderr.strip().splitlines()[-1].startswith("vplc run: FAILED: expectation failed at 0.050 s: "
                                                         "expect Main.Level = 99 within 50ms")
+
+
+def test_a_scenario_defines_what_the_robots_camera_finds(tmp_path, sim):
+    from tmsim.control import request
+    r = run(tmp_path, "at 10ms robot 2 vision_job job1 objects=300,0,5,0,0,0;310,60,5,0,0,90 seconds=0.1\n"
+                      "at 20ms robot 2 vision_job job2 pass=false\nat 30ms robot 2 vision_remove job2\nat 40ms stop\n",
+            "--virtual-time", "--sim-control", control(sim))
+    assert r.returncode == 0, r.stdout + r.stderr
+    camera = request(sim.control.port, {"cmd": "vision", "robot": 1})["result"]
+    assert camera["jobs"] == [{"job": "job1", "objects": [[300, 0, 5, 0, 0, 0], [310, 60, 5, 0, 0, 90]],
+                               "pass": True, "seconds": 0.1, "capture": None, "variable": "job1_Base_TM"}]
