@@ -9,6 +9,9 @@
    with the HMI server answering two browsers that poll the PnP page's variables every 50 ms. Target <= 10 %.
 3. Read round trip: GET /api/read of the PnP page's variables, one after the other, against the HMI tests'
    stand-in PLC (the HTTP server's own cost, not the ST program's).
+5. --compare-with DIR: the read round trip (3) and the Execute round trip (1) of this server against an older copy
+   of src/vplc/hmi in DIR (git archive <commit> src/vplc/hmi | tar -x -C /tmp/old; DIR=/tmp/old/src/vplc/hmi),
+   both in this process on the same PLC, in alternating blocks; prints the ratio new/old per block.
 4. Under 70 slow clients: the same read, the Stop page and a Stop press while 70 connections send their request
    header one byte every 5 s and open a new connection whenever the server answers 408 (issue 23, item 6).
    Target: every request served; the latency stays that of an idle server.
@@ -293,7 +296,107 @@ def http_rows() -> None:
           f"({len(others)} of each, all served)")
 
 
+def older_server(directory: str):
+    """HmiServer of an older copy of the package in ``directory``, imported as the package ``hmi_before``."""
+    import importlib.util
+    path = pathlib.Path(directory).resolve()
+    spec = importlib.util.spec_from_file_location("hmi_before", path / "__init__.py",
+                                                  submodule_search_locations=[str(path)])
+    package = importlib.util.module_from_spec(spec)
+    sys.modules["hmi_before"] = package
+    spec.loader.exec_module(package)
+    return importlib.import_module("hmi_before.server").HmiServer
+
+
+def compare_with(directory: str, blocks: int = 16, reads: int = 150, presses: int = 20) -> None:
+    from fake_plc import FakePlc, command_program
+    servers = {"before": older_server(directory), "now": HmiServer}
+
+    def ratio_line(what, figures):
+        ratios = sorted(n / b for n, b in zip(figures["now"], figures["before"]))
+        print(f"{what}: before {statistics.median(figures['before']):.3f} ms, now {statistics.median(figures['now']):.3f}"
+              f" ms (medians of {blocks} blocks); now/before per block median {statistics.median(ratios):.3f}, "
+              f"{ratios[0]:.3f} .. {ratios[-1]:.3f}")
+
+    def alternate(run):
+        figures = {"before": [], "now": []}
+        for block in range(blocks):
+            for name in ("before", "now") if block % 2 == 0 else ("now", "before"):
+                figures[name].append(run(name))
+        return figures
+
+    mapping = Mapping.load()
+    plc = FakePlc(mapping, command_program)
+    stop = threading.Event()
+
+    def scanning():
+        while not stop.wait(0.001):
+            plc.scan()
+    runner = threading.Thread(target=scanning, daemon=True)
+    runner.start()
+    started = {name: cls(plc, mapping, port=0) for name, cls in servers.items()}
+    for hmi in started.values():
+        hmi.start()
+    try:
+        urls = {n: h.url + "api/read?names=" + ",".join(PNP_PAGE_VARS) for n, h in started.items()}
+        for url in urls.values():
+            read_latencies(url, 50)
+        ratio_line(f"/api/read round trip ({len(PNP_PAGE_VARS)} variables, stand-in PLC, blocks of {reads})",
+                   alternate(lambda name: statistics.median(read_latencies(urls[name], reads))))
+    finally:
+        for hmi in started.values():
+            hmi.stop()
+        stop.set()
+        runner.join(timeout=5)
+    if load_plc is None:
+        return
+    sim = SimServer(port=0, robots=1)
+    sim.start_background()
+    plc = load_plc(SOURCES)
+    with plc.lock:
+        plc.write("Connect_AddressIP", "127.0.0.1")
+        plc.write("Connect_Dest_PortIP", sim.ports[0])
+        plc.write("Connect_Execute", True)
+    stop = threading.Event()
+    runner = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
+    runner.start()
+    started = {name: cls(plc, mapping, port=0) for name, cls in servers.items()}
+    for hmi in started.values():
+        hmi.start()
+
+    def presses_median(name):
+        hmi = started[name]
+        url = hmi.url + "api/read?names=ChangeBase_Done,ChangeBase_Busy,ChangeBase_Error"
+        samples = []
+        for _ in range(presses):
+            start = time.perf_counter()
+            post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}}, hmi.access.keys["engineer"])
+            while not any(get(url)["values"][n] for n in ("ChangeBase_Done", "ChangeBase_Error")):
+                pass
+            samples.append((time.perf_counter() - start) * 1000)
+        return statistics.median(samples)
+    try:
+        wait_for(lambda: _locked(plc, "Connect_Connected"), "the connection to the simulator")
+        ratio_line(f"Execute round trip (ChangeBase, examples + library + simulator, blocks of {presses})",
+                   alternate(presses_median))
+    finally:
+        for hmi in started.values():
+            hmi.stop()
+        stop.set()
+        runner.join(timeout=5)
+        plc.close()
+        sim.close()
+
+
+def _locked(plc, name):
+    with plc.lock:
+        return plc.read(name)
+
+
 def main() -> int:
+    if "--compare-with" in sys.argv:
+        compare_with(sys.argv[sys.argv.index("--compare-with") + 1])
+        return 0
     if load_plc is None:
         samples, held_us = stand_in_round_trip()
         samples.sort()

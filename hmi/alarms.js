@@ -50,8 +50,8 @@ async function acknowledge(body) {
 }
 
 const PRIORITY_SHOWN = { high: "High", medium: "Medium", low: "Low" };
-const STATE_SHOWN = { "active-unacknowledged": "active, unacknowledged", "active-acknowledged": "active, acknowledged",
-  "returned-unacknowledged": "returned, unacknowledged", normal: "normal" };
+const STATE_SHOWN = { "active-unacknowledged": "active, unack.", "active-acknowledged": "active, ack.",
+  "returned-unacknowledged": "returned, unack.", normal: "normal" };     // the list's column; tap a row: whole
 
 function alarmLine(a) {
   return `${a.source}${a.id ? " " + a.id : ""}: ${a.text}`;
@@ -59,7 +59,8 @@ function alarmLine(a) {
 
 function alarmWhole(a) {
   const more = a.details.length ? `  Consequences: ${a.details.map((d) => d.text).join("; ")}.` : "";
-  return `${a.time}  ${PRIORITY_SHOWN[a.priority]}  ${alarmLine(a)}${a.remedy ? " — " + a.remedy : ""}` +
+  return `${a.time}  ${PRIORITY_SHOWN[a.priority]}  ${a.state.replace("-", ", ")}  ${alarmLine(a)}` +
+    `${a.remedy ? " — " + a.remedy : ""}` +
     `${a.first_out ? "  (first out)" : ""}${more}`;
 }
 
@@ -164,7 +165,7 @@ function robotTile(container) {
       <div class="body"><table id="alarm-log"></table></div>
       <div class="actions"><button id="btn-alarm-history-close">Close</button></div></dialog>`;
   container.append(area);
-  const texts = { play: ["Play", "the robot project runs."], stop: ["Stop Project", "the robot project stopped."] };
+  const texts = { play: ["Play", "the robot project runs"], stop: ["Stop Project", "the robot project stopped"] };
   const press = (command) => executeCommand("Project_Execute", { Project_Command: PROJECT_CMD[command] }, texts[command][0])
     .then((sent) => sent && releaseWhenFinished("Project", texts[command][0], texts[command][1]));
   for (const [id, command] of [["btn-project-play", "play"], ["btn-project-stop", "stop"]]) {

@@ -99,10 +99,27 @@ def test_an_e_stop_is_one_alarm_with_its_consequences_as_details(plant):
     assert alarm["priority"] == "high" and alarm["first_out"] is True
     details = [d["text"] for d in alarm["details"]]
     assert details == ["Robot: Robot error 16#00010001: Emergency stop",
-                       "Connection: Connection to the robot lost, reconnecting — Robot error stopped the project: "
+                       "Connection 16#4006: Connection to the robot lost, reconnecting — Robot error stopped the project: "
                        "code and text in CBT_RobotStatus",
                        "Move Absolute 16#4006: Robot error stopped the project"]
     assert summary["robot"] == "E-stop"
+
+
+def test_a_consequence_lasting_after_its_cause_raises_no_alarm_until_it_has_cleared(plant):
+    """Play restarts the project after a robot error: the robot error returns, the link still reconnects for a
+    moment (a consequence of the error): no new alarm for that; a later loss of the link is an alarm again."""
+    plc, system, _ = plant
+    plc.vars["RobotStatus"].update(RobotError=True, ErrorCode=0x10001, ErrorText="Line: target pose is out of reach")
+    step(plant)
+    plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_ErrorID=0x4006)
+    step(plant, times=3)
+    plc.vars["RobotStatus"]["RobotError"] = False
+    system.acknowledge(None, "operator")
+    assert step(plant, times=int(2 * ON_DELAY_S / 0.1) + 2)["alarms"] == []
+    plc.vars.update(Connect_Connected=True, Connect_Reconnecting=False, Connect_ErrorID=0)
+    step(plant)
+    plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_ErrorID=0x2006)
+    assert listed(step(plant, times=int(ON_DELAY_S / 0.1) + 2)) == [("link", "active-unacknowledged")]
 
 
 def test_a_consequence_seen_before_its_cause_waits_for_it(plant):

@@ -206,14 +206,14 @@ def test_a_first_connect_retried_is_not_called_a_lost_connection(page, stack):
             plc.vars.update(Connect_Connected=True, Connect_Reconnecting=False, Connect_Error=False,
                             Connect_ErrorID=0, Connect_ErrorDescrip="")
         browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the link up")
-        browser.wait_for(lambda d: alarm_rows(browser)[0].endswith("returned, unacknowledged"), "the retry alarm back")
+        browser.wait_for(lambda d: alarm_rows(browser)[0].endswith("returned, unack."), "the retry alarm back")
         with plc.lock:
             plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=0,
                             Connect_Error=True, Connect_ErrorID=0x2006, Connect_ErrorDescrip="Link lost")
         browser.wait_for(lambda d: any("Connection to the robot lost, reconnecting — Link lost" in r
                                        for r in alarm_rows(browser)), "the outage alarm")
         rows = alarm_rows(browser)            # not acknowledged yet: the same alarm is active again (ISA-18.2)
-        assert len(rows) == 1 and rows[0].endswith("active, unacknowledged"), rows
+        assert len(rows) == 1 and rows[0].endswith("active, unack."), rows
     finally:
         with plc.lock:
             plc.vars.update(Connect_Execute=False, Connect_Reconnecting=False, Connect_Error=False, Connect_ErrorID=0,

@@ -5,7 +5,9 @@ turns what it reads into alarms:
 
 * one alarm per cause, ranked: PLC fault or stalled, E-stop, robot error, robot project stopped, robot outside
   its Listen node, link to the robot lost, a command that failed. A condition that comes while a higher-ranked
-  alarm is active is a consequence: it becomes a detail of that alarm, not an alarm of its own. Consequences wait
+  alarm is active is a consequence: it becomes a detail of that alarm, not an alarm of its own, also while it
+  lasts after its cause has gone (the link reconnecting after Play); it can raise an alarm again only after it
+  has cleared. Consequences wait
   ON_DELAY_S before they are raised (ISA-18.2 on-delay), so a cause seen a moment later still takes them; the
   first alarm of an episode (raised while no other alarm is listed) is marked first-out.
 * states: active-unacknowledged, active-acknowledged, returned-unacknowledged, normal (acknowledged and gone:
@@ -204,6 +206,7 @@ class AlarmSystem:
         self.robot_state = "unknown"
         self._lock = threading.Lock()
         self._pending: dict[str, float] = {}        # consequence key -> when its condition was first seen
+        self._absorbed: set[str] = set()            # consequences shown as a cause's details, until they clear
         self._events: list[tuple[float, dict]] = []  # failed commands waiting for their cause
         self._errors_seen: dict[str, tuple[bool, int]] = {}
         self._was_connected = False                # a retry before the first connect is no "lost" link
@@ -341,10 +344,14 @@ class AlarmSystem:
                     held.text, held.error_id, held.remedy = c["text"], c["error_id"], c["remedy"]
                     self.seq += 1
                 continue
+            if key in self._absorbed:                     # a cause's consequence lasting beyond it (the link
+                continue                                  # reconnecting after Play): still no alarm of its own
             top = self._top(c["rank"])
             if top is not None:                           # a consequence of an active cause
-                self._detail(top, now, f"{c['source']}: {c['text']}")
+                shown = f"{c['source']} {id_text(c['error_id'])}" if c["error_id"] else c["source"]
+                self._detail(top, now, f"{shown}: {c['text']}")
                 self._pending.pop(key, None)
+                self._absorbed.add(key)
                 continue
             if c["rank"] >= CAUSES["project"][0]:         # a consequence-type alarm waits for its cause
                 since = self._pending.setdefault(key, mono)
@@ -361,6 +368,7 @@ class AlarmSystem:
                 active[key] = self._raise(key, c, now)
         for key in [k for k in self._pending if k not in conditions]:
             del self._pending[key]
+        self._absorbed &= conditions.keys()
         for alarm in list(self.alarms.values()):          # alarms follow the process condition
             if alarm.active and alarm.key not in conditions:
                 alarm.active, alarm.returned = False, now

@@ -1,0 +1,248 @@
+"""The pages of the server's alarm system, the invalid values without the PLC and the robot's real state, in
+headless Chromium at 800x480 against the stand-in PLC (issue 25, items 2 to 5): alarm states, an acknowledge shared
+by two browser sessions, the controller's date and 24-hour time, the list and history across a reload and a server
+restart, #### and grey lamps within a second of the PLC going away, the operator's Exit Listen Node, the header's
+robot state with the way back to the Listen node, and Play that does not speak of a stop."""
+from __future__ import annotations
+
+import threading
+import time
+
+import pytest
+from selenium.webdriver.common.by import By
+
+from browser import Browser
+from fake_plc import FakePlc, command_program
+from vplc.hmi.mapping import Mapping
+from vplc.hmi.server import HmiServer
+
+CONTROLLER_START = time.mktime((2031, 7, 4, 21, 15, 30, 0, 0, -1))   # the controller's clock: not the browser's
+
+
+class ControllerClock:
+    """The server's clock, set to 4 July 2031 21:15:30 and running from there."""
+
+    def __init__(self):
+        self.origin = time.monotonic()
+
+    def __call__(self):
+        return CONTROLLER_START + (time.monotonic() - self.origin)
+
+
+class Stack:
+    def __init__(self, log_path, port=0):
+        self.mapping = Mapping.load()
+        self.plc = FakePlc(self.mapping, command_program)
+        self.plc.vars.update(Connect_Execute=True, Connect_Connected=True, Robot_InListenNode=True,
+                             RobotStatus_Valid=True)
+        self.plc.vars["RobotStatus"].update(ProjectRunning=True, AutoMode=True, ProjectSpeed=100)
+        self.plc._edges = {"Connect": True}
+        self.log_path = log_path
+        self.stop_scanning = threading.Event()
+        self.thread = threading.Thread(target=self._scan, daemon=True)
+        self.thread.start()
+        self.start_server(port)
+
+    def _scan(self):
+        while not self.stop_scanning.wait(0.001):
+            self.plc.scan()
+
+    def start_server(self, port=0):
+        self.server = HmiServer(self.plc, self.mapping, port=port, alarm_log=self.log_path, clock=ControllerClock())
+        self.server.start()
+
+    def set(self, **values):
+        with self.plc.lock:
+            for name, value in values.items():
+                if name.startswith("RS_"):
+                    self.plc.vars["RobotStatus"][name[3:]] = value
+                else:
+                    self.plc.vars[name] = value
+
+    def close(self):
+        self.server.stop()
+        self.stop_scanning.set()
+        self.thread.join(timeout=5)
+
+
+@pytest.fixture(scope="module")
+def stack(tmp_path_factory):
+    s = Stack(tmp_path_factory.mktemp("alarms") / "alarms.jsonl")
+    yield s
+    s.close()
+
+
+@pytest.fixture
+def browser(chromium, stack):
+    yield chromium
+    stack.set(RS_EStop=False, RS_RobotError=False, Robot_InListenNode=True)
+    stack.server.alarms.acknowledge(None, "engineer")
+
+
+def banner(browser):
+    element = browser.driver.find_element(By.ID, "alarm-banner")
+    return element.text if element.is_displayed() else ""
+
+
+def rows(browser):
+    found = browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
+    return [] if found == ["No alarms."] else found
+
+
+def text(browser, element_id):
+    return browser.driver.find_element(By.ID, element_id).text
+
+
+def test_an_alarm_goes_through_its_states_on_the_page(browser, stack):
+    browser.open(stack.server.page_url("index", "operator"))
+    stack.set(RS_EStop=True)
+    browser.wait_for(lambda d: "Emergency stop pressed" in banner(browser), "the E-stop in the banner")
+    assert "High" in banner(browser) and "release the emergency stop, then press Play on the Main screen" in banner(browser)
+    browser.wait_for(lambda d: rows(browser) and rows(browser)[0].endswith("active, unack."), "the row")
+    assert browser.driver.find_element(By.ID, "alarm-banner").get_attribute("data-priority") == "high"
+    assert text(browser, "pill-robot") == "Robot E-stop"
+    browser.screenshot("alarm_active_unacknowledged")
+    browser.click("btn-alarm-ack")
+    browser.wait_for(lambda d: rows(browser)[0].endswith("active, ack.") and banner(browser) == "",
+                     "the acknowledged alarm")
+    browser.screenshot("alarm_active_acknowledged")
+    stack.set(RS_EStop=False)
+    browser.wait_for(lambda d: rows(browser) == [], "the alarm normal (acknowledged and returned)")
+    stack.set(RS_EStop=True)
+    browser.wait_for(lambda d: rows(browser) and rows(browser)[0].endswith("active, unack."), "again")
+    stack.set(RS_EStop=False)
+    browser.wait_for(lambda d: rows(browser)[0].endswith("returned, unack."), "returned unacknowledged")
+    assert "Emergency stop pressed" in banner(browser)
+    browser.screenshot("alarm_returned_unacknowledged")
+    browser.click("btn-alarm-ack")
+    browser.wait_for(lambda d: rows(browser) == [] and banner(browser) == "", "normal")
+
+
+def test_one_alarm_per_cause_with_its_consequences_and_priority(browser, stack):
+    browser.open(stack.server.page_url("index", "operator"))
+    stack.set(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001, MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")
+    browser.wait_for(lambda d: any("16#3001" in r for r in rows(browser)), "the command's alarm")
+    stack.set(RS_EStop=True, RS_RobotError=True, RS_ErrorCode=0x10001, RS_ErrorText="Emergency stop",
+              Connect_Connected=False, Connect_Reconnecting=True, Connect_ErrorID=0x4006,
+              MoveRel_Error=True, MoveRel_ErrorID=0x4006, MoveRel_ErrorDescrip="Robot error stopped the project")
+    try:
+        browser.wait_for(lambda d: rows(browser) and "Emergency stop pressed (+3)" in rows(browser)[0],
+                         "the E-stop with its three consequences on top")
+        listed = rows(browser)
+        assert len(listed) == 2 and "High" in listed[0] and "Low ① Move Absolute 16#3001" in listed[1], listed
+        browser.screenshot("alarm_one_per_cause")
+        browser.driver.find_element(By.ID, "alarm-history").find_elements(By.TAG_NAME, "tr")[1].click()
+        whole = browser.message()
+        assert "Consequences: Robot: Robot error 16#00010001: Emergency stop; Connection 16#4006: Connection to the " \
+               "robot lost, reconnecting" in whole and "Move Relative 16#4006" in whole
+    finally:
+        stack.set(MoveAbs_Error=False, MoveAbs_ErrorID=0, MoveRel_Error=False, MoveRel_ErrorID=0,
+                  Connect_Connected=True, Connect_Reconnecting=False, Connect_ErrorID=0)
+
+
+def test_acknowledge_is_shared_by_two_browser_sessions(browser, stack):
+    second = Browser()
+    try:
+        browser.open(stack.server.page_url("index", "operator"))
+        second.open(stack.server.page_url("index", "operator"))
+        stack.set(Robot_InListenNode=False)
+        for b in (browser, second):
+            b.wait_for(lambda d: "The robot left the Listen node" in banner(b), "the alarm on both panels")
+        second.screenshot("alarm_second_panel_before_acknowledge")
+        browser.click("btn-alarm-ack")
+        second.wait_for(lambda d: banner(second) == "", "the acknowledge seen by the other panel")
+        browser.wait_for(lambda d: rows(browser)[0].endswith("active, ack."), "acknowledged on the first")
+        second.screenshot("alarm_second_panel_after_acknowledge")
+    finally:
+        second.close()
+
+
+def test_timestamps_are_the_controllers_date_and_24_hour_time(browser, stack):
+    browser.open(stack.server.page_url("index", "operator"))
+    stack.set(RS_EStop=True)
+    browser.wait_for(lambda d: "Emergency stop" in banner(browser), "the alarm")
+    assert banner(browser).startswith("2031-07-04 21:1"), banner(browser)      # not the browser's clock
+    assert rows(browser)[0].startswith("21:1")                                     # 24-hour, no AM/PM
+    browser.click("btn-alarm-history")
+    log = browser.driver.find_element(By.ID, "alarm-log").text.splitlines()
+    raised = [line for line in log if " raised " in line and "Emergency stop pressed" in line]
+    assert raised and raised[0].startswith("2031-07-04 21:1"), log[:5]
+    browser.screenshot("alarm_history_controller_time")
+    browser.click("btn-alarm-history-close")
+
+
+def test_the_list_the_acknowledge_and_the_history_survive_a_reload_and_a_server_restart(browser, stack):
+    browser.open(stack.server.page_url("index", "operator"))
+    browser.wait_for(lambda d: rows(browser) == [], "no alarm left by the test before")
+    stack.set(RS_EStop=True)
+    browser.wait_for(lambda d: "Emergency stop" in banner(browser), "the alarm")
+    browser.click("btn-alarm-ack")
+    browser.wait_for(lambda d: rows(browser)[0].endswith("active, ack."), "acknowledged")
+    browser.driver.refresh()
+    browser.wait_for(lambda d: rows(browser) and rows(browser)[0].endswith("active, ack."), "after reload")
+    assert banner(browser) == ""
+    stack.set(RS_EStop=False)
+    browser.wait_for(lambda d: rows(browser) == [], "normal")
+    entries = stack.server.alarms.summary(history=500)["history"]
+    port = stack.server.port
+    stack.server.stop()                                   # a server restart on the same port, same history file
+    stack.start_server(port)
+    browser.open(stack.server.page_url("index", "operator"))
+    browser.click("btn-alarm-history")
+    browser.wait_for(lambda d: len(browser.driver.find_element(By.ID, "alarm-log").text.splitlines()) >= len(entries),
+                     "the history read back")
+    shown = browser.driver.find_element(By.ID, "alarm-log").text.splitlines()[1:]
+    assert shown[0].startswith(entries[0]["time"]) and "normal" in shown[0], shown[:2]
+    browser.screenshot("alarm_history_after_restart")
+    browser.click("btn-alarm-history-close")
+
+
+def test_without_the_plc_values_read_invalid_with_a_communication_alarm(browser, stack, capsys):
+    browser.open(stack.server.page_url("moveabs", "operator"))
+    browser.wait_for(lambda d: browser.status("MoveAbs_ErrorID") == "16#0000", "a valid value")
+    port = stack.server.port
+    stack.server.stop()
+    gone = time.monotonic()
+    browser.wait_for(lambda d: browser.status("MoveAbs_ErrorID") == "####", "#### in place of the value")
+    took = time.monotonic() - gone
+    with capsys.disabled():
+        print(f"\n  values invalid {took * 1000:.0f} ms after the HMI server stopped")
+    assert browser.status("MoveAbs_Busy") == "invalid" and browser.status("Robot_Stopping") == "invalid"
+    assert text(browser, "pill-plc") == "PLC offline" and text(browser, "pill-robot") == "Robot ####"
+    assert "PLC communication lost" in banner(browser)
+    assert "not valid" in browser.message()
+    assert "plc-offline" in browser.driver.find_element(By.CSS_SELECTOR, ".panel").get_attribute("class")
+    browser.screenshot("offline_values_invalid")
+    stack.start_server(port)
+    browser.wait_for(lambda d: browser.status("MoveAbs_ErrorID") == "16#0000", "valid values again")
+    assert banner(browser) == ""
+
+
+def test_the_operator_sees_exit_listen_node_locked_and_the_engineer_may_change_it(browser, stack):
+    browser.open(stack.server.page_url("moveabs", "operator"))
+    box = browser.field("MoveAbs_Param.ExitNode")
+    assert not box.is_enabled() and browser.field("MoveAbs_Param.Speed").is_enabled()
+    assert "Engineering setting" in box.find_element(By.XPATH, "..").get_attribute("title")
+    browser.screenshot("operator_exit_node_locked")
+    browser.fresh().open(stack.server.page_url("moveabs", "engineer"))     # a new tab: the address's key counts
+    assert browser.field("MoveAbs_Param.ExitNode").is_enabled()
+
+
+def test_the_header_says_when_the_robot_left_its_listen_node_and_main_offers_the_way_back(browser, stack):
+    browser.open(stack.server.page_url("index", "operator"))
+    browser.wait_for(lambda d: text(browser, "pill-robot") == "Robot ready", "the robot ready")
+    assert not browser.driver.find_element(By.ID, "btn-back-to-node").is_displayed()
+    stack.set(Robot_InListenNode=False)
+    browser.wait_for(lambda d: text(browser, "pill-robot") == "Robot left Listen node", "the header")
+    browser.wait_for(lambda d: "Press Back to Listen Node on the Main screen" in banner(browser), "the alarm")
+    button = browser.driver.find_element(By.ID, "btn-back-to-node")
+    assert button.is_displayed() and button.is_enabled()
+    assert text(browser, "robot-link") == "connected, robot outside its Listen node"
+    browser.screenshot("robot_left_listen_node")
+
+
+def test_play_reports_that_the_project_runs_and_not_a_stop(browser, stack):
+    browser.open(stack.server.page_url("index", "operator"))
+    browser.click("btn-project-play")
+    browser.wait_for(lambda d: "Play: Done – the robot project runs" in browser.message(), "Play's answer")
+    assert "stop" not in browser.message().lower()
