@@ -156,7 +156,7 @@ def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(
         browser._fit()
 
 
-def test_the_coils_of_a_rung_stand_in_one_column_at_the_right_rail(system):
+def test_the_coils_stand_in_one_column_at_the_right_rail_in_every_rung(system):
     _plc, hmi, browser = system
     browser.open(f"{hmi.url}program.html")
     gaps = browser.driver.execute_script("""
@@ -172,6 +172,27 @@ def test_the_coils_of_a_rung_stand_in_one_column_at_the_right_rail(system):
           if (row.length) out.push(row);
         }
         return out;""")
-    assert len(gaps) >= 9
-    for row in gaps:                      # one column of coils per rung, its wires reaching the right rail
-        assert max(row) - min(row) < 2, gaps
+    every = [g for row in gaps for g in row]
+    assert len(gaps) >= 9 and max(every) - min(every) < 2, gaps     # one column, in every rung, at the rail
+    assert max(every) < 30
+
+
+def test_no_two_boxes_touch(system):
+    """Two MOVE blocks stacked in rung 11 used to share an edge; every box keeps clear of the others and of texts."""
+    _plc, hmi, browser = system
+    browser.open(f"{hmi.url}program.html")
+    touching = browser.driver.execute_script("""
+        const out = [];
+        for (const g of document.querySelectorAll('g.rung')) {
+          const boxes = [...g.querySelectorAll('rect.box')].map(r => r.getBoundingClientRect());
+          const texts = [...g.querySelectorAll('text')].filter(t => t.textContent.trim() &&
+            !t.closest('g.el.block')).map(t => [t.textContent, t.getBoundingClientRect()]);
+          boxes.forEach((a, i) => boxes.slice(i + 1).forEach(b => {
+            if (a.left < b.right + 4 && b.left < a.right + 4 && a.top < b.bottom + 4 && b.top < a.bottom + 4)
+              out.push([g.dataset.rung, 'box', 'box']);
+          }));
+          for (const b of boxes) for (const [t, r] of texts)
+            if (r.left < b.right && b.left < r.right && r.top < b.bottom && b.top < r.bottom) out.push([g.dataset.rung, 'box', t]);
+        }
+        return out;""")
+    assert touching == []

@@ -139,7 +139,9 @@ def layout_rung(rung: Rung, number: int) -> RungLayout:
         row = max(want, desired.get(e.id, 0))
         while any((col[e.id], r) in taken for r in range(row, row + rows)):
             row += 1
-        for r in range(row, row + rows):
+        # a block keeps the row under it free in its column: its box reaches below its last pin, and the next
+        # element's name (or the next block's instance name) would touch it there (two MOVEs stacked)
+        for r in range(row, row + rows + (1 if e.kind == "block" else 0)):
             taken.add((col[e.id], r))
         lay.placed[e.id] = Placed(e, col[e.id], row, rows)
     ncols = max((p.col for p in lay.placed.values()), default=-1) + 1
@@ -256,4 +258,17 @@ def _fit_names(lay: RungLayout) -> None:
 
 
 def layout(body: LadderBody) -> list[RungLayout]:
-    return [layout_rung(r, n) for n, r in enumerate(body.rungs, start=1)]
+    """Every rung of the body; the coils that end a rung stand in one column at the right rail in every rung, as
+    Sysmac Studio draws them (each rung on its own would put them right after its widest column)."""
+    lays = [layout_rung(r, n) for n, r in enumerate(body.rungs, start=1)]
+    right = max((lay.width for lay in lays), default=0.0)
+    for lay in lays:
+        read = {c.ref for e in lay.rung.elements if e.kind != "right_rail" for pin in [*e.inputs, *e.inouts]
+                for c in pin.conns}
+        for p in lay.placed.values():
+            if p.element.kind == "coil" and p.element.id not in read:
+                dx = right - 10 - (p.x + p.w)
+                p.x += dx                             # its name follows while it stays inside the rails
+                p.label_x = max(p.label_x, min(p.label_x + dx, right + RAIL_GAP - PAD - text_width(p.element.var) / 2))
+        lay.width = right
+    return lays
