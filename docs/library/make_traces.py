@@ -21,10 +21,11 @@ EXTRA = {"CBT_Connect": ["Cobot.InListenNode", "RobotReady"], "CBT_Stop": ["Cobo
          "CBT_ProjectControl": ["Cobot.Status.ProjectRunning"],
          "CBT_ReadIO": ["PartPresent"], "CBT_SetOverride": ["SpeedShown"],
          "CBT_WaitQueue": ["Cobot.Status.Moving", "Cobot.Status.TCPSpeed"],
-         "CBT_ReadVariable": ["PartCount"]}
+         "CBT_ReadVariable": ["PartCount"], "CBT_Jog": ["Cobot.Stopping"]}
 FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"], "CBT_RobotStatus": ["fbConnect.Connected"],
          "CBT_ReadIO": ["fbConnect.Connected"]}      # the FB's Enable
 HOLD_S = 0.02                   # Execute stays TRUE this long after Done, then falls: both Done cases show
+HOLD_PAGE_S = {"CBT_Jog": 0.3}  # a jog button is held a while after Active, then released
 
 
 def slug(page: str) -> str:
@@ -71,7 +72,7 @@ def page_trace(page: str, out: Path) -> None:
             if trigger:
                 plc.write(f"{program}.{trigger}", True)
             plc.run_until(lambda: sample() or read(done) or read(f"{fb}.Error"), 20 * SEC, on_scan=pump)
-            plc.run_until(sample, int(HOLD_S * SEC), on_scan=pump)
+            plc.run_until(sample, int(HOLD_PAGE_S.get(page, HOLD_S) * SEC), on_scan=pump)
             if trigger:
                 plc.write(f"{program}.{trigger}", False)
             plc.run_until(sample, int(HOLD_S * SEC), on_scan=pump)

@@ -36,6 +36,8 @@ STEPS = {
     "CBT_WaitQueue": [("MoveExec", "fbMove.Done"), ("SyncExec", "fbSync.Done")],
     "CBT_ReadVariable": [("ReadExec", "fbRead.Done")],
     "CBT_WriteVariable": [("WriteExec", "fbWrite.Done")],
+    "CBT_Jog": [("JogPlusButton", "fbJog.Active")],
+    "CBT_Teach": [("TeachButton", "fbTeach.Done")],
 }
 
 

@@ -41,8 +41,8 @@ def load(name):
 MT = load("make_types")
 # CBT_SetOverride's row (an FB input of a program of its own) is run, every value of its type, by
 # tests/lib/test_lib_set_override.py; the rows of CBT_ReadVariable / CBT_WriteVariable (members of their in-out
-# Variable) by tests/lib/test_lib_variables.py
-OWN_TESTS = ("CBT_SetOverride", "CBT_ReadVariable", "CBT_WriteVariable")
+# Variable) by tests/lib/test_lib_variables.py; CBT_Jog's (FB inputs, no Execute) by tests/lib/test_lib_jog.py
+OWN_TESTS = ("CBT_SetOverride", "CBT_ReadVariable", "CBT_WriteVariable", "CBT_Jog")
 ROWS = [r for r in MT.read_ranges() if r.error and r.struct not in OWN_TESTS]
 
 
