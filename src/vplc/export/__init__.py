@@ -55,6 +55,7 @@ def run_export(args) -> int:
     from ..frontend.diagnostics import ERROR, NOTE
     from ..project import load_project
     from .iec61131_10 import render
+    from ..ladder.model import WriteError
     from .model import ExportError, collect
     from .paste import PasteTargetError, write as write_paste
 
@@ -111,7 +112,7 @@ def run_export(args) -> int:
             _write_atomic(out, render_plcopen(export, proj))
         else:
             write_paste(export, proj, out, flat=args.flat)
-    except ExportError as exc:
+    except (ExportError, WriteError) as exc:
         print(f"vplc export: error: {exc}", file=sys.stderr)
         return 1
     except PasteTargetError as exc:

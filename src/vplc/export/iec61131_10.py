@@ -321,6 +321,16 @@ def _qualifiers(section: A.VarSection) -> dict:
 
 # ---- document ------------------------------------------------------------------------------------
 
+def _namespace_decl(containers: dict, ns: str) -> ET.Element:
+    """The NamespaceDecl of ``ns``, nested as Sysmac nests namespaces (`A\\B` is a NamespaceDecl B inside A)."""
+    if ns in containers:
+        return containers[ns]
+    outer, _, name = ns.rpartition("\\")
+    parent = _namespace_decl(containers, outer) if outer else containers[None]
+    containers[ns] = _sub(parent, "NamespaceDecl", {"name": name})
+    return containers[ns]
+
+
 def build(export: ExportSet, project, *, flat: bool = False, device: tuple[str, str] | None = None) -> ET.Element:
     """The ``Project`` element of the export; ``device`` (model, version) names the controller."""
     root = ET.Element("Project", {
@@ -340,7 +350,7 @@ def build(export: ExportSet, project, *, flat: bool = False, device: tuple[str, 
     containers: dict[str | None, ET.Element] = {None: gns}
     if not flat:
         for ns in export.namespaces:
-            containers[ns] = _sub(gns, "NamespaceDecl", {"name": ns})
+            _namespace_decl(containers, ns)
     for t in export.types:
         _data_type(containers[None if flat else t.namespace], t, project)
     for p in export.pous:                           # NamespaceDecl holds no Program in the schema

@@ -169,7 +169,7 @@ def collect(project) -> ExportSet:
             if isinstance(item, A.TypeBlock):
                 block_text = unit.span.file.text[item.span.start:item.span.end]
                 for i, decl in enumerate(item.decls):
-                    ns = unit.namespace
+                    ns = decl.namespace                      # the file's, or its NAMESPACE block's
                     t = TypeItem(decl, ns, header if i == 0 else "", block_text, path)
                     spec = decl.spec
                     if isinstance(spec, A.StructTypeRef):
@@ -180,11 +180,11 @@ def collect(project) -> ExportSet:
                     if ns:
                         namespaces.add(ns)
             elif isinstance(item, A.Pou):
-                p = PouItem(item, unit.namespace, header, body_text(item), path,
+                p = PouItem(item, item.namespace, header, body_text(item), path,
                             {id(d): comments.trailing(d.span.end) for s in item.sections for d in s.vars})
                 pous.append(p)
-                if unit.namespace:
-                    namespaces.add(unit.namespace)
+                if item.namespace:
+                    namespaces.add(item.namespace)
             elif isinstance(item, A.GlobalVarList):
                 globals_.append(GlobalItem(item, path, {id(d): comments.trailing(d.span.end)
                                                         for s in item.sections for d in s.vars}))

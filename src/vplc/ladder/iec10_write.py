@@ -28,7 +28,8 @@ from .model import Element, LadderBody, Rung
 KIND_TAG = {"left_rail": ("LdObject", "LeftPowerRail"), "right_rail": ("LdObject", "RightPowerRail"),
             "contact": ("LdObject", "Contact"), "coil": ("LdObject", "Coil"), "block": ("FbdObject", "Block"),
             "in_var": ("FbdObject", "DataSource"), "out_var": ("FbdObject", "DataSink"),
-            "inout_var": ("FbdObject", "DataSink"), "jump": ("FbdObject", "Jump"), "return": ("FbdObject", "Jump")}
+            "inout_var": ("FbdObject", "DataSink"), "jump": ("FbdObject", "Jump"), "return": ("FbdObject", "Jump"),
+            "inline_st": ("LdObject", "smcext:InlineST")}
 # Sysmac's pin names of MOVE (EN, In -> ENO, Out: field notes of engineers who imported generated files);
 # ST names are case-insensitive, so vplc reads them as IN / OUT.
 PIN_SPELLING = {"MOVE": {"IN": "In", "OUT": "Out"}}
@@ -98,7 +99,7 @@ def resolve_pins(rung: Rung) -> None:
 def _out_pins(e: Element) -> list[str | None]:
     if e.kind == "block":
         return [p.name for p in e.inouts] + [p.name for p in e.outputs]
-    if e.kind in ("left_rail", "contact", "coil", "in_var", "inout_var"):
+    if e.kind in ("left_rail", "contact", "coil", "in_var", "inout_var", "inline_st"):
         return [None]
     return []
 
@@ -134,6 +135,14 @@ def _element(r: ET.Element, e: Element, ids, end_label: str | None) -> None:
     el = _sub(r, tag, attrs)
     if e.kind == "block":
         _block_pins(el, e, ids)
+        return
+    if e.kind == "inline_st":            # Omron's extension: its children are in the smcext namespace (schema)
+        pt = _sub(el, "smcext:ConnectionPointIn")
+        for c in e.inputs[0].conns if e.inputs else ():
+            _sub(pt, "Connection", {"refConnectionPointOutId": ids[(c.ref, c.pin)]})
+        if (e.id, None) in ids:
+            _sub(el, "smcext:ConnectionPointOut", {"connectionPointOutId": ids[(e.id, None)]})
+        _sub(_sub(el, "smcext:ST"), "ST", text=e.var)
         return
     if e.kind == "right_rail":
         for pin in e.inputs:

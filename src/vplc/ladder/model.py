@@ -75,6 +75,10 @@ class Element:
         return f"{noun} {self.var}".strip()
 
 
+class WriteError(Exception):
+    """A ladder element the target format cannot express (TC6 has no inline ST); the export reports it."""
+
+
 @dataclass
 class Rung:
     elements: list[Element]

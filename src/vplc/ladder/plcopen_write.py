@@ -9,7 +9,7 @@ import xml.etree.ElementTree as ET
 
 from .iec10_write import resolve_pins
 from .layout import ROW_H, layout_rung
-from .model import Element, LadderBody
+from .model import Element, LadderBody, WriteError
 
 XHTML_NS = "http://www.w3.org/1999/xhtml"
 RUNG_GAP = 60
@@ -102,6 +102,9 @@ def _flags(attrs: dict, e: Element) -> dict:
 def _element(ld: ET.Element, e: Element, ids, xy, height: float, width: float) -> None:
     x, y = xy
     lid = ids[e.id]
+    if e.kind == "inline_st":
+        raise WriteError("a rung holds Sysmac inline ST (smcext:InlineST), which PLCopen TC6 cannot express; "
+                         "export with --format iec61131-10")
     if e.kind == "left_rail":
         el = _sub(ld, "leftPowerRail", {"localId": lid, "height": f"{height:.0f}", "width": "3"})
         _pos(el, 10, y)
