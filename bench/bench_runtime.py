@@ -169,6 +169,7 @@ def scenario_cost(when_lines: int = 100, scans: int = 4000) -> None:
     time`); the scenario's work before and after each scan is timed apart from the scan."""
     from tmsim.server import SimServer
     from vplc.cli import scenario as scn
+    from vplc.cli.scenario_run import Runner
     cell = os.path.join(ROOT, "examples", "cell")
     sim = SimServer(port=0, robots=1, svr_port=0, speedup=1)
     sim.start()
@@ -187,7 +188,7 @@ def scenario_cost(when_lines: int = 100, scans: int = 4000) -> None:
         for path, value in (("Cell.Port", sim.ports[0]), ("Cell.SvrPort", sim.robots[0].svr_port)):
             plc.write(path, value)
         scn.resolve(plc, sc)
-        runner = scn.Runner(plc, sc)
+        runner = Runner(plc, sc)
         scan_ns, hooks_ns, t = [], [], 0
         for _ in range(scans):
             sim.poll(t / 1e9)

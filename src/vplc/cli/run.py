@@ -20,6 +20,7 @@ import time
 from ..runtime.values import parse_duration
 from . import scenario as scn
 from . import simlink
+from .scenario_run import Runner
 
 
 def register(subparsers) -> None:
@@ -163,7 +164,7 @@ def _load_and_run(args, scenario, link, duration, wd, window) -> int:
     except (PathError, ValueError) as exc:
         plc.close()
         return _err(str(exc))
-    runner = scn.Runner(plc, scenario, link, wait=args.virtual_time)
+    runner = Runner(plc, scenario, link, wait=args.virtual_time)
     stats = ScanStats() if args.stats else None
     if stats is None and not args.virtual_time:
         stats = OverrunCount()                 # every real-time run reports its overruns in its final line

@@ -253,3 +253,14 @@ def test_a_scenario_defines_what_the_robots_camera_finds(tmp_path, sim):
     camera = request(sim.control.port, {"cmd": "vision", "robot": 1})["result"]
     assert camera["jobs"] == [{"job": "job1", "objects": [[300, 0, 5, 0, 0, 0], [310, 60, 5, 0, 0, 90]],
                                "pass": True, "seconds": 0.1, "capture": None, "variable": "job1_Base_TM"}]
+
+
+def test_vplc_speaks_to_the_simulator_only_through_its_documented_protocol():
+    """vplc and the simulator stay independent packages: nothing in vplc imports tmsim."""
+    src = os.path.join(ROOT, "src", "vplc")
+    for folder, _dirs, files in os.walk(src):
+        for name in files:
+            if name.endswith(".py"):
+                with open(os.path.join(folder, name), encoding="utf-8") as f:
+                    text = f.read()
+                assert not re.search(r"^\s*(from|import)\s+(tmsim|sim)\b", text, re.M), os.path.join(folder, name)
