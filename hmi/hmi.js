@@ -485,7 +485,7 @@ function releaseWhenFinished(group, what, doneText) {
       await api("/api/write", { values: { [`${group}_Execute`]: false } });
       if (finished && v[`${group}_Error`] === true) message(errorMessage(what, v, group), "error");
       else if (finished) message(`${what}: Done – ${doneText}.`, "ok");
-      else message(`${what}: no answer within 10 s; Execute reset.`, "error");
+      else message(`${what}: the robot did not answer within 10 s; the command is released.`, "error");
     } catch (e) { message(`${what}: cannot reset Execute: ${e.message}`, "error"); }
   };
   setTimeout(check, POLL_MS);
@@ -540,7 +540,7 @@ async function fbPage(key) {
     const off = document.createElement("button");
     off.className = "danger"; off.id = "btn-disconnect"; off.textContent = "Disconnect";
     off.onclick = async () => {
-      try { await api("/api/write", { values: { Connect_Execute: false } }); message("Disconnect: Execute reset.", "ok"); }
+      try { await api("/api/write", { values: { Connect_Execute: false } }); message("Disconnect: the PLC closes the connection to the robot.", "ok"); }
       catch (e) { message("Disconnect: " + e.message, "error"); }
     };
     buttons.append(off);

@@ -194,6 +194,20 @@ def test_a_stalled_or_faulted_plc_is_a_high_alarm(plant, mapping):
     assert alarm["text"] == "PLC stopped: its tasks completed no cycle for 1 s"
 
 
+def test_a_major_fault_of_the_plc_is_one_high_alarm_and_the_rest_waits(plant):
+    """After a major fault the PLC keeps its variables as they were: nothing else is judged from them."""
+    import types
+    from vplc.api import PlcFault
+    plc, _, _ = plant
+    plc.vars["RobotStatus"]["EStop"] = True
+    plc.engine = types.SimpleNamespace(fault=PlcFault(
+        "examples/PnP_Example.st:57: major fault in PnP_Example: integer division by zero (100 / 0)"))
+    alarm, = step(plant, times=10)["alarms"]
+    assert (alarm["key"], alarm["priority"], alarm["text"]) == (
+        "plc", "high", "PLC stopped: integer division by zero (100 / 0)")
+    assert alarm["remedy"].startswith("Call the maintenance engineer: the PLC must be restarted")
+
+
 def test_timestamps_are_the_servers_date_and_24_hour_time(plant):
     plc, _, clock = plant
     clock.now = 1_900_000_000.25 + 13 * 3600                    # whatever hour, shown 0..23
