@@ -1,5 +1,6 @@
 /* CBT HMI: the PnP Sequence page. The six CBT_MoveAbsolute segments of PnP_Example drawn in side view over the
-   whole panel, at one scale with a scale bar and the base height marked; each segment carries its name on the
+   whole panel (the side view every page shows: Y–Z, or X–Z when the operator chose it, robotview.js sideAxis),
+   at one scale with a scale bar and the base height marked; each segment carries its name on the
    path (tap it to edit the segment), the one in progress is orange, and the TCP trail comes from the server.
    The cycle's state (PnP_State) is the PLC's: the page shows it with what the operator can do next, and offers
    Start, End Cycle and Reset only when the PLC takes them. */
@@ -57,7 +58,9 @@ function showPnPState() {
 function buildPnP() {
   const main = frame("PnP Sequence", false);
   main.innerHTML = `<div class="pnpdraw"><svg id="pnp-svg"></svg>
-      <div class="pos" id="pnp-note">Side view. Tap a segment's name to edit it. Orange: segment in progress; green: TCP trail.</div></div>
+      <div class="pnpfoot" style="display:flex;align-items:center;gap:8px">
+        <span class="pos" id="pnp-note" style="flex:1;font-size:14px;color:#3d4852"></span>
+        <button type="button" id="pnp-side" style="flex:none;min-height:34px;min-width:34px;font-size:14px"></button></div></div>
     <div class="side"><div class="pnp-state" id="pnp-state" data-state="">
         <b id="pnp-state-name">Cycle: –</b><span id="pnp-state-text">Waiting for the PLC …</span></div>
       <div class="buttons">
@@ -86,8 +89,15 @@ function drawPnP() {
   const W = Math.max(200, Math.round(box.width)), H = Math.max(150, Math.round(box.height));
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   const pts = pnpParams.map((p) => p.TargetPosition);
-  const alongY = Math.abs(pts[3].Y - pts[0].Y) >= Math.abs(pts[3].X - pts[0].X);
-  const axis = alongY ? "Y" : "X";
+  const axis = sideAxis(), alongY = axis === "Y";          // the side view of every page (robotview.js)
+  const other = alongY ? "X" : "Y";
+  const across = Math.abs(pts[3][axis] - pts[0][axis]) < 20 && Math.abs(pts[3][other] - pts[0][other]) >= 20;
+  const note = document.getElementById("pnp-note");
+  note.textContent = across ? `Pick and place lie one behind the other in this side view (the travel runs along ` +
+    `${other}): press ${other}–Z view.` : "Side view. Tap a segment's name to edit it. Orange: segment in progress; green: TCP trail.";
+  const toggle = document.getElementById("pnp-side");
+  toggle.textContent = `${alongY ? "X" : "Y"}–Z view`;
+  toggle.title = toggle.ariaLabel = `Show the side view ${alongY ? "X" : "Y"}–Z (on every page)`;
   const horiz = (p) => (alongY ? p.Y : p.X);
   let h0 = Math.min(...pts.map(horiz)), h1 = Math.max(...pts.map(horiz));
   let v0 = Math.min(...pts.map((p) => p.Z)), v1 = Math.max(...pts.map((p) => p.Z));
@@ -135,8 +145,9 @@ function drawPnP() {
   const bar = step, bx = W - 12 - bar * s, by = H - 6;              // scale bar and axes, bottom
   out += `<path class="scale" d="M${bx},${by - 5} V${by} H${W - 12} V${by - 5}"/>
     <text class="axis" x="${W - 12}" y="${by - 8}" text-anchor="end">${bar} mm</text>
-    <text class="axis" x="6" y="${by}">${axis} → (mm, base frame) · Z ↑ · grid ${step} mm</text>`;
+    <text class="axis" x="6" y="${by}">Side ${axis}→ Z↑ (mm, base frame) · grid ${step} mm</text>`;
   svg.innerHTML = out;
+  svg.dataset.axes = `${axis}-Z`;
   for (const g of svg.querySelectorAll(".edit")) g.onclick = () => openSegment(Number(g.dataset.seg));
   updatePnP();
 }
@@ -235,6 +246,7 @@ async function pnpPage() {
   document.getElementById("btn-resume").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Resume, "Resume");
   live.listeners.push(updatePnP, showPnPState, fetchTrail);
   window.addEventListener("resize", drawPnP);
+  document.getElementById("pnp-side").onclick = () => { toggleSideAxis(); drawPnP(); };
   try { await loadPnP(); } catch (e) { message("Cannot read the PnP parameters: " + e.message, "error"); }
   startPolling(["PnP_Example_Execute", "PnP_State", "PnP_OutcomeUnknown", "PnP_Segment", "PnP_Waiting", "PnP_GripperClosed", "PnP_CycleCount", "PnP_MoveBusy",
     "PnP_MoveActive", "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",

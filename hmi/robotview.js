@@ -1,5 +1,5 @@
 /* CBT HMI: the robot view of the main page and of every motion page. Two projections, the same on every page
-   (top view X-Y, side view X-Z, both in the robot base frame), at a fixed scale the operator changes with the
+   (top view X-Y and a side view, Y-Z or X-Z as the operator chose, see sideAxis; both in the robot base frame), at a fixed scale the operator changes with the
    zoom buttons (not with the content, so the view holds still while a target is typed), with a labelled grid and
    scale bar; the TM5-700 arm drawn from the joint angles CBT_ReadActualPosition reads (forward kinematics of the
    arm data in tm5_700.json); the TCP with its tool axes; the trail the server keeps (/api/trail); and, on a
@@ -8,6 +8,13 @@
 "use strict";
 
 const VIEW = { trail: [], next: 0, preview: null, zoom: Number(sessionStorage.getItem("hmi.zoom")) || 1 };
+
+/* The side view's horizontal axis, the same on every page (the PnP page included): Y by default — the robot as
+   the operator facing it from the front (+X) sees it, Y to the right, Z up, the direction the PnP example's cycle
+   travels — or X (seen from its side, the arm's reach in profile); the operator switches it on any page and the
+   choice holds for every page of the browser tab. */
+function sideAxis() { return sessionStorage.getItem("hmi.side") === "X" ? "X" : "Y"; }
+function toggleSideAxis() { sessionStorage.setItem("hmi.side", sideAxis() === "X" ? "Y" : "X"); }
 const AXIS_COLORS = ["#d0312d", "#2e9b4f", "#1a5fb4"];          // X red, Y green, Z blue (ISO colours)
 const ZOOMS = [0.5, 1, 2, 4];                                   // 1: ±1000 mm across the narrower side
 const RED = "#c0241a", VIOLET = "#6a2fa8";
@@ -286,6 +293,7 @@ function robotViewStyle() {
     .robotview .viewfoot .note { flex: 1; min-width: 0; color: #5a2a91; }
     .robotview .viewfoot .note.refused { color: #b0211a; font-weight: bold; }
     .robotview .zoom { display: flex; align-items: center; gap: 4px; flex: none; }
+    .robotview .zoom #side-axis { font-size: 14px; margin-right: 6px; }
     .robotview .zoom button { min-width: 34px; height: 34px; padding: 0 6px; font-size: 18px; line-height: 1; }
     .robotview .zoom span { min-width: 30px; text-align: center; }`;
   document.head.append(style);
@@ -297,7 +305,8 @@ function robotView(container, preview) {
   container.classList.add("robotview");
   container.innerHTML = `<div class="views"><canvas id="view-top"></canvas><canvas id="view-side"></canvas></div>
     <div class="viewfoot"><span class="pos" id="tcp-pos">X — Y — Z —</span><span class="note" id="view-note"></span>
-    <span class="zoom"><button type="button" id="zoom-out" aria-label="Zoom out" title="Zoom out">−</button>
+    <span class="zoom"><button type="button" id="side-axis"></button>
+    <button type="button" id="zoom-out" aria-label="Zoom out" title="Zoom out">−</button>
     <span id="zoom-level"></span><button type="button" id="zoom-in" aria-label="Zoom in" title="Zoom in">+</button></span></div>`;
   const redraw = () => {
     VIEW.preview = preview ? preview() : null;
@@ -305,7 +314,10 @@ function robotView(container, preview) {
     const p = pos ? pos.TCP : null;
     const arm = readJoints() && ARM.data ? armPoints(readJoints(), [p.X, p.Y, p.Z]) : null;
     drawProjection(container.querySelector("#view-top"), "X", "Y", "Top", p, arm);
-    drawProjection(container.querySelector("#view-side"), "X", "Z", "Side", p, arm);
+    drawProjection(container.querySelector("#view-side"), sideAxis(), "Z", "Side", p, arm);
+    const other = sideAxis() === "X" ? "Y" : "X", toggle = container.querySelector("#side-axis");
+    toggle.textContent = `${other}–Z view`;
+    toggle.title = toggle.ariaLabel = `Show the side view ${other}–Z (on every page)`;
     container.querySelector("#tcp-pos").textContent = p ?
       `TCP X ${p.X.toFixed(1)} Y ${p.Y.toFixed(1)} Z ${p.Z.toFixed(1)}` : "TCP not valid (robot not connected)";
     const note = container.querySelector("#view-note"), pv = VIEW.preview;
@@ -323,6 +335,7 @@ function robotView(container, preview) {
     redraw();
   };
   if (!ZOOMS.includes(VIEW.zoom)) VIEW.zoom = 1;
+  container.querySelector("#side-axis").onclick = () => { toggleSideAxis(); redraw(); };
   container.querySelector("#zoom-out").onclick = () => zoomBy(-1);
   container.querySelector("#zoom-in").onclick = () => zoomBy(1);
   live.listeners.push(redraw);

@@ -188,17 +188,73 @@ def test_fixed_scale_zoom_buttons_labelled_grid_and_the_arm(page, size):
     frames = kinematics._frames(JOINTS)
     side = b.driver.find_element(By.ID, "view-side")
     s, w, h = scale(), side.get_attribute("width"), side.get_attribute("height")
-    for (px, py), f in zip(arm[1:7], frames[1:]):                 # drawn where the simulator puts the joints
-        assert px == pytest.approx(int(w) / 2 + f[0][3] * s, abs=1) and py == pytest.approx(int(h) / 2 - (f[2][3] - 350) * s, abs=1)
+    for (px, py), f in zip(arm[1:7], frames[1:]):                 # drawn where the simulator puts the joints (Y-Z)
+        assert px == pytest.approx(int(w) / 2 + f[1][3] * s, abs=1) and py == pytest.approx(int(h) / 2 - (f[2][3] - 350) * s, abs=1)
     font = js(b, "return parseFloat(getComputedStyle(document.querySelector('.viewfoot')).fontSize)")
     assert font >= 14
     b.screenshot(f"robotview_arm_{size[0]}x{size[1]}")
 
 
-@pytest.mark.parametrize("name", ["index", "connect", "changebase", "moverel", "moveabs", "movecircle", "setoutput", "stop"])
-def test_every_robot_view_shows_the_same_axes(page, name):
-    _, _, open_page = page
-    b = open_page(name)
+def axes(b, name):
+    if name == "pnp":
+        b.wait_for(lambda _d: b.driver.find_element(By.ID, "pnp-svg").get_attribute("data-axes"), "the PnP drawing")
+        return [b.driver.find_element(By.ID, "pnp-svg").get_attribute("data-axes")]
     b.wait_for(lambda _d: js(b, "return !!document.querySelector('.views canvas[data-axes]')"), "the view drawn")
-    axes = [c.get_attribute("data-axes") for c in b.driver.find_elements(By.CSS_SELECTOR, ".views canvas")]
-    assert axes == ["X-Y", "X-Z"]
+    return [c.get_attribute("data-axes") for c in b.driver.find_elements(By.CSS_SELECTOR, ".views canvas")]
+
+
+PAGES_WITH_VIEWS = ["index", "connect", "changebase", "moverel", "moveabs", "movecircle", "setoutput", "stop", "pnp"]
+
+
+def test_every_page_shows_the_same_axes_and_a_switch_holds_for_every_page(page):
+    """Top X-Y and side Y-Z everywhere, the PnP drawing included; X-Z chosen on one page is X-Z on all of them."""
+    plc, _, open_page = page
+    with plc.lock:                        # the PnP example's cycle: pick and place 400 mm apart along Y
+        for i, (y, z) in enumerate([(-200, 400), (-200, 250), (-200, 400), (200, 400), (200, 250), (200, 400)]):
+            plc.vars["PnP_MoveParameters"][i]["TargetPosition"].update(X=350.0, Y=float(y), Z=float(z), RX=180.0, RZ=90.0)
+    for name in PAGES_WITH_VIEWS:
+        b = open_page(name)
+        assert axes(b, name) == (["Y-Z"] if name == "pnp" else ["X-Y", "Y-Z"]), name
+    r = b.driver.find_element(By.ID, "pnp-side").rect
+    assert r["width"] >= 34 and r["height"] >= 34
+    b.click("pnp-side")
+    b.wait_for(lambda _d: axes(b, "pnp") == ["X-Z"], "the PnP drawing in X-Z")
+    assert "press Y–Z view" in b.driver.find_element(By.ID, "pnp-note").text     # the cycle is seen edge-on
+    b.screenshot("pnp_side_xz")
+    try:
+        for name in PAGES_WITH_VIEWS:
+            b = open_page(name)
+            assert axes(b, name) == (["X-Z"] if name == "pnp" else ["X-Y", "X-Z"]), name
+        b = open_page("moveabs")
+        b.click("side-axis")
+        assert axes(b, "moveabs") == ["X-Y", "Y-Z"]
+    finally:
+        js(b, "sessionStorage.removeItem('hmi.side')")
+
+
+def test_move_relative_and_a_pnp_segment_are_refused_out_of_reach(page):
+    plc, _, open_page = page
+    b = open_page("moverel")
+    Select(b.field("MoveRel_Param.MovementCommand")).select_by_visible_text("Line")
+    Select(b.field("MoveRel_Param.DataFormat")).select_by_visible_text("CPP_Rel")
+    b.type_into("MoveRel_Param.Speed", "10")
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (900, 0, 0, 0, 0, 0)):   # 400 + 900 mm along X
+        b.type_into(f"MoveRel_Param.TargetPosition.{axis}", str(value))
+    b.wait_for(lambda _d: js(b, "return !!(VIEW.preview && VIEW.preview.refused)"), "the refused preview")
+    b.click("btn-execute")
+    b.wait_for(lambda _d: "nothing was sent" in b.message(), "the refusal")
+    assert b.message().startswith("Target Position: X 1300 Y 0 Z 400 is out of reach")
+    assert plc.writes == []
+    b.screenshot("reach_refused_moverel")
+    with plc.lock:                        # segment 2 of the PnP example: Line, CPP_Abs, 30 %, down to the pick point
+        plc.vars["PnP_MoveParameters"][1].update(MovementCommand=0, DataFormat=1, Speed=30)
+        plc.vars["PnP_MoveParameters"][1]["TargetPosition"].update(X=350.0, Y=-200.0, Z=250.0, RX=180.0, RZ=90.0)
+    b = open_page("pnp")
+    b.wait_for(lambda _d: b.driver.find_elements(By.ID, "edit-1"), "the segments")
+    b.click("edit-1")
+    b.type_into("PnP_MoveParameters[1].TargetPosition.X", "1500")
+    b.click("seg-apply")
+    b.wait_for(lambda _d: "nothing was sent" in b.message(), "the refusal")
+    assert b.message().startswith("Target Position: X 1500")
+    assert "out of reach" in b.message() and plc.writes == []
+    js(b, "document.getElementById('seg-dialog').close()")
