@@ -1,5 +1,6 @@
 """The HMI's Program page: the running ladder example (examples/Commands_Example.xml) drawn and coloured live
-in headless Chromium at 800x480, against the virtual PLC in real time and the robot simulator."""
+in headless Chromium at 800x480 (and 1280x800), against the virtual PLC in real time and the robot simulator: rung
+list and jump, zoom, whole comments, 16# values, no text over another, boxes apart, coils at the right rail."""
 from __future__ import annotations
 
 import pathlib
@@ -11,6 +12,7 @@ from selenium.webdriver.support.ui import Select
 
 from browser import chromium_paths
 from hmi_http import Client
+from panel_metrics import check_controls
 from tmsim.server import SimServer
 from vplc.api import load_plc
 from vplc.hmi.mapping import Mapping
@@ -140,9 +142,7 @@ def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(
         assert drawn == [" ".join(c.split()) for c in comments]
         assert not any("…" in t for t in drawn)
         assert text_overlaps(browser) == [], "no text covers another"
-        for control in ("rung-jump", "ladder-in", "ladder-out"):
-            r = d.find_element(By.ID, control).rect
-            assert r["height"] >= 34 and r["width"] >= 34
+        check_controls(browser, ["rung-jump", "ladder-in", "ladder-out"])
         width = float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width"))
         d.find_element(By.ID, "ladder-in").click()
         assert float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width")) == pytest.approx(width * 1.25, abs=1)

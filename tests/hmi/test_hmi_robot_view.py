@@ -14,6 +14,7 @@ from selenium.webdriver.support.ui import Select
 
 from browser import ROOT
 from fake_plc import FakePlc, command_program, scanning, serving
+from panel_metrics import check_controls
 from tmsim import kinematics
 from vplc.hmi.mapping import Mapping
 
@@ -258,3 +259,17 @@ def test_move_relative_and_a_pnp_segment_are_refused_out_of_reach(page):
     assert b.message().startswith("Target Position: X 1500")
     assert "out of reach" in b.message() and plc.writes == []
     js(b, "document.getElementById('seg-dialog').close()")
+
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_view_controls_fit_a_finger_and_read_on_the_panel(page, size):
+    _, _, open_page = page
+    b = open_page("moveabs", size)
+    check_controls(b, ["zoom-in", "zoom-out", "side-axis"])
+    texts = b.driver.execute_script("return ['tcp-pos', 'view-note', 'zoom-level'].map((id) => "
+                                    "parseFloat(getComputedStyle(document.getElementById(id)).fontSize))")
+    assert min(texts) >= 14
+    b = open_page("pnp", size)
+    b.wait_for(lambda _d: b.driver.find_element(By.ID, "pnp-side").text, "the PnP drawing")
+    check_controls(b, ["pnp-side"])
