@@ -21,7 +21,8 @@ EXTRA = {"CBT_Connect": ["Cobot.InListenNode", "RobotReady"], "CBT_Stop": ["Cobo
          "CBT_ProjectControl": ["Cobot.Status.ProjectRunning"],
          "CBT_ReadIO": ["PartPresent"], "CBT_SetOverride": ["SpeedShown"],
          "CBT_WaitQueue": ["Cobot.Status.Moving", "Cobot.Status.TCPSpeed"],
-         "CBT_ReadVariable": ["PartCount"], "CBT_Jog": ["Cobot.Stopping"]}
+         "CBT_ReadVariable": ["PartCount"], "CBT_Jog": ["Cobot.Stopping"],
+         "CBT_VisionJob": ["fbVision.Found", "fbVision.ObjectCount"]}
 FIRST = {"CBT_ReadActualPosition": ["fbConnect.Connected"], "CBT_RobotStatus": ["fbConnect.Connected"],
          "CBT_ReadIO": ["fbConnect.Connected"]}      # the FB's Enable
 HOLD_S = 0.02                   # Execute stays TRUE this long after Done, then falls: both Done cases show

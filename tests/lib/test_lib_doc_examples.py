@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from rig import LIB, ROOT, SEC
+from tmsim.camera import camera_of
 from tmsim.server import SimServer
 from tmsim.svr_table import parse_variable
 from vplc.api import load_plc
@@ -38,6 +39,7 @@ STEPS = {
     "CBT_WriteVariable": [("WriteExec", "fbWrite.Done")],
     "CBT_Jog": [("JogPlusButton", "fbJog.Active")],
     "CBT_Teach": [("TeachButton", "fbTeach.Done")],
+    "CBT_VisionJob": [("CameraButton", "fbVision.Done"), ("PickButton", "fbApproach.Done")],
 }
 
 
@@ -45,10 +47,16 @@ STEPS = {
 SVR_VARIABLES = ("g_PartCount:int=17", "g_Recipe:string=\"Flange\"", "g_Offset:float[3]={0.5,-1.25,0}")
 
 
+# the vision job of the robot's project (simulator: --vision-job) and the one part its camera finds
+VISION_JOB, VISION_OBJECT = "job1", [417.5, -122.3, 300, 0, 0, 0]
+
+
 def simulator() -> SimServer:
-    """The robot the examples run against: Listen node, Ethernet Slave and the variables above."""
-    return SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0,
-                     svr_options={"variables": [parse_variable(spec) for spec in SVR_VARIABLES]})
+    """The robot the examples run against: Listen node, Ethernet Slave, the variables and the vision job above."""
+    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0,
+                    svr_options={"variables": [parse_variable(spec) for spec in SVR_VARIABLES]})
+    camera_of(srv.robots[0].session.robot).define(VISION_JOB, objects=[VISION_OBJECT])
+    return srv
 
 
 def example_of(page: str) -> tuple[str, list[str]]:

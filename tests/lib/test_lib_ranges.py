@@ -42,7 +42,8 @@ MT = load("make_types")
 # CBT_SetOverride's row (an FB input of a program of its own) is run, every value of its type, by
 # tests/lib/test_lib_set_override.py; the rows of CBT_ReadVariable / CBT_WriteVariable (members of their in-out
 # Variable) by tests/lib/test_lib_variables.py; CBT_Jog's (FB inputs, no Execute) by tests/lib/test_lib_jog.py
-OWN_TESTS = ("CBT_SetOverride", "CBT_ReadVariable", "CBT_WriteVariable", "CBT_Jog")
+# and CBT_VisionJob's (members of its Parameters, a program of its own) by tests/lib/test_lib_vision_job.py
+OWN_TESTS = ("CBT_SetOverride", "CBT_ReadVariable", "CBT_WriteVariable", "CBT_Jog", "CBT_VisionJob")
 ROWS = [r for r in MT.read_ranges() if r.error and r.struct not in OWN_TESTS]
 
 
