@@ -6,7 +6,7 @@
    (a value without room is shortened with "…"; tapping it shows it whole on the message line). */
 "use strict";
 
-const LADDER_ZOOMS = [0.6, 0.8, 1, 1.25, 1.5];
+const LADDER_ZOOMS = [0.6, 0.8, 1, 1.3, 1.6];             // from 130 % every text of the drawing is 14 px or more
 const LADDER = { zoom: Number(sessionStorage.getItem("hmi.ladderZoom")) || 1 };
 const SVG_NS = "http://www.w3.org/2000/svg";
 const COMMENT_LINE = 16;                       // px between two lines of a wrapped rung comment (12 px text)

@@ -145,7 +145,11 @@ def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(
         check_controls(browser, ["rung-jump", "ladder-in", "ladder-out"])
         width = float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width"))
         d.find_element(By.ID, "ladder-in").click()
-        assert float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width")) == pytest.approx(width * 1.25, abs=1)
+        assert float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width")) == pytest.approx(width * 1.3, abs=1)
+        small = d.execute_script("return Math.min(...[...document.querySelectorAll('#ladder text')].filter(t => "
+                                 "t.textContent.trim()).map(t => parseFloat(getComputedStyle(t).fontSize) * "
+                                 "t.getScreenCTM().a))")
+        assert small >= 14, "at 130 % every text of the drawing reads at 14 px or more"
         browser.wait_for(lambda _d: text_overlaps(browser) == [], "the values refitted")
         browser.screenshot(f"program_zoomed_{size[0]}x{size[1]}")
         d.find_element(By.ID, "ladder-out").click()
