@@ -193,6 +193,7 @@ def scenario_cost(when_lines: int = 100, scans: int = 4000) -> None:
         for _ in range(scans):
             sim.poll(t / 1e9)
             h0 = time.perf_counter_ns()
+            runner.finished(t)                              # asked before every scan, as vplc run does
             runner.before_scan(t)
             s0 = time.perf_counter_ns()
             plc.scan(t)

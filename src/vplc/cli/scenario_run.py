@@ -94,6 +94,9 @@ class Runner:
         self.unchecked = sorted(sc.expects, key=lambda e: e.from_ns)     # not judged yet: due at from_ns
         self.deadline = min((e.until_ns for e in sc.expects if e.until_ns is not None), default=None)
         self.writes = sorted(sc.writes, key=lambda w: w.at_ns)
+        self.timed = [r for r in sc.reactions if r.timed]                # `at TIME robot ...` lines
+        self.decisive = sum(1 for e in sc.expects if not e.always)        # `within` / `at` expectations
+        self.undecided = self.decisive
         groups: dict[int, list[Signal]] = {}       # direct signals by the instance they live in
         for sig in self.signals.values():
             if sig.read is None:
@@ -238,7 +241,8 @@ class Runner:
         """Judge the expectations whose variable changed, that are due for their first look, or whose window
         ends now; an expectation whose variable kept its value keeps its verdict."""
         self._sample(t_ns)
-        due = [e for s in self.changed for e in s.expects if e.state == "open" and e.from_ns <= t_ns]
+        due = [e for s in self.changed for e in s.expects if e.state == "open" and e.from_ns <= t_ns] \
+            if self.changed else []
         while self.unchecked and self.unchecked[0].from_ns <= t_ns:
             e = self.unchecked.pop(0)
             if e.last is None and e not in due:
@@ -258,8 +262,10 @@ class Runner:
         ok = e.test(v)
         if ok and not e.always:
             e.state, e.decided_ns = "held", t_ns
+            self.undecided -= 1
         elif not ok and (e.always or e.until_ns is None or t_ns >= e.until_ns):
             e.state, e.decided_ns = "failed", t_ns
+            self.undecided -= not e.always
             if self.failure is None:
                 self.first = e
                 self.failure = (f"expectation failed at {seconds(t_ns)}: {e.source} ({e.where}); "
@@ -272,12 +278,9 @@ class Runner:
             return True
         if self.sc.stop_ns is not None:
             return t_ns >= self.sc.stop_ns
-        if not self.sc.expects:
-            return False
-        return all(w.done for w in self.sc.writes) and \
-            all(r.fired and not r.due for r in self.sc.reactions if r.timed) and \
-            all(e.state != "open" for e in self.sc.expects if not e.always) and \
-            any(not e.always for e in self.sc.expects)
+        if self.undecided or not self.decisive or self.writes:
+            return False                       # (kept as counts and lists: this is asked before every scan)
+        return all(r.fired and not r.due for r in self.timed)
 
     def end_check(self, t_ns: int) -> str | None:
         """After the last scan: the reason the run did not do what the scenario asked, or None."""
