@@ -121,3 +121,10 @@ def test_the_export_validates_against_omrons_schemas_and_runs_the_same(tmp_path)
         pytest.skip(f"Omron's IEC 61131-10 schemas are not in {SCHEMAS}; set SYSMAC_XSD_DIR")
     schema = etree.XMLSchema(etree.parse(str(xsd)))
     assert schema.validate(etree.parse(str(out))), [e.message for e in schema.error_log]
+
+
+def test_the_plcopen_export_refuses_inline_st_by_name(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "vplc", "export", str(PROJECT), "--format", "plcopen", "-o",
+                        str(tmp_path / "tc6.xml")], capture_output=True, text=True, cwd=ROOT,
+                       env={**os.environ, "PYTHONPATH": str(ROOT / "src")})
+    assert r.returncode == 1 and "smcext:InlineST" in r.stderr and "Traceback" not in r.stderr
