@@ -18,6 +18,7 @@
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import pathlib
 import socket
@@ -70,8 +71,9 @@ def wait_for(predicate, what, timeout=10.0):
         pause.wait(0.005)
 
 
-def round_trip() -> list[float]:
-    mapping = Mapping.load()
+@contextlib.contextmanager
+def connected_plc():
+    """The examples + library on the virtual PLC in real time, connected to the simulator (background thread)."""
     sim = SimServer(port=0, robots=1)
     sim.start_background()
     plc = load_plc(SOURCES)
@@ -82,32 +84,46 @@ def round_trip() -> list[float]:
     stop = threading.Event()
     runner = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
     runner.start()
-    hmi = HmiServer(plc, mapping, port=0)
-    hmi.start()
     try:
-        def read(name):
-            with plc.lock:
-                return plc.read(name)
-        wait_for(lambda: read("Connect_Connected"), "the connection to the simulator")
-        samples = []
-        read_url = hmi.url + "api/read?names=ChangeBase_Done,ChangeBase_Busy,ChangeBase_Error"
-        for _ in range(ROUND_TRIPS):
-            start = time.perf_counter()
-            post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}}, hmi.access.keys["engineer"])
-            while True:
-                values = get(read_url)["values"]
-                if values["ChangeBase_Done"] or values["ChangeBase_Error"]:
-                    break
-            samples.append((time.perf_counter() - start) * 1000)
-            if values["ChangeBase_Error"]:
-                raise SystemExit("bench_hmi: ChangeBase reported an error: " + str(read("ChangeBase_ErrorDescrip")))
-        return samples
+        wait_for(lambda: _locked(plc, "Connect_Connected"), "the connection to the simulator")
+        yield plc
     finally:
-        hmi.stop()
         stop.set()
         runner.join(timeout=5)
         plc.close()
         sim.close()
+
+
+def _locked(plc, name):
+    with plc.lock:
+        return plc.read(name)
+
+
+def presses(hmi, plc, count: int) -> list[float]:
+    """Round trips in ms: Execute of ChangeBase as the page sends it, then reads until Done (or Error) shows."""
+    samples = []
+    read_url = hmi.url + "api/read?names=ChangeBase_Done,ChangeBase_Busy,ChangeBase_Error"
+    for _ in range(count):
+        start = time.perf_counter()
+        post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}}, hmi.access.keys["engineer"])
+        while True:
+            values = get(read_url)["values"]
+            if values["ChangeBase_Done"] or values["ChangeBase_Error"]:
+                break
+        samples.append((time.perf_counter() - start) * 1000)
+        if values["ChangeBase_Error"]:
+            raise SystemExit("bench_hmi: ChangeBase reported an error: " + str(_locked(plc, "ChangeBase_ErrorDescrip")))
+    return samples
+
+
+def round_trip() -> list[float]:
+    with connected_plc() as plc:
+        hmi = HmiServer(plc, Mapping.load(), port=0)
+        hmi.start()
+        try:
+            return presses(hmi, plc, ROUND_TRIPS)
+        finally:
+            hmi.stop()
 
 
 def mean_scan_us(plc) -> float:
@@ -155,8 +171,8 @@ def scan_cost(rounds: int = 5) -> tuple[float, float, int]:
     return statistics.median(without), statistics.median(with_hmi), served
 
 
-def stand_in_hmi():
-    """A stand-in PLC scanning every 1 ms in a thread and its HMI server; call the returned finish() at the end."""
+def stand_in_plc():
+    """The HMI tests' stand-in PLC scanning every 1 ms in a thread: (plc, mapping, stop scanning)."""
     from fake_plc import FakePlc, command_program
     mapping = Mapping.load()
     plc = FakePlc(mapping, command_program)
@@ -167,13 +183,22 @@ def stand_in_hmi():
             plc.scan()
     runner = threading.Thread(target=scanning, daemon=True)
     runner.start()
+
+    def halt():
+        stop.set()
+        runner.join(timeout=5)
+    return plc, mapping, halt
+
+
+def stand_in_hmi():
+    """A stand-in PLC scanning every 1 ms in a thread and its HMI server; call the returned finish() at the end."""
+    plc, mapping, halt = stand_in_plc()
     hmi = HmiServer(plc, mapping, port=0)
     hmi.start()
 
     def finish():
         hmi.stop()
-        stop.set()
-        runner.join(timeout=5)
+        halt()
     return hmi, finish
 
 
@@ -308,8 +333,7 @@ def older_server(directory: str):
     return importlib.import_module("hmi_before.server").HmiServer
 
 
-def compare_with(directory: str, blocks: int = 16, reads: int = 150, presses: int = 20) -> None:
-    from fake_plc import FakePlc, command_program
+def compare_with(directory: str, blocks: int = 16, reads: int = 150, count: int = 20) -> None:
     servers = {"before": older_server(directory), "now": HmiServer}
 
     def ratio_line(what, figures):
@@ -325,18 +349,14 @@ def compare_with(directory: str, blocks: int = 16, reads: int = 150, presses: in
                 figures[name].append(run(name))
         return figures
 
-    mapping = Mapping.load()
-    plc = FakePlc(mapping, command_program)
-    stop = threading.Event()
+    def both(plc, mapping):
+        started = {name: cls(plc, mapping, port=0) for name, cls in servers.items()}
+        for hmi in started.values():
+            hmi.start()
+        return started
 
-    def scanning():
-        while not stop.wait(0.001):
-            plc.scan()
-    runner = threading.Thread(target=scanning, daemon=True)
-    runner.start()
-    started = {name: cls(plc, mapping, port=0) for name, cls in servers.items()}
-    for hmi in started.values():
-        hmi.start()
+    plc, mapping, halt = stand_in_plc()
+    started = both(plc, mapping)
     try:
         urls = {n: h.url + "api/read?names=" + ",".join(PNP_PAGE_VARS) for n, h in started.items()}
         for url in urls.values():
@@ -346,51 +366,17 @@ def compare_with(directory: str, blocks: int = 16, reads: int = 150, presses: in
     finally:
         for hmi in started.values():
             hmi.stop()
-        stop.set()
-        runner.join(timeout=5)
+        halt()
     if load_plc is None:
         return
-    sim = SimServer(port=0, robots=1)
-    sim.start_background()
-    plc = load_plc(SOURCES)
-    with plc.lock:
-        plc.write("Connect_AddressIP", "127.0.0.1")
-        plc.write("Connect_Dest_PortIP", sim.ports[0])
-        plc.write("Connect_Execute", True)
-    stop = threading.Event()
-    runner = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
-    runner.start()
-    started = {name: cls(plc, mapping, port=0) for name, cls in servers.items()}
-    for hmi in started.values():
-        hmi.start()
-
-    def presses_median(name):
-        hmi = started[name]
-        url = hmi.url + "api/read?names=ChangeBase_Done,ChangeBase_Busy,ChangeBase_Error"
-        samples = []
-        for _ in range(presses):
-            start = time.perf_counter()
-            post(hmi.url + "api/execute", {"execute": "ChangeBase_Execute", "values": {}}, hmi.access.keys["engineer"])
-            while not any(get(url)["values"][n] for n in ("ChangeBase_Done", "ChangeBase_Error")):
-                pass
-            samples.append((time.perf_counter() - start) * 1000)
-        return statistics.median(samples)
-    try:
-        wait_for(lambda: _locked(plc, "Connect_Connected"), "the connection to the simulator")
-        ratio_line(f"Execute round trip (ChangeBase, examples + library + simulator, blocks of {presses})",
-                   alternate(presses_median))
-    finally:
-        for hmi in started.values():
-            hmi.stop()
-        stop.set()
-        runner.join(timeout=5)
-        plc.close()
-        sim.close()
-
-
-def _locked(plc, name):
-    with plc.lock:
-        return plc.read(name)
+    with connected_plc() as plc:
+        started = both(plc, mapping)
+        try:
+            ratio_line(f"Execute round trip (ChangeBase, examples + library + simulator, blocks of {count})",
+                       alternate(lambda name: statistics.median(presses(started[name], plc, count))))
+        finally:
+            for hmi in started.values():
+                hmi.stop()
 
 
 def main() -> int:

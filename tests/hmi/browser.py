@@ -95,6 +95,16 @@ class Browser:
     def wait_status(self, variable: str, expected: str, timeout: float = WAIT_S):
         self.wait_for(lambda d: self.status(variable) == expected, f"{variable} = {expected}", timeout)
 
+    def banner(self) -> str:
+        """The alarm banner's text, "" while it is hidden."""
+        element = self.driver.find_element(By.ID, "alarm-banner")
+        return element.text if element.is_displayed() else ""
+
+    def alarm_rows(self) -> list[str]:
+        """The rows of the main page's alarm list, without its header ([] for "No alarms.")."""
+        rows = self.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
+        return [] if rows == ["No alarms."] else rows
+
     def message(self) -> str:
         try:
             return self.driver.find_element(By.ID, "message").text

@@ -9,10 +9,10 @@ import threading
 import time
 
 import pytest
-from selenium.webdriver.common.by import By
-
 from browser import Browser
 from fake_plc import FakePlc, command_program
+from selenium.webdriver.common.by import By
+
 from vplc.hmi.mapping import Mapping
 from vplc.hmi.server import HmiServer
 
@@ -79,14 +79,6 @@ def browser(chromium, stack):
     stack.server.alarms.acknowledge(None, "engineer")
 
 
-def banner(browser):
-    element = browser.driver.find_element(By.ID, "alarm-banner")
-    return element.text if element.is_displayed() else ""
-
-
-def rows(browser):
-    found = browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
-    return [] if found == ["No alarms."] else found
 
 
 def text(browser, element_id):
@@ -96,39 +88,39 @@ def text(browser, element_id):
 def test_an_alarm_goes_through_its_states_on_the_page(browser, stack):
     browser.open(stack.server.page_url("index", "operator"))
     stack.set(RS_EStop=True)
-    browser.wait_for(lambda d: "Emergency stop pressed" in banner(browser), "the E-stop in the banner")
-    assert "High" in banner(browser) and "release the emergency stop, then press Play on the Main screen" in banner(browser)
-    browser.wait_for(lambda d: rows(browser) and rows(browser)[0].endswith("active, unack."), "the row")
+    browser.wait_for(lambda d: "Emergency stop pressed" in browser.banner(), "the E-stop in the banner")
+    assert "High" in browser.banner() and "release the emergency stop, then press Play on the Main screen" in browser.banner()
+    browser.wait_for(lambda d: browser.alarm_rows() and browser.alarm_rows()[0].endswith("active, unack."), "the row")
     assert browser.driver.find_element(By.ID, "alarm-banner").get_attribute("data-priority") == "high"
     assert text(browser, "pill-robot") == "Robot E-stop"
     browser.screenshot("alarm_active_unacknowledged")
     browser.click("btn-alarm-ack")
-    browser.wait_for(lambda d: rows(browser)[0].endswith("active, ack.") and banner(browser) == "",
+    browser.wait_for(lambda d: browser.alarm_rows()[0].endswith("active, ack.") and browser.banner() == "",
                      "the acknowledged alarm")
     browser.screenshot("alarm_active_acknowledged")
     stack.set(RS_EStop=False)
-    browser.wait_for(lambda d: rows(browser) == [], "the alarm normal (acknowledged and returned)")
+    browser.wait_for(lambda d: browser.alarm_rows() == [], "the alarm normal (acknowledged and returned)")
     stack.set(RS_EStop=True)
-    browser.wait_for(lambda d: rows(browser) and rows(browser)[0].endswith("active, unack."), "again")
+    browser.wait_for(lambda d: browser.alarm_rows() and browser.alarm_rows()[0].endswith("active, unack."), "again")
     stack.set(RS_EStop=False)
-    browser.wait_for(lambda d: rows(browser)[0].endswith("returned, unack."), "returned unacknowledged")
-    assert "Emergency stop pressed" in banner(browser)
+    browser.wait_for(lambda d: browser.alarm_rows()[0].endswith("returned, unack."), "returned unacknowledged")
+    assert "Emergency stop pressed" in browser.banner()
     browser.screenshot("alarm_returned_unacknowledged")
     browser.click("btn-alarm-ack")
-    browser.wait_for(lambda d: rows(browser) == [] and banner(browser) == "", "normal")
+    browser.wait_for(lambda d: browser.alarm_rows() == [] and browser.banner() == "", "normal")
 
 
 def test_one_alarm_per_cause_with_its_consequences_and_priority(browser, stack):
     browser.open(stack.server.page_url("index", "operator"))
     stack.set(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001, MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")
-    browser.wait_for(lambda d: any("16#3001" in r for r in rows(browser)), "the command's alarm")
+    browser.wait_for(lambda d: any("16#3001" in r for r in browser.alarm_rows()), "the command's alarm")
     stack.set(RS_EStop=True, RS_RobotError=True, RS_ErrorCode=0x10001, RS_ErrorText="Emergency stop",
               Connect_Connected=False, Connect_Reconnecting=True, Connect_ErrorID=0x4006,
               MoveRel_Error=True, MoveRel_ErrorID=0x4006, MoveRel_ErrorDescrip="Robot error stopped the project")
     try:
-        browser.wait_for(lambda d: rows(browser) and "Emergency stop pressed (+3)" in rows(browser)[0],
+        browser.wait_for(lambda d: browser.alarm_rows() and "Emergency stop pressed (+3)" in browser.alarm_rows()[0],
                          "the E-stop with its three consequences on top")
-        listed = rows(browser)
+        listed = browser.alarm_rows()
         assert len(listed) == 2 and "High" in listed[0] and "Low ① Move Absolute 16#3001" in listed[1], listed
         browser.screenshot("alarm_one_per_cause")
         browser.driver.find_element(By.ID, "alarm-history").find_elements(By.TAG_NAME, "tr")[1].click()
@@ -147,11 +139,11 @@ def test_acknowledge_is_shared_by_two_browser_sessions(browser, stack):
         second.open(stack.server.page_url("index", "operator"))
         stack.set(Robot_InListenNode=False)
         for b in (browser, second):
-            b.wait_for(lambda d: "The robot left the Listen node" in banner(b), "the alarm on both panels")
+            b.wait_for(lambda d, b=b: "The robot left the Listen node" in b.banner(), "the alarm on both panels")
         second.screenshot("alarm_second_panel_before_acknowledge")
         browser.click("btn-alarm-ack")
-        second.wait_for(lambda d: banner(second) == "", "the acknowledge seen by the other panel")
-        browser.wait_for(lambda d: rows(browser)[0].endswith("active, ack."), "acknowledged on the first")
+        second.wait_for(lambda d: second.banner() == "", "the acknowledge seen by the other panel")
+        browser.wait_for(lambda d: browser.alarm_rows()[0].endswith("active, ack."), "acknowledged on the first")
         second.screenshot("alarm_second_panel_after_acknowledge")
     finally:
         second.close()
@@ -160,9 +152,9 @@ def test_acknowledge_is_shared_by_two_browser_sessions(browser, stack):
 def test_timestamps_are_the_controllers_date_and_24_hour_time(browser, stack):
     browser.open(stack.server.page_url("index", "operator"))
     stack.set(RS_EStop=True)
-    browser.wait_for(lambda d: "Emergency stop" in banner(browser), "the alarm")
-    assert banner(browser).startswith("2031-07-04 21:1"), banner(browser)      # not the browser's clock
-    assert rows(browser)[0].startswith("21:1")                                     # 24-hour, no AM/PM
+    browser.wait_for(lambda d: "Emergency stop" in browser.banner(), "the alarm")
+    assert browser.banner().startswith("2031-07-04 21:1"), browser.banner()      # not the browser's clock
+    assert browser.alarm_rows()[0].startswith("21:1")                                     # 24-hour, no AM/PM
     browser.click("btn-alarm-history")
     log = browser.driver.find_element(By.ID, "alarm-log").text.splitlines()
     raised = [line for line in log if " raised " in line and "Emergency stop pressed" in line]
@@ -173,16 +165,16 @@ def test_timestamps_are_the_controllers_date_and_24_hour_time(browser, stack):
 
 def test_the_list_the_acknowledge_and_the_history_survive_a_reload_and_a_server_restart(browser, stack):
     browser.open(stack.server.page_url("index", "operator"))
-    browser.wait_for(lambda d: rows(browser) == [], "no alarm left by the test before")
+    browser.wait_for(lambda d: browser.alarm_rows() == [], "no alarm left by the test before")
     stack.set(RS_EStop=True)
-    browser.wait_for(lambda d: "Emergency stop" in banner(browser), "the alarm")
+    browser.wait_for(lambda d: "Emergency stop" in browser.banner(), "the alarm")
     browser.click("btn-alarm-ack")
-    browser.wait_for(lambda d: rows(browser)[0].endswith("active, ack."), "acknowledged")
+    browser.wait_for(lambda d: browser.alarm_rows()[0].endswith("active, ack."), "acknowledged")
     browser.driver.refresh()
-    browser.wait_for(lambda d: rows(browser) and rows(browser)[0].endswith("active, ack."), "after reload")
-    assert banner(browser) == ""
+    browser.wait_for(lambda d: browser.alarm_rows() and browser.alarm_rows()[0].endswith("active, ack."), "after reload")
+    assert browser.banner() == ""
     stack.set(RS_EStop=False)
-    browser.wait_for(lambda d: rows(browser) == [], "normal")
+    browser.wait_for(lambda d: browser.alarm_rows() == [], "normal")
     entries = stack.server.alarms.summary(history=500)["history"]
     port = stack.server.port
     stack.server.stop()                                   # a server restart on the same port, same history file
@@ -209,13 +201,13 @@ def test_without_the_plc_values_read_invalid_with_a_communication_alarm(browser,
         print(f"\n  values invalid {took * 1000:.0f} ms after the HMI server stopped")
     assert browser.status("MoveAbs_Busy") == "invalid" and browser.status("Robot_Stopping") == "invalid"
     assert text(browser, "pill-plc") == "PLC offline" and text(browser, "pill-robot") == "Robot ####"
-    assert "PLC communication lost" in banner(browser)
+    assert "PLC communication lost" in browser.banner()
     assert "not valid" in browser.message()
     assert "plc-offline" in browser.driver.find_element(By.CSS_SELECTOR, ".panel").get_attribute("class")
     browser.screenshot("offline_values_invalid")
     stack.start_server(port)
     browser.wait_for(lambda d: browser.status("MoveAbs_ErrorID") == "16#0000", "valid values again")
-    assert banner(browser) == ""
+    assert browser.banner() == ""
 
 
 def test_the_operator_sees_exit_listen_node_locked_and_the_engineer_may_change_it(browser, stack):
@@ -234,7 +226,7 @@ def test_the_header_says_when_the_robot_left_its_listen_node_and_main_offers_the
     assert not browser.driver.find_element(By.ID, "btn-back-to-node").is_displayed()
     stack.set(Robot_InListenNode=False)
     browser.wait_for(lambda d: text(browser, "pill-robot") == "Robot left Listen node", "the header")
-    browser.wait_for(lambda d: "Press Back to Listen Node on the Main screen" in banner(browser), "the alarm")
+    browser.wait_for(lambda d: "Press Back to Listen Node on the Main screen" in browser.banner(), "the alarm")
     button = browser.driver.find_element(By.ID, "btn-back-to-node")
     assert button.is_displayed() and button.is_enabled()
     assert text(browser, "robot-link") == "connected, robot outside its Listen node"

@@ -8,9 +8,9 @@ import json
 import threading
 
 import pytest
-
 from fake_plc import FakePlc, command_program
 from hmi_http import Client
+
 from vplc.hmi import alarms as alarm_module
 from vplc.hmi.alarms import HISTORY, ON_DELAY_S, AlarmSystem
 
@@ -99,8 +99,8 @@ def test_an_e_stop_is_one_alarm_with_its_consequences_as_details(plant):
     assert alarm["priority"] == "high" and alarm["first_out"] is True
     details = [d["text"] for d in alarm["details"]]
     assert details == ["Robot: Robot error 16#00010001: Emergency stop",
-                       "Connection 16#4006: Connection to the robot lost, reconnecting — Robot error stopped the project: "
-                       "code and text in CBT_RobotStatus",
+                       ("Connection 16#4006: Connection to the robot lost, reconnecting — Robot error stopped the project: "
+                        "code and text in CBT_RobotStatus"),
                        "Move Absolute 16#4006: Robot error stopped the project"]
     assert summary["robot"] == "E-stop"
 
@@ -184,8 +184,8 @@ def test_a_first_connect_retried_is_not_called_a_lost_link(plant):
     assert alarm["text"] == "Not connected to the robot, retrying (attempt 1) — Robot not reachable"
 
 
-def test_a_stalled_or_faulted_plc_is_a_high_alarm(plant, mapping):
-    plc, system, clock = plant
+def test_a_stalled_plc_is_a_high_alarm(plant):
+    _, system, clock = plant
     for _ in range(15):                                          # the PLC stops scanning
         clock.now += 0.1
         system.sample()
@@ -197,6 +197,7 @@ def test_a_stalled_or_faulted_plc_is_a_high_alarm(plant, mapping):
 def test_a_major_fault_of_the_plc_is_one_high_alarm_and_the_rest_waits(plant):
     """After a major fault the PLC keeps its variables as they were: nothing else is judged from them."""
     import types
+
     from vplc.api import PlcFault
     plc, _, _ = plant
     plc.vars["RobotStatus"]["EStop"] = True

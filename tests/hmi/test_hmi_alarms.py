@@ -6,7 +6,6 @@ connected again, however many reconnect attempts it takes; a robot that left its
 header says so, and Back to Listen Node on Main brings it back through CBT_ProjectControl."""
 import pytest
 from selenium.webdriver.common.by import By
-
 from test_hmi_end_to_end import System
 
 
@@ -24,14 +23,6 @@ def text(browser, element_id):
     return browser.driver.find_element(By.ID, element_id).text
 
 
-def banner(browser):
-    element = browser.driver.find_element(By.ID, "alarm-banner")
-    return element.text if element.is_displayed() else ""
-
-
-def rows(browser):
-    found = browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
-    return [] if found == ["No alarms."] else found
 
 
 def alarms(system):
@@ -55,13 +46,13 @@ def running_project(system, browser):
 def test_a_robot_error_is_one_alarm_that_returns_to_normal_after_play(system):
     browser = system.open("index")
     running_project(system, browser)
-    assert rows(browser) == [] and banner(browser) == ""
+    assert browser.alarm_rows() == [] and browser.banner() == ""
     with system.sim.lock:
         system.robot.session.fire("robot_fault", reason="Line: target pose is out of reach")
     browser.wait_for(lambda d: "out of reach" in text(browser, "robot-error"), "the robot error on the tile")
-    browser.wait_for(lambda d: "Robot error 16#00010001: Line: target pose is out of reach" in banner(browser),
+    browser.wait_for(lambda d: "Robot error 16#00010001: Line: target pose is out of reach" in browser.banner(),
                      "the robot error in the banner")
-    assert "press Play on the Main screen" in banner(browser)
+    assert "press Play on the Main screen" in browser.banner()
     assert text(browser, "pill-robot") == "Robot error"
     system.wait(lambda: any("16#4006" in d["text"] for a in alarms(system) for d in a["details"]),
                 "CBT_Connect's 16#4006 as a detail of the robot error", 10)
@@ -69,13 +60,13 @@ def test_a_robot_error_is_one_alarm_that_returns_to_normal_after_play(system):
     assert [a["key"] for a in listed] == ["robot"], listed          # one alarm for the cause
     browser.screenshot("e2e_robot_error_one_alarm")
     browser.click("btn-alarm-ack")
-    browser.wait_for(lambda d: banner(browser) == "", "the banner clear")
+    browser.wait_for(lambda d: browser.banner() == "", "the banner clear")
     browser.click("btn-project-play")
     browser.wait_for(lambda d: "Play: Done – the robot project runs" in browser.message(), "Play's answer")
     browser.wait_for(lambda d: text(browser, "robot-project").startswith("running"), "the project running again")
     system.wait(lambda: system.read("Connect_Connected"), "the automatic reconnect", 15)
     browser.wait_for(lambda d: text(browser, "robot-link") == "Listen node connected", "the link on the tile")
-    browser.wait_for(lambda d: rows(browser) == [], "the alarm normal: acknowledged and its cause gone")
+    browser.wait_for(lambda d: browser.alarm_rows() == [], "the alarm normal: acknowledged and its cause gone")
     browser.wait_for(lambda d: text(browser, "pill-robot") == "Robot ready", "the robot ready in the header")
     browser.screenshot("e2e_robot_tile")
 
@@ -87,7 +78,7 @@ def test_a_refused_project_command_is_a_message_not_an_alarm(system):
         system.robot.svr_source.model.estop = True
     try:
         browser.wait_for(lambda d: text(browser, "robot-safety").startswith("E-STOP"), "the E-stop on the tile")
-        browser.wait_for(lambda d: "Emergency stop pressed" in banner(browser), "the E-stop alarm")
+        browser.wait_for(lambda d: "Emergency stop pressed" in browser.banner(), "the E-stop alarm")
         browser.click("btn-project-play")
         browser.wait_for(lambda d: "Error 16#400A" in browser.message(), "the refusal on the message line")
         assert "error" in browser.driver.find_element(By.ID, "message").get_attribute("class")
@@ -104,7 +95,7 @@ def test_leaving_the_listen_node_is_an_alarm_and_back_to_listen_node_brings_the_
     with system.sim.lock:
         system.robot.inject("leave_node", path="Pass")
     browser.wait_for(lambda d: text(browser, "pill-robot") == "Robot left Listen node", "the header")
-    browser.wait_for(lambda d: "The robot left the Listen node" in banner(browser), "the alarm")
+    browser.wait_for(lambda d: "The robot left the Listen node" in browser.banner(), "the alarm")
     button = browser.driver.find_element(By.ID, "btn-back-to-node")
     assert button.is_displayed()
     browser.screenshot("e2e_left_listen_node")
@@ -113,9 +104,9 @@ def test_leaving_the_listen_node_is_an_alarm_and_back_to_listen_node_brings_the_
     system.wait(lambda: system.read("Connect_Connected") and system.read("Robot_InListenNode"),
                 "the robot in its Listen node again", 30)
     browser.wait_for(lambda d: text(browser, "pill-robot") == "Robot ready", "the robot ready again", timeout=30)
-    browser.wait_for(lambda d: all("returned" in r for r in rows(browser)), "the alarm returned")
+    browser.wait_for(lambda d: all("returned" in r for r in browser.alarm_rows()), "the alarm returned")
     browser.click("btn-alarm-ack-all")
-    browser.wait_for(lambda d: rows(browser) == [], "normal")
+    browser.wait_for(lambda d: browser.alarm_rows() == [], "normal")
 
 
 def test_a_link_outage_is_one_alarm_through_every_reconnect_attempt_until_connected(system):
@@ -130,7 +121,7 @@ def test_a_link_outage_is_one_alarm_through_every_reconnect_attempt_until_connec
     try:
         system.wait(lambda: any(a["key"] == "link" for a in alarms(system)), "the connection alarm", 15)
         number = next(a["number"] for a in alarms(system) if a["key"] == "link")
-        browser.wait_for(lambda d: "Connection to the robot lost, reconnecting" in banner(browser), "the banner")
+        browser.wait_for(lambda d: "Connection to the robot lost, reconnecting" in browser.banner(), "the banner")
         browser.click("btn-alarm-ack")
         system.wait(lambda: any("(attempt 1)" in a["text"] for a in alarms(system)), "attempt 1", 15)
         with system.sim.lock:                                  # the robot goes away while attempt 1 runs
@@ -139,11 +130,11 @@ def test_a_link_outage_is_one_alarm_through_every_reconnect_attempt_until_connec
         system.wait(lambda: any("(attempt 2)" in a["text"] for a in alarms(system)), "attempt 2", 30)
         listed = [a for a in alarms(system) if a["key"] == "link"]
         assert len(listed) == 1 and listed[0]["number"] == number and listed[0]["state"] == "active-acknowledged"
-        assert banner(browser) == ""
+        assert browser.banner() == ""
     finally:
         with system.sim.lock:
             system.robot.clear_faults()
     system.wait(lambda: system.read("Connect_Connected"), "the reconnect after the fault was cleared", 30)
-    browser.wait_for(lambda d: rows(browser) == [], "the connection alarm normal")
+    browser.wait_for(lambda d: browser.alarm_rows() == [], "the connection alarm normal")
     link = [e for e in system.hmi.alarms.summary(history=200)["history"] if e["alarm"] == number]
     assert [e["event"] for e in link][:2] == ["normal", "returned"]

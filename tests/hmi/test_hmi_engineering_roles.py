@@ -4,7 +4,6 @@ command with it leaves the robot outside its Listen node and every later command
 from __future__ import annotations
 
 import pytest
-
 from hmi_http import Client
 
 ENGINEERING = [

@@ -145,10 +145,6 @@ def test_pnp_segment_edit_writes_only_that_segment(page):
     assert {path.split("]")[0] for path, _ in plc.writes} == {"PnP_MoveParameters[4"}
 
 
-def alarm_rows(browser):
-    rows = browser.driver.find_element(By.ID, "alarm-history").text.splitlines()[1:]
-    return [] if rows == ["No alarms."] else rows
-
 
 def test_alarm_list_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
     """Six alarms raised one after the other (a command FB's Error with a new ErrorID each time, each an alarm of the
@@ -163,7 +159,7 @@ def test_alarm_list_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
         for n, (error_id, text) in enumerate(zip(ids, texts), 1):
             with plc.lock:
                 plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=error_id, MoveAbs_ErrorDescrip=text)
-            browser.wait_for(lambda d: len(alarm_rows(browser)) == n, f"alarm {n} in the list")
+            browser.wait_for(lambda d, n=n: len(browser.alarm_rows()) == n, f"alarm {n} in the list")
         whole, one_line, box_scrolls_sideways = browser.driver.execute_script("""
             const table = document.getElementById('alarm-history');
             let box = table;
@@ -184,7 +180,7 @@ def test_alarm_list_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
         with plc.lock:
             plc.vars.update(MoveAbs_Error=False, MoveAbs_ErrorID=0, MoveAbs_ErrorDescrip="")
         browser.click("btn-alarm-ack-all")
-        browser.wait_for(lambda d: alarm_rows(browser) == [], "the list empty")
+        browser.wait_for(lambda d: browser.alarm_rows() == [], "the list empty")
 
 
 def test_a_first_connect_retried_is_not_called_a_lost_connection(page, stack):
@@ -201,23 +197,23 @@ def test_a_first_connect_retried_is_not_called_a_lost_connection(page, stack):
     browser = open_page("index")
     try:
         browser.wait_for(lambda d: any("Not connected to the robot, retrying (attempt 1)" in r
-                                       for r in alarm_rows(browser)), "the retry alarm")
+                                       for r in browser.alarm_rows()), "the retry alarm")
         with plc.lock:
             plc.vars.update(Connect_Connected=True, Connect_Reconnecting=False, Connect_Error=False,
                             Connect_ErrorID=0, Connect_ErrorDescrip="")
         browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the link up")
-        browser.wait_for(lambda d: alarm_rows(browser)[0].endswith("returned, unack."), "the retry alarm back")
+        browser.wait_for(lambda d: browser.alarm_rows()[0].endswith("returned, unack."), "the retry alarm back")
         with plc.lock:
             plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=0,
                             Connect_Error=True, Connect_ErrorID=0x2006, Connect_ErrorDescrip="Link lost")
         browser.wait_for(lambda d: any("Connection to the robot lost, reconnecting — Link lost" in r
-                                       for r in alarm_rows(browser)), "the outage alarm")
-        rows = alarm_rows(browser)            # not acknowledged yet: the same alarm is active again (ISA-18.2)
+                                       for r in browser.alarm_rows()), "the outage alarm")
+        rows = browser.alarm_rows()            # not acknowledged yet: the same alarm is active again (ISA-18.2)
         assert len(rows) == 1 and rows[0].endswith("active, unack."), rows
     finally:
         with plc.lock:
             plc.vars.update(Connect_Execute=False, Connect_Reconnecting=False, Connect_Error=False, Connect_ErrorID=0,
                             Connect_ErrorDescrip="", Connect_RetryCount=0, Connect_Connected=False)
-        browser.wait_for(lambda d: all("returned" in r for r in alarm_rows(browser)), "the alarms returned")
+        browser.wait_for(lambda d: all("returned" in r for r in browser.alarm_rows()), "the alarms returned")
         browser.click("btn-alarm-ack-all")
-        browser.wait_for(lambda d: alarm_rows(browser) == [], "the list empty")
+        browser.wait_for(lambda d: browser.alarm_rows() == [], "the list empty")

@@ -231,7 +231,7 @@ class AlarmSystem:
         while not self._stop.wait(PERIOD_S):
             try:
                 self.sample()
-            except Exception:                          # noqa: BLE001 - the alarm thread must survive a bad read
+            except Exception:
                 log.exception("HMI alarm sample failed")
 
     def _read(self) -> tuple[dict | None, dict | None, tuple | None]:
