@@ -91,6 +91,7 @@ def check_global(ctx, decl, vt: T.Type):
         ctx.diags.error("ST1110", f"{where}: reaches word {last} of the {area} area, which has "
                         f"{AREA_WORDS[area]} words (0 to {AREA_WORDS[area] - 1})", decl.name_span)
         return None
+    ctx.note_edition3(f"AT {decl.at} (a Sysmac memory area)", decl.name_span)
     return area, bank, word, bit or 0, layout, AREA_WORDS[area]
 
 

@@ -115,6 +115,8 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
                 continue
             p = positional[pos]
             pos += 1
+            if p.direction == "out":
+                ctx.note_edition3("an output given without `=>` (Sysmac's non-formal call)", arg.span)
         else:
             formal_seen = True
             p = pt.param(arg.name) or _iec_alias(pt, arg.name)

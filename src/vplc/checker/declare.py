@@ -42,6 +42,7 @@ class Declarer:
             inner = getattr(item, "declared_namespace", None)
             if inner:
                 # an item of a NAMESPACE block: its namespace is nested in the file's (a library folder's)
+                self.ctx.note_edition3("NAMESPACE (3rd edition)", getattr(item, "name_span", None) or item.span)
                 full = f"{file_unit.namespace}\\{inner}" if file_unit.namespace else inner
                 unit = views.get(full) or views.setdefault(full, NamespaceView(file_unit, full))
             else:
@@ -174,6 +175,8 @@ class Declarer:
             st.fields[f.name.upper()] = T.StructField(f.name, ftype, f.init, f)
             if st.kind == "union":
                 union_member.check(self.ctx, st, f, ftype)
+        if st.kind == "union":
+            self.ctx.note_edition3("UNION (a Sysmac extension)", spec.span)
 
     # ---- type references ----------------------------------------------------------------------
     def resolve(self, ref: A.TypeRef, unit, scope) -> T.Type:

@@ -67,3 +67,14 @@ def test_globals_used_without_var_external_are_one_st1009_warning_per_pou(tmp_pa
     fixed = glob + "PROGRAM Main\nVAR_EXTERNAL Count, Limit : INT; END_VAR\nCount := Count + Limit;\nEND_PROGRAM\n"
     assert codes(check_text(tmp_path, fixed)) == []
     assert "ST1009" not in codes(check_text(tmp_path, glob + program("Count := 1;"), dialect="iec"))
+
+
+def test_portable_reports_the_sysmac_extensions_as_st2003(tmp_path):
+    src = ("NAMESPACE nsA\nTYPE u : UNION W : WORD; B : BYTE; END_UNION; END_TYPE\nEND_NAMESPACE\n"
+           "VAR_GLOBAL X AT %W1 : WORD; END_VAR\n"
+           + program("t(TRUE, T#1s, q, e);", "t : TON; q : BOOL; e : TIME;"))
+    proj = check_text(tmp_path, src, portable=True)
+    texts = [d.message for d in proj.diagnostics if d.code == "ST2003"]
+    assert any("NAMESPACE" in t for t in texts) and any("UNION" in t for t in texts)
+    assert any("AT %W1" in t for t in texts) and sum("without `=>`" in t for t in texts) == 2
+    assert "ST2003" not in codes(check_text(tmp_path, src))
