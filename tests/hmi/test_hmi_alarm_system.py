@@ -266,9 +266,21 @@ def test_a_sample_never_waits_for_the_disk(plant, monkeypatch):
     assert system.summary(history=5)["history"][0]["n"] == system.entry_number
 
 
+def test_a_flood_of_unacknowledged_events_keeps_the_list_bounded(plant):
+    plc, system, _ = plant
+    for n in range(alarm_module.MAX_LISTED + 50):               # a failed command, every time another ErrorID
+        plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001 + n % 2, MoveAbs_ErrorDescrip="No reply")
+        step(plant, seconds=ON_DELAY_S)
+    summary = step(plant, seconds=ON_DELAY_S, times=2)
+    assert len(summary["alarms"]) == alarm_module.MAX_LISTED
+    assert summary["alarms"][-1]["number"] == system.alarm_number - alarm_module.MAX_LISTED + 1
+    assert any(e["event"] == "left the full list unacknowledged" for e in summary["history"])
+
+
 def test_a_history_file_with_a_damaged_line_is_read_without_it(mapping, tmp_path):
     path = tmp_path / "alarms.jsonl"
-    path.write_text('{"n": 1, "alarm": 1, "event": "raised"}\nnot json\n{"n": 2, "alarm": 1, "event": "normal"}\n')
+    path.write_text('{"n": 1, "alarm": 1, "event": "raised"}\nnot json\n{"n": 2, "alarm": 1, "event": "normal"}\n'
+                    '{"n": 2, "alarm": 1, "event": "normal"}\n')
     system = AlarmSystem(FakePlc(mapping), mapping, path)
     assert [e["n"] for e in system.summary(history=10)["history"]] == [2, 1]
 

@@ -45,6 +45,7 @@ STALL_S = 1.0           # the PLC's tasks completed no cycle for this long: "PLC
 LOCK_WAIT_S = 0.5       # plc.lock not free for this long: "PLC not answering"
 HISTORY = 1000          # history entries kept (and read back from the file at start-up)
 MAX_DETAILS = 20        # consequences kept per alarm
+MAX_LISTED = 200        # alarms listed at most: beyond, the oldest returned ones leave the list unacknowledged
 
 PRIORITIES = {1: "high", 2: "medium", 3: "low"}
 
@@ -136,7 +137,9 @@ class History:
             except json.JSONDecodeError:
                 log.warning("%s:%d: not a history entry (skipped)", self.path, number)
                 continue
-            if isinstance(entry, dict) and isinstance(entry.get("n"), int):
+            # entries numbered in order only: a rewrite of the file may have left an entry twice at its end
+            if isinstance(entry, dict) and isinstance(entry.get("n"), int) and \
+                    (not self.entries or entry["n"] > self.entries[-1]["n"]):
                 self.entries.append(entry)
         self._lines = len(lines)
 
@@ -327,6 +330,10 @@ class AlarmSystem:
                       first_out=not self.alarms)     # the first of an episode: nothing else listed
         self.alarms[alarm.number] = alarm
         self._record(now, "raised" if active else "event", alarm, first_out=alarm.first_out)
+        if len(self.alarms) > MAX_LISTED:                 # bounded: nobody acknowledges a flood of events
+            for old in [a for a in self.alarms.values() if not a.active][:len(self.alarms) - MAX_LISTED]:
+                del self.alarms[old.number]
+                self._record(now, "left the full list unacknowledged", old)
         return alarm
 
     def _detail(self, alarm: Alarm, now: float, text: str) -> None:
