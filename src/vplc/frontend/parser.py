@@ -16,6 +16,7 @@ from .parser_stmts import StatementsMixin
 from .source import SourceFile, Span
 
 SECTION_WORDS = frozenset(A.SECTION_KINDS)
+MAX_NAMESPACE_DEPTH = 32     # NAMESPACE blocks inside each other (Sysmac projects nest two or three)
 POU_END = {"FUNCTION": "END_FUNCTION", "FUNCTION_BLOCK": "END_FUNCTION_BLOCK", "PROGRAM": "END_PROGRAM"}
 
 
@@ -27,6 +28,8 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
         globals_sections: list[A.VarSection] = []
         gstart = None
         spaces: list[str] = []          # the NAMESPACE blocks open here, outermost first
+        current = ""                    # their joined name
+        too_deep = 0                    # NAMESPACE blocks beyond MAX_NAMESPACE_DEPTH (reported once)
         while self.tok.kind != "EOF":
             t = self.tok
             start_i = self.i
@@ -39,15 +42,26 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                     globals_sections.append(self.var_section())
                     continue
                 if t.kind == "IDENT" and t.up == "NAMESPACE":
+                    if len(spaces) >= MAX_NAMESPACE_DEPTH:
+                        if not too_deep:
+                            self.diags.error("ST0203", f"namespaces nested deeper than {MAX_NAMESPACE_DEPTH} "
+                                             "levels", self.tok_span(t))
+                        too_deep += 1
+                        self.namespace_name()
+                        continue
                     spaces.append(self.namespace_name())
+                    current = "\\".join(spaces)
                     continue
                 if t.kind == "IDENT" and t.up == "END_NAMESPACE":
                     self.advance()
                     self.accept_op(";")
-                    if not spaces:
+                    if too_deep:
+                        too_deep -= 1
+                    elif not spaces:
                         self.diags.error("ST0206", "`END_NAMESPACE` without NAMESPACE", self.tok_span(t))
                     else:
                         spaces.pop()
+                        current = "\\".join(spaces)
                     continue
                 if t.kind == "IDENT" and t.up in POU_END:
                     items.append(self.pou())
@@ -61,7 +75,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                     self.fail(f"expected FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE, VAR_GLOBAL or CONFIGURATION, "
                               f"found {self.describe(t)}", "ST0206")
                 if spaces:
-                    items[-1].declared_namespace = "\\".join(spaces)
+                    items[-1].declared_namespace = current
             except (ParseError, DepthExceeded):
                 self.depth = 0
                 if self.i == start_i:

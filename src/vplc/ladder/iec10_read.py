@@ -84,6 +84,8 @@ def _namespace(container: ET.Element, ns: str | None, units: dict) -> None:
     for item in container:
         if item.tag == "NamespaceDecl":
             inner = item.get("name") or None
+            if ns is not None and ns.count("\\") >= 31:
+                raise FormatError(f"namespace {ns}", "namespaces nested deeper than 32 levels")
             if ns is not None and inner is not None:
                 inner = f"{ns}\\{inner}"      # a nested namespace (Sysmac: Namespace1\Namespace1): its full name
             _namespace(item, inner, units)

@@ -78,3 +78,9 @@ def test_portable_reports_the_sysmac_extensions_as_st2003(tmp_path):
     assert any("NAMESPACE" in t for t in texts) and any("UNION" in t for t in texts)
     assert any("AT %W1" in t for t in texts) and sum("without `=>`" in t for t in texts) == 2
     assert "ST2003" not in codes(check_text(tmp_path, src))
+
+
+def test_namespaces_nested_10000_deep_are_one_st0203_in_linear_time(tmp_path):
+    src = "NAMESPACE a\n" * 10000 + "TYPE e : (A, B); END_TYPE\n" + "END_NAMESPACE\n" * 10000
+    proj = check_text(tmp_path, src)
+    assert [d.code for d in proj.diagnostics] == ["ST0203"] and "deeper than 32" in proj.diagnostics[0].message

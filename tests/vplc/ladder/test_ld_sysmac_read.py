@@ -329,3 +329,8 @@ def test_using_directive_outside_a_pou_is_refused(tmp_path):
                                "<UsingDirective>Other</UsingDirective><Type><TypeName>BOOL</TypeName>", 1)
     text = doc(fb)
     refused(write(tmp_path, text), "Variable Go", "UsingDirective Other")
+
+
+def test_namespace_declarations_nested_too_deep_are_refused(tmp_path):
+    t = '<NamespaceDecl name="N">' * 40 + '</NamespaceDecl>' * 40
+    refused(write(tmp_path, doc(t)), "deeper than 32")
