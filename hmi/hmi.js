@@ -433,6 +433,7 @@ function mainPage() {
   robotView(document.getElementById("robotview"));
   robotTile(document.getElementById("robotview"));
   document.querySelector("header h1").insertAdjacentHTML("afterend",
+    '<a class="menu" id="nav-jog" href="jog.html">Jog / Teach</a>' +
     '<a class="menu" id="nav-program" href="program.html">Program (Ladder)</a>');
   startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", ...ROBOT_STATUS, ...ROBOT_TILE_VARS]);
 }
@@ -603,6 +604,7 @@ async function boot() {
   document.body.dataset.role = ACCESS.role;
   if (key === "main") mainPage();
   else if (key === "pnp") pnpPage();
+  else if (key === "jog") jogPage();
   else if (key === "program") programPage();
   else fbPage(key);
 }

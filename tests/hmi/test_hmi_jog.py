@@ -1,0 +1,139 @@
+"""The Jog/Teach page from the engineer's seat: headless Chromium at 800x480 -> HMI server -> the example programs
+(JogTeach_Example) and the library on the virtual PLC in real time -> the robot simulator over loopback. Holding a
+jog button moves the robot, releasing it stops the robot at once; a page that falls silent with the button held
+is released by the PLC; Teach stores the robot's position into the table the page lists."""
+from __future__ import annotations
+
+import pathlib
+import threading
+import time
+
+import pytest
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+
+from tmsim.server import SimServer
+from vplc.api import load_plc
+from vplc.hmi.mapping import Mapping
+from vplc.hmi.server import HmiServer
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
+WAIT_S = 20
+
+
+class Cell:
+    """Robot simulator, the example programs on the virtual PLC in real time and the HMI server."""
+
+    def __init__(self, browser):
+        self.mapping = Mapping.load()
+        self.sim = SimServer(port=0, robots=1, svr_port=0, auto_enter=True)
+        self.sim.start_background()
+        self.robot = self.sim.robots[0]
+        self.plc = load_plc(SOURCES)
+        self.mapping.check_against_plc(self.plc)
+        with self.plc.lock:
+            self.plc.write("Connect_AddressIP", "127.0.0.1")
+            self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
+            self.plc.write("Connect_SvrPort", self.robot.svr_port)
+            self.plc.write("Connect_Execute", True)
+        self.stop_event = threading.Event()
+        self.plc_thread = threading.Thread(target=self.plc.run_realtime, args=(self.stop_event,),
+                                           kwargs={"spin_ns": 0}, daemon=True)
+        self.plc_thread.start()
+        self.hmi = HmiServer(self.plc, self.mapping, port=0)
+        self.hmi.start()
+        self.browser = browser
+        self.wait(lambda: self.read("Connect_Connected") and self.read("ReadPos_Valid"), "the connection")
+
+    def close(self):
+        self.hmi.stop()
+        self.stop_event.set()
+        self.plc_thread.join(timeout=5)
+        self.plc.close()
+        self.sim.close()
+
+    def read(self, name):
+        with self.plc.lock:
+            return self.plc.read(name)
+
+    def state(self):
+        with self.sim.lock:
+            return self.robot.state()
+
+    def events(self, kind):
+        with self.sim.lock:
+            return [e for e in self.robot.events if e["kind"] == kind]
+
+    def wait(self, predicate, what, timeout=WAIT_S):
+        deadline = time.monotonic() + timeout
+        while not predicate():
+            assert time.monotonic() < deadline, f"timed out after {timeout} s waiting for {what}"
+            time.sleep(0.02)
+
+    def open(self):
+        self.browser.open(self.hmi.page_url("jog", "engineer"))
+        self.browser.wait_for(lambda d: d.find_elements(By.ID, "jog-3p"), "the jog buttons")
+        self.browser.wait_for(lambda d: d.find_element(By.CSS_SELECTOR, "[data-jog-now='0']").text not in ("", "####"),
+                              "the live position")
+        return self.browser
+
+
+@pytest.fixture(scope="module")
+def cell(chromium):
+    c = Cell(chromium)
+    yield c
+    c.close()
+
+
+def test_holding_a_button_jogs_and_releasing_it_stops_the_robot(cell):
+    browser = cell.open()
+    browser.click("jog-frame-JogBase")
+    start = cell.state()["tcp"]
+    button = browser.driver.find_element(By.ID, "jog-3p")                     # Z+
+    ActionChains(browser.driver).click_and_hold(button).perform()
+    cell.wait(lambda: cell.read("Jog_Active"), "the jog to move the robot")
+    time.sleep(0.3)
+    assert cell.state()["moving"] and cell.read("Jog_Forward")
+    stops = len(cell.events("stop"))
+    ActionChains(browser.driver).release(button).perform()
+    cell.wait(lambda: len(cell.events("stop")) > stops, "the release's stop")
+    cell.wait(lambda: not cell.read("Jog_Busy"), "the jog to end")
+    end = cell.state()
+    assert not end["moving"] and end["tcp"][2] > start[2] + 5.0
+    assert end["tcp"][:2] == pytest.approx(start[:2], abs=0.01)
+    assert cell.read("Cobot.Stopping") is False and not cell.read("Jog_Error")
+    browser.screenshot("jog_page")
+
+
+def test_a_page_that_stops_answering_is_released_by_the_plc(cell):
+    browser = cell.open()
+    button = browser.driver.find_element(By.ID, "jog-1m")
+    ActionChains(browser.driver).click_and_hold(button).perform()
+    cell.wait(lambda: cell.read("Jog_Active"), "the jog to move the robot")
+    browser.driver.execute_script("clearInterval(jog.timer)")                # the page's beat stops, button held
+    cell.wait(lambda: cell.read("Jog_Dropped"), "the PLC to drop the jog", timeout=5)
+    cell.wait(lambda: not cell.read("Jog_Busy") and not cell.state()["moving"], "the robot to stop", timeout=5)
+    assert cell.read("Jog_Forward") is False and cell.read("Jog_Backward") is False
+    browser.wait_for(lambda d: "stopped the jog because this page stopped answering" in browser.message(),
+                     "the page to say why")
+    ActionChains(browser.driver).release(button).perform()
+
+
+def test_teach_stores_the_position_in_the_chosen_entry(cell):
+    browser = cell.open()
+    browser.driver.find_element(By.CSS_SELECTOR, "#teach-index option[value='5']").click()
+    name = browser.driver.find_element(By.ID, "teach-name")
+    name.clear()
+    name.send_keys("Pick")
+    browser.click("btn-teach")
+    cell.wait(lambda: cell.read("TeachTable[5]")["Taught"], "the point to be taught")
+    entry = cell.read("TeachTable[5]")
+    tcp = cell.state()["tcp"]
+    assert entry["Name"] == "Pick"
+    assert [entry["Pose"][k] for k in ("X", "Y", "Z")] == pytest.approx(tcp[:3], abs=0.01)
+    browser.wait_for(lambda d: d.find_elements(By.CSS_SELECTOR, "#teach-points tr")[4].text.startswith("5 Pick"),
+                     "the table row to show the point")
+    browser.wait_for(lambda d: "Teach: Done" in browser.message(), "Done on the message line")
+    cell.wait(lambda: cell.read("Teach_Execute") is False, "the page to release Teach")
+    browser.screenshot("jog_page_taught")
