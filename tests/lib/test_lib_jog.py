@@ -282,3 +282,14 @@ def test_teach_without_a_robot_ends_with_no_position_after_1_s():
         assert not point(rig, 1)[3]
     finally:
         rig.close()
+
+
+def test_a_jog_without_a_connection_ends_with_16_2001_and_sends_nothing():
+    rig = Rig(program="Main_Jog.st", connect=False)
+    try:
+        rig.write("JogFwd", True)
+        assert rig.until(lambda: rig.read("jog.Error"), 0.05)
+        assert rig.read("jog.ErrorID") == 0x2001 and not rig.read("jog.Busy")
+        assert rig.scripts_in() == [] and not rig.read("Cobot.Stopping")
+    finally:
+        rig.close()
