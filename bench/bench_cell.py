@@ -1,6 +1,6 @@
 """Statements per scan of the issue 26 function blocks (CBT_ReadIO, CBT_SetOverride, CBT_WaitQueue, the motion
 status of CBT_RobotStatus, CBT_ReadVariable, CBT_WriteVariable, an aborting CBT_MoveAbsolute, CBT_Jog,
-CBT_Teach) against an idle CBT_MoveAbsolute, on the virtual PLC (1 ms task) with the simulator's
+CBT_Teach, CBT_VisionJob) against an idle CBT_MoveAbsolute, on the virtual PLC (1 ms task) with the simulator's
 Listen node and Ethernet Slave (data table every 100 ms).
 
     PYTHONPATH=tests/lib .venv/bin/python bench/bench_cell.py
@@ -26,6 +26,7 @@ VAR
     MoveParam : stCBT_MovAbsParam;
     Variable : stCBT_Variable;
     Point : stCBT_TeachPoint;
+    VisParam : stCBT_VisionParam;
     fb : {fb};
 END_VAR
 """
@@ -42,6 +43,7 @@ CALLS = {
     "CBT_Jog": "fb(CBT := Cobot, JogForward := On, JogBackward := FALSE, Frame := eCBT_JogFrame#JogBase, Axis := 3, "
                "Velocity := 10);",
     "CBT_Teach": "fb(CBT := Cobot, Execute := On, Name := 'P1', Point := Point);",
+    "CBT_VisionJob": "fb(CBT := Cobot, Execute := On, Parameters := VisParam);",
 }
 TAIL = """conn(CBT := Cobot, Execute := ConnExec, IPAddress := '127.0.0.1', IPPort := Port, Time_Out := 10,
      SvrPort := SvrPort);
@@ -87,7 +89,7 @@ def main():
         base = measure(program(folder, None), False)
         rows = [("CBT_MoveAbsolute", "idle (Execute FALSE)", measure(program(folder, "CBT_MoveAbsolute"), False))]
         for fb in ("CBT_MoveAbsolute Aborting", "CBT_WaitQueue", "CBT_SetOverride", "CBT_ReadVariable",
-                   "CBT_WriteVariable", "CBT_Teach"):
+                   "CBT_WriteVariable", "CBT_Teach", "CBT_VisionJob"):
             rows.append((fb, "idle (Execute FALSE)", measure(program(folder, fb), False)))
         rows.append(("CBT_Jog", "idle (not held)", measure(program(folder, "CBT_Jog"), False)))
         for fb in ("CBT_ReadIO", "CBT_RobotStatus"):
