@@ -164,6 +164,16 @@ def test_a_row_that_is_not_a_pose_is_16_4053(rig):
     assert rig.read("vis.ErrorID") == 0x4053
 
 
+def test_a_row_printed_with_quoted_values_is_read_as_the_same_pose(rig):
+    """The manual does not show how GetString prints a string array; {"300","60",...} reads as {300,60,...}."""
+    rig.camera.define("job1", objects=PARTS, seconds=0)
+    rig.camera.finish(rig.camera.jobs["job1"])
+    rig.camera.outputs["job1_Base_TM"] = [[f'"{v}"' for v in row] for row in rig.camera.outputs["job1_Base_TM"]]
+    rig.camera.finish = lambda job: True                     # the next run leaves the quoted rows as they are
+    vision(rig, ObjectIndex=2)
+    assert rig.read("vis.Found") and pose(rig, "vis.Object") == pytest.approx(PARTS[2], abs=1e-3)
+
+
 def test_a_new_rising_edge_while_reading_replaces_the_command(rig):
     rig.set_struct("VisParam", dict(JobName="job1", ObjectVariable="job1_Base_TM", ObjectIndex=0))
     rig.write("VisExec", True)
