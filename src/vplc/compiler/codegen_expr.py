@@ -217,6 +217,8 @@ class ExprGen:
             container, key = _cell(sym, self.self_name)
             if container.endswith(".__dict__"):            # plain attribute access: the fast path
                 return f"{container[:-len('.__dict__')]}.{key[1:-1]}"
+            if container == "G.i__members":
+                return f"G.{key[1:-1]}"
             return f"{container}[{key}]"
         if kind == "PouSymbol" and sym.type.kind == "program":
             return f"_PROGRAMS[{sym.type.name.upper()!r}]"
@@ -348,7 +350,10 @@ class ExprGen:
             container, key = _cell(e.sym, self.self_name)
             return f"({container}, {key})"
         if isinstance(e, A.Member):
-            return f"({self.expr_raw(e.base)}.__dict__, {attr(e.sym.name if e.sym else e.member)!r})"
+            bt = T.unalias(e.base.ty) if e.base.ty is not None else None
+            # a union's members are properties over its memory image: the mapping view (runtime/unions.py)
+            members = "i__members" if isinstance(bt, T.StructType) and bt.kind == "union" else "__dict__"
+            return f"({self.expr_raw(e.base)}.{members}, {attr(e.sym.name if e.sym else e.member)!r})"
         if isinstance(e, A.Index):
             code = self.expr_raw(e)
             base, _, rest = code.partition("[")
@@ -447,6 +452,8 @@ def _cell(sym, s: str = "s") -> tuple[str, str]:
         sym = sym.target
     a = attr(sym.name)
     if sym.section in ("VAR_GLOBAL", "VAR_EXTERNAL"):
+        if getattr(sym, "at_address", None) is not None:
+            return "G.i__members", repr(a)        # a memory-area variable: a property (runtime/at_memory.py)
         return "G.__dict__", repr(a)
     if sym.section == "VAR_IN_OUT" and is_scalar(sym.type):
         return f"{s}.{a}__r", f"{s}.{a}__k"

@@ -81,3 +81,12 @@ def test_an_io_port_name_is_refused_as_not_modelled(tmp_path):
 
 def test_iec_addresses_keep_their_meaning_of_before(tmp_path):
     assert _errors(tmp_path, "VAR_GLOBAL\n    Q AT %QX0.1 : BOOL;\n    M AT %MW10 : WORD;\nEND_VAR\n") == []
+
+
+def test_a_placed_variable_passed_as_in_out_is_written_into_the_area(tmp_path):
+    (tmp_path / "g.st").write_text("VAR_GLOBAL\n    Cnt AT %D0 : UINT;\n    Word0 AT %D0 : WORD;\nEND_VAR\n")
+    (tmp_path / "main.st").write_text("PROGRAM Main\nVAR_EXTERNAL Cnt : UINT; Word0 : WORD; END_VAR\n"
+                                      "Inc(Cnt);\nInc(Cnt);\nEND_PROGRAM\n")
+    p = load_plc([str(tmp_path / "g.st"), str(tmp_path / "main.st")], task="Main@1ms")
+    p.scan(0)
+    assert p.read("Cnt") == 2 and p.read("Word0") == 2

@@ -132,3 +132,10 @@ def test_union_members_without_a_memory_image_or_with_initial_values_are_st1109(
     from vplc.project import load_project
     (tmp_path / "u.st").write_text("TYPE uText : UNION\n    S : STRING[8];\n    W : WORD := 1;\nEND_UNION;\nEND_TYPE\n")
     assert [d.code for d in load_project([str(tmp_path / "u.st")]).diagnostics] == ["ST1109", "ST1109"]
+
+
+def test_a_union_member_passed_as_in_out_is_written_into_the_image(tmp_path):
+    fb = "FUNCTION_BLOCK Bump\nVAR_IN_OUT X : WORD; END_VAR\nX := X OR 16#1000;\nEND_FUNCTION_BLOCK\n"
+    plc = run1(tmp_path, "u.W := 16#0102; b(X := u.W); hi := u.Bytes[1];", "u : uWord; b : Bump; hi : BYTE;",
+               UNIONS + fb)
+    assert plc.read("Main.u.W") == 0x1102 and plc.read("Main.hi") == 0x11
