@@ -186,15 +186,24 @@ def test_a_new_rising_edge_while_reading_replaces_the_command(rig):
     assert rig.read("vis.Done") and pose(rig, "vis.Object") == pytest.approx(PARTS[2], abs=1e-3)
 
 
-def test_a_stop_while_the_job_runs_ends_it(rig):
+@pytest.mark.parametrize("mode, aborted", [("StopNormal", False), ("StopImmediate", False),
+                                           ("StopAbortScript", True), ("StopDiscardAll", True)])
+def test_a_stop_while_the_job_runs(rig, mode, aborted):
+    """StopAndClearBuffer() / (0) leave the running script (§13.4, §15.8): the job ends and is Done; (1) and (2)
+    abandon it, the robot answers OK without its answers: CommandAborted, the job never finished."""
     rig.camera.define("job1", objects=PARTS, seconds=2.0)
     rig.set_struct("VisParam", dict(JobName="job1", ObjectVariable="job1_Base_TM"))
+    rig.write("StopParam.Mode", mode)
     rig.write("VisExec", True)
     assert rig.until(lambda: rig.read("vis.Busy"), 0.1)
     rig.until(lambda: False, 0.2)
     rig.write("StopExec", True)
     assert rig.until(lambda: not rig.read("vis.Busy"), 5)
-    assert rig.read("vis.CommandAborted") or rig.read("vis.Done") or rig.read("vis.Error")
+    runs = [e["result"] for e in rig.robot.events if e["kind"] == "vision_job"]
+    if aborted:
+        assert rig.read("vis.CommandAborted") and not rig.read("vis.Error") and runs == []
+    else:
+        assert rig.read("vis.Done") and rig.read("vis.Found") and runs == ["pass"]
 
 
 # ---- every parameter row of ranges.tsv (the generic test leaves this struct to this file) ----------------------
