@@ -89,6 +89,7 @@ def test_an_alarm_goes_through_its_states_on_the_page(browser, stack):
     browser.open(stack.server.page_url("index", "operator"))
     stack.set(RS_EStop=True)
     browser.wait_for(lambda d: "Emergency stop pressed" in browser.banner(), "the E-stop in the banner")
+    assert browser.viewport_overflow() == []
     assert "High" in browser.banner() and "release the emergency stop, then press Play on the Main screen" in browser.banner()
     browser.wait_for(lambda d: browser.alarm_rows() and browser.alarm_rows()[0].endswith("active, unack."), "the row")
     assert browser.driver.find_element(By.ID, "alarm-banner").get_attribute("data-priority") == "high"
@@ -114,7 +115,8 @@ def test_one_alarm_per_cause_with_its_consequences_and_priority(browser, stack):
     browser.open(stack.server.page_url("index", "operator"))
     stack.set(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001, MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")
     browser.wait_for(lambda d: any("16#3001" in r for r in browser.alarm_rows()), "the command's alarm")
-    stack.set(RS_EStop=True, RS_RobotError=True, RS_ErrorCode=0x10001, RS_ErrorText="Emergency stop",
+    stack.set(RS_EStop=True, RS_RobotError=True, RS_ErrorCode=0x10001,
+              RS_ErrorText="Emergency stop: the robot stopped its motion and its project; release it to go on",
               Connect_Connected=False, Connect_Reconnecting=True, Connect_ErrorID=0x4006,
               MoveRel_Error=True, MoveRel_ErrorID=0x4006, MoveRel_ErrorDescrip="Robot error stopped the project")
     try:
@@ -122,10 +124,13 @@ def test_one_alarm_per_cause_with_its_consequences_and_priority(browser, stack):
                          "the E-stop with its three consequences on top")
         listed = browser.alarm_rows()
         assert len(listed) == 2 and "High" in listed[0] and "Low ① Move Absolute 16#3001" in listed[1], listed
+        assert browser.viewport_overflow() == [] and browser.driver.execute_script(   # a long robot error text
+            "const d = document.documentElement; return d.scrollWidth <= innerWidth && d.scrollHeight <= innerHeight")
         browser.screenshot("alarm_one_per_cause")
         browser.driver.find_element(By.ID, "alarm-history").find_elements(By.TAG_NAME, "tr")[1].click()
         whole = browser.message()
-        assert "Consequences: Robot: Robot error 16#00010001: Emergency stop; Connection 16#4006: Connection to the " \
+        assert "Consequences: Robot: Robot error 16#00010001: Emergency stop: the robot stopped its motion and its " \
+               "project; release it to go on; Connection 16#4006: Connection to the " \
                "robot lost, reconnecting" in whole and "Move Relative 16#4006" in whole
     finally:
         stack.set(MoveAbs_Error=False, MoveAbs_ErrorID=0, MoveRel_Error=False, MoveRel_ErrorID=0,
