@@ -215,6 +215,18 @@ def item(it) -> list[str]:
 
 
 def print_unit(unit: A.CompilationUnit) -> str:
-    """The whole file as ST text."""
-    blocks = ["\n".join(item(it)) for it in unit.items]
+    """The whole file as ST text; items of NAMESPACE blocks inside their blocks again."""
+    blocks: list[str] = []
+    open_: list[str] = []
+    for it in unit.items:
+        path = getattr(it, "declared_namespace", None)
+        want = path.split("\\") if path else []
+        keep = 0
+        while keep < min(len(open_), len(want)) and open_[keep] == want[keep]:
+            keep += 1
+        blocks.extend("END_NAMESPACE" for _ in open_[keep:])
+        blocks.extend(f"NAMESPACE {name}" for name in want[keep:])
+        open_ = want
+        blocks.append("\n".join(item(it)))
+    blocks.extend("END_NAMESPACE" for _ in open_)
     return "\n\n".join(blocks) + "\n"

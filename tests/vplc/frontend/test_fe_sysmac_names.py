@@ -84,3 +84,14 @@ def test_namespaces_nested_10000_deep_are_one_st0203_in_linear_time(tmp_path):
     src = "NAMESPACE a\n" * 10000 + "TYPE e : (A, B); END_TYPE\n" + "END_NAMESPACE\n" * 10000
     proj = check_text(tmp_path, src)
     assert [d.code for d in proj.diagnostics] == ["ST0203"] and "deeper than 32" in proj.diagnostics[0].message
+
+
+def test_the_printer_keeps_namespaces_and_unions():
+    from fe_helpers import parse_text
+    from vplc.frontend.printer import print_unit
+    src = (pathlib.Path(__file__).resolve().parents[1] / "sysmac" / "manual_project" / "Types.st").read_text()
+    unit, diags = parse_text(src)
+    again, diags2 = parse_text(print_unit(unit))
+    assert diags == diags2 == [] and again == unit
+    assert [i.declared_namespace for i in again.items] == ["nsMachine", "nsMachine\\Io"]
+    assert "END_UNION" in print_unit(unit)
