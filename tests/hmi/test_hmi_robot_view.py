@@ -170,10 +170,17 @@ def test_fixed_scale_zoom_buttons_labelled_grid_and_the_arm(page, size):
     _, _, open_page = page
     b = open_page("moveabs", size)
     scale = lambda: float(b.driver.find_element(By.ID, "view-top").get_attribute("data-scale"))  # noqa: E731
-    before = scale()
+    span = lambda: js(b, "const c = document.getElementById('view-top'); "          # noqa: E731
+                         "return Math.min(c.width, c.height) / Number(c.dataset.scale)")
+    assert span() == pytest.approx(1800)                        # mm across the narrower side at 1x
+    Select(b.field("MoveAbs_Param.MovementCommand")).select_by_visible_text("PTP")
+    Select(b.field("MoveAbs_Param.DataFormat")).select_by_visible_text("CPP_Abs")
+    for axis, value in zip(("Y", "Z", "RX", "RY", "RZ"), (0, 300, 180, 0, 90)):
+        b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     b.type_into("MoveAbs_Param.TargetPosition.X", "650")        # typing does not re-zoom the view
     b.wait_for(lambda _d: js(b, "return !!VIEW.preview && !!VIEW.preview.path"), "the preview")
-    assert scale() == before
+    assert span() == pytest.approx(1800)
+    before = scale()
     for button in ("zoom-in", "zoom-out"):
         r = b.driver.find_element(By.ID, button).rect
         assert r["width"] >= 34 and r["height"] >= 34, (button, r)
@@ -204,15 +211,21 @@ def axes(b, name):
     return [c.get_attribute("data-axes") for c in b.driver.find_elements(By.CSS_SELECTOR, ".views canvas")]
 
 
+def pnp_example_cycle(plc):
+    """The PnP example's cycle: pick and place 400 mm apart along Y; Line, CPP_Abs, 30 %."""
+    with plc.lock:
+        for i, (y, z) in enumerate([(-200, 400), (-200, 250), (-200, 400), (200, 400), (200, 250), (200, 400)]):
+            plc.vars["PnP_MoveParameters"][i].update(MovementCommand=0, DataFormat=1, Speed=30)
+            plc.vars["PnP_MoveParameters"][i]["TargetPosition"].update(X=350.0, Y=float(y), Z=float(z), RX=180.0, RZ=90.0)
+
+
 PAGES_WITH_VIEWS = ["index", "connect", "changebase", "moverel", "moveabs", "movecircle", "setoutput", "stop", "pnp"]
 
 
 def test_every_page_shows_the_same_axes_and_a_switch_holds_for_every_page(page):
     """Top X-Y and side Y-Z everywhere, the PnP drawing included; X-Z chosen on one page is X-Z on all of them."""
     plc, _, open_page = page
-    with plc.lock:                        # the PnP example's cycle: pick and place 400 mm apart along Y
-        for i, (y, z) in enumerate([(-200, 400), (-200, 250), (-200, 400), (200, 400), (200, 250), (200, 400)]):
-            plc.vars["PnP_MoveParameters"][i]["TargetPosition"].update(X=350.0, Y=float(y), Z=float(z), RX=180.0, RZ=90.0)
+    pnp_example_cycle(plc)
     for name in PAGES_WITH_VIEWS:
         b = open_page(name)
         assert axes(b, name) == (["Y-Z"] if name == "pnp" else ["X-Y", "Y-Z"]), name
@@ -247,9 +260,7 @@ def test_move_relative_and_a_pnp_segment_are_refused_out_of_reach(page):
     assert b.message().startswith("Target Position: X 1300 Y 0 Z 400 is out of reach")
     assert plc.writes == []
     b.screenshot("reach_refused_moverel")
-    with plc.lock:                        # segment 2 of the PnP example: Line, CPP_Abs, 30 %, down to the pick point
-        plc.vars["PnP_MoveParameters"][1].update(MovementCommand=0, DataFormat=1, Speed=30)
-        plc.vars["PnP_MoveParameters"][1]["TargetPosition"].update(X=350.0, Y=-200.0, Z=250.0, RX=180.0, RZ=90.0)
+    pnp_example_cycle(plc)
     b = open_page("pnp")
     b.wait_for(lambda _d: b.driver.find_elements(By.ID, "edit-1"), "the segments")
     b.click("edit-1")
