@@ -17,3 +17,14 @@ def test_symbol_blocks_compare_and_add_like_their_iec_names(tmp_path):
     assert (r["Less"], r["Same"], r["Sum"], r["Diff"]) == (True, False, 7, -1)
     r.scan(A=4, B=4)
     assert (r["Less"], r["Same"], r["Sum"], r["Diff"]) == (False, True, 8, 0)
+
+
+def test_a_ctd_block_with_the_iec_pin_ld_loads_the_counter(tmp_path):
+    """W502 2-134 names the input Load; a ladder drawn with IEC's LD pin means the same input."""
+    body = [rail(1), invar(2, "Pulse"), invar(3, "Reload", y=10), invar(4, "3", y=20),
+            block(5, "CTD", {"CD": 2, "LD": 3, "PV": 4}, ["Q", "CV"], instance="Down"),
+            outvar(6, "Left", (5, "CV"))]
+    r = Run(tmp_path, {"Pulse": "BOOL", "Reload": "BOOL", "Left": "INT", "Down": "CTD"}, body)
+    assert r.scan(Reload=True)["Left"] == 3
+    r.scan(Reload=False)
+    assert r.scan(Pulse=True)["Left"] == 2
