@@ -289,9 +289,10 @@ function robotViewStyle() {
   const style = document.createElement("style");
   style.id = "robotview-style";
   style.textContent = `.robotview .viewfoot { align-items: center; font-size: 14px; color: #3d4852; min-height: 34px; }
-    .robotview .viewfoot .pos { font-size: 14px; color: #3d4852; }
+    .robotview .viewfoot .pos { font-size: 14px; color: #3d4852; min-width: 0; overflow: hidden;
+      text-overflow: ellipsis; white-space: nowrap; }
     .robotview .viewfoot .note { flex: 1; min-width: 0; color: #5a2a91; }
-    .robotview .viewfoot .note.refused { color: #b0211a; font-weight: bold; }
+    .robotview .viewfoot .note.refused { color: #b0211a; font-weight: bold; order: -1; flex: none; }
     .robotview .zoom { display: flex; align-items: center; gap: 4px; flex: none; }
     .robotview .zoom #side-axis { font-size: 14px; margin-right: 6px; }
     .robotview .zoom button { min-width: 34px; height: 34px; padding: 0 6px; font-size: 18px; line-height: 1; }
