@@ -453,11 +453,12 @@ def test_connection_loss_shows_on_the_connect_page(connected):
 
 
 def test_message_line_shows_the_fb_error_of_a_motion_the_robot_refuses(connected):
-    """An unreachable target passes the page's range check (±100000 mm) but not the robot: the message line shows
-    the FB's Error, ErrorID and ErrorDescrip."""
+    """A move the page accepts but the robot refuses (its script answered ERROR, injected in the simulator; an
+    unreachable target no longer serves: the page refuses it before sending): the message line shows the FB's
+    Error, ErrorID and ErrorDescrip."""
     browser = connected.open("moveabs")
     browser.click("btn-preset")
-    browser.type_into("MoveAbs_Param.TargetPosition.X", "5000")
+    connected.robot.inject("reply_error", count=1)
     browser.click("btn-execute")
     browser.wait_for(lambda d: "Move Absolute: Error 16#" in browser.message(), "the FB's error on the message line")
     error_id = connected.read("MoveAbs_ErrorID")
