@@ -16,7 +16,7 @@ unexport PYTHONDONTWRITEBYTECODE
 
 ## demo: robot simulator + virtual PLC running the examples + web HMI (Ctrl-C stops everything)
 demo: install
-	@$(VPY) -m cbt_hmi
+	@$(VPY) -m cbt_hmi --alarm-log build/alarm_history.jsonl
 
 ## test: every test (unit, golden, ST suites, simulator, library end-to-end, HMI in headless Chromium),
 ## on two worker processes; each test file stays on one worker (its module fixtures and test order hold)

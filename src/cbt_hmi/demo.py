@@ -1,7 +1,7 @@
 """`make demo`: robot simulator + virtual PLC running the examples in real time + web HMI, stopped by Ctrl-C.
 
     cbt-demo [--host 127.0.0.1] [--robot-port 5890] [--svr-port 5891] [--hmi-port 8080] [--control-port 5889]
-             [--project DIR]
+             [--alarm-log FILE] [--project DIR]
 
 Also `python3 -m cbt_hmi` and, from a checkout, `python3 examples/run_demo.py` (the launcher kept for existing
 users). The demo runs the library and the examples of a project folder: --project, else the current folder when
@@ -164,6 +164,9 @@ def parse_args(argv):
     parser.add_argument("--control-port", type=tcp_port, default=None,
                         help="simulator control channel port, always on 127.0.0.1 (default: the robot port - 1, "
                              "i.e. 5889; any free port, printed at start, when that one is taken)")
+    parser.add_argument("--alarm-log", metavar="FILE", default=None,
+                        help="keep the HMI's alarm history in FILE (JSON lines) across restarts (default: in memory "
+                             "only; make demo uses build/alarm_history.jsonl)")
     parser.add_argument("--project", metavar="DIR", default=None,
                         help="folder holding lib/CBT_Commands_Lib and examples/ (default: the current folder, else "
                              "the checkout this program is installed from)")
@@ -172,8 +175,9 @@ def parse_args(argv):
 
 class Demo:
     def __init__(self, host: str, robot_port: int, hmi_port: int, svr_port: int | None = None,
-                 control_port: int | None = None, project: pathlib.Path | None = None):
-        self.project = project
+                 control_port: int | None = None, project: pathlib.Path | None = None,
+                 alarm_log: str | None = None):
+        self.project, self.alarm_log = project, alarm_log
         self.host, self.robot_port, self.hmi_port = host, robot_port, hmi_port
         self.svr_port = svr_port or (robot_port + 1 if robot_port < 65535 else robot_port - 1)
         self.control_port = control_port          # None: derived from the robot port at start
@@ -225,7 +229,12 @@ class Demo:
             raise DemoError(f"error: robot simulator: {exc.strerror}") from None
         with self.plc.lock:
             self.plc.write("Connect_SvrPort", self.sim.robots[0].svr_port)
-        self.hmi = HmiServer(self.plc, mapping, host=self.host, port=self.hmi_port)
+        if self.alarm_log is not None:
+            try:
+                pathlib.Path(self.alarm_log).parent.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise DemoError(f"error: --alarm-log {self.alarm_log}: {exc.strerror}") from None
+        self.hmi = HmiServer(self.plc, mapping, host=self.host, port=self.hmi_port, alarm_log=self.alarm_log)
         try:
             self.hmi.start()
         except OSError as exc:
@@ -307,7 +316,7 @@ def main(argv=None) -> int:
     except DemoError as exc:
         print(exc, file=sys.stderr)
         return 2
-    demo = Demo(args.host, args.robot_port, args.hmi_port, args.svr_port, args.control_port, project)
+    demo = Demo(args.host, args.robot_port, args.hmi_port, args.svr_port, args.control_port, project, args.alarm_log)
     signal.signal(signal.SIGTERM, lambda *_: demo.stop_event.set())
     try:
         demo.start()
