@@ -15,6 +15,7 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "operation_mode", "robot": 0, "mode": "manual"}
     {"cmd": "svr_config", "robot": 0, "period": 0.1, "mode": 1, "items": [...], "write_permission": true}
     {"cmd": "svr_inject", "robot": 0, "fault": "stall", "params": {"enabled": true}}   / "svr_clear_faults"
+    {"cmd": "set_input", "robot": 0, "name": "End_DI0", "value": 1}   a digital (0/1) or analog (V) input
     {"cmd": "vision_job", "robot": 0, "job": "job1", "objects": [[x, y, z, rx, ry, rz], ...], "pass": true,
      "seconds": 0.2, "capture": [j1, ..., j6], "variable": "job1_Base_TM"}   a vision job (sim/camera.py)
     {"cmd": "vision_remove", "robot": 0, "job": "job1"} / {"cmd": "vision", "robot": 0}   remove / show
@@ -45,7 +46,7 @@ from .listener import Listener, receive
 from .session import TransitionError
 
 _FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission",
-           "plc_time"}
+           "plc_time", "name", "value"}
 _VISION_FIELDS = {"job", "objects", "pass", "seconds", "capture", "variable"}
 _FIELDS |= _VISION_FIELDS
 _BRACKETS = re.compile(rb'"(?:[^"\\]|\\.)*"|[\[\]{}]')
@@ -105,6 +106,7 @@ class ControlChannel:
             "svr_config": self._svr_config,
             "svr_inject": self._svr_inject,
             "svr_clear_faults": self._svr_clear_faults,
+            "set_input": self._set_input,
             "vision_job": self._vision_job,
             "vision_remove": self._vision_remove,
             "vision": self._vision,
@@ -327,6 +329,16 @@ class ControlChannel:
                 robot.svr.write_permission = _bool_field(request, "write_permission", True)
         return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
                 "write_permission": robot.svr.write_permission}
+
+    def _set_input(self, robot, request):
+        """An input of the robot changes as a wired sensor would change it (RobotDataSource.set_input checks the
+        item and the value and names either when it is refused)."""
+        source = _svr(robot)
+        name = _text_field(request, "name")
+        if "value" not in request:
+            raise RequestError(f"'value' missing: the new value of {name} (0 or 1; volts in -10..10 if analog)")
+        with self.server.lock:
+            source.set_input(name, request["value"])
 
     def _svr_inject(self, robot, request):
         _svr(robot)

@@ -6,6 +6,7 @@ override writes it (mode 2, multiples of 5 in 5..100) is in test_ethernet_slave.
 import pytest
 
 from sim_harness import Harness
+from tmsim.server import SimServer
 from test_ethernet_slave import ask, values
 
 
@@ -55,3 +56,32 @@ def test_an_output_written_by_the_ethernet_slave_reads_back_in_the_data_table_it
     peer = h.connect_svr()
     assert ask(h, peer, "W1,2,End_DO0=1") == ("TMSVR", b"W1,0,00,OK")
     assert values(h, peer, ["End_DO0"]) == {"End_DO0": 1}
+
+
+def test_the_control_channel_sets_an_input_and_names_what_it_refuses():
+    """`set_input` on the control channel (docs/simulator.md, Control channel) is RobotDataSource.set_input: the
+    next read shows the value; a wrong item, a wrong value or a missing field is answered ok: false by name."""
+    from tmsim.control import request
+    srv = SimServer(port=0, control_port=0, svr_port=0)
+    srv.start_background()
+    try:
+        port = srv.control.port
+        assert request(port, {"cmd": "set_input", "name": "End_DI0", "value": 1}) == {"ok": True, "result": None}
+        assert request(port, {"cmd": "set_input", "name": "Ctrl_AI0", "value": 2.5})["ok"]
+        assert request(port, {"cmd": "set_input", "name": "Ctrl_DI3", "value": True})["ok"]
+        io = srv.robots[0].session.robot.io
+        assert (io["EndModule.DI[0]"], io["ControlBox.AI[0]"], io["ControlBox.DI[3]"]) == (1, 2.5, 1)
+        assert "not an input" in request(port, {"cmd": "set_input", "name": "End_DO0", "value": 1})["error"]
+        assert "0 or 1" in request(port, {"cmd": "set_input", "name": "End_DI0", "value": 2})["error"]
+        assert "'value' missing" in request(port, {"cmd": "set_input", "name": "End_DI0"})["error"]
+        assert "'name' must be a text" in request(port, {"cmd": "set_input", "value": 1})["error"]
+        assert io["EndModule.DI[0]"] == 1
+    finally:
+        srv.close()
+    plain = SimServer(port=0, control_port=0)
+    plain.start_background()
+    try:
+        assert "not running" in request(plain.control.port, {"cmd": "set_input", "name": "End_DI0",
+                                                             "value": 1})["error"]
+    finally:
+        plain.close()

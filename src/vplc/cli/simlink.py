@@ -56,6 +56,8 @@ COMMANDS = {
                                     "write_permission": "bool"}, needs_one_key=True),
     "svr_inject": Command({}, positional="fault", choices=tuple(SVR_FAULTS), keys={}, into_params=True),
     "svr_clear_faults": Command({}),
+    # an input of the robot as a wired sensor changes it: End_DI0..3, Ctrl_DI0..15 (0/1), *_AI* (volts)
+    "set_input": Command({}, keys={"name": "text", "value": "number"}, needs_one_key=True),
     # the robot's camera: a vision job of its project and what it finds (docs/simulator.md, Virtual camera)
     "vision_job": Command({}, positional="job", keys={"objects": "poses", "pass": "bool", "seconds": "number",
                                                       "capture": "pose", "variable": "text"}),
