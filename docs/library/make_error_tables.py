@@ -8,7 +8,7 @@ remedy (for the engineer: the FB pages and errors.md), operator (what the operat
 screens and buttons, never a function block) and hmi ("alarm": the HMI server raises an alarm when a command
 ends with it, unless a cause it already shows explains it; "message": a refused start, nothing happened, the
 page's message line says it). Generated from it:
-  lib/CBT_Commands_Lib/core/CBT_ErrorText.st   the ST text function (decimal CASE labels, IEC 61131-3 Ed. 2
+  lib/CBT_Commands_Lib/core/CBTi_ErrorText.st   the ST text function (decimal CASE labels, IEC 61131-3 Ed. 2
                                                has no based-number CASE labels; the hex ID in a comment)
   docs/library/errors.md                       the table between the BEGIN / END markers
   docs/library/CBT_*.md                        the "## ErrorIDs" section of every FB page; which IDs an FB
@@ -27,7 +27,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 TABLE = HERE / "errors.tsv"
-ST_FILE = ROOT / "lib" / "CBT_Commands_Lib" / "core" / "CBT_ErrorText.st"
+ST_FILE = ROOT / "lib" / "CBT_Commands_Lib" / "core" / "CBTi_ErrorText.st"
 HMI_FILE = ROOT / "hmi" / "errors.json"
 COLUMNS = ["id", "raised_by", "text", "cause", "remedy", "operator", "hmi"]
 HMI_KINDS = ("alarm", "message")
@@ -90,13 +90,13 @@ def st_function(rows: dict) -> str:
     out = ["(* The library's ErrorID texts (ErrorDescrip), generated from docs/library/errors.tsv by",
            "   docs/library/make_error_tables.py: edit the table, not this file. 16#1xxx parameter, 16#2xxx",
            "   connection, 16#3xxx protocol, 16#4xxx robot; docs/library/errors.md gives cause and remedy. *)",
-           "FUNCTION CBT_ErrorText : STRING[80]",
+           "FUNCTION CBTi_ErrorText : STRING[80]",
            "VAR_INPUT", "    ErrorID : WORD;", "END_VAR",
            "CASE WORD_TO_UINT(ErrorID) OF",
-           "0: CBT_ErrorText := '';"]
-    out += [f"{int(code[3:], 16)}: (* {code} *) CBT_ErrorText := {st_string(row['text'])};"
+           "0: CBTi_ErrorText := '';"]
+    out += [f"{int(code[3:], 16)}: (* {code} *) CBTi_ErrorText := {st_string(row['text'])};"
             for code, row in rows.items()]
-    out += ["ELSE", "    CBT_ErrorText := CONCAT('Unknown ErrorID 16#', WORD_TO_STRING(ErrorID));",
+    out += ["ELSE", "    CBTi_ErrorText := CONCAT('Unknown ErrorID 16#', WORD_TO_STRING(ErrorID));",
             "END_CASE;", "END_FUNCTION"]
     return "\n".join(out) + "\n"
 

@@ -75,9 +75,9 @@ VAR
     I : UINT;
 END_VAR
 FOR I := 1 TO {n} DO
-    Texts[I] := CBT_ErrorText(Ids[I]);
+    Texts[I] := CBTi_ErrorText(Ids[I]);
 END_FOR;
-Unknown := CBT_ErrorText(WORD#16#4FFF);
+Unknown := CBTi_ErrorText(WORD#16#4FFF);
 END_PROGRAM
 """, encoding="utf-8")
     with load_plc([str(LIB), str(tmp_path / "Texts.st")], task="Main@1ms") as plc:

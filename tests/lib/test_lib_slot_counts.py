@@ -1,4 +1,4 @@
-"""The connection's request counts (stCBT_Connection.Queued, Waiting and QueueDepth) are kept by CBT_SetSlot at every
+"""The connection's request counts (stCBT_Connection.Queued, Waiting and QueueDepth) are kept by CBTi_SetSlot at every
 slot change instead of being recounted each scan; they must equal a recount of the 16 slots in every state the
 table goes through: filled, sent, waiting for tags, replaced by a new edge (R5), aborted by a stop, timed out,
 ended by a link loss and by a reconnect."""
@@ -42,7 +42,7 @@ def test_counts_equal_a_recount_through_fill_tags_retrigger_timeout_loss_and_rec
         assert_counts_match(r, "blended motion sent into the black hole")
         r.until(lambda: r.read("mv[17].Error"), 10)
         assert_counts_match(r, "reply timeout")
-        r.write("ConnExec", False)                   # close: everything pending ends (CBT_FailAll)
+        r.write("ConnExec", False)                   # close: everything pending ends (CBTi_FailAll)
         r.scans(3)
         assert assert_counts_match(r, "closed") == 0
         r.robot.clear_faults()

@@ -5,11 +5,11 @@ IEC 61131-3 2nd edition calls a function only inside an expression; a call state
 
 Passing (portable)::
 
-    Ended := CBT_EndSlot(CBT := CBT, S := I, State := SlotFailed, ErrorID := Err);
+    Ended := CBTi_EndSlot(CBT := CBT, S := I, State := SlotFailed, ErrorID := Err);
 
 Failing (portable)::
 
-    CBT_EndSlot(CBT := CBT, S := I, State := SlotFailed, ErrorID := Err);     (* ST2007 *)
+    CBTi_EndSlot(CBT := CBT, S := I, State := SlotFailed, ErrorID := Err);     (* ST2007 *)
 """
 from __future__ import annotations
 

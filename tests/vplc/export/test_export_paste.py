@@ -17,7 +17,7 @@ STOP_VARIABLES = [
     ["ErrorID", "WORD", "", "", "False", "False", ""],
     ["ErrorDescrip", "STRING[80]", "", "", "False", "False", ""],
     ["CmdID_Ack", "UINT", "", "", "False", "False", ""],
-    ["Core", "CBT_CommandCore", "", "", "False", "False", ""],
+    ["Core", "CBTi_CommandCore", "", "", "False", "False", ""],
     ["P", "stCBT_StopParam", "", "", "False", "False", ""],
     ["Err", "WORD", "", "", "False", "False", ""],
     ["Script", "STRING[256]", "", "", "False", "False", ""],
@@ -78,7 +78,7 @@ def test_order_lists_types_then_pous_each_after_what_it_uses(lib_paste, lib_proj
     assert [int(r[0]) for r in rows] == list(range(1, len(rows) + 1))
     assert all(r[3] == r[2] + "/" and (lib_paste / r[2]).is_dir() for r in rows)
     returns = {r[2]: " ".join(r[4:]) for r in rows}
-    assert returns["CBT_HexDigit"] == "BYTE" and returns["CBT_Stop"] == ""
+    assert returns["CBTi_HexDigit"] == "BYTE" and returns["CBT_Stop"] == ""
     pos = {r[2].upper(): i for i, r in enumerate(rows)}
     for unit in lib_project.units:
         if getattr(unit, "in_prelude", False):
