@@ -10,7 +10,7 @@
 3. Read round trip: GET /api/read of the PnP page's variables, one after the other, against the HMI tests'
    stand-in PLC (the HTTP server's own cost, not the ST program's).
 5. --compare-with DIR: the read round trip (3) and the Execute round trip (1) of this server against an older copy
-   of src/vplc/hmi in DIR (git archive <commit> src/vplc/hmi | tar -x -C /tmp/old; DIR=/tmp/old/src/vplc/hmi),
+   of src/cbt_hmi/web in DIR (git archive <commit> src/cbt_hmi/web | tar -x -C /tmp/old; DIR=/tmp/old/src/cbt_hmi/web),
    both in this process on the same PLC, in alternating blocks; prints the ratio new/old per block.
 4. Under 70 slow clients: the same read, the Stop page and a Stop press while 70 connections send their request
    header one byte every 5 s and open a new connection whenever the server answers 408 (issue 23, item 6).
@@ -29,8 +29,8 @@ import time
 import urllib.request
 
 from tmsim.server import SimServer
-from vplc.hmi.mapping import Mapping
-from vplc.hmi.server import HmiServer
+from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.server import HmiServer
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 

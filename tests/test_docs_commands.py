@@ -9,7 +9,7 @@ BARE = re.compile(r"(^|[^A-Za-z0-9_./-])python (-m |sim/|examples/|bench/|docs/)
 
 def test_no_user_facing_command_uses_bare_python():
     places = [ROOT / "README.md", *ROOT.glob("docs/**/*.md")]
-    for folder in ("src", "sim", "examples", "bench", "docs", "hmi"):
+    for folder in ("src", "sim", "examples", "bench", "docs"):
         places += [p for p in (ROOT / folder).rglob("*") if p.suffix in (".py", ".st", ".md", ".scn", ".js", ".html")]
     offenders = [f"{p.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}"
                  for p in set(places) for text in [p.read_text(encoding="utf-8", errors="replace")]

@@ -14,7 +14,7 @@ page's message line says it). Generated from it:
   docs/library/CBT_*.md                        the "## ErrorIDs" section of every FB page; which IDs an FB
                                                raises is read from its page (ranges such as 16#3011..16#3015
                                                are expanded)
-  hmi/errors.json                              text, cause, remedy, operator remedy and alarm/message for
+  src/cbt_hmi/pages/errors.json                              text, cause, remedy, operator remedy and alarm/message for
                                                the HMI (pages and the server's alarm system)
 """
 from __future__ import annotations
@@ -28,7 +28,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 TABLE = HERE / "errors.tsv"
 ST_FILE = ROOT / "lib" / "CBT_Commands_Lib" / "core" / "CBTi_ErrorText.st"
-HMI_FILE = ROOT / "hmi" / "errors.json"
+HMI_FILE = ROOT / "src" / "cbt_hmi" / "pages" / "errors.json"
 COLUMNS = ["id", "raised_by", "text", "cause", "remedy", "operator", "hmi"]
 HMI_KINDS = ("alarm", "message")
 FB_NAME = re.compile(r"\bCBT_\w+|\b(?:MoveAbsolute|MoveRelative|MoveCircle|ProgramControl|ProjectControl)\b")

@@ -10,7 +10,7 @@ document a unit). tests/lib/test_lib_ranges.py runs every row against the librar
 the table cannot drift from what the FBs check.
 Written:
   docs/library/types.md    member, type, range, unit and description of every structure; values of every enum
-  hmi/ranges.json          the same ranges per parameter and condition, for the HMI's limits and hints
+  src/cbt_hmi/pages/ranges.json          the same ranges per parameter and condition, for the HMI's limits and hints
 """
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ ROOT = HERE.parents[1]
 TYPES_DIR = ROOT / "lib" / "CBT_Commands_Lib" / "types"
 TABLE = HERE / "ranges.tsv"
 DOC_FILE = HERE / "types.md"
-HMI_FILE = ROOT / "hmi" / "ranges.json"
+HMI_FILE = ROOT / "src" / "cbt_hmi" / "pages" / "ranges.json"
 COLUMNS = ["struct", "member", "when", "min", "max", "unit", "error"]
 
 _COMMENT = re.compile(r"\(\*(.*?)\*\)", re.S)

@@ -20,8 +20,8 @@ import threading
 
 from tmsim.control import robot_numbering
 from tmsim.server import SimServer
-from vplc.hmi.mapping import Mapping, MappingError
-from vplc.hmi.server import HmiServer
+from cbt_hmi.web.mapping import Mapping, MappingError
+from cbt_hmi.web.server import HmiServer
 
 LIBRARY, EXAMPLES = pathlib.Path("lib", "CBT_Commands_Lib"), pathlib.Path("examples")
 CONTROL_HOST = "127.0.0.1"     # the simulator's control channel stays on loopback whatever --host says

@@ -9,7 +9,7 @@ import pytest
 
 from tmsim.server import SimServer
 from vplc.api import load_plc
-from vplc.hmi.mapping import Mapping
+from cbt_hmi.web.mapping import Mapping
 from vplc.project import load_project
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -7,7 +7,7 @@ from selenium.common.exceptions import WebDriverException
 from browser import Browser
 from fake_plc import FakePlc, command_program, scanning, serving
 from hmi_http import Client
-from vplc.hmi.mapping import Mapping
+from cbt_hmi.web.mapping import Mapping
 
 
 @pytest.fixture

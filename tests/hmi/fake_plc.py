@@ -9,7 +9,7 @@ import contextlib
 import re
 import threading
 
-from vplc.hmi.mapping import INT_RANGES, Mapping
+from cbt_hmi.web.mapping import INT_RANGES, Mapping
 
 _STEP = re.compile(r"\.?([A-Za-z_]\w*)|\[(\d+)\]")
 
@@ -139,7 +139,7 @@ def scanning(plc: FakePlc, period_s: float = 0.001):
 @contextlib.contextmanager
 def serving(plc, mapping):
     """An HMI server for ``plc`` on an ephemeral loopback port while the block runs."""
-    from vplc.hmi.server import HmiServer
+    from cbt_hmi.web.server import HmiServer
     server = HmiServer(plc, mapping, port=0)
     server.start()
     try:

@@ -13,8 +13,8 @@ from browser import Browser
 from fake_plc import FakePlc, command_program
 from selenium.webdriver.common.by import By
 
-from vplc.hmi.mapping import Mapping
-from vplc.hmi.server import HmiServer
+from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.server import HmiServer
 
 CONTROLLER_START = time.mktime((2031, 7, 4, 21, 15, 30, 0, 0, -1))   # the controller's clock: not the browser's
 

@@ -11,8 +11,8 @@ import pytest
 from fake_plc import FakePlc, command_program
 from hmi_http import Client
 
-from vplc.hmi import alarms as alarm_module
-from vplc.hmi.alarms import HISTORY, ON_DELAY_S, AlarmSystem
+from cbt_hmi.web import alarms as alarm_module
+from cbt_hmi.web.alarms import HISTORY, ON_DELAY_S, AlarmSystem
 
 START = 1_900_000_000.0          # 2030-03-17, whatever the test machine's clock says
 

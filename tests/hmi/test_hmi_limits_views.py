@@ -12,7 +12,7 @@ from selenium.webdriver.support.ui import Select
 
 from browser import ROOT, Browser
 from fake_plc import FakePlc, command_program, scanning, serving
-from vplc.hmi.mapping import Mapping
+from cbt_hmi.web.mapping import Mapping
 
 TCP = {"X": 400.0, "Y": 0.0, "Z": 400.0, "RX": 180.0, "RY": 0.0, "RZ": 90.0}
 
@@ -84,7 +84,7 @@ def test_a_value_refused_for_one_format_is_sent_for_another(page):
 def test_page_limits_are_the_library_range_table(page):
     """Inertia above 100000 kg·mm² is refused on the page as by CBT_ChangeTCP (the page used to take 1e9)."""
     plc, server, open_page = page
-    table = json.loads((ROOT / "hmi" / "ranges.json").read_text(encoding="utf-8"))
+    table = json.loads((ROOT / "src" / "cbt_hmi" / "pages" / "ranges.json").read_text(encoding="utf-8"))
     leaves = server.mapping.leaves
     assert (leaves["ChangeTCP_Param.MomentOfInertia.Ixx"].min, leaves["ChangeTCP_Param.MomentOfInertia.Ixx"].max) == \
         (table["stCBT_TCParam"]["MomentOfInertia"][0]["min"], table["stCBT_TCParam"]["MomentOfInertia"][0]["max"])

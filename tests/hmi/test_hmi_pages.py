@@ -8,8 +8,8 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
 from fake_plc import FakePlc, command_program
-from vplc.hmi.mapping import Mapping
-from vplc.hmi.server import HmiServer
+from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.server import HmiServer
 
 PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "setoutput", "stop", "pnp"]
 

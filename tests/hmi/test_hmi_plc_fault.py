@@ -13,8 +13,8 @@ import pytest
 from fake_plc import FakePlc, command_program, scanning, serving
 from hmi_http import Client
 from vplc.api import PlcFault, load_plc
-from vplc.hmi.mapping import Mapping
-from vplc.hmi.server import HmiServer
+from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.server import HmiServer
 
 FAULT = "examples/PnP_Example.st:57: major fault in PnP_Example: integer division by zero (100 / 0)"
 

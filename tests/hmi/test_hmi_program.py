@@ -15,8 +15,8 @@ from hmi_http import Client
 from panel_metrics import check_controls
 from tmsim.server import SimServer
 from vplc.api import load_plc
-from vplc.hmi.mapping import Mapping
-from vplc.hmi.server import HmiServer
+from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.server import HmiServer
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]

@@ -3,7 +3,7 @@ table does not feed at all (CBT_SetOverride, issue 26, while the HMI has no over
 it feeds, and every structure, must have each ranged member, so a misspelt name stays an error."""
 import pytest
 
-from vplc.hmi.ranges import RangeTableError, apply_ranges
+from cbt_hmi.web.ranges import RangeTableError, apply_ranges
 
 ROW = [{"when": {}, "unit": "%", "error": "16#1040", "min": 5, "max": 100}]
 

@@ -16,9 +16,9 @@ from browser import ROOT
 from fake_plc import FakePlc, command_program, scanning, serving
 from panel_metrics import check_controls
 from tmsim import kinematics
-from vplc.hmi.mapping import Mapping
+from cbt_hmi.web.mapping import Mapping
 
-ARM = json.loads((ROOT / "hmi" / "tm5_700.json").read_text(encoding="utf-8"))
+ARM = json.loads((ROOT / "src" / "cbt_hmi" / "pages" / "tm5_700.json").read_text(encoding="utf-8"))
 TCP = [400.0, 0.0, 400.0, 180.0, 0.0, 90.0]
 JOINTS = kinematics.inverse_kinematics(kinematics.pose_to_matrix(TCP))
 SIZES = [(800, 480), (1280, 800)]

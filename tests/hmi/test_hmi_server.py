@@ -7,8 +7,8 @@ import pytest
 
 from fake_plc import FakePlc
 from hmi_http import Client
-from vplc.hmi.mapping import Mapping, MappingError
-from vplc.hmi.server import MAX_BODY, HmiServer
+from cbt_hmi.web.mapping import Mapping, MappingError
+from cbt_hmi.web.server import MAX_BODY, HmiServer
 
 
 def test_main_page_and_script_are_served_with_text_types(client):
@@ -26,7 +26,7 @@ def test_every_listed_page_is_served_from_the_one_page_shell(client, page):
     assert status == 200 and body == shell and headers["Content-Type"].startswith("text/html")
 
 
-@pytest.mark.parametrize("path", ["/nothing.html", "/../src/vplc/hmi/server.py", "/%2e%2e/Makefile"])
+@pytest.mark.parametrize("path", ["/nothing.html", "/../web/server.py", "/%2e%2e/Makefile"])
 def test_unknown_or_escaping_paths_are_not_found(client, path):
     status, answer = client.json(path)
     assert status == 404 and answer["ok"] is False and "no such page" in answer["error"]
@@ -223,7 +223,7 @@ def test_date_and_time_is_shown_as_an_iec_literal(client, fake_plc):
 
 @pytest.mark.parametrize("gone", [BrokenPipeError(32, "Broken pipe"), ConnectionResetError(104, "reset")])
 def test_a_client_leaving_mid_request_is_one_debug_line_not_a_traceback(server, capsys, caplog, gone):
-    caplog.set_level("DEBUG", logger="vplc")
+    caplog.set_level("DEBUG", logger="cbt_hmi")
     try:
         raise gone
     except OSError:

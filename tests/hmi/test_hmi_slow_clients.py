@@ -17,9 +17,9 @@ import pytest
 
 from fake_plc import FakePlc, command_program, scanning
 from hmi_http import Client
-from vplc.hmi.front import MAX_HEAD, HttpLimits
-from vplc.hmi.mapping import Mapping
-from vplc.hmi.server import HmiServer
+from cbt_hmi.web.front import MAX_HEAD, HttpLimits
+from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.server import HmiServer
 
 SHORT = HttpLimits(header_s=0.4, body_s=0.4, idle_s=0.4, send_s=2.0)
 GAP_S = 0.05                      # an attacker sends its next byte after this (the review: 5 s; deadlines 5 s)

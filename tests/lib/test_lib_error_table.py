@@ -57,7 +57,7 @@ def test_every_id_of_the_table_is_raised_somewhere_in_the_library():
 
 
 def test_hmi_texts_are_the_table():
-    hmi = json.loads((ROOT / "hmi" / "errors.json").read_text(encoding="utf-8"))
+    hmi = json.loads((ROOT / "src" / "cbt_hmi" / "pages" / "errors.json").read_text(encoding="utf-8"))
     rows = tables.load()
     assert list(hmi) == list(rows)
     assert all(hmi[c]["text"] == rows[c]["text"] and hmi[c]["remedy"] == rows[c]["remedy"] for c in rows)

@@ -17,10 +17,10 @@ import pytest
 
 from tests.hmi.fake_plc import FakePlc, command_program, scanning, serving
 from tests.hmi.hmi_http import Client
-from vplc.hmi import front
-from vplc.hmi import server as hmi_server
-from vplc.hmi.mapping import Mapping
-from vplc.hmi.server import HmiServer  # noqa: E402
+from cbt_hmi.web import front
+from cbt_hmi.web import server as hmi_server
+from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.server import HmiServer  # noqa: E402
 
 MOVE = {"execute": "MoveAbs_Execute", "values": {"MoveAbs_Param.TargetPosition.Z": 300.0}}
 

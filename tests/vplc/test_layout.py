@@ -16,7 +16,6 @@ ALLOWED = {
     "export": {"project", "ladder", "frontend"},
     "api": {"compiler", "runtime", "project", "frontend"},
     "cli": {"api", "export", "trace", "compiler", "runtime", "project", "ladder", "checker", "frontend"},
-    "hmi": {"api", "export", "trace", "compiler", "runtime", "project", "ladder", "checker", "frontend"},
 }
 
 

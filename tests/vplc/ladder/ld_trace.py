@@ -8,7 +8,7 @@ import pathlib
 from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
-MAPPING = json.loads((ROOT / "hmi" / "mapping.json").read_text(encoding="utf-8"))
+MAPPING = json.loads((ROOT / "src" / "cbt_hmi" / "pages" / "mapping.json").read_text(encoding="utf-8"))
 EXECUTES = sorted(n for n in MAPPING["variables"] if n.endswith("_Execute") and n != "Connect_Execute")
 WATCHED = sorted(MAPPING["variables"])
 

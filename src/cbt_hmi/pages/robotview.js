@@ -19,7 +19,7 @@ const AXIS_COLORS = ["#d0312d", "#2e9b4f", "#1a5fb4"];          // X red, Y gree
 const ZOOMS = [0.5, 1, 2, 4];                                   // 1: ±1000 mm across the narrower side
 const RED = "#c0241a", VIOLET = "#6a2fa8";
 
-/* ---- the TM5-700's kinematics, from the one data file hmi/tm5_700.json (checked against the simulator's
+/* ---- the TM5-700's kinematics, from the one data file src/cbt_hmi/pages/tm5_700.json (checked against the simulator's
    src/tmsim/kinematics.py by tests/hmi/test_hmi_robot_model.py). Matrices are 4x4 row lists. ---- */
 const ARM = { data: null };
 const armReady = fetch("tm5_700.json").then((r) => r.json()).then((d) => { ARM.data = d; })

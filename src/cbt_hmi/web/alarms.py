@@ -21,7 +21,7 @@ turns what it reads into alarms:
 * a history of HISTORY entries, appended to a JSON-lines file by a writer thread of its own (neither a scan nor
   a request ever waits for the disk) and read back at start-up, so it survives a browser and a server restart.
 
-Texts: the ErrorIDs' operator remedies come from hmi/errors.json (generated from docs/library/errors.tsv); the
+Texts: the ErrorIDs' operator remedies come from cbt_hmi/pages/errors.json (generated from docs/library/errors.tsv); the
 causes without an ErrorID (PLC, E-stop) have theirs in CAUSES below.
 """
 from __future__ import annotations
@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 
 from .mapping import HMI_DIR
 
-log = logging.getLogger("vplc.hmi")
+log = logging.getLogger("cbt_hmi.web")
 
 PERIOD_S = 0.1          # sampling period of the alarm thread
 ON_DELAY_S = 0.5        # a consequence waits this long for its cause before it is raised on its own
@@ -444,5 +444,5 @@ def _load_errors() -> dict:
     try:
         return json.loads((HMI_DIR / "errors.json").read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError) as exc:
-        log.warning("hmi/errors.json not read (%s): alarms without operator remedies", exc)
+        log.warning("cbt_hmi/pages/errors.json not read (%s): alarms without operator remedies", exc)
         return {}

@@ -1,5 +1,5 @@
 /* CBT HMI – alarms, the Robot tile and FB results.
-   The alarm list belongs to the server (src/vplc/hmi/alarms.py, ISA-18.2): one alarm per cause with its
+   The alarm list belongs to the server (src/cbt_hmi/web/alarms.py, ISA-18.2): one alarm per cause with its
    consequences as details, priority, states, timestamps of the controller's clock, acknowledge shared by every
    panel, a history of 1000 entries. The pages only show it: every /api/read answer carries the alarm list's
    change count, and the page asks /api/alarms when it changed.

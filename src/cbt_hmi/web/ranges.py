@@ -1,4 +1,4 @@
-"""Parameter ranges of the HMI taken from the library's one range table (hmi/ranges.json, generated from
+"""Parameter ranges of the HMI taken from the library's one range table (cbt_hmi/pages/ranges.json, generated from
 docs/library/ranges.tsv by docs/library/make_types.py), never typed into the variable table a second time.
 
 For every structure member (or FB input) in the table, the variable table's spec gets (an FB of which the
@@ -17,7 +17,7 @@ import pathlib
 
 
 class RangeTableError(ValueError):
-    """hmi/ranges.json is unreadable or names something the variable table does not have."""
+    """cbt_hmi/pages/ranges.json is unreadable or names something the variable table does not have."""
 
 
 def read_json(path: pathlib.Path, what: str, error: type[Exception]):

@@ -1,5 +1,5 @@
 /* CBT HMI: one script for every page. A page is described in PAGES; forms are built from the PLC-HMI
-   variable table served at /api/mapping, so ranges and enumerations live in one place (hmi/mapping.json).
+   variable table served at /api/mapping, so ranges and enumerations live in one place (src/cbt_hmi/pages/mapping.json).
    The server checks every write again; the checks here only spare the operator a round trip. */
 "use strict";
 

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from http import HTTPStatus
 
-from ..ladder.svg import svg_document
+from vplc.ladder.svg import svg_document
 from .mapping import format_dt
-from ..runtime.values import PathError
+from vplc.runtime.values import PathError
 
 
 class ProgramError(Exception):

@@ -1,7 +1,7 @@
-"""Web HMI server: serves hmi/ and a JSON API over the PLC-HMI variable table (hmi/mapping.json).
+"""Web HMI server: serves cbt_hmi/pages/ and a JSON API over the PLC-HMI variable table (pages/mapping.json).
 
 The browser is not trusted. Every request must address this server (Host); every write must come from the
-HMI's own pages, as JSON, with an access key whose role may change that variable (vplc.hmi.access). Every
+HMI's own pages, as JSON, with an access key whose role may change that variable (cbt_hmi.web.access). Every
 write names a variable of the mapping file, is checked against its type and range here again, and reaches the
 PLC only through Contract A (plc.write under plc.lock), all values or none. Reads are limited to mapped
 variables too.
@@ -11,9 +11,9 @@ API (all answers are JSON objects with "ok"):
   GET  /api/session                         {"ok", "role"}: the role the request's X-HMI-Key grants
   GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "clock", "plc": "run"|"fault", ["fault",] "alarms",
                                             "robot", "values": {...}}: "alarms" changes with the alarm list
-  GET  /api/alarms[?history=N]              the alarm list and the newest N history entries (vplc.hmi.alarms)
+  GET  /api/alarms[?history=N]              the alarm list and the newest N history entries (cbt_hmi.web.alarms)
   POST /api/alarms/ack {"alarms": [n, ...]} | {"all": true}   acknowledge (operator or engineer)
-  GET  /api/program[/state?pou=NAME]        ladder drawings and their live power flow (vplc.hmi.program)
+  GET  /api/program[/state?pou=NAME]        ladder drawings and their live power flow (cbt_hmi.web.program)
   POST /api/write   {"values": {path: v}}   validate all, then write all in one scan gap
   POST /api/execute {"execute": "X_Execute", "values": {path: v}}
                                             validate, write the values and Execute := FALSE, wait for one
@@ -21,7 +21,7 @@ API (all answers are JSON objects with "ok"):
 
 One thread reads every request without blocking, each within its deadlines (header, body), answers complete
 reads itself and passes complete writes to a bounded pool of workers; connections are limited per client
-address and in all, and the longest-waiting one makes room for a new one (vplc.hmi.front), so slow or idle
+address and in all, and the longest-waiting one makes room for a new one (cbt_hmi.web.front), so slow or idle
 clients cannot lock the operator out. After a major fault of the PLC every answer says so (/api/read:
 "plc": "fault") and writes are refused.
 """
@@ -49,7 +49,7 @@ MAX_DIGITS = 40                    # digits of one number in a request body (a L
 MAX_NAMES = 400
 SCAN_WAIT_S = 1.0
 
-log = logging.getLogger("vplc.hmi")
+log = logging.getLogger("cbt_hmi.web")
 
 _POINT_NUMBER = re.compile(r"[0-9]{1,18}")       # /api/trail?since=N: ASCII digits, within an int64
 _HISTORY_COUNT = re.compile(r"[0-9]{1,6}")        # /api/alarms?history=N
@@ -381,7 +381,7 @@ class _Handler(BaseHTTPRequestHandler):
     do_HEAD = do_GET
 
     def _program(self, url) -> None:
-        """The Program page's ladder drawings and their live state (vplc.hmi.program)."""
+        """The Program page's ladder drawings and their live state (cbt_hmi.web.program)."""
         from .program import ProgramError, ProgramMonitor
         if self.hmi.program is None:
             self.hmi.program = ProgramMonitor(self.hmi.plc)

@@ -1,4 +1,4 @@
-/* CBT HMI: limits and hints that follow the selected data format. The ranges are the library's own (hmi/ranges.json,
+/* CBT HMI: limits and hints that follow the selected data format. The ranges are the library's own (src/cbt_hmi/pages/ranges.json,
    generated from docs/library/ranges.tsv; the server merges them into the variable table it serves), so a value
    the page accepts is one the FB accepts, and a data format the FB refuses for the motion command is refused
    here with the same ErrorID. */
@@ -77,7 +77,7 @@ function watchLimits(root, prefix) {
    The FB checks every pose member against one range (±100000, docs/library/ranges.tsv) whatever its unit; the
    page also knows the unit: an angle (RX, RY, RZ) beyond one turn, ±360°, is a typing slip (our choice: TMflow
    shows orientations within ±180°); in a joint format the six values are J1..J6, each within its joint range
-   from the arm data (hmi/tm5_700.json, ±2 × the range for joint offsets); millimetres are judged by the reach
+   from the arm data (src/cbt_hmi/pages/tm5_700.json, ±2 × the range for joint offsets); millimetres are judged by the reach
    check on the whole pose (robotview.js reachCheck). */
 const POSE_KEYS = ["X", "Y", "Z", "RX", "RY", "RZ"];
 const ANGLE_LIMIT = 360;

@@ -1,5 +1,5 @@
-"""The PLC-HMI variable table (hmi/mapping.json, limits from hmi/ranges.json) and the checks every value from
-the browser passes before it reaches the PLC: type, range, enumeration, text length, IPv4 pattern."""
+"""The PLC-HMI variable table (pages/mapping.json, limits from pages/ranges.json) and the checks every value from the
+browser passes before it reaches the PLC: type, range, enumeration, text length, IPv4 pattern."""
 from __future__ import annotations
 
 import datetime
@@ -11,7 +11,7 @@ from http import HTTPStatus
 
 from .ranges import RangeTableError, apply_ranges, load_ranges, read_json
 
-HMI_DIR = pathlib.Path(__file__).resolve().parents[3] / "hmi"
+HMI_DIR = pathlib.Path(__file__).resolve().parent.parent / "pages"
 DEFAULT_MAPPING = HMI_DIR / "mapping.json"
 DEFAULT_RANGES = HMI_DIR / "ranges.json"
 

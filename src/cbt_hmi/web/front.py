@@ -3,7 +3,7 @@
 One thread owns every socket and reads requests without blocking; a request is answered only when its header
 and its body have arrived whole, so a client that sends slowly or not at all holds no thread, only one of a
 bounded number of connections until its deadline (docs/hmi.md, "Serving every client"). What a request means
-is the handler's business (vplc.hmi.server); this module only moves bytes.
+is the handler's business (cbt_hmi.web.server); this module only moves bytes.
 """
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ LINGER_S = 1.0                     # after answering a request not read to its e
 WORKERS = 16                       # requests answered in worker threads at once (complete requests only)
 LISTEN_BACKLOG = 128
 
-log = logging.getLogger("vplc.hmi")
+log = logging.getLogger("cbt_hmi.web")
 
 
 @dataclass(frozen=True)

@@ -1,1 +1,0 @@
-"""HMI server: serves hmi/ and maps web fields to PLC variables."""
