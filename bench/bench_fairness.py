@@ -31,7 +31,7 @@ import sys
 import tempfile
 import time
 
-from tmsim import codec
+from tmsim.protocol import codec
 
 TCP_HOME = (417.5, -122.3, 359.7)              # the TM5-700's TCP at the simulator's home joints
 

@@ -28,7 +28,7 @@ import threading
 import time
 import urllib.request
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer
 

@@ -118,7 +118,7 @@ class ExamplesRig:
     Ethernet Slave, on virtual time (the cost() interface of Rig: .plc and .pump)."""
 
     def __init__(self):
-        from tmsim.server import SimServer
+        from tmsim.net.server import SimServer
         from vplc.api import load_plc
         self.sim = SimServer(host="127.0.0.1", port=0, robots=1, svr_port=0)
         self.sim.start()

@@ -167,7 +167,7 @@ def scenario_cost(when_lines: int = 100, scans: int = 4000) -> None:
     its batch against the simulator in this process (polled between scans, not timed) on virtual time, driven by
     its commissioning scenario's reactions plus ``when_lines`` more (each on one of ten cell signals, `every
     time`); the scenario's work before and after each scan is timed apart from the scan."""
-    from tmsim.server import SimServer
+    from tmsim.net.server import SimServer
     from vplc.cli import scenario as scn
     from vplc.cli.scenario_run import Runner
     cell = os.path.join(ROOT, "examples", "cell")

@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 from vplc.runtime.stats import percentile
 

@@ -18,9 +18,9 @@ import subprocess
 import sys
 import time
 
-from tmsim import codec
-from tmsim.server import SimServer
-from tmsim.svr_session import DEFAULT_STREAM
+from tmsim.protocol import codec
+from tmsim.net.server import SimServer
+from tmsim.protocol.svr_session import DEFAULT_STREAM
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

@@ -18,8 +18,8 @@ import socket
 import sys
 import threading
 
-from tmsim.control import robot_numbering
-from tmsim.server import SimServer
+from tmsim.net.control import robot_numbering
+from tmsim.net.server import SimServer
 from cbt_hmi.web.mapping import Mapping, MappingError
 from cbt_hmi.web.server import HmiServer
 

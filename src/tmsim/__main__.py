@@ -1,4 +1,4 @@
 """`python3 -m tmsim`: the simulator's command line (the same as the console script `tmflow-sim`)."""
-from .cli import main
+from tmsim.cli import main
 
 raise SystemExit(main())

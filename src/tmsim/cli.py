@@ -24,12 +24,12 @@ import socket
 import sys
 import threading
 
-from tmsim.camera import Camera, camera_of, parse_option
-from tmsim.control import robot_numbering
-from tmsim.profiles import STOP_TAGS, VERSIONS, Profile
-from tmsim.server import SimServer
-from tmsim.svr_session import DEFAULT_STREAM
-from tmsim.svr_table import ITEMS, SvrValueError, parse_variable
+from tmsim.robot.camera import Camera, camera_of, parse_option
+from tmsim.net.control import robot_numbering
+from tmsim.tmscript.profiles import STOP_TAGS, VERSIONS, Profile
+from tmsim.net.server import SimServer
+from tmsim.protocol.svr_session import DEFAULT_STREAM
+from tmsim.protocol.svr_table import ITEMS, SvrValueError, parse_variable
 
 SVR_FORMATS = {"binary": 1, "string": 2, "json": 3}
 

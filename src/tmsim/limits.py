@@ -29,7 +29,7 @@ DEPTH_MAX = 100                             # nesting of one expression (operand
 STEPS_MAX = 20_000                          # work of one script: statements + expression nodes + array
                                             # elements copied / 8 + string characters built or sent / 256
 
-# ---- work of one turn of the scheduler (sim/work.py): a unit is 1-5 us of the simulator's time (project VM) ---
+# ---- work of one turn of the scheduler (tmsim/tmscript/work.py): a unit is 1-5 us of the simulator's time (project VM) ---
 TURN_WORK = 500                             # units one turn of one robot may do; then its work goes on later
 WORK_CHAR = 1                               # a character of a script line parsed and checked ...
 WORK_LINE = 4                               # ... plus this per line

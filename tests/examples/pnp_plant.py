@@ -6,7 +6,7 @@ import pathlib
 
 import pytest
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -12,7 +12,7 @@ import sys
 
 import pytest
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "cell"

@@ -7,7 +7,7 @@ import pathlib
 
 import pytest
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 from cbt_hmi.web.mapping import Mapping
 from vplc.project import load_project

@@ -16,9 +16,9 @@ import pathlib
 
 import pytest
 
-from tmsim import kinematics as kin
-from tmsim.camera import camera_of
-from tmsim.server import SimServer
+from tmsim.robot import kinematics as kin
+from tmsim.robot.camera import camera_of
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -13,7 +13,7 @@ import pytest
 from selenium.webdriver.common.by import By
 
 from browser import Browser
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer

@@ -13,7 +13,7 @@ from selenium.webdriver.support.ui import Select
 from browser import chromium_paths
 from hmi_http import Client
 from panel_metrics import check_controls
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer

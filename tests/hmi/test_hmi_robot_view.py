@@ -1,5 +1,5 @@
 """The robot view and the reach check in headless Chromium at 800x480 and 1280x800 against a fake PLC: the TM5-700
-arm data the browser uses is the simulator's (tm5_700.json against src/tmsim/kinematics.py), the arm is drawn from
+arm data the browser uses is the simulator's (tm5_700.json against src/tmsim/robot/kinematics.py), the arm is drawn from
 the joint angles read, a target the TM5-700 cannot reach is previewed in red and refused with its reason, angles and
 joints have their own limits, the scale is fixed (zoom buttons, labelled grid) and every page shows the same axes."""
 from __future__ import annotations
@@ -15,7 +15,7 @@ from selenium.webdriver.support.ui import Select
 from browser import ROOT
 from fake_plc import FakePlc, command_program, scanning, serving
 from panel_metrics import check_controls
-from tmsim import kinematics
+from tmsim.robot import kinematics
 from cbt_hmi.web.mapping import Mapping
 
 ARM = json.loads((ROOT / "src" / "cbt_hmi" / "pages" / "tm5_700.json").read_text(encoding="utf-8"))
@@ -25,7 +25,7 @@ SIZES = [(800, 480), (1280, 800)]
 
 
 def test_arm_data_is_the_simulators_kinematics():
-    """One fact, one home: the browser's link lengths and joint ranges are those src/tmsim/kinematics.py uses."""
+    """One fact, one home: the browser's link lengths and joint ranges are those src/tmsim/robot/kinematics.py uses."""
     joints = ARM["joints"]
     assert [j["alpha"] for j in joints] == list(kinematics.ALPHA)
     assert [j["a"] for j in joints] == list(kinematics.A)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
 ROOT = Path(__file__).resolve().parents[2]

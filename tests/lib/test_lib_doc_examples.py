@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 
 from rig import LIB, ROOT, SEC
-from tmsim.camera import camera_of
-from tmsim.server import SimServer
-from tmsim.svr_table import parse_variable
+from tmsim.robot.camera import camera_of
+from tmsim.net.server import SimServer
+from tmsim.protocol.svr_table import parse_variable
 from vplc.api import load_plc
 
 DOCS = ROOT / "docs" / "library"

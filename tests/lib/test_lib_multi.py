@@ -1,5 +1,5 @@
 """32 robots from one program, each with its own stCBT_Connection, independent of each other."""
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
 from rig import LIB, SEC, ST

@@ -4,7 +4,7 @@ checksums, and a stop in the middle. Every mover ends exactly once; Done never b
 import pytest
 
 from rig import LIB, SEC, ST
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
 PUSH = "$TMSTA,10,01,"          # a tag push (and a TMSTA 01 'true' answer): 01,NN,true
@@ -135,7 +135,7 @@ def test_a_stop_in_the_middle_aborts_exactly_the_motions_it_cleared(rig):
 def test_a_stop_the_library_did_not_send_ends_waiting_motions_with_4004_never_done(rig):
     """Another client clears the queue: the last four tags answer 'none' (not existed), and the older ones
     were reached or cleared - the library cannot tell which, so none of them reports Done."""
-    from tmsim import codec
+    from tmsim.protocol import codec
     import socket
     rig.plc.write("Main.Speed", 20)
     rig.start_all()

@@ -5,7 +5,7 @@ connection's RobotSoftware is TMflow1x, and a TMflow 1.8 robot would reject them
 import pytest
 
 from rig import Rig, move_abs
-from tmsim.profiles import Profile
+from tmsim.tmscript.profiles import Profile
 from test_lib_commands import circ, rel, run
 
 LINE = dict(MovementCommand=0, TargetPosition=dict(X=417.5, Y=-122.3, Z=300, RX=180, RY=0, RZ=90))

@@ -8,7 +8,7 @@ import math
 import pytest
 
 from rig import Rig
-from tmsim import svr_table as table
+from tmsim.protocol import svr_table as table
 
 SPECS = ['g_count:int=5', 'g_ratio:float=0.5', 'g_ok:bool=true', 'g_name:string="Cell 1"',
          'g_pos:float[6]={1,2,3,0.1,0.2,0.3}', 'g_ss:string[3]={"Hi","TM","Robot"}', 'g_flags:bool[3]={1,0,1}',

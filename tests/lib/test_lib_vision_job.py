@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from rig import ROOT, SEC, Rig, move_abs
-from tmsim.camera import camera_of
+from tmsim.robot.camera import camera_of
 
 PARTS = [[417.5, -122.3, 300, 0, 0, 0], [467.5, -62.3, 300, 0, 0, 30], [377.5, -182.3, 310, 0, 0, -45]]
 NOT_CONNECTED = 0x2001

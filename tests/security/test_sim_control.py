@@ -6,7 +6,7 @@ import socket
 import pytest
 
 from tmsim.limits import CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 
 from sim_probe import ControlClient
 

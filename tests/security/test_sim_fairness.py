@@ -1,5 +1,5 @@
 """One client cannot starve another (issue 23 item 5): the scheduler's turns are bounded in work
-(sim/work.py, limits.TURN_WORK), so a client of robot 1 attacking with costly scripts, huge string sends,
+(tmsim/tmscript/work.py, limits.TURN_WORK), so a client of robot 1 attacking with costly scripts, huge string sends,
 Cartesian PVT streams or a control-channel flood leaves robot 2 served. Each test reproduces one attack on
 loopback with the virtual clock and asserts on the server's own counters (work of a turn, turns ended by
 the budget) and on the order of the answers, never on wall time; the latency figures are in
@@ -8,11 +8,11 @@ import json
 import math
 import socket
 
-from tmsim import eventlog
+from tmsim.robot import eventlog
 from tmsim.limits import (CONTROL_TURN_PIECES, CONTROL_TURN_REQUESTS, PARSE_SLICE, STEPS_MAX, TURN_WORK, WORK_CHAR,
                           WORK_LINE, WORK_LOG_BYTES, WORK_PVT_CARTESIAN, WORK_TOKEN)
-from tmsim.robot import RobotModel
-from tmsim.session import ListenSession
+from tmsim.robot.model import RobotModel
+from tmsim.protocol.listen_session import ListenSession
 
 from sim_probe import Harness, sct, sta
 

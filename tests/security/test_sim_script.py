@@ -5,7 +5,7 @@ Error), §2.3 (at most 2048 array elements), §2.5 (a value beyond the float ran
 Every probe gets a reply (OK or ERROR;line), nothing is dropped and the project keeps running."""
 import pytest
 
-from tmsim import script
+from tmsim.tmscript import parser as script
 from tmsim.limits import (ARRAY_MAX, STATEMENTS_MAX, STEPS_MAX, STRING_MAX, TOKENS_MAX, VARIABLE_BYTES_MAX,
                         VARIABLES_MAX)
 
@@ -51,7 +51,7 @@ def test_squaring_an_int_wraps_at_32_bits(robot):
 
 
 def test_state_answer_after_a_large_integer_computation_is_valid_json():
-    from tmsim.server import SimServer
+    from tmsim.net.server import SimServer
     from sim_probe import ControlClient, Peer
     srv = SimServer(port=0, control_port=0).start_background()
     try:

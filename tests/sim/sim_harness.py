@@ -2,8 +2,8 @@
 import select
 import socket
 
-from tmsim import codec
-from tmsim.server import SimServer
+from tmsim.protocol import codec
+from tmsim.net.server import SimServer
 
 
 class Peer:

@@ -1,7 +1,7 @@
 """Codec: every worked frame of tm_protocol.md §3/§4 decoded whole, split in two, byte by byte and glued."""
 import pytest
 
-from tmsim import codec
+from tmsim.protocol import codec
 
 VECTORS = [
     b"$TMSCT,5,10,OK,*6D\r\n",

@@ -5,10 +5,10 @@ import json
 
 import pytest
 
-from tmsim import codec
-from tmsim import svr_table as table
-from tmsim.svr_table import ITEMS
-from tmsim.server import SimServer
+from tmsim.protocol import codec
+from tmsim.protocol import svr_table as table
+from tmsim.protocol.svr_table import ITEMS
+from tmsim.net.server import SimServer
 from sim_harness import Harness, sct, sta
 
 
@@ -151,7 +151,7 @@ def test_data_table_is_sent_every_period_on_virtual_time_ids_0_to_9(h):
 
 
 def test_stream_items_modes_and_period_are_checked():
-    from tmsim.svr_session import SvrConfigError
+    from tmsim.protocol.svr_session import SvrConfigError
     for options in ({"items": ["Joint_Angel"]}, {"mode": 4}, {"period": -1}):
         with pytest.raises(SvrConfigError):
             Harness(svr_port=0, svr_options=options)
@@ -265,7 +265,7 @@ def test_a_client_that_never_reads_the_stream_is_dropped_not_the_others():
 
 
 def test_control_channel_presses_the_estop_switches_mode_and_configures_the_stream():
-    from tmsim.control import request
+    from tmsim.net.control import request
     srv = SimServer(port=0, control_port=0, svr_port=0)
     srv.start_background()
     try:
@@ -430,7 +430,7 @@ def test_fault_disconnect_closes_the_ethernet_slave_clients_not_the_listen_node(
 
 
 def test_clients_beyond_the_limit_are_closed_at_once(h, monkeypatch):
-    from tmsim import ethernet_slave
+    from tmsim.net import ethernet_slave
     monkeypatch.setattr(ethernet_slave, "MAX_CLIENTS", 2)
     first, second, third = h.connect_svr(), h.connect_svr(), h.connect_svr()
     assert h.until(lambda: third.closed, timeout=1)

@@ -4,8 +4,9 @@ priority commands take a literal argument only - a packet with StopAndClearBuffe
 (ERROR;line) and nothing of it runs."""
 import pytest
 
-from tmsim import codec, tmscript
-from tmsim.profiles import Profile
+from tmsim.protocol import codec
+from tmsim.tmscript import functions as tmscript
+from tmsim.tmscript.profiles import Profile
 from test_session import PTP_LONG, S, sct
 
 

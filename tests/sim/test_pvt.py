@@ -2,7 +2,7 @@
 Hermite curves between the points, speed and reach checked, PVT mode ending on PVTExit or a stop."""
 import pytest
 
-from tmsim.motion import hermite
+from tmsim.robot.motion import hermite
 from test_session import S, sct
 
 ROS_TRAJECTORY = ("PVTEnter(0)\r\n"

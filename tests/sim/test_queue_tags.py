@@ -2,8 +2,8 @@
 CheckQueueTag): the last four tags only, 1 / 0 / -1 results, the no-argument wait, and what a stop does."""
 import pytest
 
-from tmsim import codec
-from tmsim.profiles import Profile
+from tmsim.protocol import codec
+from tmsim.tmscript.profiles import Profile
 from test_session import PTP_LONG, S, sct, sta
 
 PTP_SHORT = 'PTP("JPP",0,0,90,0,90,10,100,200,0,false)'

@@ -4,9 +4,9 @@ import random
 
 import pytest
 
-from tmsim import kinematics as kin
-from tmsim.motion import SETTLE_S, MotionRequest, rotation_angle, trapezoid_fraction, trapezoid_time
-from tmsim.robot import RobotModel
+from tmsim.robot import kinematics as kin
+from tmsim.robot.motion import SETTLE_S, MotionRequest, rotation_angle, trapezoid_fraction, trapezoid_time
+from tmsim.robot.model import RobotModel
 
 
 def req(function, fmt, target, speed=100, accel=200, blend=0, precise=False, **kw):

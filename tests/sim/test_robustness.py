@@ -3,10 +3,10 @@ import random
 import socket
 import time
 
-from tmsim import codec
-from tmsim.script import split_lines
-from tmsim.checker import check_script
-from tmsim.server import MAX_PENDING
+from tmsim.protocol import codec
+from tmsim.tmscript.parser import split_lines
+from tmsim.tmscript.static_check import check_script
+from tmsim.net.server import MAX_PENDING
 from sim_harness import Harness, sct, sta
 
 

@@ -1,8 +1,8 @@
 """Script parser and checker: ERROR;lines for exactly the offending lines, OK;lines for warnings."""
 import pytest
 
-from tmsim.checker import check_script
-from tmsim.script import Call, Decl, split_lines
+from tmsim.tmscript.static_check import check_script
+from tmsim.tmscript.parser import Call, Decl, split_lines
 
 
 def check(script, variables=None):
@@ -130,7 +130,7 @@ def test_deeply_nested_expression_is_an_error_not_a_crash():
     'F(1) // note', 'F(1));', 'F(-0)', 'F(-0.0)', 'F(007)', 'F(.e5)', 'F(1.e5)', 'int(3)',
 ])
 def test_fast_path_for_literal_calls_gives_the_same_tree_as_the_parser(text):
-    from tmsim.script import ScriptSyntaxError, _Parser, _simple_call, tokenize
+    from tmsim.tmscript.parser import ScriptSyntaxError, _Parser, _simple_call, tokenize
     fast = _simple_call(text)
     try:
         full = repr(_Parser(tokenize(text)).line())

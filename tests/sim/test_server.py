@@ -7,9 +7,9 @@ import pathlib
 
 import pytest
 
-from tmsim import codec
-from tmsim.control import request as control_request
-from tmsim.server import SimServer
+from tmsim.protocol import codec
+from tmsim.net.control import request as control_request
+from tmsim.net.server import SimServer
 
 from sim_harness import Harness, sct, sta
 

@@ -4,10 +4,10 @@ import struct
 
 import pytest
 
-from tmsim import codec
-from tmsim import svr_table as table
-from tmsim.svr_session import HEADERS
-from tmsim.svr_table import ITEMS, SvrContentError, SvrValueError
+from tmsim.protocol import codec
+from tmsim.protocol import svr_table as table
+from tmsim.protocol.svr_session import HEADERS
+from tmsim.protocol.svr_table import ITEMS, SvrContentError, SvrValueError
 
 TMSVR = HEADERS | {"CPERR"}
 
@@ -132,7 +132,7 @@ def test_content_that_does_not_match_its_mode_is_invalid_data(kind, content):
 
 
 def test_docs_item_table_matches_the_data_table():
-    """docs/simulator.md lists every item with the type, size and access of sim/svr_table.py (one fact, one home)."""
+    """docs/simulator.md lists every item with the type, size and access of tmsim/protocol/svr_table.py (one fact, one home)."""
     import pathlib
     import re
     text = (pathlib.Path(__file__).resolve().parents[2] / "docs" / "simulator.md").read_text(encoding="utf-8")

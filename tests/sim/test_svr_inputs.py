@@ -6,7 +6,7 @@ override writes it (mode 2, multiples of 5 in 5..100) is in test_ethernet_slave.
 import pytest
 
 from sim_harness import Harness
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from test_ethernet_slave import ask, values
 
 
@@ -61,7 +61,7 @@ def test_an_output_written_by_the_ethernet_slave_reads_back_in_the_data_table_it
 def test_the_control_channel_sets_an_input_and_names_what_it_refuses():
     """`set_input` on the control channel (docs/simulator.md, Control channel) is RobotDataSource.set_input: the
     next read shows the value; a wrong item, a wrong value or a missing field is answered ok: false by name."""
-    from tmsim.control import request
+    from tmsim.net.control import request
     srv = SimServer(port=0, control_port=0, svr_port=0)
     srv.start_background()
     try:

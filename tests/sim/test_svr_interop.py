@@ -10,8 +10,8 @@ import struct
 
 import pytest
 
-from tmsim import codec
-from tmsim.server import SimServer
+from tmsim.protocol import codec
+from tmsim.net.server import SimServer
 from sim_harness import Harness, sct
 
 # tm_robot_state.h TmRobotStateData: the C field each item is copied into, its size in bytes, and whether the

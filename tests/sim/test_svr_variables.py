@@ -5,10 +5,10 @@ the simulator knows only the variables declared to it). Reads in modes 11/12/13,
 value of the wrong type or size; the manual's byte dump of the string array g_ss; the --svr-var option."""
 import pytest
 
-from tmsim import codec
-from tmsim import svr_table as table
+from tmsim.protocol import codec
+from tmsim.protocol import svr_table as table
 from tmsim.cli import build_parser, check_args, check_variables
-from tmsim.svr_session import SvrConfigError, SvrSession
+from tmsim.protocol.svr_session import SvrConfigError, SvrSession
 from sim_harness import Harness
 
 SPECS = ['g_count:int=5', 'g_ratio:float=0.5', 'g_ok:bool=true', 'g_name:string="Cell 1"',

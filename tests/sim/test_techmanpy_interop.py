@@ -9,7 +9,7 @@ import pytest
 
 techmanpy = pytest.importorskip("techmanpy")
 
-from tmsim.server import SimServer  # noqa: E402
+from tmsim.net.server import SimServer  # noqa: E402
 
 
 @pytest.fixture

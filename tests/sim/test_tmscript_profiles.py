@@ -1,12 +1,13 @@
-"""Version profiles (--tmflow 1.8 / 2.24) from the one function table sim.tmscript: every function, data
+"""Version profiles (--tmflow 1.8 / 2.24) from the one function table tmsim.tmscript.functions: every function, data
 format and Robot[0] attribute passes where its version has it and is refused (ERROR;line, as an unknown
 name) where it does not; values print as a 32-bit TM float does."""
 import pytest
 
-from tmsim import codec, tmscript
-from tmsim.camera import camera_of
-from tmsim.interp import float_text
-from tmsim.profiles import Profile
+from tmsim.protocol import codec
+from tmsim.tmscript import functions as tmscript
+from tmsim.robot.camera import camera_of
+from tmsim.tmscript.interp import float_text
+from tmsim.tmscript.profiles import Profile
 from test_session import S, sct
 
 # one call per overload that the checker accepts, and one it refuses (wrong type or arity)
@@ -160,7 +161,7 @@ def test_the_docs_profile_table_names_every_function_format_and_attribute_of_the
 
 
 def test_overloads_of_one_arity_agree_on_their_int_parameters():
-    """The interpreter converts int arguments by arity (tmsim.tmscript.INT_ARGUMENTS): that needs one set of
+    """The interpreter converts int arguments by arity (tmsim.tmscript.functions.INT_ARGUMENTS): that needs one set of
     int positions per arity of every function."""
     assert all(len(kinds) == 1 for kinds in tmscript.int_parameter_kinds().values())
 
@@ -184,7 +185,7 @@ INT_CASES = [(name, params, position) for name, (_queued, entries) in sorted(tms
 @pytest.mark.parametrize("name,params,position", INT_CASES)
 def test_manual_2_2_a_value_outside_int_in_any_int_parameter_is_an_error_of_its_line(name, params, position, bad):
     """docs/simulator.md "Limits": a float outside int converted to int is ERROR;n - for variables and, in one
-    place (tmsim.interp._arguments), for every int parameter of every function: Sleep(1e30) once waited 10^27 s
+    place (tmsim.tmscript.interp._arguments), for every int parameter of every function: Sleep(1e30) once waited 10^27 s
     and the robot served no script after it. A decimal constant beyond int is a float constant [MAN 2.24 §2.2]."""
     node = node_of("2.24")
     script = _call_with(name, params, position, bad)

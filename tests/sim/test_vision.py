@@ -1,4 +1,4 @@
-"""The virtual camera (sim/camera.py) behind the vision functions of TMscript 2.24: Vision_IsJobAvailable
+"""The virtual camera (tmsim/robot/camera.py) behind the vision functions of TMscript 2.24: Vision_IsJobAvailable
 (§14.1), Vision_DoJob / _PTP / _Line (§13.32-13.34: run in order with the motions, True = the job passed,
 False = failed or could not run, a capture point refused by Vision_DoJob), Vision_GetOutputArraySize /
 Vision_GetOutputArrayValue (§14.2: one row per object, an index outside the rows is an error); jobs set through
@@ -7,10 +7,10 @@ import threading
 
 import pytest
 
-from tmsim import codec
-from tmsim.camera import Camera, camera_of, parse_option
+from tmsim.protocol import codec
+from tmsim.robot.camera import Camera, camera_of, parse_option
 from tmsim.cli import build_parser, check_vision_jobs
-from tmsim.control import ControlChannel
+from tmsim.net.control import ControlChannel
 from test_session import PTP_LONG, S, sct
 
 PARTS = [[300, 0, 5, 0, 0, 0], [300, 60, 5, 0, 0, 90], [240, -60, 5, 0, 0, -45.5]]

@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.cli import simlink
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
@@ -223,7 +223,7 @@ def test_every_unmet_expectation_is_listed_with_its_last_value_and_the_first_mar
 
 
 def test_the_simulator_refuses_a_controller_time_that_is_not_a_time(sim):
-    from tmsim.control import request
+    from tmsim.net.control import request
     for bad in (-1, "5s", True, 1e10):
         answer = request(sim.control.port, {"cmd": "ping", "plc_time": bad})
         assert answer["ok"] is False and "'plc_time' must be the controller time in seconds" in answer["error"]
@@ -245,7 +245,7 @@ def test_members_and_unchanged_values_are_judged_like_any_other(tmp_path):
 
 
 def test_a_scenario_defines_what_the_robots_camera_finds(tmp_path, sim):
-    from tmsim.control import request
+    from tmsim.net.control import request
     r = run(tmp_path, "at 10ms robot 2 vision_job job1 objects=300,0,5,0,0,0;310,60,5,0,0,90 seconds=0.1\n"
                       "at 20ms robot 2 vision_job job2 pass=false\nat 30ms robot 2 vision_remove job2\nat 40ms stop\n",
             "--virtual-time", "--sim-control", control(sim))

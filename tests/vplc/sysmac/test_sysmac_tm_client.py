@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from tmsim.server import SimServer
+from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
 HERE = Path(__file__).resolve().parent

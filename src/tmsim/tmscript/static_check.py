@@ -9,8 +9,8 @@ the robot they fail at run time.
 """
 from __future__ import annotations
 
-from . import script as ast
-from . import tmscript as table
+from tmsim.tmscript import parser as ast
+from tmsim.tmscript import functions as table
 
 F, I, S, B, FA, IA, ANY, VOID = "float", "int", "string", "bool", "float[]", "int[]", "any", "void"
 
@@ -21,7 +21,7 @@ class CheckError(Exception):
 
 def check_script(lines: list[ast.Line], variables: dict[str, str], version: str = table.V224) -> dict[str, str]:
     """Check every line in place (sets ``line.error`` / ``line.warnings``) against the function set of
-    TMflow ``version`` (sim.tmscript: a function, format or attribute of another version is unknown).
+    TMflow ``version`` (tmsim.tmscript.functions: a function, format or attribute of another version is unknown).
 
     ``variables`` are the node-session variables (name -> type). Returns the variables the script
     would declare; the caller adds them only if the script runs.

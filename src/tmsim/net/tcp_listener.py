@@ -10,7 +10,7 @@ from __future__ import annotations
 import selectors
 import socket
 
-from .limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
+from tmsim.limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
 
 RECV_SIZE = 65536                      # bytes taken from one connection per read
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import datetime
 
-from . import kinematics as kin
-from .svr_table import ITEMS
+from tmsim.robot import kinematics as kin
+from tmsim.protocol.svr_table import ITEMS
 
 _SPEED_STEP_S = 0.01          # Joint_Speed / TCP_Speed: difference quotient over this much motion time
 
@@ -44,7 +44,7 @@ def io_key(name: str) -> str | None:
 
 
 class RobotDataSource:
-    """``robot`` is a ``sim.server.Robot`` (its ``session`` is the ListenSession with the RobotModel)."""
+    """``robot`` is a ``tmsim.net.server.Robot`` (its ``session`` is the ListenSession with the RobotModel)."""
 
     def __init__(self, robot, log, origin: datetime.datetime | None = None):
         self.robot = robot

@@ -1,5 +1,5 @@
 """TCP adapter of the Ethernet Slave ($TMSVR): one listening port per robot, served by the SimServer's
-selector and clock (thin: bytes in and out; the protocol is ``sim.svr_session``).
+selector and clock (thin: bytes in and out; the protocol is ``tmsim.protocol.svr_session``).
 
 TMscript 2.24 chapter 17: the robot's Ethernet Slave listens on port 5891; the simulator gives robot i
 the port ``svr_port + i`` (the CLI's default ``svr_port`` is the first port after the Listen node ports,
@@ -14,10 +14,10 @@ from __future__ import annotations
 import selectors
 import socket
 
-from . import codec
-from .listener import Listener, receive
-from .svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
-from .svr_source import RobotDataSource
+from tmsim.protocol import codec
+from tmsim.net.tcp_listener import Listener, receive
+from tmsim.protocol.svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
+from tmsim.robot.svr_source import RobotDataSource
 
 MAX_CLIENTS = 64
 MAX_OUTBOX = 1 << 20

@@ -27,7 +27,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from .limits import DEPTH_MAX, HEX_DIGITS_MAX, INT_MAX, PARSE_SLICE, STATEMENTS_MAX, STRING_MAX, TOKENS_MAX
+from tmsim.limits import DEPTH_MAX, HEX_DIGITS_MAX, INT_MAX, PARSE_SLICE, STATEMENTS_MAX, STRING_MAX, TOKENS_MAX
 
 TYPES = frozenset({"int", "float", "double", "string", "bool", "byte"})
 

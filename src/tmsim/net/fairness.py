@@ -2,7 +2,7 @@
 
 The server only schedules: which client's input is processed next and how much of it. One turn lets the
 robot's session (``ListenSession.process``) handle at most SERVE_ITEMS items of one client's input and
-decode at most SERVE_SCAN, and do at most TURN_WORK units of work (sim/work.py: checking and running
+decode at most SERVE_SCAN, and do at most TURN_WORK units of work (tmsim/tmscript/work.py: checking and running
 scripts, logging; a script that is not done goes on in the robot's next turn, ``SimServer._advance``);
 what is left waits in that client's receive buffer in the session
 (``_backlog``), which is not read further meanwhile, while the other clients get their turn, round
@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import time
 
-from . import codec
-from .limits import SERVE_ITEMS, SERVE_SCAN, TURN_WORK
-from .session import FRAME_LIMIT, INPUT_DONE
+from tmsim.protocol import codec
+from tmsim.limits import SERVE_ITEMS, SERVE_SCAN, TURN_WORK
+from tmsim.protocol.listen_session import FRAME_LIMIT, INPUT_DONE
 
 MAX_PENDING = 1000          # buffered scripts per robot (TCP back-pressure beyond, see server.py)
 POLL_BUDGET_S = 0.004       # backlog turns of one poll stop after this long

@@ -11,7 +11,7 @@ STOP_TAGS = ("forget", "reached")
 @dataclass(frozen=True)
 class Profile:
     tmflow: str = "2.24"            # TMscript function set and formats of this TMflow release
-    stop_tags: str = "forget"       # what a stop does to the queue tags it drops, see sim.robot.STOP_TAGS
+    stop_tags: str = "forget"       # what a stop does to the queue tags it drops, see tmsim.robot.model.STOP_TAGS
     tag_history: int = 4            # queue tags whose status the robot keeps (TMscript 2.24 §13.2: four)
 
     def __post_init__(self):

@@ -10,11 +10,11 @@ Limits (per robot unless noted):
   server stops reading from that robot's clients (TCP back-pressure) until the buffer is half empty
 * MAX_OUTBOX bytes waiting to be sent to one client, OUTBOX_TOTAL_MAX to all clients of a robot; a client
   that does not read (the one with most waiting, for the total) is dropped
-* fairness: each client's input is processed in bounded turns, floods after the others (sim/fairness.py);
-  CPERR answers to bad packets limited per client (the session, sim/session.py)
-* the event log: bounded by count and bytes in memory, the file rotated at LOG_FILE_BYTES_MAX (sim/eventlog.py)
+* fairness: each client's input is processed in bounded turns, floods after the others (tmsim/net/fairness.py);
+  CPERR answers to bad packets limited per client (the session, tmsim/protocol/listen_session.py)
+* the event log: bounded by count and bytes in memory, the file rotated at LOG_FILE_BYTES_MAX (tmsim/robot/eventlog.py)
 * work: every turn of a robot (a client's input, advancing its motions and script) does at most TURN_WORK
-  units; what is left goes on in its next turn, after the others (sim/work.py)
+  units; what is left goes on in its next turn, after the others (tmsim/tmscript/work.py)
 """
 from __future__ import annotations
 
@@ -25,23 +25,23 @@ import socket
 import threading
 import time
 
-from . import codec
-from .control import ControlChannel
-from .ethernet_slave import EthernetSlave
-from .listener import RECV_SIZE, Listener, receive
-from .eventlog import EventLog, LogFile, text as _text
-from .fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
-from .faults import FaultState, check_params as check_fault_params
-from .limits import EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, TURN_WORK
-from .profiles import Profile
-from .robot import RobotModel
-from .session import STOPPED, ListenSession
+from tmsim.protocol import codec
+from tmsim.net.control import ControlChannel
+from tmsim.net.ethernet_slave import EthernetSlave
+from tmsim.net.tcp_listener import RECV_SIZE, Listener, receive
+from tmsim.robot.eventlog import EventLog, LogFile, text as _text
+from tmsim.net.fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
+from tmsim.robot.faults import FaultState, check_params as check_fault_params
+from tmsim.limits import EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, TURN_WORK
+from tmsim.tmscript.profiles import Profile
+from tmsim.robot.model import RobotModel
+from tmsim.protocol.listen_session import STOPPED, ListenSession
 
 MAX_CLIENTS = 256
 MAX_OUTBOX = 1 << 20
 RBUF_READ_BELOW = codec.MAX_DATA + 64     # a receive buffer this full holds a complete item: process it first
 EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all, rotated), and at
-                            # most limits.EVENT_BYTES_MAX bytes (sim/eventlog.py)
+                            # most limits.EVENT_BYTES_MAX bytes (tmsim/robot/eventlog.py)
 GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
 
@@ -176,7 +176,7 @@ class SimServer(FairInput):
         self.manage_gc = manage_gc            # the CLI: garbage collection between bursts, see _collect_garbage
         self.control = None
         self._control_port = control_port
-        self.svr = None                       # Ethernet Slave (sim/ethernet_slave.py) when svr_port is not None
+        self.svr = None                       # Ethernet Slave (tmsim/net/ethernet_slave.py) when svr_port is not None
         self._svr = (svr_port, svr_options or {})
         self._control_host = control_host
 

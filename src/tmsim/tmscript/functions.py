@@ -1,6 +1,6 @@
 """The one table of the TM script language the simulator knows: functions (overloads with parameter and
 return types, queued or immediate), data formats, Robot[0] attributes and IO points, each with the TMflow
-versions that have it. The checker (sim.checker) and the interpreter (sim.interp) read only this table;
+versions that have it. The checker (tmsim.tmscript.static_check) and the interpreter (tmsim.tmscript.interp) read only this table;
 docs/simulator.md lists it ("Version profiles").
 
 Sources: TMscript 2.24 manual (ch. 11 parameterized objects, ch. 13 motion functions, ch. 15 Listen Node);
@@ -54,7 +54,7 @@ FUNCTIONS: dict[str, tuple[bool, list[tuple[tuple[str, ...], str, tuple[str, ...
     "ListenPacket": (False, [((S,), S, ALL), ((S, S), S, ALL)]),
     "GetString": (False, [((ANY,), S, ALL), ((ANY, I), S, ALL), ((ANY, I, I), S, ALL)]),
     "Sleep": (False, [((I,), VOID, NEW)]),
-    # vision (sim/camera.py). The jobs run in order with the motions (§13.33, §13.34 "queue with the motion
+    # vision (tmsim/robot/camera.py). The jobs run in order with the motions (§13.33, §13.34 "queue with the motion
     # commands"); the script waits for the result, the bool they return. Not queued here: the interpreter
     # waits for the queue itself. Flying Trigger / Inspection forms (§14.2 second halves) are not simulated
     "Vision_DoJob": (False, [((S,), B, ALL)]),                                               # §13.32

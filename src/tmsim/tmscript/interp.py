@@ -7,7 +7,7 @@
     ("idle", None, None)      WaitQueueTag(): until every queued motion is done
     ("delay", None, s)        Sleep(ms), WaitQueueTag(0, ms)
     ("room", None, None)      a queued statement while the FIFO is full
-    ("turn", None, None)      the turn's work budget is spent (ctx.meter, sim/work.py): go on in a later turn
+    ("turn", None, None)      the turn's work budget is spent (ctx.meter, tmsim/tmscript/work.py): go on in a later turn
 
 It returns "exit" when ScriptExit() ran (the rest of the packet is ignored), else None.
 Immediate statements run when reached; motions, queue tags, base/TCP/load changes and DO/AO writes
@@ -28,14 +28,14 @@ import math
 import struct
 from decimal import Decimal
 
-from . import script as ast
-from . import tmscript as table
-from .camera import camera_of
-from .codec import encode as encode_frame
-from .limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
+from tmsim.tmscript import parser as ast
+from tmsim.tmscript import functions as table
+from tmsim.robot.camera import camera_of
+from tmsim.protocol.codec import encode as encode_frame
+from tmsim.limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
                      VARIABLES_MAX, WORK_STEP)
-from .motion import MotionRequest
-from .work import WorkMeter
+from tmsim.robot.motion import MotionRequest
+from tmsim.tmscript.work import WorkMeter
 
 MOTIONS = ("PTP", "Line", "Circle", "PLine", "Move_PTP", "Move_Line", "Move_PLine")
 _DEFAULTS = {"int": 0, "float": 0.0, "string": "", "bool": False, "byte": 0}
@@ -58,7 +58,7 @@ class Context:
         self.stop_and_clear = stop_and_clear    # () -> None
         self.log_line = log_line                # (line) -> None
         self.log_event = log_event or (lambda kind, **fields: None)     # (kind, **fields) -> None
-        self.meter = meter or WorkMeter()       # the turn's work (sim/work.py): a spent turn suspends the script
+        self.meter = meter or WorkMeter()       # the turn's work (tmsim/tmscript/work.py): a spent turn suspends the script
 
 
 def run_script(lines, ctx: Context):
@@ -178,7 +178,7 @@ def _to_int(value) -> int:
 def _int_arguments(name, args, positions):
     """The arguments of a call with its int (and int[]) parameters converted by the rule of _to_int, for
     every function in one place: Sleep(1e30) or WaitQueueTag(1, 2147483648) is an error of its line, not a
-    wait of 10^27 s. ``positions``: sim.tmscript.INT_ARGUMENTS."""
+    wait of 10^27 s. ``positions``: tmsim.tmscript.functions.INT_ARGUMENTS."""
     args = list(args)
     for position, is_array in positions:
         try:
@@ -367,7 +367,7 @@ def _eval(node, ctx, line):
 
 
 def _io_array(node, robot):
-    """IO["Module"].ATTR as an array (TMscript 2.24 §11.5); sizes: sim.tmscript.IO_SIZES."""
+    """IO["Module"].ATTR as an array (TMscript 2.24 §11.5); sizes: tmsim.tmscript.functions.IO_SIZES."""
     module = node.obj.index
     name = module.id if isinstance(module, ast.Name) else module.value
     attribute = node.name.replace("Instant", "")
@@ -541,7 +541,7 @@ def _call(node, args, ctx, line):
 
 
 def _vision(name, args, ctx, line):
-    """The vision functions against the robot's virtual camera (sim/camera.py). A job runs in order with the
+    """The vision functions against the robot's virtual camera (tmsim/robot/camera.py). A job runs in order with the
     motions: Vision_DoJob* first wait until the motions queued before them are done (§13.33, §13.34 "queue with
     the motion commands"), _PTP / _Line then move to the job's capture point and wait for that motion, and the
     job takes its time; the script goes on with the job's result. An unknown job returns False, "fail to

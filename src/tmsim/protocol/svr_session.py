@@ -11,7 +11,7 @@ The server also sends the configured data table to every client periodically, tr
 Confirmation": mode, write permission, content vs mode, item exists, not read only, M/A mode, value type)
 and performed only when every item passes.
 
-``source`` gives the values and performs writes (``sim.svr_source.RobotDataSource``): ``values(names)``
+``source`` gives the values and performs writes (``tmsim.robot.svr_source.RobotDataSource``): ``values(names)``
 -> {name: value}, ``write({name: value})``, ``auto_mode``. The global variables of the robot's project (§17.2
 "Global Variable") are items of the session itself: ``declare`` adds one, ``variables`` holds their values.
 """
@@ -19,9 +19,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from . import codec
-from . import svr_table as table
-from .svr_table import ITEMS, Item, SvrContentError, SvrValueError
+from tmsim.protocol import codec
+from tmsim.protocol import svr_table as table
+from tmsim.protocol.svr_table import ITEMS, Item, SvrContentError, SvrValueError
 
 HEADERS = frozenset({"TMSVR"})
 

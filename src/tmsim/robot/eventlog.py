@@ -13,7 +13,7 @@ import json
 import os
 import threading
 
-from .limits import LOG_FILE_BYTES_MAX, WORK_LOG_BYTES
+from tmsim.limits import LOG_FILE_BYTES_MAX, WORK_LOG_BYTES
 
 EVENT_OVERHEAD = 200        # bytes an event counts, plus the length of its texts
 

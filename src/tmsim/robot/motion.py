@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
-from . import kinematics as kin
+from tmsim.robot import kinematics as kin
 
 JOINT_SPEED = (180.0, 180.0, 180.0, 225.0, 225.0, 225.0)   # deg/s, TM5-700 data sheet
 TCP_SPEED = 1100.0                                           # mm/s

@@ -17,7 +17,7 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
     {"cmd": "svr_inject", "robot": 0, "fault": "stall", "params": {"enabled": true}}   / "svr_clear_faults"
     {"cmd": "set_input", "robot": 0, "name": "End_DI0", "value": 1}   a digital (0/1) or analog (V) input
     {"cmd": "vision_job", "robot": 0, "job": "job1", "objects": [[x, y, z, rx, ry, rz], ...], "pass": true,
-     "seconds": 0.2, "capture": [j1, ..., j6], "variable": "job1_Base_TM"}   a vision job (sim/camera.py)
+     "seconds": 0.2, "capture": [j1, ..., j6], "variable": "job1_Base_TM"}   a vision job (tmsim/robot/camera.py)
     {"cmd": "vision_remove", "robot": 0, "job": "job1"} / {"cmd": "vision", "robot": 0}   remove / show
 Any request may carry "plc_time": the client's controller time in seconds, logged as event ``control`` (with
 ``cmd``) next to the robot clock's ``t``.
@@ -38,12 +38,12 @@ import re
 import selectors
 import socket
 
-from .limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
+from tmsim.limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
                      CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_BYTES, CONTROL_TURN_PIECES,
                      CONTROL_TURN_REQUESTS)
-from .camera import camera_of
-from .listener import Listener, receive
-from .session import TransitionError
+from tmsim.robot.camera import camera_of
+from tmsim.net.tcp_listener import Listener, receive
+from tmsim.protocol.listen_session import TransitionError
 
 _FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission",
            "plc_time", "name", "value"}
@@ -349,7 +349,7 @@ class ControlChannel:
         self.server.svr.clear_faults(robot)
 
     def _vision_job(self, robot, request):
-        """A vision job of the robot's project and what it finds (sim/camera.py checks every value)."""
+        """A vision job of the robot's project and what it finds (tmsim/robot/camera.py checks every value)."""
         with self.server.lock:
             return camera_of(robot.session.robot).define(
                 name=request.get("job"), objects=request.get("objects", []), passed=request.get("pass", True),

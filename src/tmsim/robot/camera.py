@@ -3,7 +3,7 @@
 A job is set through the control channel (``vision_job``) or the start-up option ``--vision-job``; the script
 functions of TMscript 2.24 §13.32-13.34 (Vision_DoJob, Vision_DoJob_PTP, Vision_DoJob_Line) and chapter 14
 (Vision_IsJobAvailable §14.1, Vision_GetOutputArraySize / Vision_GetOutputArrayValue §14.2) ask it
-(sim/interp.py). What a job holds:
+(tmsim/tmscript/interp.py). What a job holds:
 
     objects   the located objects, each a pose X, Y, Z (mm), RX, RY, RZ (deg) relative to RobotBase: the vision
               base the job defines for that object (our model of a landmark / object-locating job)
@@ -81,7 +81,7 @@ class Camera:
 
     def finish(self, job: VisionJob) -> bool:
         """The job has run: its output variable now holds its objects (none when it failed)."""
-        from .interp import float_text         # the texts GetString prints (interp imports this module)
+        from tmsim.tmscript.interp import float_text         # the texts GetString prints (interp imports this module)
         self.runs += 1
         rows = [[float_text(v) for v in pose] for pose in job.objects] if job.passed else []
         self.outputs[job.variable] = rows
@@ -160,7 +160,7 @@ def parse_option(text: str) -> dict:
 
 
 def camera_of(model) -> Camera:
-    """The camera of a robot model (sim/robot.py), made when first asked; it lives as long as the model."""
+    """The camera of a robot model (tmsim/robot/model.py), made when first asked; it lives as long as the model."""
     camera = getattr(model, "vision_camera", None)
     if camera is None:
         camera = Camera()

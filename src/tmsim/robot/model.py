@@ -2,18 +2,18 @@
 
 State changes only in ``tick(dt)`` (and in the immediate commands ``pause``, ``resume``,
 ``stop_and_clear``). FIFO items run strictly in order; a queue tag is reached when every item
-queued before it has finished. Durations come from ``sim.motion`` (documented formulas there).
+queued before it has finished. Durations come from ``tmsim.robot.motion`` (documented formulas there).
 """
 from __future__ import annotations
 
 import math
 from collections import deque
 
-from . import kinematics as kin
-from .motion import MotionError, MotionRequest, Planner
-from .limits import WORK_PLAN, WORK_PVT_CARTESIAN
-from .robot_errors import classify
-from .work import WorkMeter
+from tmsim.robot import kinematics as kin
+from tmsim.robot.motion import MotionError, MotionRequest, Planner
+from tmsim.limits import WORK_PLAN, WORK_PVT_CARTESIAN
+from tmsim.robot.errors import classify
+from tmsim.tmscript.work import WorkMeter
 
 HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)
 FIFO_LIMIT = 1000       # queued items (motions, tags, settings) per robot; a script waits while it is full
@@ -35,12 +35,12 @@ class RobotModel:
         self.io = {}
         self.fifo = deque()
         self.active = None
-        self.meter = WorkMeter()   # the robot's turn budget, shared with its session (sim/work.py)
+        self.meter = WorkMeter()   # the robot's turn budget, shared with its session (tmsim/tmscript/work.py)
         self.owed = 0.0            # seconds of robot clock not run yet: the turn's budget ended the tick
         self.active_t = 0.0
         self.paused = False
         self.tag_history = tag_history
-        self.stop_tags = stop_tags     # sim.profiles.STOP_TAGS: what a stop does to the tags it drops
+        self.stop_tags = stop_tags     # tmsim.tmscript.profiles.STOP_TAGS: what a stop does to the tags it drops
         self.tags = {}             # tag -> "true" | "false", the last tag_history tags in the order they were queued
         self.tag_gen = {}          # tag -> generation of its latest QueueTag (a reused tag's older item stays mute)
         self._gen = 0

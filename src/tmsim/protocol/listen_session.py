@@ -3,7 +3,7 @@
 A server calls ``connect``/``receive_data(conn, bytes)``/``disconnect``/``advance(now)`` and takes
 ``data_to_send(conn)`` (one bytes object per frame, so each goes out in one send); the control channel
 uses the control methods (``enter_node``, ``stop_project`` ...). A server that shares its input fairly
-between clients (sim/fairness.py) calls ``buffer_data`` and then ``process`` in bounded turns instead of
+between clients (tmsim/net/fairness.py) calls ``buffer_data`` and then ``process`` in bounded turns instead of
 ``receive_data``; the session decodes, limits its CPERR answers to bad packets (CPERR_BURST, CPERR_PER_S
 in sim/limits.py) and logs ``frame_in`` either way. The node state follows an explicit transition table;
 the scripts of all clients are run strictly in arrival order, one at a time.
@@ -14,14 +14,14 @@ import re
 from collections import deque
 from dataclasses import dataclass, field
 
-from . import codec
-from .checker import ScriptChecker
-from .eventlog import text as _text
-from .interp import Context, ScriptRuntimeError, run_script, variable_memory
-from .limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN
-from .profiles import Profile
-from .robot import RobotModel
-from .script import iter_lines
+from tmsim.protocol import codec
+from tmsim.tmscript.static_check import ScriptChecker
+from tmsim.robot.eventlog import text as _text
+from tmsim.tmscript.interp import Context, ScriptRuntimeError, run_script, variable_memory
+from tmsim.limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN
+from tmsim.tmscript.profiles import Profile
+from tmsim.robot.model import RobotModel
+from tmsim.tmscript.parser import iter_lines
 
 STOPPED, IDLE, IN_NODE, EXITING = "project_stopped", "not_in_node", "in_node", "exiting"
 
@@ -89,7 +89,7 @@ class ListenSession:
         self.profile = profile or Profile()
         self.robot = robot or RobotModel()
         self.robot.tag_history, self.robot.stop_tags = self.profile.tag_history, self.profile.stop_tags
-        self.meter = self.robot.meter       # work of the current turn (sim/work.py), shared with the robot
+        self.meter = self.robot.meter       # work of the current turn (tmsim/tmscript/work.py), shared with the robot
         self.send_message = send_message
         self.log = log or (lambda kind, **fields: None)
         self.state = STOPPED
@@ -296,7 +296,7 @@ class ListenSession:
         self._step(None)
 
     def _script(self, packet):
-        """Check the packet line by line, then run it (a generator, like sim.interp.run_script, whose waits
+        """Check the packet line by line, then run it (a generator, like tmsim.tmscript.interp.run_script, whose waits
         it passes on). Returns the reply status and whether ScriptExit() ran. Parsing and checking count
         WORK_CHAR per character and WORK_LINE per line, a long line WORK_TOKEN per token as its parsing goes
         (PARSE_SLICE tokens at a time); when the turn's budget is spent, the rest waits for a later turn
@@ -351,7 +351,7 @@ class ListenSession:
         run.wait = (kind, tag, None if timeout is None else self.now + timeout)
 
     def _resume_waits(self):
-        """Resume the running script if what it waits for has happened. Waits (see sim.interp):
+        """Resume the running script if what it waits for has happened. Waits (see tmsim.tmscript.interp):
         turn (the budget of a turn ended its checking or running: a new turn), room (FIFO full), idle
         (WaitQueueTag(): every queued motion done), delay (Sleep, tag 0), and
         tag: 1 completed / -1 not existed end the wait at once, 0 when the timeout passes (§13.2)."""
