@@ -3,7 +3,8 @@
     python3 docs/library/make_error_tables.py           # rewrite the generated files
     python3 docs/library/make_error_tables.py --check   # exit 1 and name the files that are out of date
 
-errors.tsv has one row per ErrorID: id (16#XXXX), raised_by, text (the ErrorDescrip, <= 79 characters), cause,
+errors.tsv has one row per ErrorID: id (16#XXXX), name (ErrXxx: the name every WORD#16#XXXX literal of the
+library's ST carries in a comment on its line, tests/lib/test_lib_error_table.py), raised_by, text (the ErrorDescrip, <= 79 characters), cause,
 remedy (for the engineer: the FB pages and errors.md), operator (what the operator does at the panel; it names
 screens and buttons, never a function block) and hmi ("alarm": the HMI server raises an alarm when a command
 ends with it, unless a cause it already shows explains it; "message": a refused start, nothing happened, the
@@ -29,10 +30,11 @@ ROOT = HERE.parents[1]
 TABLE = HERE / "errors.tsv"
 ST_FILE = ROOT / "lib" / "CBT_Commands_Lib" / "core" / "CBTi_ErrorText.st"
 HMI_FILE = ROOT / "src" / "cbt_hmi" / "pages" / "errors.json"
-COLUMNS = ["id", "raised_by", "text", "cause", "remedy", "operator", "hmi"]
+COLUMNS = ["id", "name", "raised_by", "text", "cause", "remedy", "operator", "hmi"]
 HMI_KINDS = ("alarm", "message")
 FB_NAME = re.compile(r"\bCBT_\w+|\b(?:MoveAbsolute|MoveRelative|MoveCircle|ProgramControl|ProjectControl)\b")
 ID = re.compile(r"16#[0-9A-F]{4}")
+NAME = re.compile(r"Err[A-Z][A-Za-z0-9]{1,28}")
 CODE = re.compile(r"16#([0-9A-F]{4})(?:\.\.16#([0-9A-F]{4}))?")
 BEGIN = "<!-- BEGIN table generated from errors.tsv by make_error_tables.py -->"
 END = "<!-- END table -->"
@@ -69,6 +71,12 @@ def load(path: Path = TABLE) -> dict[str, dict[str, str]]:
                 raise TableError(f"{where}: ErrorID {code} has no {column}")
             if "|" in row[column]:
                 raise TableError(f"{where}: ErrorID {code}: '|' in {column} would break the docs table")
+        if not NAME.fullmatch(row["name"]):
+            raise TableError(f"{where}: ErrorID {code}: name {row['name']!r} is not Err followed by a capital "
+                             "letter, letters and digits, at most 31 characters")
+        twin = next((c for c, r in rows.items() if r["name"] == row["name"]), None)
+        if twin:
+            raise TableError(f"{where}: ErrorID {code}: name {row['name']} is already the name of {twin}")
         if row["hmi"] not in HMI_KINDS:
             raise TableError(f"{where}: ErrorID {code}: hmi is {row['hmi']!r}, expected alarm or message")
         named = FB_NAME.search(row["operator"])
@@ -94,7 +102,7 @@ def st_function(rows: dict) -> str:
            "VAR_INPUT", "    ErrorID : WORD;", "END_VAR",
            "CASE WORD_TO_UINT(ErrorID) OF",
            "0: CBTi_ErrorText := '';"]
-    out += [f"{int(code[3:], 16)}: (* {code} *) CBTi_ErrorText := {st_string(row['text'])};"
+    out += [f"{int(code[3:], 16)}: (* {code} {row['name']} *) CBTi_ErrorText := {st_string(row['text'])};"
             for code, row in rows.items()]
     out += ["ELSE", "    CBTi_ErrorText := CONCAT('Unknown ErrorID 16#', WORD_TO_STRING(ErrorID));",
             "END_CASE;", "END_FUNCTION"]
@@ -104,8 +112,8 @@ def st_function(rows: dict) -> str:
 def errors_md(rows: dict, text: str) -> str:
     if BEGIN not in text or END not in text:
         raise TableError(f"errors.md: the markers {BEGIN} and {END} are missing")
-    table = ["| ErrorID | Raised by | Description | Cause | Remedy |", "|---|---|---|---|---|"]
-    table += [f"| {c} | {r['raised_by']} | {r['text']} | {r['cause']} | {r['remedy']} |" for c, r in rows.items()]
+    table = ["| ErrorID | Name | Raised by | Description | Cause | Remedy |", "|---|---|---|---|---|---|"]
+    table += [f"| {c} | {r['name']} | {r['raised_by']} | {r['text']} | {r['cause']} | {r['remedy']} |" for c, r in rows.items()]
     head, rest = text.split(BEGIN, 1)
     tail = rest.split(END, 1)[1]
     return head + BEGIN + "\n" + "\n".join(table) + "\n" + END + tail
