@@ -24,6 +24,7 @@ import socket
 import sys
 import threading
 
+from tmsim.limits import NODE_TIMEOUT_MAX_S, SPEEDUP_MAX
 from tmsim.robot.camera import Camera, camera_of, parse_option
 from tmsim.net.control import robot_numbering
 from tmsim.tmscript.profiles import STOP_TAGS, VERSIONS, Profile
@@ -124,8 +125,6 @@ def check_variables(args) -> tuple[list[str], list]:
     return problems, variables
 
 
-MAX_SPEEDUP = 1000.0
-MAX_NODE_TIMEOUT_S = 86_400.0
 
 
 def check_args(args) -> tuple[list[str], int | None, list[str]]:
@@ -135,15 +134,15 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
         problems.append(f"--robots must be between 1 and 512 (got {args.robots})")
     if not 0 <= args.port <= 65535 or (args.port and args.port + args.robots - 1 > 65535):
         problems.append(f"--port {args.port} with {args.robots} robot(s) leaves the port range 1..65535")
-    if not (math.isfinite(args.speedup) and 0 < args.speedup <= MAX_SPEEDUP):
-        problems.append(f"--speedup must be positive and at most {MAX_SPEEDUP:g} (got {args.speedup:g})")
+    if not (math.isfinite(args.speedup) and 0 < args.speedup <= SPEEDUP_MAX):
+        problems.append(f"--speedup must be positive and at most {SPEEDUP_MAX:g} (got {args.speedup:g})")
     if args.control_port is not None and not 0 <= args.control_port <= 65535:
         problems.append(f"--control-port must be 0..65535 (got {args.control_port})")
     if not 1 <= args.tag_history <= 1000:
         problems.append(f"--tag-history must be between 1 and 1000 (got {args.tag_history})")
     for flag, value in (("--data-timeout", args.data_timeout), ("--connection-timeout", args.connection_timeout)):
-        if not (math.isfinite(value) and 0 <= value <= MAX_NODE_TIMEOUT_S):
-            problems.append(f"{flag} must be 0 (none) to {MAX_NODE_TIMEOUT_S:g} seconds (got {value:g})")
+        if not (math.isfinite(value) and 0 <= value <= NODE_TIMEOUT_MAX_S):
+            problems.append(f"{flag} must be 0 (none) to {NODE_TIMEOUT_MAX_S:g} seconds (got {value:g})")
     svr_port = None if args.no_svr else args.port + args.robots if args.svr_port is None and args.port else \
         (args.svr_port or 0)
     if svr_port is not None and not (0 <= svr_port and (not svr_port or svr_port + args.robots - 1 <= 65535)):

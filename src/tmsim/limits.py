@@ -55,7 +55,35 @@ CONTROL_TURN_REQUESTS = 4                   # requests of one client answered in
 CONTROL_TURN_BYTES = 64 << 10               # ... and no more once this turn's answers reach this many bytes
 CONTROL_TURN_PIECES = 1_024                 # pieces (numbers, texts) of one large answer encoded in one turn
 
+# ---- the command line ----------------------------------------------------------------------------
+SPEEDUP_MAX = 1000.0                        # --speedup: the robot clock at most this many times the wall clock
+NODE_TIMEOUT_MAX_S = 86_400.0               # --data-timeout / --connection-timeout of the Listen node
+
+# ---- one frame ---------------------------------------------------------------------------------------
+FRAME_DATA_MAX = 65_536                     # DATA of one Listen-node or Ethernet Slave frame; a longer declared
+                                            # length is a packet error (CPERR 01)
+SVR_STRING_MAX = 256                        # bytes of a text value written through the Ethernet Slave (status 07)
+SVR_ARRAY_MAX = 1_024                       # elements of an array variable of the Ethernet Slave's data table
+
+# ---- the virtual camera (per robot) ---------------------------------------------------------------
+VISION_JOBS_MAX = 64                        # vision jobs of one project
+VISION_OBJECTS_MAX = 64                     # objects one job finds
+VISION_SECONDS_MAX = 60.0                   # the longest job
+VISION_POSE_MAX = 100_000.0                 # mm / deg of a pose the camera reports, as the library's range
+
+# ---- the robot model ------------------------------------------------------------------------------
+FIFO_ITEMS_MAX = 1_000                      # queued items (motions, tags, settings); a script waits while full
+
 # ---- robot servers (per robot unless noted) -----------------------------------------------------
+LISTEN_CLIENTS_MAX = 256                    # Listen-node clients; more are accepted and closed at once
+LISTEN_OUTBOX_MAX = 1 << 20                 # unsent bytes of one Listen-node client; beyond: it is disconnected
+SVR_CLIENTS_MAX = 64                        # Ethernet Slave clients; more are accepted and closed at once
+SVR_OUTBOX_MAX = 1 << 20                    # unsent bytes of one Ethernet Slave client; beyond: disconnected
+PENDING_SCRIPTS_MAX = 1_000                 # buffered scripts (TCP back-pressure beyond, with PENDING_BYTES_MAX)
+RECV_BYTES = 65_536                         # bytes taken from one connection per read
+EVENTS_KEPT_MAX = 40_000                    # events kept in memory, all robots together (see also EVENT_BYTES_MAX)
+POLL_BUDGET_S = 0.004                       # backlog turns of one poll stop after this long (wall clock)
+IO_SLICE_S = 0.0003                         # between two turns the sockets are polled this often (wall clock)
 EVENT_BYTES_MAX = 20 << 20                  # event log kept in memory, all robots together
 LOG_FILE_BYTES_MAX = 64 << 20               # the --log file: then renamed to FILE.1 and begun anew
 ACCEPT_BACKOFF_S = 0.1                      # out of descriptors: stop accepting for this long

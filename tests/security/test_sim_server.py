@@ -176,7 +176,7 @@ def polite_conn(h, peer):
 
 def test_listen_send_fan_out_to_lazy_clients_is_bounded_in_memory(monkeypatch):
     """Probe: a 60 KB ListenSend to many clients that never read (old: 3.6 GB). Unsent output is bounded per
-    client (MAX_OUTBOX) and per robot (OUTBOX_TOTAL_MAX: the laziest client is dropped); the event log by bytes."""
+    client (LISTEN_OUTBOX_MAX) and per robot (OUTBOX_TOTAL_MAX: the laziest client is dropped); the event log by bytes."""
     from tmsim.net import server
     monkeypatch.setattr(server, "OUTBOX_TOTAL_MAX", 1 << 20)    # the kernel buffers must fill first: keep it short
     h = Harness()

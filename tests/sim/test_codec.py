@@ -1,6 +1,7 @@
 """Codec: every worked frame of tm_protocol.md §3/§4 decoded whole, split in two, byte by byte and glued."""
 import pytest
 
+from tmsim.limits import FRAME_DATA_MAX
 from tmsim.protocol import codec
 
 VECTORS = [
@@ -109,7 +110,7 @@ def test_bad_packet_resynchronises_on_the_next_frame():
 
 
 def test_oversized_declared_length_is_rejected_without_waiting_for_the_data():
-    item, used = codec.decode(b"$TMSCT,%d,1," % (codec.MAX_DATA + 1))
+    item, used = codec.decode(b"$TMSCT,%d,1," % (FRAME_DATA_MAX + 1))
     assert isinstance(item, codec.BadFrame) and item.code == "01" and "limit" in item.reason
 
 

@@ -431,7 +431,7 @@ def test_fault_disconnect_closes_the_ethernet_slave_clients_not_the_listen_node(
 
 def test_clients_beyond_the_limit_are_closed_at_once(h, monkeypatch):
     from tmsim.net import ethernet_slave
-    monkeypatch.setattr(ethernet_slave, "MAX_CLIENTS", 2)
+    monkeypatch.setattr(ethernet_slave, "SVR_CLIENTS_MAX", 2)
     first, second, third = h.connect_svr(), h.connect_svr(), h.connect_svr()
     assert h.until(lambda: third.closed, timeout=1)
     assert not first.closed and not second.closed

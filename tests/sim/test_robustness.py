@@ -6,7 +6,7 @@ import time
 from tmsim.protocol import codec
 from tmsim.tmscript.parser import split_lines
 from tmsim.tmscript.static_check import check_script
-from tmsim.net.server import MAX_PENDING
+from tmsim.limits import FRAME_DATA_MAX, PENDING_SCRIPTS_MAX as MAX_PENDING
 from sim_harness import Harness, sct, sta
 
 
@@ -30,7 +30,7 @@ def test_random_bytes_from_a_client_never_break_the_server(harness):
 def test_oversized_frame_is_rejected_with_cperr_01_and_bytes_are_skipped(harness):
     h = harness
     peer = h.connect()
-    huge = b"$TMSCT,%d,1," % (codec.MAX_DATA + 10) + b"x" * (codec.MAX_DATA + 10) + b",*00\r\n"
+    huge = b"$TMSCT,%d,1," % (FRAME_DATA_MAX + 10) + b"x" * (FRAME_DATA_MAX + 10) + b",*00\r\n"
     peer.send(huge + sta("00"))
     assert h.until(lambda: ("TMSTA", "00,true,Listen1") in peer.texts(), timeout=5)
     assert peer.texts()[0] == ("CPERR", "01")
@@ -40,7 +40,7 @@ def test_oversized_frame_is_rejected_with_cperr_01_and_bytes_are_skipped(harness
 def test_largest_allowed_frame_is_processed(harness):
     h = harness
     peer = h.connect()
-    body = "1," + "\r\n".join(["ChangeLoad(1)"] * ((codec.MAX_DATA - 10) // 15))
+    body = "1," + "\r\n".join(["ChangeLoad(1)"] * ((FRAME_DATA_MAX - 10) // 15))
     assert h.request(peer, codec.encode("TMSCT", body), timeout=20) == [("TMSCT", "1,OK")]
 
 

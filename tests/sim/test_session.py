@@ -359,7 +359,7 @@ def frame(header, data):
 
 
 def test_full_motion_fifo_makes_the_script_wait_for_room(monkeypatch):
-    monkeypatch.setattr("tmsim.robot.model.FIFO_LIMIT", 4)
+    monkeypatch.setattr("tmsim.robot.model.FIFO_ITEMS_MAX", 4)
     node = S()
     node.connect()
     script = "\r\n".join(f'PTP("JPP",0,0,90,0,90,{k},100,0,0,false)' for k in range(6))
@@ -372,7 +372,7 @@ def test_full_motion_fifo_makes_the_script_wait_for_room(monkeypatch):
 
 
 def test_stop_and_clear_buffer_frees_a_script_waiting_for_room(monkeypatch):
-    monkeypatch.setattr("tmsim.robot.model.FIFO_LIMIT", 2)
+    monkeypatch.setattr("tmsim.robot.model.FIFO_ITEMS_MAX", 2)
     node = S()
     node.connect()
     script = "\r\n".join(f"QueueTag({k})" for k in (1, 2, 3))

@@ -4,6 +4,7 @@ import struct
 
 import pytest
 
+from tmsim.limits import SVR_STRING_MAX
 from tmsim.protocol import codec
 from tmsim.protocol import svr_table as table
 from tmsim.protocol.svr_session import HEADERS
@@ -109,7 +110,7 @@ def test_every_item_encodes_in_all_three_formats_and_reads_back():
 @pytest.mark.parametrize("name, text", [
     ("Ctrl_DO0", "2"), ("Ctrl_DO0", "abc"), ("Project_Speed", "7"), ("Project_Speed", "105"),
     ("Project_Speed", "0"), ("Ctrl_AO0", "nan"), ("Ctrl_AO0", "{1,2}"), ("Project_Name", "NoQuotes"),
-    ("Project_Name", '"' + "x" * (table.MAX_STRING + 1) + '"'), ("Stick_Play", "3"), ("Camera_Light", "1.5"),
+    ("Project_Name", '"' + "x" * (SVR_STRING_MAX + 1) + '"'), ("Stick_Play", "3"), ("Camera_Light", "1.5"),
 ])
 def test_value_that_does_not_fit_its_item_is_a_value_error(name, text):
     with pytest.raises(SvrValueError):

@@ -6,21 +6,20 @@ the port ``svr_port + i`` (the CLI's default ``svr_port`` is the first port afte
 so one robot gets 5890 and 5891). The Ethernet Slave keeps serving while the project is stopped; it is
 a service of the controller, not of the project.
 
-Limits: a received frame's DATA <= codec.MAX_DATA (longer: CPERR 01); MAX_CLIENTS connections per robot;
-a client that leaves more than MAX_OUTBOX bytes unread is dropped.
+Limits: a received frame's DATA <= FRAME_DATA_MAX (longer: CPERR 01); SVR_CLIENTS_MAX connections per robot;
+a client that leaves more than SVR_OUTBOX_MAX bytes unread is dropped (tmsim/limits.py).
 """
 from __future__ import annotations
 
 import selectors
 import socket
 
+from tmsim.limits import SVR_CLIENTS_MAX, SVR_OUTBOX_MAX
 from tmsim.protocol import codec
 from tmsim.net.tcp_listener import Listener, receive
 from tmsim.protocol.svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
 from tmsim.robot.svr_source import RobotDataSource
 
-MAX_CLIENTS = 64
-MAX_OUTBOX = 1 << 20
 
 
 class _Conn:
@@ -74,8 +73,8 @@ class EthernetSlave:
             if accepted is None:
                 return
             sock, addr = accepted
-            if len(robot.svr_conns) >= MAX_CLIENTS:
-                robot._log("svr_rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")
+            if len(robot.svr_conns) >= SVR_CLIENTS_MAX:
+                robot._log("svr_rejected_connection", peer=addr[0], reason=f"more than {SVR_CLIENTS_MAX} clients")
                 sock.close()
                 continue
             sock.setblocking(False)
@@ -123,8 +122,8 @@ class EthernetSlave:
             except OSError as exc:
                 self._drop(robot, conn, f"send failed: {exc.strerror}")
                 continue
-            if len(conn.wbuf) > MAX_OUTBOX:
-                self._drop(robot, conn, f"client does not read (more than {MAX_OUTBOX} bytes waiting)")
+            if len(conn.wbuf) > SVR_OUTBOX_MAX:
+                self._drop(robot, conn, f"client does not read (more than {SVR_OUTBOX_MAX} bytes waiting)")
 
     def _drop(self, robot, conn, reason):
         if robot.svr_conns.pop(conn.id, None) is None:

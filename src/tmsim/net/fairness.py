@@ -14,13 +14,9 @@ from __future__ import annotations
 
 import time
 
-from tmsim.protocol import codec
-from tmsim.limits import SERVE_ITEMS, SERVE_SCAN, TURN_WORK
+from tmsim.limits import FRAME_DATA_MAX, IO_SLICE_S, PENDING_SCRIPTS_MAX, POLL_BUDGET_S, SERVE_ITEMS, SERVE_SCAN, TURN_WORK
 from tmsim.protocol.listen_session import FRAME_LIMIT, INPUT_DONE
 
-MAX_PENDING = 1000          # buffered scripts per robot (TCP back-pressure beyond, see server.py)
-POLL_BUDGET_S = 0.004       # backlog turns of one poll stop after this long
-IO_SLICE_S = 0.0003         # between two turns, the sockets are polled for new requests this often
 
 
 class FairInput:
@@ -30,7 +26,7 @@ class FairInput:
         closes the connection right after the frame that reaches its count (its replies are sent first)."""
         key = (robot.index, conn.id)
         robot.session.meter.begin(TURN_WORK)
-        _, outcome = robot.session.process(conn.id, SERVE_ITEMS, SERVE_SCAN, max_waiting=MAX_PENDING,
+        _, outcome = robot.session.process(conn.id, SERVE_ITEMS, SERVE_SCAN, max_waiting=PENDING_SCRIPTS_MAX,
                                            frame_limit=robot.faults.close_after)
         if outcome == INPUT_DONE:
             self._backlog.pop(key, None)
@@ -43,13 +39,13 @@ class FairInput:
             conn.greedy = True
 
     def _buffer_full(self, robot, fraction=1.0) -> bool:
-        """The robot's buffered scripts reach MAX_PENDING or its share of PENDING_BYTES_MAX (times
+        """The robot's buffered scripts reach PENDING_SCRIPTS_MAX or its share of PENDING_BYTES_MAX (times
         ``fraction``). Checked once a turn: one turn may add SERVE_ITEMS frames more."""
         waiting = robot.session.waiting_scripts
-        if waiting >= MAX_PENDING * fraction:
+        if waiting >= PENDING_SCRIPTS_MAX * fraction:
             return True
         limit = self.pending_bytes_limit * fraction
-        return waiting * codec.MAX_DATA >= limit and robot.session.waiting_script_bytes() >= limit
+        return waiting * FRAME_DATA_MAX >= limit and robot.session.waiting_script_bytes() >= limit
 
     def _serve_backlog(self):
         """Turns for the clients with input left over, round robin, until none is left or POLL_BUDGET_S has

@@ -4,11 +4,11 @@
 read, process, write. ``start_background()`` runs the same step in a thread on the wall clock.
 
 Limits (per robot unless noted):
-* frame DATA <= codec.MAX_DATA (64 KiB); longer declared lengths are answered with CPERR 01
-* MAX_CLIENTS simultaneous connections; more are accepted and closed at once
-* MAX_PENDING buffered scripts or their share of PENDING_BYTES_MAX (all robots together); beyond that the
+* frame DATA <= FRAME_DATA_MAX (64 KiB); longer declared lengths are answered with CPERR 01
+* LISTEN_CLIENTS_MAX simultaneous connections; more are accepted and closed at once
+* PENDING_SCRIPTS_MAX buffered scripts or their share of PENDING_BYTES_MAX (all robots together); beyond that the
   server stops reading from that robot's clients (TCP back-pressure) until the buffer is half empty
-* MAX_OUTBOX bytes waiting to be sent to one client, OUTBOX_TOTAL_MAX to all clients of a robot; a client
+* LISTEN_OUTBOX_MAX bytes waiting to be sent to one client, OUTBOX_TOTAL_MAX to all clients of a robot; a client
   that does not read (the one with most waiting, for the total) is dropped
 * fairness: each client's input is processed in bounded turns, floods after the others (tmsim/net/fairness.py);
   CPERR answers to bad packets limited per client (the session, tmsim/protocol/listen_session.py)
@@ -28,20 +28,18 @@ import time
 from tmsim.protocol import codec
 from tmsim.net.control import ControlChannel
 from tmsim.net.ethernet_slave import EthernetSlave
-from tmsim.net.tcp_listener import RECV_SIZE, Listener, receive
+from tmsim.net.tcp_listener import Listener, receive
 from tmsim.robot.eventlog import EventLog, LogFile, text as _text
-from tmsim.net.fairness import IO_SLICE_S, MAX_PENDING, POLL_BUDGET_S, FairInput, is_greedy as _is_greedy
+from tmsim.net.fairness import FairInput, is_greedy as _is_greedy
 from tmsim.robot.faults import FaultState, check_params as check_fault_params
-from tmsim.limits import EVENT_BYTES_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, TURN_WORK
+from tmsim.limits import (EVENT_BYTES_MAX, EVENTS_KEPT_MAX, FRAME_DATA_MAX, IO_SLICE_S, LISTEN_CLIENTS_MAX,
+                          LISTEN_OUTBOX_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, PENDING_SCRIPTS_MAX, POLL_BUDGET_S,
+                          RECV_BYTES, TURN_WORK)
 from tmsim.tmscript.profiles import Profile
 from tmsim.robot.model import RobotModel
 from tmsim.protocol.listen_session import STOPPED, ListenSession
 
-MAX_CLIENTS = 256
-MAX_OUTBOX = 1 << 20
-RBUF_READ_BELOW = codec.MAX_DATA + 64     # a receive buffer this full holds a complete item: process it first
-EVENT_BUDGET = 40_000       # events kept in memory, shared by all robots (the JSONL file gets all, rotated), and at
-                            # most limits.EVENT_BYTES_MAX bytes (tmsim/robot/eventlog.py)
+RBUF_READ_BELOW = FRAME_DATA_MAX + 64     # a receive buffer this full holds a complete item: process it first
 GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
 
@@ -54,7 +52,7 @@ class _Conn:
         self.sock, self.id, self.peer = sock, conn_id, peer
         self.wbuf = bytearray()
         self.eof = False
-        self.greedy = False                     # its last read filled RECV_SIZE, or input is left over
+        self.greedy = False                     # its last read filled RECV_BYTES, or input is left over
         self._session = session
 
     @property
@@ -152,9 +150,9 @@ class SimServer(FairInput):
             raise ValueError(f"speedup must be a positive number, got {speedup}")
         self.host, self.speedup, self.auto_enter = host, speedup, auto_enter
         self.lock = threading.RLock()
-        self.event_limit = event_limit or EVENT_BUDGET // robots    # per robot: all robots together keep <= 40,000
+        self.event_limit = event_limit or EVENTS_KEPT_MAX // robots    # per robot: all robots together keep <= 40,000
         self.event_bytes_limit = EVENT_BYTES_MAX // robots           # per robot: all together keep <= 20 MiB
-        self.pending_bytes_limit = max(4 * codec.MAX_DATA, PENDING_BYTES_MAX // robots)
+        self.pending_bytes_limit = max(4 * FRAME_DATA_MAX, PENDING_BYTES_MAX // robots)
         try:
             self.log_file = LogFile(log_path) if log_path else None
         except OSError as exc:
@@ -410,8 +408,8 @@ class SimServer(FairInput):
             sock, addr = accepted
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            if len(robot.conns) >= MAX_CLIENTS:
-                robot._log("rejected_connection", peer=addr[0], reason=f"more than {MAX_CLIENTS} clients")
+            if len(robot.conns) >= LISTEN_CLIENTS_MAX:
+                robot._log("rejected_connection", peer=addr[0], reason=f"more than {LISTEN_CLIENTS_MAX} clients")
                 sock.close()
                 continue
             conn = _Conn(sock, self._next_conn, addr[0], robot.session)
@@ -440,7 +438,7 @@ class SimServer(FairInput):
                 self.selector.unregister(conn.sock)
                 robot._log("peer_closed", conn=conn.id)
                 return
-            conn.greedy = len(data) == RECV_SIZE
+            conn.greedy = len(data) == RECV_BYTES
             if robot.faults.black_hole:
                 robot._log("black_hole", conn=conn.id, bytes=len(data))
                 return
@@ -489,8 +487,8 @@ class SimServer(FairInput):
             except OSError as exc:
                 self._drop(robot, conn, f"send failed: {exc.strerror}")
                 continue
-            if len(conn.wbuf) > MAX_OUTBOX:
-                self._drop(robot, conn, f"client does not read (more than {MAX_OUTBOX} bytes waiting)")
+            if len(conn.wbuf) > LISTEN_OUTBOX_MAX:
+                self._drop(robot, conn, f"client does not read (more than {LISTEN_OUTBOX_MAX} bytes waiting)")
                 continue
             waiting += len(conn.wbuf)
             if close:

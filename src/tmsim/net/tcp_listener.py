@@ -10,16 +10,14 @@ from __future__ import annotations
 import selectors
 import socket
 
-from tmsim.limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS
-
-RECV_SIZE = 65536                      # bytes taken from one connection per read
+from tmsim.limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS, RECV_BYTES
 
 
 def receive(sock: socket.socket) -> tuple[bytes | None, str | None]:
     """One non-blocking read of an accepted connection: ``(data, None)``; ``(b"", None)`` when the peer closed;
     ``(None, None)`` when nothing is there yet; ``(None, reason)`` when the socket failed."""
     try:
-        return sock.recv(RECV_SIZE), None
+        return sock.recv(RECV_BYTES), None
     except (BlockingIOError, InterruptedError):
         return None, None
     except OSError as exc:

@@ -16,8 +16,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from tmsim.limits import FRAME_DATA_MAX
+
 HEADERS = frozenset({"TMSCT", "TMSTA", "CPERR"})
-MAX_DATA = 65536          # largest DATA accepted; a longer declared length is a packet error (CPERR 01)
 _MAX_HEADER = 8           # characters allowed before the first ',' (real headers have 5)
 _MAX_LENGTH_FIELD = 20    # characters allowed in the LENGTH field
 
@@ -110,8 +111,8 @@ def decode(buf: bytes | bytearray, headers=HEADERS) -> tuple[Frame | Garbage | B
     length = parse_length(bytes(buf[comma1 + 1:comma2]))
     if length is None:
         return BadFrame(CPERR_PACKET, "length is not a non-negative number", bytes(buf[:1])), 1
-    if length > MAX_DATA:
-        return BadFrame(CPERR_PACKET, f"length {length} exceeds the limit of {MAX_DATA} bytes", bytes(buf[:1])), 1
+    if length > FRAME_DATA_MAX:
+        return BadFrame(CPERR_PACKET, f"length {length} exceeds the limit of {FRAME_DATA_MAX} bytes", bytes(buf[:1])), 1
     data_end = comma2 + 1 + length
     total = data_end + 6                       # ",*" + 2 checksum digits + CR LF
     if len(buf) < total:

@@ -24,7 +24,7 @@ import math
 import struct
 from dataclasses import dataclass
 
-MAX_STRING = 256          # bytes in a written string value; longer is status 07 (our limit, the manual gives none)
+from tmsim.limits import SVR_ARRAY_MAX, SVR_STRING_MAX
 
 _WIDTH = {"bool": 1, "byte": 1, "int": 4, "float": 4}
 _PACK = {"bool": "B", "byte": "B", "int": "i", "float": "f"}
@@ -111,8 +111,8 @@ def check_value(item: Item, value):
 def _scalar(item, value):
     kind = item.type
     if kind == "string":
-        if not isinstance(value, str) or len(value.encode("utf-8")) > MAX_STRING:
-            raise SvrValueError(f"{item.name} needs a text of at most {MAX_STRING} bytes")
+        if not isinstance(value, str) or len(value.encode("utf-8")) > SVR_STRING_MAX:
+            raise SvrValueError(f"{item.name} needs a text of at most {SVR_STRING_MAX} bytes")
         return value
     if isinstance(value, bool):
         value = int(value)
@@ -339,7 +339,6 @@ def split_json(content: str, with_values: bool) -> list[tuple[str, object]]:
 # knows only the variables declared to it (start-up option --svr-var, SvrSession.declare). TMflow names them
 # g_<name> (the manual's example item g_ss, string[]); the simulator does not insist on the prefix.
 VARIABLE_TYPES = ("bool", "byte", "int", "float", "string")
-VARIABLE_SIZE_MAX = 1024                 # elements of an array variable (our limit, the manual gives none)
 VARIABLE_ACCESS = {"rw": "MA", "auto": "A", "ro": ""}   # write in manual and auto mode / auto only / read only
 
 
@@ -352,8 +351,8 @@ def variable_item(name: str, kind: str, size: int = 1, access: str = "rw") -> It
         raise SvrValueError(f"variable name {name!r} is a predefined item of the data table")
     if kind not in VARIABLE_TYPES:
         raise SvrValueError(f"variable {name}: type {str(kind)[:20]!r} is not one of {', '.join(VARIABLE_TYPES)}")
-    if isinstance(size, bool) or not isinstance(size, int) or not 1 <= size <= VARIABLE_SIZE_MAX:
-        raise SvrValueError(f"variable {name}: array size must be 1..{VARIABLE_SIZE_MAX}, got {size!r}")
+    if isinstance(size, bool) or not isinstance(size, int) or not 1 <= size <= SVR_ARRAY_MAX:
+        raise SvrValueError(f"variable {name}: array size must be 1..{SVR_ARRAY_MAX}, got {size!r}")
     if access not in VARIABLE_ACCESS:
         raise SvrValueError(f"variable {name}: access {str(access)[:20]!r} is not one of {', '.join(VARIABLE_ACCESS)}")
     return Item(name, kind, size, VARIABLE_ACCESS[access])

@@ -25,10 +25,8 @@ from __future__ import annotations
 import math
 import re
 
-JOBS_MAX = 64                   # jobs per robot
-OBJECTS_MAX = 64                # objects one job finds
-SECONDS_MAX = 60.0              # the longest job
-POSE_LIMIT = 100_000.0          # mm / deg, as the library's range for a pose
+from tmsim.limits import VISION_JOBS_MAX, VISION_OBJECTS_MAX, VISION_POSE_MAX, VISION_SECONDS_MAX
+
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,47}\Z")
 
 
@@ -55,15 +53,15 @@ class Camera:
 
     def define(self, name, objects=(), passed=True, seconds=0.2, capture=None, variable=None) -> dict:
         name = _name(name, "job name")
-        if name not in self.jobs and len(self.jobs) >= JOBS_MAX:
-            raise ValueError(f"at most {JOBS_MAX} vision jobs per robot")
-        if not isinstance(objects, (list, tuple)) or len(objects) > OBJECTS_MAX:
-            raise ValueError(f"'objects' must be a list of at most {OBJECTS_MAX} poses")
+        if name not in self.jobs and len(self.jobs) >= VISION_JOBS_MAX:
+            raise ValueError(f"at most {VISION_JOBS_MAX} vision jobs per robot")
+        if not isinstance(objects, (list, tuple)) or len(objects) > VISION_OBJECTS_MAX:
+            raise ValueError(f"'objects' must be a list of at most {VISION_OBJECTS_MAX} poses")
         poses = [_pose(p, f"object {i}") for i, p in enumerate(objects)]
         if not isinstance(passed, bool):
             raise ValueError("'pass' must be true or false")
-        if isinstance(seconds, bool) or not isinstance(seconds, (int, float)) or not 0 <= seconds <= SECONDS_MAX:
-            raise ValueError(f"'seconds' must be 0 .. {SECONDS_MAX:g}, got {seconds!r}")
+        if isinstance(seconds, bool) or not isinstance(seconds, (int, float)) or not 0 <= seconds <= VISION_SECONDS_MAX:
+            raise ValueError(f"'seconds' must be 0 .. {VISION_SECONDS_MAX:g}, got {seconds!r}")
         joints = None if capture is None else _pose(capture, "capture point")
         variable = f"{name}_Base_TM" if variable is None else _name(variable, "output variable")
         self.jobs[name] = VisionJob(name, poses, passed, float(seconds), joints, variable)
@@ -129,8 +127,8 @@ def _pose(value, what) -> tuple:
     if not isinstance(value, (list, tuple)) or len(value) != 6:
         raise ValueError(f"{what} must be 6 numbers, got {repr(value)[:40]}")
     for v in value:
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or abs(v) > POSE_LIMIT:
-            raise ValueError(f"{what}: {v!r} is not a finite number within +-{POSE_LIMIT:g}")
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or abs(v) > VISION_POSE_MAX:
+            raise ValueError(f"{what}: {v!r} is not a finite number within +-{VISION_POSE_MAX:g}")
     return tuple(float(v) for v in value)
 
 

@@ -11,12 +11,11 @@ from collections import deque
 
 from tmsim.robot import kinematics as kin
 from tmsim.robot.motion import MotionError, MotionRequest, Planner
-from tmsim.limits import WORK_PLAN, WORK_PVT_CARTESIAN
+from tmsim.limits import FIFO_ITEMS_MAX, WORK_PLAN, WORK_PVT_CARTESIAN
 from tmsim.robot.errors import classify
 from tmsim.tmscript.work import WorkMeter
 
 HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)
-FIFO_LIMIT = 1000       # queued items (motions, tags, settings) per robot; a script waits while it is full
 _MATRICES: dict[tuple, list] = {}          # pose -> matrix of bases and tools in use (never modified)
 IDENTITY_POSE = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
@@ -80,8 +79,8 @@ class RobotModel:
 
     @property
     def has_room(self) -> bool:
-        """False while the FIFO holds FIFO_LIMIT items (bounded memory; the script queueing more waits)."""
-        return len(self.fifo) < FIFO_LIMIT
+        """False while the FIFO holds FIFO_ITEMS_MAX items (bounded memory; the script queueing more waits)."""
+        return len(self.fifo) < FIFO_ITEMS_MAX
 
     @property
     def idle(self):
