@@ -80,8 +80,8 @@ _PIECES = json.JSONEncoder(allow_nan=False, ensure_ascii=False)
 class ControlChannel:
     def __init__(self, server, host="127.0.0.1", port=0):
         self.server = server
-        server._dispatch["control_listen"] = self._accept
-        server._dispatch["control_conn"] = self._serve_client
+        server.handle("control_listen", self._accept)
+        server.handle("control_conn", self._serve_client)
         self.listener = Listener(server.selector, host, port, ("control_listen", None, None),
                                  "open the control channel on {where}")
         self.host = host
@@ -92,7 +92,7 @@ class ControlChannel:
         self._commands = {
             "ping": lambda robot, req: "pong",
             "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.state,
-                                           "svr_port": getattr(r, "svr_port", None)} for r in server.robots],
+                                           "svr_port": r.svr_port} for r in server.robots],
             "state": lambda robot, req: self._state(robot),
             "events": self._events,
             "enter_listen_node": lambda robot, req: robot.enter_listen_node(),
@@ -114,7 +114,7 @@ class ControlChannel:
 
     # ---- sockets ------------------------------------------------------------------------------
     def _accept(self, _robot, _conn):
-        accepted = self.listener.accept(self.server._now, self.server._log_server, prefix="control_")
+        accepted = self.listener.accept(self.server.now, self.server.log_server, prefix="control_")
         if accepted is None:
             return
         sock, _addr = accepted
@@ -164,7 +164,7 @@ class ControlChannel:
             if end < 0:
                 if len(client.rbuf) > CONTROL_LINE_MAX:
                     client.closing = True
-                    self.server._log_server("control_closed", reason="request line too long")
+                    self.server.log_server("control_closed", reason="request line too long")
                     self._answer(client, _error(f"request line longer than {CONTROL_LINE_MAX} bytes; "
                                                 f"connection closed"))
                 break
@@ -176,7 +176,7 @@ class ControlChannel:
             del client.rbuf[:end + 1]
             if len(line) > CONTROL_LINE_MAX:
                 client.closing = True
-                self.server._log_server("control_closed", reason="request line too long")
+                self.server.log_server("control_closed", reason="request line too long")
                 answer = _error(f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed")
             else:
                 answer = self.execute(line)
@@ -204,7 +204,7 @@ class ControlChannel:
                 self.backlog.pop(sock, None)
             else:
                 self._turn(client)
-                self.server._breathe()          # the robots' sockets are served between two turns
+                self.server.breathe()          # the robots' sockets are served between two turns
 
     @property
     def has_backlog(self) -> bool:
@@ -271,7 +271,7 @@ class ControlChannel:
     def _close(self, sock, reason=None):
         self.backlog.pop(sock, None)
         if self.clients.pop(sock, None) is not None and reason:
-            self.server._log_server("control_closed", reason=reason)
+            self.server.log_server("control_closed", reason=reason)
         try:
             self.server.selector.unregister(sock)
         except (KeyError, ValueError):
@@ -324,9 +324,8 @@ class ControlChannel:
                                    or not math.isfinite(period)):
             raise RequestError(f"'period' must be a finite number of seconds, got {_show(period)}")
         with self.server.lock:
-            robot.svr.configure(items, mode, period)
-            if "write_permission" in request:
-                robot.svr.write_permission = _bool_field(request, "write_permission", True)
+            permission = _bool_field(request, "write_permission", True) if "write_permission" in request else None
+            robot.svr.configure(items, mode, period, write_permission=permission)
         return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
                 "write_permission": robot.svr.write_permission}
 
@@ -468,7 +467,7 @@ def _params(request) -> dict:
 
 
 def _svr(robot):
-    source = getattr(robot, "svr_source", None)
+    source = robot.svr_source
     if source is None:
         raise RequestError("the Ethernet Slave is not running (simulator started with --no-svr)")
     return source

@@ -38,8 +38,8 @@ class EthernetSlave:
         self.server = server
         self.listeners = []
         self._next_conn = 1
-        server._dispatch["svr_listen"] = self._accept
-        server._dispatch["svr_conn"] = self._read
+        server.handle("svr_listen", self._accept)
+        server.handle("svr_conn", self._read)
         try:
             for robot in server.robots:
                 robot.svr_source = RobotDataSource(robot, robot._log)
@@ -61,7 +61,7 @@ class EthernetSlave:
     def poll(self, now):
         """Stream the data tables that are due and send what is waiting (called by SimServer.poll)."""
         for robot in self.server.robots:
-            if getattr(robot, "svr_listener", None) is not None:
+            if robot.svr_listener is not None:
                 robot.svr_listener.tick(now)
             if robot.svr.clients:
                 robot.svr.advance(now)
@@ -69,7 +69,7 @@ class EthernetSlave:
 
     def _accept(self, _none, robot):
         for _ in range(16):
-            accepted = robot.svr_listener.accept(self.server._now, robot._log, prefix="svr_")
+            accepted = robot.svr_listener.accept(self.server.now, robot._log, prefix="svr_")
             if accepted is None:
                 return
             sock, addr = accepted
@@ -172,7 +172,7 @@ class EthernetSlave:
 
     def close(self):
         for robot in self.server.robots:
-            for conn in list(getattr(robot, "svr_conns", {}).values()):
+            for conn in list(robot.svr_conns.values()):
                 self._drop(robot, conn, "simulator closed")
         for listener in self.listeners:
             listener.close()

@@ -33,7 +33,7 @@ class FairInput:
         elif outcome == FRAME_LIMIT:
             robot.faults.close_after = None
             self._flush(robot)
-            self._drop(robot, conn, "fault: close_after")
+            self.drop(robot, conn, "fault: close_after")
         else:
             self._backlog[key] = (robot, conn)
             conn.greedy = True

@@ -78,6 +78,14 @@ class Robot(EventLog):
         self.port_hold = None                  # the Listen-node port, bound but not listening while it is closed
         self.conns: dict[int, _Conn] = {}
         self.reading_paused = False
+        # The robot's Ethernet Slave service (tmsim/net/ethernet_slave.py fills it in when the server runs one;
+        # all stay None / empty with --no-svr): the data table's values, the sans-I/O session, its connections,
+        # its listening socket and port.
+        self.svr_source = None
+        self.svr = None
+        self.svr_conns: dict = {}
+        self.svr_listener = None
+        self.svr_port = None
 
     # ---- control ------------------------------------------------------------------------------
     def enter_listen_node(self):
@@ -91,12 +99,12 @@ class Robot(EventLog):
     def stop_project(self):
         with self._server.lock:
             self.session.stop_project()
-            self._server._close_robot_sockets(self)
+            self._server.close_robot_sockets(self)
 
     def start_project(self, enter_node=None):
         with self._server.lock:
             self.session.start_project(enter_node=False)
-            self._server._listen(self)
+            self._server.open_port(self)
             if self._server.auto_enter if enter_node is None else enter_node:
                 self.session.enter_node()
 
@@ -113,10 +121,10 @@ class Robot(EventLog):
                 self.stop_project()
             elif fault == "refuse_connections":
                 self.faults.arm(fault, **params)
-                self._server._apply_refuse(self)
+                self._server.apply_refuse(self)
             elif fault == "disconnect":
                 for conn in list(self.conns.values()):
-                    self._server._drop(self, conn, "fault: disconnect")
+                    self._server.drop(self, conn, "fault: disconnect")
             else:
                 self.faults.arm(fault, **params)
             self._log("fault", fault=fault, params=params)
@@ -127,7 +135,7 @@ class Robot(EventLog):
             self.faults = FaultState()
             self.faults.adopt(held)          # frames already held back still leave at their time
             self.session.clear_reply_errors()
-            self._server._apply_refuse(self)
+            self._server.apply_refuse(self)
             self._log("fault", fault="cleared", params={})
 
     def state(self) -> dict:
@@ -165,7 +173,7 @@ class SimServer(FairInput):
         self._thread = None
         self._stop = threading.Event()
         self._now = 0.0
-        self._dispatch = {"listen": self._accept, "conn": self._read}
+        self._dispatch = {"listen": self._accept, "conn": self._read}     # selector key kind -> handler (see handle)
         self._touched: list[Robot] = []       # robots that received data and still have to advance
         self._backlog: dict[tuple, tuple] = {}    # (robot index, conn id) -> (robot, conn) with input left over
         self._starting = False
@@ -187,7 +195,7 @@ class SimServer(FairInput):
         with self.lock:
             try:
                 for robot in self.robots:
-                    self._listen(robot)
+                    self.open_port(robot)
                 if self._control_port is not None:
                     self.control = ControlChannel(self, self._control_host, self._control_port)
                 if self._svr[0] is not None:
@@ -198,7 +206,7 @@ class SimServer(FairInput):
             self.started = True
         return self
 
-    def _listen(self, robot):
+    def open_port(self, robot):
         if robot.listener is not None or robot.faults.refuse:
             return
         held, robot.port_hold = robot.port_hold, None
@@ -212,19 +220,31 @@ class SimServer(FairInput):
         robot.port_hold = robot.listener.close(hold_port=hold_port)
         robot.listener = None
 
-    def _log_server(self, kind, **fields):
+    def handle(self, kind: str, handler):
+        """Serve the selector keys of ``kind`` with ``handler(robot, conn)``: how a port's TCP adapter (Ethernet
+        Slave, control channel) joins the server's one selector and clock."""
+        if kind in self._dispatch:
+            raise ValueError(f"selector key kind {kind!r} is already served")
+        self._dispatch[kind] = handler
+
+    @property
+    def now(self) -> float:
+        """The robot clock (s) of the poll in progress."""
+        return self._now
+
+    def log_server(self, kind, **fields):
         """An event of the server as a whole (control channel): logged in robot 0's log."""
         self.robots[0]._log(kind, **fields)
 
-    def _apply_refuse(self, robot):
+    def apply_refuse(self, robot):
         if robot.faults.refuse and robot.listener is not None:
             self._close_listener(robot)
         elif not robot.faults.refuse and robot.listener is None and robot.session.state != STOPPED:
-            self._listen(robot)
+            self.open_port(robot)
 
-    def _close_robot_sockets(self, robot, reason="project stopped"):
+    def close_robot_sockets(self, robot, reason="project stopped"):
         for conn in list(robot.conns.values()):
-            self._drop(robot, conn, reason)
+            self.drop(robot, conn, reason)
         if robot.listener is not None:
             self._close_listener(robot)
 
@@ -232,7 +252,7 @@ class SimServer(FairInput):
         self.stop()
         with self.lock:
             for robot in self.robots:
-                self._close_robot_sockets(robot, "simulator closed")
+                self.close_robot_sockets(robot, "simulator closed")
                 if robot.port_hold is not None:
                     robot.port_hold.close()
                     robot.port_hold = None
@@ -292,7 +312,7 @@ class SimServer(FairInput):
                 self._advance(robot)
                 if session.has_output() and not robot.faults.active:
                     self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
-                self._breathe()
+                self.breathe()
             if self.svr is not None:
                 self.svr.poll(self._now)
             if self.control is not None:
@@ -305,7 +325,7 @@ class SimServer(FairInput):
             for robot in self.robots:
                 self._flush(robot)
                 if robot.session.state == STOPPED and (robot.listener is not None or robot.conns):
-                    self._close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
+                    self.close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
                 if robot.reading_paused and not self._buffer_full(robot, 0.5):
                     self._set_reading(robot, True)
             if self.manage_gc:
@@ -316,7 +336,7 @@ class SimServer(FairInput):
         return bool(self._backlog) or (self.control is not None and self.control.has_backlog) or \
             any(robot.session.has_turn_work for robot in self.robots)
 
-    def _breathe(self, budgeted=False):
+    def breathe(self, budgeted=False):
         """Between two pieces of work: serve the sockets when IO_SLICE_S has passed since they were
         served. ``budgeted``: not after POLL_BUDGET_S (work that new requests extend - a flood of
         requests must not hold the clock)."""
@@ -370,7 +390,7 @@ class SimServer(FairInput):
                 if robot is None or conn is None:
                     raise
                 robot._log("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
-                self._drop(robot, conn, "internal error while handling this client")
+                self.drop(robot, conn, "internal error while handling this client")
             if robot is not None:
                 if robot not in self._touched:
                     self._touched.append(robot)
@@ -396,7 +416,7 @@ class SimServer(FairInput):
                 robot = self._touched.pop(0)
                 self._advance(robot)
                 self._flush(robot)
-                self._breathe(budgeted=True)
+                self.breathe(budgeted=True)
         finally:
             self._starting = False
 
@@ -429,7 +449,7 @@ class SimServer(FairInput):
         if robot.session.input_bytes(conn.id) < RBUF_READ_BELOW:    # else: what is buffered goes first (fairness)
             data, failed = receive(conn.sock)
             if failed:
-                self._drop(robot, conn, failed)
+                self.drop(robot, conn, failed)
                 return
             if data is None:
                 return
@@ -485,28 +505,28 @@ class SimServer(FairInput):
                 if conn.wbuf:
                     del conn.wbuf[:_send(conn.sock, conn.wbuf)]
             except OSError as exc:
-                self._drop(robot, conn, f"send failed: {exc.strerror}")
+                self.drop(robot, conn, f"send failed: {exc.strerror}")
                 continue
             if len(conn.wbuf) > LISTEN_OUTBOX_MAX:
-                self._drop(robot, conn, f"client does not read (more than {LISTEN_OUTBOX_MAX} bytes waiting)")
+                self.drop(robot, conn, f"client does not read (more than {LISTEN_OUTBOX_MAX} bytes waiting)")
                 continue
             waiting += len(conn.wbuf)
             if close:
-                self._drop(robot, conn, "fault: close_mid_frame")
+                self.drop(robot, conn, "fault: close_mid_frame")
             elif conn.eof and not conn.wbuf and not robot.faults.holding(conn_id) and \
                     not robot.session.has_work_for(conn_id):
-                self._drop(robot, conn, "peer closed its side")
+                self.drop(robot, conn, "peer closed its side")
         if only is not None:
             return
         for conn in [c for c in robot.conns.values() if not robot.session.is_connected(c.id)]:
-            self._drop(robot, conn, "session ended")
+            self.drop(robot, conn, "session ended")
         while waiting > OUTBOX_TOTAL_MAX:             # e.g. a large ListenSend to many clients that do not read
             laziest = max(robot.conns.values(), key=lambda c: len(c.wbuf))
             waiting -= len(laziest.wbuf)
-            self._drop(robot, laziest, f"client does not read (its robot's clients have more than "
+            self.drop(robot, laziest, f"client does not read (its robot's clients have more than "
                                        f"{OUTBOX_TOTAL_MAX} bytes waiting)")
 
-    def _drop(self, robot, conn, reason):
+    def drop(self, robot, conn, reason):
         if robot.conns.pop(conn.id, None) is None:
             return
         if not conn.eof:

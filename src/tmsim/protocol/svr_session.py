@@ -77,8 +77,9 @@ class SvrSession:
         self.corrupt = 0          # fault "corrupt_checksum": this many more frames leave with a wrong checksum
         self.refuse = 0           # fault "refuse_writes": every well-formed write is answered with this status
 
-    def configure(self, items=None, mode=None, period=None):
-        """Set the streamed data table (TransmitFile, §17.2): items in order, mode 1/2/3, period in s (0 = off)."""
+    def configure(self, items=None, mode=None, period=None, write_permission=None):
+        """Set the streamed data table (TransmitFile, §17.2): items in order, mode 1/2/3, period in s (0 = off);
+        ``write_permission`` False refuses every write (status 02). None keeps what is set."""
         items = list(self.stream_items if items is None else items)
         mode = self.stream_mode if mode is None else mode
         period = self.period if period is None else period
@@ -93,6 +94,8 @@ class SvrSession:
             items.remove("Robot_Link")
         self.stream_items = ["Robot_Link", *dict.fromkeys(items)]
         self.stream_mode, self.period = mode, period
+        if write_permission is not None:
+            self.write_permission = bool(write_permission)
 
     def declare(self, item: Item, value=None):
         """Add (or redeclare) a global variable of the robot's project (``svr_table.variable_item`` /
