@@ -19,3 +19,54 @@ def check_controls(b, ids):
         assert w >= 34 and h >= 34, (name, w, h)
         assert font >= 14, (name, font)
         assert contrast >= 4.5, (name, contrast)
+
+
+# Every visible control, text and lamp of the page, measured as the operator meets them. A control's touch area is
+# the control with its label when tapping the label works the control (a check box and its <label for>). A text's
+# contrast is taken with the opacity of its ancestors blended in (a dimmed button reads as dim as it looks). Canvas
+# drawings are not in the DOM; the robot view's tests measure their texts themselves.
+PAGE_METRICS = """
+    const rgba = (c) => { const v = (c.match(/[\\d.]+/g) || ['0', '0', '0', '0']).map(Number);
+      return [v[0], v[1], v[2], v.length > 3 ? v[3] : 1]; };
+    const lum = (v) => { const l = v.slice(0, 3).map((x) => x / 255)
+      .map((x) => (x <= 0.03928 ? x / 12.92 : ((x + 0.055) / 1.055) ** 2.4)); return 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2]; };
+    const mix = (top, under, a) => top.slice(0, 3).map((x, i) => a * x + (1 - a) * under[i]);
+    const background = (el) => { for (; el; el = el.parentElement) { const c = rgba(getComputedStyle(el).backgroundColor);
+      if (c[3] > 0) return c; } return [255, 255, 255, 1]; };
+    const opacity = (el) => { let o = 1; for (; el; el = el.parentElement) o *= parseFloat(getComputedStyle(el).opacity); return o; };
+    const shown = (el) => { if (!el.getClientRects().length || el.closest('dialog:not([open])')) return false;
+      const r = el.getBoundingClientRect(), s = getComputedStyle(el);
+      return r.width > 0 && r.height > 0 && s.visibility !== 'hidden'; };
+    const name = (el) => el.id || el.dataset.path || el.dataset.status || (el.className && el.className.baseVal !== undefined ?
+      el.className.baseVal : el.className) || el.tagName.toLowerCase();
+    const out = { small: [], text: [], contrast: [] };
+    const controls = 'button, a, input, select';   // alarm rows: see style.css, .alarm-list
+    for (const el of document.querySelectorAll(controls)) {
+      if (!shown(el)) continue;
+      let r = el.getBoundingClientRect();
+      const label = el.id && el.type === 'checkbox' && document.querySelector(`label[for="${el.id}"]`);
+      if (label) { const l = label.getBoundingClientRect();
+        r = { width: Math.max(r.right, l.right) - Math.min(r.left, l.left), height: Math.max(r.bottom, l.bottom) - Math.min(r.top, l.top) }; }
+      if (r.width < 34 - 0.5 || r.height < 34 - 0.5) out.small.push([name(el), Math.round(r.width), Math.round(r.height)]);
+    }
+    const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+    const seen = new Set();
+    for (let t = walker.nextNode(); t; t = walker.nextNode()) {
+      const el = t.parentElement;
+      if (!t.textContent.trim() || seen.has(el) || !el || ['SCRIPT', 'STYLE', 'OPTION', 'NOSCRIPT'].includes(el.tagName)) continue;
+      seen.add(el);
+      if (!shown(el)) continue;
+      const s = getComputedStyle(el), size = parseFloat(s.fontSize);
+      if (size < 14 - 0.01) out.text.push([name(el), t.textContent.trim().slice(0, 30), size]);
+      const under = background(el), svg = el instanceof SVGElement;
+      const fg = rgba(svg ? s.fill : s.color), shownFg = mix(mix(fg, under, fg[3]), under, opacity(el));
+      const a = lum(shownFg), b = lum(under), ratio = (Math.max(a, b) + 0.05) / (Math.min(a, b) + 0.05);
+      if (ratio < 4.5) out.contrast.push([name(el), t.textContent.trim().slice(0, 30), Math.round(ratio * 100) / 100]);
+    }
+    return out;"""
+
+
+def page_metrics(b) -> dict:
+    """The panel rules' violations on the page shown: {"small": [(name, w, h)], "text": [(name, text, px)],
+    "contrast": [(name, text, ratio)]}; all three empty on a page an operator can use."""
+    return b.driver.execute_script(PAGE_METRICS)

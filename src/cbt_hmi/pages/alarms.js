@@ -155,12 +155,10 @@ function robotTile(container) {
       <tr><td>Robot error</td><td id="robot-error" data-invalid></td></tr>
       <tr><td>Safety / mode</td><td id="robot-safety" data-invalid></td></tr>
       <tr><td>Link</td><td id="robot-link" data-invalid></td></tr></table>
-    <div class="buttons"><button id="btn-project-play">Play</button>
-      <button id="btn-project-stop">Stop Project</button>
+    <div class="buttons"><button id="btn-project-play">Play</button><button id="btn-alarm-ack-all">Acknowledge all</button>
+      <button id="btn-project-stop">Stop Project</button><button id="btn-alarm-history">History</button>
       <button id="btn-back-to-node" hidden>Back to Listen Node</button></div></div>
-    <div class="alarms-head">Alarms <button id="btn-alarm-ack-all">Acknowledge all</button>
-      <button id="btn-alarm-history">History</button></div>
-    <div class="alarm-list"><table id="alarm-history"></table></div>
+    <div class="alarm-list" aria-label="Alarms"><table id="alarm-history"></table></div>
     <dialog id="alarm-log-dialog"><header><h1>Alarm history (controller time, newest first)</h1></header>
       <div class="body"><table id="alarm-log"></table></div>
       <div class="actions"><button id="btn-alarm-history-close">Close</button></div></dialog>`;

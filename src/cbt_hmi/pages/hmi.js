@@ -412,7 +412,7 @@ function frame(title, isMain) {
   document.title = "CBT HMI – " + title;
   document.body.innerHTML = `<div class="panel">
     <header>${isMain ? "" : '<a class="menu" id="btn-menu" href="index.html">◀ Main Menu</a>'}
-      <h1>${title}</h1><span class="pill ${ACCESS.role === "monitor" ? "off" : "on"}" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span></header>
+      <h1>${title}</h1><span class="pill" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span></header>
     <main id="main"></main><div id="message">${ACCESS.role === "monitor" ?
       "Monitor mode (read only): open the operator address printed at start-up to operate." : "Ready."}</div></div>`;
   alarmBanner(document.querySelector(".panel"));
@@ -434,7 +434,7 @@ function mainPage() {
   robotTile(document.getElementById("robotview"));
   document.querySelector("header h1").insertAdjacentHTML("afterend",
     '<a class="menu" id="nav-jog" href="jog.html">Jog / Teach</a>' +
-    '<a class="menu" id="nav-program" href="program.html">Program (Ladder)</a>');
+    '<a class="menu" id="nav-program" href="program.html">Ladder</a>');
   startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", ...ROBOT_STATUS, ...ROBOT_TILE_VARS]);
 }
 
@@ -539,7 +539,7 @@ async function fbPage(key) {
   buttons.append(exec);
   if (key === "connect") {
     const off = document.createElement("button");
-    off.className = "danger"; off.id = "btn-disconnect"; off.textContent = "Disconnect";
+    off.id = "btn-disconnect"; off.textContent = "Disconnect";
     off.onclick = async () => {
       try { await api("/api/write", { values: { Connect_Execute: false } }); message("Disconnect: the PLC closes the connection to the robot.", "ok"); }
       catch (e) { message("Disconnect: " + e.message, "error"); }
@@ -602,7 +602,8 @@ async function boot() {
     return;
   }
   document.body.dataset.role = ACCESS.role;
-  if (key === "main") mainPage();
+  if (MAP.custom_pages && MAP.custom_pages[key]) customPage(key);    // custom.js: a page description file
+  else if (key === "main") (MAP.variables.Connect_Connected ? mainPage() : customIndexPage());
   else if (key === "pnp") pnpPage();
   else if (key === "jog") jogPage();
   else if (key === "program") programPage();

@@ -17,10 +17,11 @@ const JOG_STYLE = `
 .jog { display: grid; grid-template-columns: 380px 1fr; gap: 10px; }
 .jog fieldset { border: 1px solid #8895a3; border-radius: 4px; padding: 4px 8px; margin: 0 0 6px 0; }
 .jog .frames button { min-width: 70px; height: 36px; }
-.jog .frames button[aria-pressed="true"] { background: #2368a8; color: #fff; }
+.jog .frames button[aria-pressed="true"] { background: #3c4650; color: #fff; font-weight: bold; }
 .jog .axes { display: grid; grid-template-columns: 60px 90px 90px 1fr; gap: 4px 8px; align-items: center; }
 .jog .axes button { height: 36px; font-size: 18px; touch-action: none; user-select: none; }
-.jog .axes button.held { background: #2368a8; color: #fff; }
+.jog .axes button.held { background: #3c4650; color: #fff; }
+.jog .indicators { grid-template-columns: repeat(4, minmax(0, 1fr)); }
 .jog .teach-row { display: flex; gap: 6px; align-items: center; margin-bottom: 4px; }
 .jog .teach-row input, .jog .teach-row select { height: 34px; font-size: 14px; }
 .jog table.points { border-collapse: collapse; font-size: 14px; width: 100%; }
@@ -149,11 +150,11 @@ function jogPage() {
       ${JOG_FRAMES.map((f) => `<button type="button" id="jog-frame-${f}" data-frame="${f}">${f.slice(3)}</button>`).join("")}
       </div></fieldset>
       <fieldset><legend>Hold to jog (<span id="jog-unit"></span>) — speed
-        <input id="jog-velocity" type="number" min="1" max="100" step="1" value="10" style="width:60px"> %</legend>
+        <input id="jog-velocity" type="number" min="1" max="100" step="1" value="10" style="width:64px;height:34px;font:inherit"> %</legend>
         <div class="axes" id="jog-axes"></div></fieldset>
       <div class="indicators"><span data-status="Jog_Busy" class="lamp active">Busy</span>
         <span data-status="Jog_Active" class="lamp active">Moving</span>
-        <span data-status="Jog_Error" class="lamp">Error</span>
+        <span data-status="Jog_Error" class="lamp error">Error</span>
         <span data-status="Robot_Stopping" class="lamp stopping">Stopping</span></div></div>
     <div><fieldset><legend>Teach the robot's position</legend><div class="teach-row">
       Point <select id="teach-index">${options}</select>

@@ -66,7 +66,7 @@ function buildPnP() {
       <div class="buttons">
       <button class="primary" id="btn-execute" disabled>Start</button><button id="btn-stop" disabled>End Cycle</button>
       <button id="btn-reset" disabled>Reset</button><button id="btn-preset">Preset Values</button>
-      <button class="warn" id="btn-pause">Pause</button><button id="btn-resume">Resume</button></div>
+      <button id="btn-pause">Pause</button><button id="btn-resume">Resume</button></div>
     <div id="pnp-status"></div></div>
     <dialog id="seg-dialog"><header><h1 id="seg-title">Segment</h1></header><div class="body" id="seg-body"></div>
       <div class="actions"><button id="seg-cancel">Cancel</button><button class="primary" id="seg-apply">Apply</button></div></dialog>`;

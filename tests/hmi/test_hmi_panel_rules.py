@@ -1,0 +1,97 @@
+"""Every HMI page in headless Chromium at 800x480 (the 9-inch panel) and 1280x800 (a 12-inch panel), as engineer and
+as operator, against a fake PLC: controls at least 34x34 px, text at least 14 px, contrast at least 4.5:1
+(STYLE.md, HMI), the panel filling the screen without black bands, and grey for every normal state (ISA-101).
+The screenshots go to artifacts/screenshots/panel_<page>_<role>_<size>.png."""
+from __future__ import annotations
+
+import pytest
+
+from fake_plc import FakePlc, command_program, scanning, serving
+from panel_metrics import page_metrics
+from cbt_hmi.web.mapping import Mapping
+
+PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "setoutput", "stop",
+         "pnp", "jog"]
+SIZES = [(800, 480), (1280, 800)]
+
+# the chroma (max - min of R, G, B) above which a background counts as coloured rather than grey
+GREY_CHROMA = 40
+NORMAL_STATE_ELEMENTS = ("#pill-role, #pill-robot, #pill-plc, #message, header a.menu, .area .tiles a, "
+                         "button:not(#btn-execute.danger), .lamp, .led")
+
+COLOURS = """
+    const rgba = (c) => (c.match(/[\\d.]+/g) || []).map(Number);
+    const out = [];
+    for (const el of document.querySelectorAll(arguments[0])) {
+      if (!el.getClientRects().length) continue;
+      const c = rgba(getComputedStyle(el).backgroundColor);
+      if (c.length > 3 && c[3] === 0) continue;
+      const chroma = Math.max(c[0], c[1], c[2]) - Math.min(c[0], c[1], c[2]);
+      if (chroma > arguments[1]) out.push([el.id || el.className || el.tagName, el.textContent.trim().slice(0, 30),
+        getComputedStyle(el).backgroundColor]);
+    }
+    return out;"""
+
+
+@pytest.fixture(scope="module")
+def stack(chromium):
+    mapping = Mapping.load()
+    with scanning(FakePlc(mapping, command_program)) as plc, serving(plc, mapping) as server:
+        with plc.lock:                 # a robot in its normal state: connected, in its Listen node, project running
+            plc.vars["Connect_Execute"] = True
+            plc.vars["Robot_InListenNode"] = True
+            plc.vars["ReadPos_Valid"] = True
+            plc.vars["RobotStatus_Valid"] = True
+            plc.vars["RobotStatus"]["ProjectRunning"] = True
+        yield plc, server, chromium
+    chromium._fit()
+
+
+def open_sized(stack, name: str, role: str, size):
+    _, server, browser = stack
+    d = browser.driver
+    dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
+    d.set_window_size(size[0] + dw, size[1] + dh)
+    d.get("about:blank")            # a new load: an address differing only in its #key= would not reload the page
+    browser.open(server.page_url(name, role))
+    role_shown = d.find_element("id", "pill-role").text
+    assert role_shown == role.capitalize(), role_shown
+    assert d.execute_script("return [innerWidth, innerHeight]") == list(size)
+    return browser
+
+
+@pytest.mark.parametrize("size", SIZES, ids=["800x480", "1280x800"])
+@pytest.mark.parametrize("role", ["engineer", "operator"])
+@pytest.mark.parametrize("name", PAGES)
+def test_every_page_meets_the_panel_rules(stack, name, role, size):
+    browser = open_sized(stack, name, role, size)
+    browser.wait_for(lambda d: d.execute_script("return document.querySelectorAll('[data-status]').length > 0"),
+                     "the page's status values")
+    browser.screenshot(f"panel_{name}_{role}_{size[0]}x{size[1]}")
+    found = page_metrics(browser)
+    assert found["small"] == [], f"controls under 34x34 px: {found['small']}"
+    assert found["text"] == [], f"text under 14 px: {found['text']}"
+    assert found["contrast"] == [], f"contrast under 4.5:1: {found['contrast']}"
+    assert browser.viewport_overflow() == []
+
+
+@pytest.mark.parametrize("size", SIZES, ids=["800x480", "1280x800"])
+def test_the_panel_fills_the_screen_and_its_text_grows_with_it(stack, size):
+    browser = open_sized(stack, "moveabs", "engineer", size)
+    panel, body_px = browser.driver.execute_script(
+        "const r = document.querySelector('.panel').getBoundingClientRect();"
+        "return [[r.left, r.top, r.width, r.height], parseFloat(getComputedStyle(document.querySelector("
+        "'.field label')).fontSize) * (parseFloat(getComputedStyle(document.querySelector('.panel')).zoom) || 1)]")
+    assert [round(v) for v in panel] == [0, 0, size[0], size[1]]          # no black bands
+    # 9-inch 800x480: 4.1 px/mm; 12.1-inch 1280x800: 4.9 px/mm. The same text in mm is 1.2 times the pixels.
+    assert body_px >= (14 if size[0] == 800 else 16.8)
+
+
+@pytest.mark.parametrize("name", ["index", "connect", "moveabs", "pnp"])
+def test_normal_states_are_grey(stack, name):
+    """Robot connected and in its Listen node, PLC online, operator logged in, a command done: nothing is coloured
+    (ISA-101). Only the Stop command's own key keeps its red."""
+    browser = open_sized(stack, name, "operator", (800, 480))
+    browser.wait_for(lambda d: browser.driver.find_element("id", "pill-robot").text == "Robot ready", "the robot state")
+    browser.driver.execute_script("message('Move Absolute: Done – the robot arrived at the target.', 'ok')")
+    assert browser.driver.execute_script(COLOURS, NORMAL_STATE_ELEMENTS, GREY_CHROMA) == []
