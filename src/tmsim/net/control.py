@@ -34,26 +34,17 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import selectors
 import socket
 
-from tmsim.limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_DEPTH_MAX, CONTROL_EVENTS_MAX,
+from tmsim.limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_EVENTS_MAX,
                      CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_BYTES, CONTROL_TURN_PIECES,
                      CONTROL_TURN_REQUESTS)
 from tmsim.robot.camera import camera_of
 from tmsim.net.tcp_listener import Listener, receive
+from tmsim.protocol.control import (RequestError, bool_field, decode_request, encode_answer, error_answer, fault_params,
+                                    int_field, next_line, operation_mode, plc_time, show, text_field)
 from tmsim.protocol.listen_session import TransitionError
-
-_FIELDS = {"cmd", "robot", "since", "fault", "params", "pressed", "mode", "period", "items", "write_permission",
-           "plc_time", "name", "value"}
-_VISION_FIELDS = {"job", "objects", "pass", "seconds", "capture", "variable"}
-_FIELDS |= _VISION_FIELDS
-_BRACKETS = re.compile(rb'"(?:[^"\\]|\\.)*"|[\[\]{}]')
-
-
-class RequestError(ValueError):
-    """A request that is not valid; its text is the answer's ``error``."""
 
 
 class _Client:
@@ -99,10 +90,10 @@ class ControlChannel:
             "leave_listen_node": lambda robot, req: robot.leave_listen_node(),
             "stop_project": lambda robot, req: robot.stop_project(),
             "start_project": lambda robot, req: robot.start_project(),
-            "inject": lambda robot, req: robot.inject(_text_field(req, "fault"), **_params(req)),
+            "inject": lambda robot, req: robot.inject(text_field(req, "fault"), **fault_params(req)),
             "clear_faults": lambda robot, req: robot.clear_faults(),
-            "estop": lambda robot, req: _svr(robot).set_estop(_bool_field(req, "pressed", True)),
-            "operation_mode": lambda robot, req: _svr(robot).set_auto_mode(_mode(req.get("mode"))),
+            "estop": lambda robot, req: _svr(robot).set_estop(bool_field(req, "pressed", True)),
+            "operation_mode": lambda robot, req: _svr(robot).set_auto_mode(operation_mode(req.get("mode"))),
             "svr_config": self._svr_config,
             "svr_inject": self._svr_inject,
             "svr_clear_faults": self._svr_clear_faults,
@@ -160,24 +151,23 @@ class ControlChannel:
             self.turns_deferred += 1
             return
         while not client.closing:
-            end = client.rbuf.find(b"\n")
-            if end < 0:
+            line, used = next_line(client.rbuf)
+            if not used:
                 if len(client.rbuf) > CONTROL_LINE_MAX:
                     client.closing = True
                     self.server.log_server("control_closed", reason="request line too long")
-                    self._answer(client, _error(f"request line longer than {CONTROL_LINE_MAX} bytes; "
+                    self._answer(client, error_answer(f"request line longer than {CONTROL_LINE_MAX} bytes; "
                                                 f"connection closed"))
                 break
             if answered >= CONTROL_TURN_REQUESTS or written >= CONTROL_TURN_BYTES:
                 self.backlog[sock] = client
                 self.turns_deferred += 1
                 return
-            line = bytes(client.rbuf[:end])
-            del client.rbuf[:end + 1]
+            del client.rbuf[:used]
             if len(line) > CONTROL_LINE_MAX:
                 client.closing = True
                 self.server.log_server("control_closed", reason="request line too long")
-                answer = _error(f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed")
+                answer = error_answer(f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed")
             else:
                 answer = self.execute(line)
             before = len(client.wbuf)
@@ -235,7 +225,7 @@ class ControlChannel:
             else:
                 return False
         except ValueError as exc:           # e.g. a value JSON cannot carry
-            client.wbuf += _encode(_error(f"the answer cannot be written as JSON ({exc})"))
+            client.wbuf += encode_answer(error_answer(f"the answer cannot be written as JSON ({exc})"))
         client.encoding, client.pieces = None, []
         return self._write(client)
 
@@ -245,9 +235,9 @@ class ControlChannel:
         if not self._outbox_room(client):
             return False
         try:
-            client.wbuf += _encode(answer)
+            client.wbuf += encode_answer(answer)
         except ValueError as exc:           # e.g. a value JSON cannot carry
-            client.wbuf += _encode(_error(f"the answer cannot be written as JSON ({exc})"))
+            client.wbuf += encode_answer(error_answer(f"the answer cannot be written as JSON ({exc})"))
         return self._write(client)
 
     def _write(self, client) -> bool:
@@ -287,24 +277,24 @@ class ControlChannel:
     def execute(self, line: bytes) -> dict:
         """The answer to one request line (never raises)."""
         try:
-            request = _decode(line)
-            name = _text_field(request, "cmd")
+            request = decode_request(line)
+            name = text_field(request, "cmd")
             command = self._commands.get(name)
             if command is None:
                 raise RequestError(f"unknown command {name!r}; known: {', '.join(self._commands)}")
             count = len(self.server.robots)
-            index = _int_field(request, "robot", 0, 0, count - 1,
+            index = int_field(request, "robot", 0, 0, count - 1,
                                f"robot {{}} does not exist: this simulator has {count} "
                                f"robot{'s' if count > 1 else ''}; {robot_numbering(count)} of the start-up lines")
             robot = self.server.robots[index]
             if "plc_time" in request:
-                robot._log("control", cmd=name, plc_time=_plc_time(request))
+                robot._log("control", cmd=name, plc_time=plc_time(request))
             result = command(robot, request)
             return _Streamed(ok=True, result=result) if type(result) is _Streamed else {"ok": True, "result": result}
         except (ValueError, TypeError, TransitionError) as exc:
-            return _error(str(exc))
+            return error_answer(str(exc))
         except Exception as exc:          # noqa: BLE001 - a request never ends the simulator
-            return _error(f"internal error of the simulator ({type(exc).__name__}: {exc})")
+            return error_answer(f"internal error of the simulator ({type(exc).__name__}: {exc})")
 
     @staticmethod
     def _state(robot):
@@ -315,16 +305,16 @@ class ControlChannel:
         _svr(robot)
         items = request.get("items")
         if items is not None and not (isinstance(items, list) and all(isinstance(i, str) for i in items)):
-            raise RequestError(f"'items' must be a list of item names, got {_show(items)}")
+            raise RequestError(f"'items' must be a list of item names, got {show(items)}")
         mode = request.get("mode")
         if mode is not None and type(mode) is not int:
-            raise RequestError(f"'mode' must be an integer, got {_show(mode)}")
+            raise RequestError(f"'mode' must be an integer, got {show(mode)}")
         period = request.get("period")
         if period is not None and (isinstance(period, bool) or not isinstance(period, (int, float))
                                    or not math.isfinite(period)):
-            raise RequestError(f"'period' must be a finite number of seconds, got {_show(period)}")
+            raise RequestError(f"'period' must be a finite number of seconds, got {show(period)}")
         with self.server.lock:
-            permission = _bool_field(request, "write_permission", True) if "write_permission" in request else None
+            permission = bool_field(request, "write_permission", True) if "write_permission" in request else None
             robot.svr.configure(items, mode, period, write_permission=permission)
         return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
                 "write_permission": robot.svr.write_permission}
@@ -333,7 +323,7 @@ class ControlChannel:
         """An input of the robot changes as a wired sensor would change it (RobotDataSource.set_input checks the
         item and the value and names either when it is refused)."""
         source = _svr(robot)
-        name = _text_field(request, "name")
+        name = text_field(request, "name")
         if "value" not in request:
             raise RequestError(f"'value' missing: the new value of {name} (0 or 1; volts in -10..10 if analog)")
         with self.server.lock:
@@ -341,7 +331,7 @@ class ControlChannel:
 
     def _svr_inject(self, robot, request):
         _svr(robot)
-        self.server.svr.inject(robot, _text_field(request, "fault"), **_params(request))
+        self.server.svr.inject(robot, text_field(request, "fault"), **fault_params(request))
 
     def _svr_clear_faults(self, robot, _request):
         _svr(robot)
@@ -356,13 +346,13 @@ class ControlChannel:
 
     def _vision_remove(self, robot, request):
         with self.server.lock:
-            return camera_of(robot.session.robot).remove(_text_field(request, "job"))
+            return camera_of(robot.session.robot).remove(text_field(request, "job"))
 
     def _vision(self, robot, _request):
         return camera_of(robot.session.robot).state()
 
     def _events(self, robot, request):
-        since = _int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")
+        since = int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")
         first = robot.events_dropped
         start = max(since, first)
         sizes = robot.event_sizes(start - first, CONTROL_EVENTS_MAX)
@@ -375,65 +365,6 @@ class ControlChannel:
         return {"events": events, "next": start + len(events), "first": first}
 
 
-def _decode(line: bytes) -> dict:
-    if line.count(b"[") + line.count(b"{") > CONTROL_DEPTH_MAX:
-        depth = deepest = 0
-        for match in _BRACKETS.finditer(line):
-            token = match.group()
-            if token in (b"[", b"{"):
-                depth += 1
-                deepest = max(deepest, depth)
-            elif token in (b"]", b"}"):
-                depth -= 1
-        if deepest > CONTROL_DEPTH_MAX:
-            raise RequestError(f"request nested deeper than {CONTROL_DEPTH_MAX} levels")
-    try:
-        request = json.loads(line, parse_constant=_no_constant, parse_int=_small_int)
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise RequestError(f"a request must be one JSON object on one line ({exc})") from None
-    except RecursionError:
-        raise RequestError(f"request nested deeper than {CONTROL_DEPTH_MAX} levels") from None
-    if not isinstance(request, dict):
-        raise RequestError("a request must be a JSON object")
-    unknown = sorted(set(request) - _FIELDS)
-    if unknown:
-        raise RequestError(f"unknown field {unknown[0]!r}; known: {', '.join(sorted(_FIELDS))}")
-    return request
-
-
-def _plc_time(request) -> float:
-    """The controller's time (s) a client such as ``vplc run --scenario`` sends with its request, logged next to
-    the robot clock's ``t`` so that both logs line up."""
-    value = request["plc_time"]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < 1e9:
-        raise RequestError(f"'plc_time' must be the controller time in seconds (0 .. 1e9), got {_show(value)}")
-    return value
-
-
-def _small_int(text):
-    if len(text.lstrip("-")) > 18:
-        raise RequestError(f"number {text[:20]}... has more than 18 digits")
-    return int(text)
-
-
-def _no_constant(name):
-    raise RequestError(f"{name} is not a number a request may carry")
-
-
-def _text_field(request, name) -> str:
-    value = request.get(name)
-    if not isinstance(value, str):
-        raise RequestError(f"'{name}' must be a text, got {_show(value)}")
-    return value
-
-
-def _bool_field(request, name, default) -> bool:
-    value = request.get(name, default)
-    if not isinstance(value, bool):
-        raise RequestError(f"'{name}' must be true or false, got {_show(value)}")
-    return value
-
-
 def robot_numbering(count: int) -> str:
     """'"robot": 0 is robot 1' for ``count`` robots: the control channel counts them from 0, the start-up
     lines (and the demo's log) from 1, as a PLC program does."""
@@ -442,54 +373,11 @@ def robot_numbering(count: int) -> str:
     return f'"robot": 0 to {count - 1} are robots 1 to {count}'
 
 
-def _int_field(request, name, default, low, high, message) -> int:
-    value = request.get(name, default)
-    if type(value) is not int:
-        raise RequestError(f"'{name}' must be an integer, got {_show(value)}")
-    if value < low or (high is not None and value > high):
-        raise RequestError(message.format(_show(value)))
-    return value
-
-
-def _params(request) -> dict:
-    params = request.get("params", {})
-    if params is None:
-        return {}
-    if not isinstance(params, dict):
-        raise RequestError(f"'params' must be an object, got {_show(params)}")
-    for key, value in params.items():
-        if isinstance(value, float) and not math.isfinite(value):
-            raise RequestError(f"parameter '{key}' must be a finite number")
-        if not isinstance(value, (bool, int, float, str)) or (isinstance(value, str) and len(value) > 64):
-            raise RequestError(f"parameter '{key}' must be a number, true/false or a short text, got "
-                               f"{_show(value)}")
-    return params
-
-
 def _svr(robot):
     source = robot.svr_source
     if source is None:
         raise RequestError("the Ethernet Slave is not running (simulator started with --no-svr)")
     return source
-
-
-def _mode(text):
-    if text not in ("auto", "manual"):
-        raise RequestError(f"operation mode must be \"auto\" or \"manual\", got {_show(text)}")
-    return text == "auto"
-
-
-def _show(value) -> str:
-    text = json.dumps(value) if isinstance(value, (dict, list, str)) else repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
-def _error(text) -> dict:
-    return {"ok": False, "error": text}
-
-
-def _encode(answer) -> bytes:
-    return (json.dumps(answer, allow_nan=False, ensure_ascii=False) + "\n").encode("utf-8")
 
 
 def request(port: int, payload: dict, host="127.0.0.1", timeout=5.0) -> dict:

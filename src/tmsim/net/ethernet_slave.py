@@ -15,19 +15,17 @@ import selectors
 import socket
 
 from tmsim.limits import SVR_CLIENTS_MAX, SVR_OUTBOX_MAX
-from tmsim.protocol import codec
 from tmsim.net.tcp_listener import Listener, receive
-from tmsim.protocol.svr_session import DEFAULT_STREAM, FAULTS, HEADERS, SvrSession
+from tmsim.protocol.svr_session import DEFAULT_STREAM, SvrSession
 from tmsim.robot.svr_source import RobotDataSource
 
 
 
 class _Conn:
-    __slots__ = ("sock", "id", "rbuf", "wbuf", "robot")
+    __slots__ = ("sock", "id", "wbuf", "robot")
 
     def __init__(self, sock, conn_id, robot):
         self.sock, self.id, self.robot = sock, conn_id, robot
-        self.rbuf = bytearray()
         self.wbuf = bytearray()
 
 
@@ -95,10 +93,8 @@ class EthernetSlave:
             return
         if data is None:
             return
-        conn.rbuf += data
         try:
-            for item in codec.decode_all(conn.rbuf, HEADERS):
-                robot.svr.handle(conn.id, item)
+            robot.svr.receive_data(conn.id, data)
         except Exception as exc:          # noqa: BLE001 - safety net: one bad client never stops the others
             robot._log("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
             self._drop(robot, conn, "internal error while handling this Ethernet Slave client")
@@ -106,11 +102,11 @@ class EthernetSlave:
         self._flush(robot)
 
     def _flush(self, robot):
-        for conn_id, client in list(robot.svr.clients.items()):
+        for conn_id in list(robot.svr.clients):
             conn = robot.svr_conns.get(conn_id)
-            if conn is None or (not client.outbox and not conn.wbuf):
+            if conn is None or (not conn.wbuf and not robot.svr.has_output(conn_id)):
                 continue
-            frames, client.outbox = client.outbox, []
+            frames = robot.svr.data_to_send(conn_id)
             try:
                 for frame in frames:
                     if conn.wbuf:
@@ -143,31 +139,14 @@ class EthernetSlave:
         ``disconnect``: every Ethernet Slave client of the robot is closed now;
         ``refuse_writes`` (status=6): every well-formed write is answered with that status code (1..7), nothing is
         written. ValueError when unknown."""
-        if fault not in FAULTS:
-            raise ValueError(f"unknown Ethernet Slave fault '{fault}'; known: {', '.join(FAULTS)}")
-        unknown = set(params) - {"stall": {"enabled"}, "corrupt_checksum": {"count"}, "disconnect": set(),
-                                 "refuse_writes": {"status"}}[fault]
-        if unknown:
-            raise ValueError(f"Ethernet Slave fault '{fault}' has no parameter {', '.join(sorted(unknown))}")
-        if fault == "stall":
-            robot.svr.stalled = bool(params.get("enabled", True))
-        elif fault == "corrupt_checksum":
-            count = params.get("count", 1)
-            if type(count) is not int or not 1 <= count <= 1_000_000:
-                raise ValueError(f"'count' of fault 'corrupt_checksum' must be 1..1000000, got {count!r}")
-            robot.svr.corrupt += count
-        elif fault == "refuse_writes":
-            status = params.get("status", 6)
-            if type(status) is not int or not 1 <= status <= 7:
-                raise ValueError(f"'status' of fault 'refuse_writes' must be 1..7 (a §17.4.1 code), got {status!r}")
-            robot.svr.refuse = status
-        else:
+        robot.svr.inject(fault, **params)         # checks the fault and its parameters; arms the protocol's
+        if fault == "disconnect":                 # ... the sockets are this adapter's
             for conn in list(robot.svr_conns.values()):
                 self._drop(robot, conn, "fault: disconnect")
         robot._log("svr_fault", fault=fault, params=params)
 
     def clear_faults(self, robot):
-        robot.svr.stalled, robot.svr.corrupt, robot.svr.refuse = False, 0, 0
+        robot.svr.clear_faults()
         robot._log("svr_fault", fault="cleared", params={})
 
     def close(self):

@@ -25,7 +25,6 @@ import socket
 import threading
 import time
 
-from tmsim.protocol import codec
 from tmsim.net.control import ControlChannel
 from tmsim.net.ethernet_slave import EthernetSlave
 from tmsim.net.tcp_listener import Listener, receive
@@ -33,7 +32,7 @@ from tmsim.robot.eventlog import EventLog, LogFile, text as _text
 from tmsim.net.fairness import FairInput, is_greedy as _is_greedy
 from tmsim.robot.faults import FaultState, check_params as check_fault_params
 from tmsim.limits import (EVENT_BYTES_MAX, EVENTS_KEPT_MAX, FRAME_DATA_MAX, IO_SLICE_S, LISTEN_CLIENTS_MAX,
-                          LISTEN_OUTBOX_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, PENDING_SCRIPTS_MAX, POLL_BUDGET_S,
+                          LISTEN_OUTBOX_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, POLL_BUDGET_S,
                           RECV_BYTES, TURN_WORK)
 from tmsim.tmscript.profiles import Profile
 from tmsim.robot.model import RobotModel

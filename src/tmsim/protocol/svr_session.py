@@ -56,6 +56,7 @@ class SvrConfigError(ValueError):
 class Client:
     peer: str
     outbox: list = field(default_factory=list)
+    rbuf: bytearray = field(default_factory=bytearray)      # received bytes of an incomplete frame
 
 
 class SvrSession:
@@ -118,6 +119,58 @@ class SvrSession:
     def disconnect(self, conn: int):
         if self.clients.pop(conn, None) is not None:
             self.log("svr_disconnect", conn=conn)
+
+    def receive_data(self, conn: int, data: bytes):
+        """Bytes received from connection ``conn``: every complete item in them (and in what an earlier call left
+        incomplete) is handled at once; a partial frame waits in the session's buffer of that connection (at most
+        one frame: a longer declared length is a packet error at once, codec.decode)."""
+        client = self.clients.get(conn)
+        if client is None:
+            return
+        client.rbuf += data
+        for item in codec.decode_all(client.rbuf, HEADERS):
+            self.handle(conn, item)
+
+    def data_to_send(self, conn: int) -> list[bytes]:
+        """The frames for connection ``conn`` produced so far (one bytes object per frame); the session forgets
+        them."""
+        client = self.clients.get(conn)
+        if client is None or not client.outbox:
+            return []
+        frames, client.outbox = client.outbox, []
+        return frames
+
+    def has_output(self, conn: int) -> bool:
+        client = self.clients.get(conn)
+        return client is not None and bool(client.outbox)
+
+    # ---- faults -------------------------------------------------------------------------------
+    def inject(self, fault: str, **params):
+        """``stall`` (enabled=True): no data table and no answers, connections stay open; ``corrupt_checksum``
+        (count=1): the next frames leave with a wrong checksum; ``refuse_writes`` (status=6): every well-formed
+        write is answered with that status code (1..7), nothing is written. (``disconnect`` closes sockets: the
+        TCP adapter's.) ValueError naming what is unknown or out of range."""
+        if fault not in FAULTS:
+            raise ValueError(f"unknown Ethernet Slave fault '{fault}'; known: {', '.join(FAULTS)}")
+        unknown = set(params) - {"stall": {"enabled"}, "corrupt_checksum": {"count"}, "disconnect": set(),
+                                 "refuse_writes": {"status"}}[fault]
+        if unknown:
+            raise ValueError(f"Ethernet Slave fault '{fault}' has no parameter {', '.join(sorted(unknown))}")
+        if fault == "stall":
+            self.stalled = bool(params.get("enabled", True))
+        elif fault == "corrupt_checksum":
+            count = params.get("count", 1)
+            if type(count) is not int or not 1 <= count <= 1_000_000:
+                raise ValueError(f"'count' of fault 'corrupt_checksum' must be 1..1000000, got {count!r}")
+            self.corrupt += count
+        elif fault == "refuse_writes":
+            status = params.get("status", 6)
+            if type(status) is not int or not 1 <= status <= 7:
+                raise ValueError(f"'status' of fault 'refuse_writes' must be 1..7 (a §17.4.1 code), got {status!r}")
+            self.refuse = status
+
+    def clear_faults(self):
+        self.stalled, self.corrupt, self.refuse = False, 0, 0
 
     def _send(self, conn, data):
         self._out(conn, codec.encode("TMSVR", data))
