@@ -8,6 +8,7 @@ function customLabel(item) { return item.unit ? `${item.label} (${item.unit})` :
 /* the main page of a table generated from a user program (no CBT example variables): one tile per page */
 function customIndexPage() {
   const main = frame("Main", true);
+  main.classList.add("custom");
   const area = document.createElement("div");
   area.className = "area custom-index";
   area.innerHTML = "<h2>Pages</h2>";
@@ -32,6 +33,7 @@ function hideRobotPill() {                      // a program without the CBT con
 async function customPage(key) {
   const page = MAP.custom_pages[key];
   const main = frame(page.title, false);
+  main.classList.add("custom");
   hideRobotPill();
   const params = document.createElement("div");
   params.className = "params full";
