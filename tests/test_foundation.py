@@ -11,8 +11,9 @@ import tomllib
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SRC = ROOT / "src"
-# package -> the project packages it may import (layout.md's table)
+# package -> the project packages it may import (layout.md's table); of vplc, cbt_hmi uses only the public API
 MAY_IMPORT = {"vplc": set(), "tmsim": set(), "cbt_hmi": {"vplc", "tmsim"}}
+PUBLIC_MODULES = {"vplc": {"vplc.api"}}
 RUNTIME_TREES = [SRC / package for package in MAY_IMPORT] + [ROOT / "sim", ROOT / "examples"]
 OWN_PACKAGES = set(MAY_IMPORT)
 
@@ -89,6 +90,50 @@ def test_toolchain_and_simulator_import_neither_each_other_nor_the_application()
             for name in _imported_top_level_modules(path) & (set(MAY_IMPORT) - {package} - allowed):
                 wrong.append(f"{path.relative_to(ROOT)} imports {name}")
     assert not wrong, "\n".join(wrong)
+
+
+def _imported_modules(path: pathlib.Path) -> set[str]:
+    """Dotted names of the absolute imports of one file (``from vplc import api`` is vplc.api)."""
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            top = node.module.split(".")[0]
+            if node.module == top and top in PUBLIC_MODULES:
+                names.update(f"{top}.{alias.name}" for alias in node.names)
+            else:
+                names.add(node.module)
+    return names
+
+
+def test_the_application_uses_only_the_toolchains_public_api():
+    wrong = []
+    for path in sorted((SRC / "cbt_hmi").rglob("*.py")):
+        for module in _imported_modules(path):
+            top = module.split(".")[0]
+            if top in PUBLIC_MODULES and module not in PUBLIC_MODULES[top]:
+                wrong.append(f"{path.relative_to(ROOT)} imports {module}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_public_api_guard_names_a_reach_into_the_toolchain(tmp_path):
+    sample = tmp_path / "sample.py"
+    sample.write_text("from vplc.api import load_plc\nfrom vplc import api, ladder\nimport vplc.runtime.values\n",
+                      encoding="utf-8")
+    assert _imported_modules(sample) == {"vplc.api", "vplc.ladder", "vplc.runtime.values"}
+
+
+def test_the_hmi_pages_are_package_data_of_the_application():
+    """The pages are found through the package: an install from a wheel or a checkout serves the same files."""
+    import importlib.resources
+
+    import cbt_hmi
+    pages = importlib.resources.files("cbt_hmi") / "pages"
+    assert (pages / "index.html").is_file() and (pages / "mapping.json").is_file()
+    assert pathlib.Path(str(pages)).resolve() == cbt_hmi.PAGES
+    package_data = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
+    assert "pages/*" in package_data["package-data"]["cbt_hmi"]
 
 
 def test_every_console_script_names_a_function_that_exists():

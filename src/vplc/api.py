@@ -12,6 +12,7 @@ import re
 import threading
 import time
 from collections import OrderedDict
+from dataclasses import dataclass
 
 from .frontend import types as T
 from .compiler.codegen import CodeGen
@@ -19,11 +20,33 @@ from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
 from .runtime.values import PathError, Resolver, parse_duration
 
-__all__ = ["load_plc", "compile_program", "LoadError", "PlcFault", "Plc"]
+__all__ = ["load_plc", "compile_program", "LoadError", "PlcFault", "Plc", "LadderProgram", "integer_ranges"]
 
 
 class LoadError(Exception):
     """The sources could not be loaded: ``str()`` is the rendered diagnostics."""
+
+
+def integer_ranges() -> dict[str, tuple[int, int]]:
+    """(lowest, highest) value of every IEC 61131-3 integer and bit-string type by name (SINT .. ULINT,
+    BYTE .. LWORD): the type model the checker, compiler and runtime use, for a tool that judges a value before
+    it writes it (the HMI's value checks)."""
+    return {name: (t.lo, t.hi) for name, t in T.ELEMENTARY.items() if t.kind in ("int", "uint", "bit")}
+
+
+@dataclass(frozen=True)
+class LadderProgram:
+    """A ladder (LD) PROGRAM the PLC runs, for a monitor that draws it and shows its power flow."""
+
+    name: str                   # as declared
+    instance: str               # the instance its own variables are read under (Plc.read("<instance>.<name>"))
+    ladder: object              # the LD model (vplc.ladder): rungs of elements (id, kind, var ...) and wires
+    own_names: frozenset[str]   # upper-case names it declares itself; a VAR_EXTERNAL is read as the global
+
+    def svg(self) -> str:
+        """The drawing as one SVG document; elements and wires carry the ids the power flow names."""
+        from .ladder.svg import svg_document
+        return svg_document(self.ladder)
 
 
 def parse_task(task: str) -> tuple[str, int]:
@@ -242,6 +265,26 @@ class Plc:
         """(count, the latest 100 messages) of instructions that ended in error without stopping the controller
         (ENO FALSE on an NJ/NX, e.g. LrealToFormatString with DecPlace > MinLen: Out is not changed)."""
         return self.engine.instruction_error_count, list(self.engine.instruction_errors)
+
+    @property
+    def fault(self) -> PlcFault | None:
+        """The major fault the controller stopped on, None while it scans. From that scan on the PLC no longer
+        scans, its variables keep the values of that moment and its sockets are closed."""
+        return self.engine.fault
+
+    def ladder_programs(self) -> list[LadderProgram]:
+        """The ladder (LD) PROGRAMs of the loaded sources, in source order, each with the instance it runs as
+        (its own name when no task runs it)."""
+        found = []
+        for unit in self.project.units:
+            for item in unit.items:
+                if getattr(item, "ladder", None) is None or item.kind != "PROGRAM":
+                    continue
+                instance = next((inst.i__path for inst in self.instances.values()
+                                 if inst.i__type.name.upper() == item.name.upper()), item.name)
+                own = frozenset(d.name.upper() for s in item.sections if s.kind != "VAR_EXTERNAL" for d in s.vars)
+                found.append(LadderProgram(item.name, instance, item.ladder, own))
+        return found
 
     @property
     def statements_executed(self) -> int:

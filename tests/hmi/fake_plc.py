@@ -53,6 +53,11 @@ class FakePlc:
         for path, leaf in mapping.leaves.items():
             self.types[path] = leaf.type
 
+    @property
+    def fault(self):
+        """Like vplc's Plc.fault: the major fault, None while it scans (a test faults it with plc.engine)."""
+        return getattr(getattr(self, "engine", None), "fault", None)
+
     def _walk(self, path: str):
         steps = [m.group(1) if m.group(1) else int(m.group(2)) for m in _STEP.finditer(path)]
         container, key = self.vars, steps[0]

@@ -14,7 +14,7 @@ ALLOWED = {
     "compiler": {"runtime", "frontend"},
     "trace": {"frontend"},
     "export": {"project", "ladder", "frontend"},
-    "api": {"compiler", "runtime", "project", "frontend"},
+    "api": {"compiler", "runtime", "project", "ladder", "frontend"},
     "cli": {"api", "export", "trace", "compiler", "runtime", "project", "ladder", "checker", "frontend"},
 }
 

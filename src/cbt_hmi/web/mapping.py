@@ -9,18 +9,16 @@ import math
 import pathlib
 from http import HTTPStatus
 
+from vplc.api import integer_ranges
+
+from .. import PAGES
 from .ranges import RangeTableError, apply_ranges, load_ranges, read_json
 
-HMI_DIR = pathlib.Path(__file__).resolve().parent.parent / "pages"
+HMI_DIR = PAGES
 DEFAULT_MAPPING = HMI_DIR / "mapping.json"
 DEFAULT_RANGES = HMI_DIR / "ranges.json"
 
-INT_RANGES = {
-    "SINT": (-2**7, 2**7 - 1), "INT": (-2**15, 2**15 - 1), "DINT": (-2**31, 2**31 - 1),
-    "LINT": (-2**63, 2**63 - 1), "USINT": (0, 2**8 - 1), "UINT": (0, 2**16 - 1), "UDINT": (0, 2**32 - 1),
-    "ULINT": (0, 2**64 - 1), "BYTE": (0, 2**8 - 1), "WORD": (0, 2**16 - 1), "DWORD": (0, 2**32 - 1),
-    "LWORD": (0, 2**64 - 1),
-}
+INT_RANGES = integer_ranges()    # IEC integer and bit-string types: (lowest, highest), the toolchain's own table
 REAL_TYPES = {"REAL", "LREAL"}
 
 

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from http import HTTPStatus
 
-from vplc.ladder.svg import svg_document
+from vplc.api import PathError
+
 from .mapping import format_dt
-from vplc.runtime.values import PathError
 
 
 class ProgramError(Exception):
@@ -30,14 +30,14 @@ class ProgramError(Exception):
 class LadderView:
     """One ladder POU running in the PLC: its drawing and how to read its variables."""
 
-    def __init__(self, plc, pou, instance: str) -> None:
+    def __init__(self, plc, program) -> None:
+        """program: a vplc.api.LadderProgram of plc."""
         self.plc = plc
-        self.pou = pou
-        self.ladder = pou.ladder
-        self.instance = instance
-        # a VAR_EXTERNAL operand is read as the global it names
-        self.locals = {d.name.upper() for s in pou.sections if s.kind != "VAR_EXTERNAL" for d in s.vars}
-        self.svg = svg_document(self.ladder)
+        self.name = program.name
+        self.ladder = program.ladder
+        self.instance = program.instance
+        self.locals = program.own_names       # a VAR_EXTERNAL operand is read as the global it names
+        self.svg = program.svg()
         names = set()
         for rung in self.ladder.rungs:
             for e in rung.elements:
@@ -150,15 +150,11 @@ class ProgramMonitor:
 
     def __init__(self, plc) -> None:
         self.views: dict[str, LadderView] = {}
-        for unit in plc.project.units:
-            for item in unit.items:
-                if getattr(item, "ladder", None) is not None and item.kind == "PROGRAM":
-                    instance = next((inst.i__path for inst in plc.instances.values()
-                                     if inst.i__type.name.upper() == item.name.upper()), item.name)
-                    self.views[item.name.upper()] = LadderView(plc, item, instance)
+        for program in plc.ladder_programs():
+            self.views[program.name.upper()] = LadderView(plc, program)
 
     def page(self) -> dict:
-        return {"ok": True, "programs": [{"pou": v.pou.name, "instance": v.instance, "svg": v.svg,
+        return {"ok": True, "programs": [{"pou": v.name, "instance": v.instance, "svg": v.svg,
                                           "rungs": [{"number": n, "label": r.label, "comment": r.comment}
                                                     for n, r in enumerate(v.ladder.rungs, start=1)]}
                                          for v in self.views.values()]}

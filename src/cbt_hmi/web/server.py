@@ -66,10 +66,10 @@ def _number_digits(text: str) -> str:
 
 def plc_fault(plc) -> dict | None:
     """The PLC's major fault, None while it can scan: {"message": the controller's whole text, "what": the
-    cause alone (after "major fault in <instance>: ")}. vplc's Plc keeps the fault in engine.fault from the scan
-    that faulted on; the PLC no longer scans, its variables keep the values of that moment and its sockets are
-    closed (vplc.runtime.engine). A PLC stand-in without an engine never faults."""
-    fault = getattr(getattr(plc, "engine", None), "fault", None)
+    cause alone (after "major fault in <instance>: ")}. vplc's Plc.fault holds it from the scan that faulted on;
+    the PLC no longer scans, its variables keep the values of that moment and its sockets are closed. A PLC
+    stand-in without a fault property never faults."""
+    fault = getattr(plc, "fault", None)
     if fault is None:
         return None
     message = str(fault)
