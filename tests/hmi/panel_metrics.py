@@ -56,8 +56,9 @@ PAGE_METRICS = """
       if (!t.textContent.trim() || seen.has(el) || !el || ['SCRIPT', 'STYLE', 'OPTION', 'NOSCRIPT'].includes(el.tagName)) continue;
       seen.add(el);
       if (!shown(el)) continue;
-      const s = getComputedStyle(el), size = parseFloat(s.fontSize);
-      if (size < 14 - 0.01) out.text.push([name(el), t.textContent.trim().slice(0, 30), size]);
+      const s = getComputedStyle(el), m = el instanceof SVGElement && el.getScreenCTM && el.getScreenCTM();
+      const size = parseFloat(s.fontSize) * (m ? Math.hypot(m.a, m.b) : 1);      // an SVG drawing may be scaled
+      if (size < 14 - 0.01 && !(arguments[0] && el.closest(arguments[0]))) out.text.push([name(el), t.textContent.trim().slice(0, 30), size]);
       const under = background(el), svg = el instanceof SVGElement;
       const fg = rgba(svg ? s.fill : s.color), shownFg = mix(mix(fg, under, fg[3]), under, opacity(el));
       const a = lum(shownFg), b = lum(under), ratio = (Math.max(a, b) + 0.05) / (Math.min(a, b) + 0.05);
@@ -66,7 +67,8 @@ PAGE_METRICS = """
     return out;"""
 
 
-def page_metrics(b) -> dict:
+def page_metrics(b, zoomable: str = "") -> dict:
     """The panel rules' violations on the page shown: {"small": [(name, w, h)], "text": [(name, text, px)],
-    "contrast": [(name, text, ratio)]}; all three empty on a page an operator can use."""
-    return b.driver.execute_script(PAGE_METRICS)
+    "contrast": [(name, text, ratio)]}; all three empty on a page an operator can use. ``zoomable``: a selector of
+    drawings with their own zoom keys, whose text size is left out (the operator enlarges them)."""
+    return b.driver.execute_script(PAGE_METRICS, zoomable)

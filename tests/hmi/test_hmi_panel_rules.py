@@ -95,3 +95,36 @@ def test_normal_states_are_grey(stack, name):
     browser.wait_for(lambda d: browser.driver.find_element("id", "pill-robot").text == "Robot ready", "the robot state")
     browser.driver.execute_script("message('Move Absolute: Done – the robot arrived at the target.', 'ok')")
     assert browser.driver.execute_script(COLOURS, NORMAL_STATE_ELEMENTS, GREY_CHROMA) == []
+
+
+@pytest.fixture(scope="module")
+def ladder_stack(chromium):
+    """The Program page needs the real ladder example: the examples on the virtual PLC (no robot needed)."""
+    import pathlib
+    import threading
+    from vplc.api import load_plc
+    from cbt_hmi.web.server import HmiServer
+    root = pathlib.Path(__file__).resolve().parents[2]
+    plc = load_plc([str(root / "lib" / "CBT_Commands_Lib"), str(root / "examples")])
+    stop = threading.Event()
+    thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
+    thread.start()
+    server = HmiServer(plc, Mapping.load(), port=0)
+    server.start()
+    yield plc, server, chromium
+    server.stop()
+    stop.set()
+    thread.join(timeout=5)
+    plc.close()
+    chromium._fit()
+
+
+@pytest.mark.parametrize("size", SIZES, ids=["800x480", "1280x800"])
+def test_the_program_page_meets_the_panel_rules(ladder_stack, size):
+    """The rung bar, the zoom keys and the rung headings; the ladder drawing's own text has the zoom keys."""
+    browser = open_sized(ladder_stack, "program", "operator", size)
+    browser.wait_for(lambda d: d.execute_script("return document.querySelector('.ladder svg') !== null"),
+                     "the ladder drawing")
+    browser.screenshot(f"panel_program_operator_{size[0]}x{size[1]}")
+    found = page_metrics(browser, zoomable=".ladder svg")
+    assert found == {"small": [], "text": [], "contrast": []}, found

@@ -136,8 +136,8 @@ function drawPnP() {
       d = `M${x1},${y1} Q${lx},${cy} ${x2},${y2}`; ly = (y1 + y2) / 4 + cy / 2 - 14;
     } else { d = `M${x1},${y1} L${x2},${y2}`; ly += 18; }
     out += `<path class="seg" id="seg-${i}" d="${d}"/>`;
-    labels.push(`<g class="edit" id="edit-${i}" data-seg="${i}"><rect x="${lx - 62}" y="${ly - 12}" width="124" height="24"/>
-      <text x="${lx}" y="${ly + 4}" text-anchor="middle">${i + 1} ${PNP_SEGMENTS[i]} ✎</text></g>`);
+    labels.push(`<g class="edit" id="edit-${i}" data-seg="${i}"><rect x="${lx - 86}" y="${ly - 14}" width="172" height="28"/>
+      <text x="${lx}" y="${ly + 5}" text-anchor="middle">${i + 1} ${PNP_SEGMENTS[i]} ✎</text></g>`);
   }
   pts.forEach((p) => { out += `<circle class="pt" cx="${X(p)}" cy="${Y(p)}" r="3.5"/>`; });
   out += `<polyline class="trail" id="pnp-trail" points=""/><circle class="tcp" id="pnp-tcp" r="5" cx="-20" cy="-20"/>`;

@@ -123,7 +123,9 @@ async function programPage() {
   jump.onchange = () => {
     const [pou, n] = jump.value.split(":");
     const g = holder.querySelector(`section[data-pou="${pou}"] g.rung[data-rung="${n}"]`);
-    if (g) holder.scrollTop += g.getBoundingClientRect().top - holder.getBoundingClientRect().top - 30;
+    // client rectangles are in screen pixels, scrollTop in the panel's: the panel is drawn larger from 1280x800
+    const zoom = parseFloat(getComputedStyle(document.querySelector(".panel")).zoom) || 1;
+    if (g) holder.scrollTop += (g.getBoundingClientRect().top - holder.getBoundingClientRect().top) / zoom - 30;
   };
   const zoomBy = (d) => {
     const g = holder.querySelector(`g.rung[data-rung="${jump.value.split(":")[1]}"]`);
