@@ -10,7 +10,8 @@
 3. Read round trip: GET /api/read of the PnP page's variables, one after the other, against the HMI tests'
    stand-in PLC (the HTTP server's own cost, not the ST program's).
 5. --compare-with DIR: the read round trip (3) and the Execute round trip (1) of this server against an older copy
-   of src/cbt_hmi/web in DIR (git archive <commit> src/cbt_hmi/web | tar -x -C /tmp/old; DIR=/tmp/old/src/cbt_hmi/web),
+   of it in DIR (git archive <commit> src/cbt_hmi | tar -x -C /tmp/old; DIR=/tmp/old/src/cbt_hmi/web; a commit
+   from before the HMI left the toolchain: git archive <commit> src/vplc/hmi hmi, DIR=/tmp/old/src/vplc/hmi),
    both in this process on the same PLC, in alternating blocks; prints the ratio new/old per block.
 4. Under 70 slow clients: the same read, the Stop page and a Stop press while 70 connections send their request
    header one byte every 5 s and open a new connection whenever the server answers 408 (issue 23, item 6).
@@ -325,12 +326,16 @@ def older_server(directory: str):
     """HmiServer of an older copy of the package in ``directory``, imported as the package ``hmi_before``."""
     import importlib.util
     path = pathlib.Path(directory).resolve()
+    if path.name == "web" and (path.parent / "__init__.py").is_file():   # cbt_hmi/web: load it with its package
+        path, server = path.parent, "hmi_before.web.server"                # (the pages are found through it)
+    else:                                                                   # vplc/hmi, before the move
+        server = "hmi_before.server"
     spec = importlib.util.spec_from_file_location("hmi_before", path / "__init__.py",
                                                   submodule_search_locations=[str(path)])
     package = importlib.util.module_from_spec(spec)
     sys.modules["hmi_before"] = package
     spec.loader.exec_module(package)
-    return importlib.import_module("hmi_before.server").HmiServer
+    return importlib.import_module(server).HmiServer
 
 
 def compare_with(directory: str, blocks: int = 16, reads: int = 150, count: int = 20) -> None:
