@@ -1,4 +1,4 @@
-"""docs/simulator.md ("Limits") shows every bound of sim/limits.py with its value (one fact, one home)."""
+"""docs/simulator.md ("Limits") shows every bound of tmsim/limits.py with its value (one fact, one home)."""
 import pathlib
 import re
 

@@ -22,7 +22,7 @@ or ``{"ok": false, "error": "..."}``. Requests (``robot`` defaults to 0):
 Any request may carry "plc_time": the client's controller time in seconds, logged as event ``control`` (with
 ``cmd``) next to the robot clock's ``t``.
 
-Every field is checked (type, range, finite numbers, nesting, line length: sim/limits.py); a bad
+Every field is checked (type, range, finite numbers, nesting, line length: tmsim/limits.py); a bad
 request gets ``ok: false`` with the reason and the connection stays usable, except after a line
 longer than CONTROL_LINE_MAX (answered, then closed). Answers are written without blocking; a client
 that lets more than CONTROL_OUTBOX_MAX bytes of answers pile up is closed. Each client is served in

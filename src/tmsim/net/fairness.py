@@ -8,7 +8,7 @@ what is left waits in that client's receive buffer in the session
 (``_backlog``), which is not read further meanwhile, while the other clients get their turn, round
 robin. A client whose last read filled the receive size or who has input left over is "greedy":
 ``SimServer._serve`` serves it after the others. The session limits the CPERR answers to bad packets
-(CPERR_BURST, CPERR_PER_S per client). Bounds: sim/limits.py.
+(CPERR_BURST, CPERR_PER_S per client). Bounds: tmsim/limits.py.
 """
 from __future__ import annotations
 

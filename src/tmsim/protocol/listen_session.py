@@ -5,7 +5,7 @@ A server calls ``connect``/``receive_data(conn, bytes)``/``disconnect``/``advanc
 uses the control methods (``enter_node``, ``stop_project`` ...). A server that shares its input fairly
 between clients (tmsim/net/fairness.py) calls ``buffer_data`` and then ``process`` in bounded turns instead of
 ``receive_data``; the session decodes, limits its CPERR answers to bad packets (CPERR_BURST, CPERR_PER_S
-in sim/limits.py) and logs ``frame_in`` either way. The node state follows an explicit transition table;
+in tmsim/limits.py) and logs ``frame_in`` either way. The node state follows an explicit transition table;
 the scripts of all clients are run strictly in arrival order, one at a time.
 """
 from __future__ import annotations

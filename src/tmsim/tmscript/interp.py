@@ -13,7 +13,7 @@ It returns "exit" when ScriptExit() ran (the rest of the packet is ignored), els
 Immediate statements run when reached; motions, queue tags, base/TCP/load changes and DO/AO writes
 are appended to the robot FIFO.
 
-Values are bounded as on the robot (sim/limits.py; each bound is a run-time ``ERROR;line``):
+Values are bounded as on the robot (tmsim/limits.py; each bound is a run-time ``ERROR;line``):
 int arithmetic wraps at 32 bits and byte arithmetic at 8 bits [MAN 2.24 §2.2]; a value outside int
 converted to int (a variable, an IO point, any int parameter of any function) is an error [§2.2], so no
 Sleep or WaitQueueTag timeout exceeds INT_MAX ms; a float variable refuses

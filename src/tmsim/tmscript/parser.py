@@ -12,7 +12,7 @@ One statement per line. Grammar (informal)::
     postfix   = primary { "[" expr "]" | "." NAME }
     primary   = NUMBER | STRING | true | false | NAME ["(" [expr {"," expr}] ")"] | "{" [expr {"," expr}] "}" | "(" expr ")"
 
-Bounds (sim/limits.py), each a syntax error of its line (``ERROR;line``): at most TOKENS_MAX tokens per
+Bounds (tmsim/limits.py), each a syntax error of its line (``ERROR;line``): at most TOKENS_MAX tokens per
 script (a line that is a call with constant arguments only - a motion line - counts as one), DEPTH_MAX
 levels of nesting per expression, STATEMENTS_MAX statements per script, string constants of at most
 STRING_MAX characters, hexadecimal constants of at most 32 bits. A decimal integer constant beyond the

@@ -3,7 +3,7 @@
 One simulator thread serves every robot, so a turn that does unbounded work for one client stalls all
 the others. Each turn the server gives a robot (a client's input, advancing its motions and its running
 script) starts with ``begin(TURN_WORK)``; the session, the interpreter, the motion planner and the event
-log add what they do (``add``) in work units (sim/limits.py: WORK_* costs); a piece of work that finds
+log add what they do (``add``) in work units (tmsim/limits.py: WORK_* costs); a piece of work that finds
 the turn ``spent`` stops at its next safe point and goes on in a later turn - a script between two
 statements or two lines it checks, the motion planner between two motions (its clock keeps the time it
 owes). One item (a statement, a line, a motion plan) is never split, so a turn may pass TURN_WORK by the
