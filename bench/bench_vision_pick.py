@@ -3,18 +3,14 @@ CBT_Connect with the Ethernet Slave, the cell's step machine) on the virtual PLC
 simulator, on virtual time: idle (connected, Start not given) and over a whole cell of 3 parts found by the camera
 (the test's table plays the part-present sensor).
 
-    PYTHONPATH=tests/examples .venv/bin/python bench/bench_vision_pick.py
+    make bench       (or: PYTHONPATH=tests/examples .venv/bin/python bench/bench_vision_pick.py)
 
 Idle is the mean of 2,000 scans (the Enable FBs copy a data table once per 100 scans, so a median would hide it);
 the cell's figures are the mean and the largest scan from Start to Done.
 """
 import statistics
-import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "examples"))
-
-from test_vision_pick import PARTS, SEC, Cell   # noqa: E402  (the test's cell: simulator, camera, table)
+from test_vision_pick import PARTS, SEC, Cell   # the test's cell: simulator, camera, table (make bench finds it)
 
 
 def per_scan(cell, pred, seconds):

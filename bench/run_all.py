@@ -19,8 +19,8 @@ def main() -> int:
         return 1
     failed = []
     # the benchmarks drive the tests' rigs (tests/lib: the library on the virtual PLC against the simulator;
-    # tests/hmi: the stand-in PLC); the packages themselves come from the install (make install)
-    rigs = [str(here.parent / "tests" / "lib"), str(here.parent / "tests" / "hmi")]
+    # tests/hmi: the stand-in PLC; tests/examples: the example cells); the packages come from the install
+    rigs = [str(here.parent / "tests" / folder) for folder in ("lib", "hmi", "examples")]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(rigs + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     for script in scripts:
         print(f"\n=== {script.name} " + "=" * max(0, 60 - len(script.name)), flush=True)
