@@ -14,7 +14,7 @@ const JOG_VARS = ["Jog_Forward", "Jog_Backward", "Jog_Frame", "Jog_Axis", "Jog_V
   "Jog_Done", "Jog_Error", "Jog_ErrorID", "Jog_ErrorDescrip", "Jog_Dropped", "Teach_Execute", "Teach_Index",
   "Teach_Name", "Teach_Busy", "Teach_Done", "Teach_Error", "Teach_ErrorID", "Teach_ErrorDescrip", "TeachTable"];
 const JOG_STYLE = `
-.jog { display: grid; grid-template-columns: 380px 1fr; gap: 10px; }
+.jog { display: grid; grid-template-columns: 380px 1fr; gap: 10px; flex: 1; align-content: start; }
 .jog fieldset { border: 1px solid #8895a3; border-radius: 4px; padding: 4px 8px; margin: 0 0 6px 0; }
 .jog .frames button { min-width: 70px; height: 36px; }
 .jog .frames button[aria-pressed="true"] { background: #3c4650; color: #fff; font-weight: bold; }
