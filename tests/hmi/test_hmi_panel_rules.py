@@ -128,3 +128,22 @@ def test_the_program_page_meets_the_panel_rules(ladder_stack, size):
     browser.screenshot(f"panel_program_operator_{size[0]}x{size[1]}")
     found = page_metrics(browser, zoomable=".ladder svg")
     assert found == {"small": [], "text": [], "contrast": []}, found
+
+
+def test_disabled_fields_and_keys_look_disabled(stack):
+    """Fields, check boxes and keys the operator may not use: flat grey with a dashed border (a check box: a dashed
+    outline and a grey label), text still readable (the issue: disabled fields looked editable)."""
+    browser = open_sized(stack, "setoutput", "operator", (800, 480))
+    looks = browser.driver.execute_script("""
+        const look = (el) => { const s = getComputedStyle(el); return [el.disabled, s.backgroundColor, s.borderTopStyle]; };
+        const box = document.querySelector('[data-path="SetOutput_Param.ExitNode"]');
+        return [[look(document.querySelector('[data-path="SetOutput_Param.Module"]')), look(document.getElementById('btn-execute'))],
+                [box.disabled, getComputedStyle(box).outlineStyle, getComputedStyle(box.nextElementSibling).color]];""")
+    for disabled, background, border in looks[0]:
+        assert disabled and background == "rgb(227, 231, 235)" and border == "dashed", (disabled, background, border)
+    assert looks[1] == [True, "dashed", "rgb(80, 91, 102)"]             # a check box: dashed outline, grey label
+    browser = open_sized(stack, "setoutput", "engineer", (800, 480))
+    disabled, background, border = browser.driver.execute_script(
+        "const el = document.querySelector('[data-path=\"SetOutput_Param.Module\"]'), s = getComputedStyle(el);"
+        "return [el.disabled, s.backgroundColor, s.borderTopStyle];")
+    assert not disabled and background == "rgb(255, 255, 255)" and border == "solid"
