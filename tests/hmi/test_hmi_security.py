@@ -15,8 +15,8 @@ import threading
 
 import pytest
 
-from tests.hmi.fake_plc import FakePlc, command_program, scanning, serving
-from tests.hmi.hmi_http import Client
+from fake_plc import FakePlc, command_program, scanning, serving
+from hmi_http import Client
 from cbt_hmi.web import front
 from cbt_hmi.web import server as hmi_server
 from cbt_hmi.web.mapping import Mapping
@@ -249,7 +249,7 @@ def attacker_site(hmi):
 
 
 def test_a_page_of_another_origin_cannot_move_the_robot_in_chromium(hmi, plc, attacker_site):
-    from tests.hmi.browser import Browser, chromium_paths
+    from browser import Browser, chromium_paths
     if chromium_paths() is None:
         pytest.fail("chromium and chromedriver are needed: run `make browser`")
     browser = Browser()

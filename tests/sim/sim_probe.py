@@ -3,7 +3,7 @@ JSON-lines client of the control channel."""
 import json
 import socket
 
-from tests.sim.sim_harness import Harness, Peer, sct, sta  # noqa: F401
+from sim_harness import Harness, Peer, sct, sta  # noqa: F401
 
 
 class ControlClient:
