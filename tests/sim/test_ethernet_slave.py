@@ -10,6 +10,7 @@ from tmsim.protocol import svr_table as table
 from tmsim.protocol.svr_table import ITEMS
 from tmsim.net.server import SimServer
 from sim_harness import Harness, sct, sta
+from svr_client import ask, svr, values
 
 
 @pytest.fixture
@@ -17,29 +18,6 @@ def h():
     harness = Harness(svr_port=0, svr_options={"period": 0})      # no stream unless a test asks for it
     yield harness
     harness.close()
-
-
-def svr(data):
-    return codec.encode("TMSVR", data)
-
-
-def ask(h, peer, data):
-    """One request (its DATA), its one reply as (header, data bytes)."""
-    start = len(peer.frames)
-    peer.send(svr(data))
-    assert h.until(lambda: len(peer.frames) > start, timeout=2), "the Ethernet Slave did not answer"
-    frame = peer.frames[start]
-    return frame.header, frame.data
-
-
-def values(h, peer, names):
-    header, data = ask(h, peer, "R1,12," + "\r\n".join(names))
-    assert header == "TMSVR" and data.startswith(b"R1,12,"), data
-    out = {}
-    for line in data[6:].decode().split("\r\n"):
-        name, _, text = line.partition("=")
-        out[name] = table.parse_string_value(ITEMS[name], text)
-    return out
 
 
 def test_every_item_is_read_in_string_json_and_binary_mode_17_4_5_to_17_4_7(h):

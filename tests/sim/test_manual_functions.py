@@ -7,18 +7,11 @@ import pytest
 from tmsim.protocol import codec
 from tmsim.tmscript import functions as tmscript
 from tmsim.tmscript.profiles import Profile
-from test_session import PTP_LONG, S, sct
+from session_rig import PTP_LONG, S, sct
 
 
 def reply(ident, status):
     return codec.encode("TMSCT", f"{ident},{status}").decode()
-
-
-@pytest.fixture
-def node():
-    n = S()
-    n.connect(1)
-    return n
 
 
 def test_change_base_with_a_name_and_an_index_is_valid_and_changes_the_base_by_name(node):

@@ -3,7 +3,7 @@ Hermite curves between the points, speed and reach checked, PVT mode ending on P
 import pytest
 
 from tmsim.robot.motion import hermite
-from test_session import S, sct
+from session_rig import S, sct
 
 ROS_TRAJECTORY = ("PVTEnter(0)\r\n"
                   "PVTPoint(10,0,90,0,90,0,20,0,0,0,0,0,1)\r\n"

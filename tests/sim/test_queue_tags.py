@@ -4,7 +4,7 @@ import pytest
 
 from tmsim.protocol import codec
 from tmsim.tmscript.profiles import Profile
-from test_session import PTP_LONG, S, sct, sta
+from session_rig import PTP_LONG, S, sct, sta
 
 PTP_SHORT = 'PTP("JPP",0,0,90,0,90,10,100,200,0,false)'
 
@@ -35,11 +35,10 @@ def status(node, tag):
 
 
 @pytest.fixture
-def node():
-    n = S()
-    n.connect(1)
-    n.out(1)
-    return n
+def node(node):
+    """The shared node (conftest.py) with what connecting sent already read."""
+    node.out(1)
+    return node
 
 
 def test_manual_13_2_only_the_last_four_queued_tags_exist_even_while_their_motion_runs(node):

@@ -6,54 +6,8 @@ import pytest
 from tmsim.protocol import codec
 from tmsim.limits import CPERR_BURST, CPERR_PER_S
 from tmsim.protocol.listen_session import (EXITING, FRAME_LIMIT, IDLE, IN_NODE, INPUT_DONE, INPUT_LEFT, STOPPED, TRANSITIONS,
-                         ListenSession, TransitionError)
-
-
-class S:
-    """A session with connected clients; ``send`` returns the frames each client received."""
-
-    def __init__(self, **kwargs):
-        self.events = []
-        self.s = ListenSession(log=lambda kind, **f: self.events.append((kind, f)), **kwargs)
-        self.t = 0.0
-
-    def connect(self, conn=1, peer="127.0.0.1"):
-        self.s.connect(conn, peer)
-
-    def send(self, conn, raw):
-        buf = bytearray(raw)
-        for item in codec.decode_all(buf):
-            self.s.handle(conn, item)
-        return self.out(conn)
-
-    def out(self, conn=1):
-        frames = self.s.clients[conn].outbox[:]
-        self.s.clients[conn].outbox.clear()
-        return [f.decode("utf-8", "backslashreplace") for f in frames]
-
-    def advance(self, seconds, dt=0.01):
-        end = self.t + seconds
-        while self.t < end - 1e-9:
-            self.t = min(end, self.t + dt)
-            self.s.advance(self.t)
-
-
-def sct(ident, script):
-    return codec.encode("TMSCT", f"{ident},{script}")
-
-
-def sta(data):
-    return codec.encode("TMSTA", data)
-
-
-@pytest.fixture
-def node():
-    n = S()
-    n.connect(1)
-    return n
-
-
-PTP_LONG = 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)'   # 90 deg at 18 deg/s: 5.35 s
+                         TransitionError)
+from session_rig import PTP_LONG, S, sct, sta
 
 
 def test_nothing_is_sent_on_connect_and_enter_message_only_when_entering():

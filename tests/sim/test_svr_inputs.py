@@ -7,7 +7,7 @@ import pytest
 
 from sim_harness import Harness
 from tmsim.net.server import SimServer
-from test_ethernet_slave import ask, values
+from svr_client import ask, values
 
 
 @pytest.fixture

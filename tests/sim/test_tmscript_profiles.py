@@ -8,7 +8,7 @@ from tmsim.tmscript import functions as tmscript
 from tmsim.robot.camera import camera_of
 from tmsim.tmscript.interp import float_text
 from tmsim.tmscript.profiles import Profile
-from test_session import S, sct
+from session_rig import S, sct
 
 # one call per overload that the checker accepts, and one it refuses (wrong type or arity)
 EXAMPLES = {

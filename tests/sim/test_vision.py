@@ -11,7 +11,7 @@ from tmsim.protocol import codec
 from tmsim.robot.camera import Camera, camera_of, parse_option
 from tmsim.cli import build_parser, check_vision_jobs
 from tmsim.net.control import ControlChannel
-from test_session import PTP_LONG, S, sct
+from session_rig import PTP_LONG, sct
 
 PARTS = [[300, 0, 5, 0, 0, 0], [300, 60, 5, 0, 0, 90], [240, -60, 5, 0, 0, -45.5]]
 
@@ -25,11 +25,10 @@ def pushes(frames):
 
 
 @pytest.fixture
-def node():
-    n = S()
-    n.connect(1)
-    camera_of(n.s.robot).define("job1", objects=PARTS, seconds=0.5)
-    return n
+def node(node):
+    """The shared node (conftest.py) with job1 defined on its camera."""
+    camera_of(node.s.robot).define("job1", objects=PARTS, seconds=0.5)
+    return node
 
 
 def test_an_unknown_job_is_not_available_and_does_not_run(node):
