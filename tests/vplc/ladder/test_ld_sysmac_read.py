@@ -7,10 +7,10 @@ from __future__ import annotations
 import pytest
 
 from ld_xml import IEC10_HEAD, iec10_program
+from ld_run import Run
 from vplc.api import load_plc
 from vplc.project import load_project
 
-MS = 1_000_000
 SMC = 'name="https://www.ia.omron.com/Smc IEC61131_10_Ed1_0_SmcExt1_0_Spc1_0.xsd" handleUnknown="discard"'
 RAIL = '<LdObject xsi:type="LeftPowerRail"><ConnectionPointOut connectionPointOutId="1"/></LdObject>'
 
@@ -53,22 +53,6 @@ def refused(path, *words):
     for w in words:
         assert w in text, text
     return errors[0]
-
-
-class Run:
-    def __init__(self, path, extra=()):
-        self.plc = load_plc([str(path), *map(str, extra)], task="Main@1ms")
-        self.t = 0
-
-    def scan(self, **values):
-        for k, v in values.items():
-            self.plc.write(f"Main.{k}", v)
-        self.plc.scan(self.t)
-        self.t += MS
-        return self
-
-    def __getitem__(self, name):
-        return self.plc.read(f"Main.{name}")
 
 
 def test_latch_set_and_reset_coils_hold_their_value(tmp_path):

@@ -1,6 +1,6 @@
 """Ladder blocks Sysmac names by their symbols (W502 2-87, 2-89): `<`, `=`, `+` ... run as LT, EQ, ADD ..."""
 from ld_xml import block, coil, invar, outvar, rail, right
-from test_ld_semantics import Run
+from ld_run import Run
 
 
 def test_symbol_blocks_compare_and_add_like_their_iec_names(tmp_path):
@@ -12,7 +12,7 @@ def test_symbol_blocks_compare_and_add_like_their_iec_names(tmp_path):
             outvar(14, "Sum", (13, "Out"), y=80),
             invar(15, "A", y=120), invar(16, "B", y=130), block(17, "-", {"In1": 15, "In2": 16}, ["Out"], y=120),
             outvar(18, "Diff", (17, "Out"), y=120)]
-    r = Run(tmp_path, {"A": "INT", "B": "INT", "Less": "BOOL", "Same": "BOOL", "Sum": "INT", "Diff": "INT"}, body)
+    r = Run.of(tmp_path, {"A": "INT", "B": "INT", "Less": "BOOL", "Same": "BOOL", "Sum": "INT", "Diff": "INT"}, body)
     r.scan(A=3, B=4)
     assert (r["Less"], r["Same"], r["Sum"], r["Diff"]) == (True, False, 7, -1)
     r.scan(A=4, B=4)
@@ -24,7 +24,7 @@ def test_a_ctd_block_with_the_iec_pin_ld_loads_the_counter(tmp_path):
     body = [rail(1), invar(2, "Pulse"), invar(3, "Reload", y=10), invar(4, "3", y=20),
             block(5, "CTD", {"CD": 2, "LD": 3, "PV": 4}, ["Q", "CV"], instance="Down"),
             outvar(6, "Left", (5, "CV"))]
-    r = Run(tmp_path, {"Pulse": "BOOL", "Reload": "BOOL", "Left": "INT", "Down": "CTD"}, body)
+    r = Run.of(tmp_path, {"Pulse": "BOOL", "Reload": "BOOL", "Left": "INT", "Down": "CTD"}, body)
     assert r.scan(Reload=True)["Left"] == 3
     r.scan(Reload=False)
     assert r.scan(Pulse=True)["Left"] == 2
