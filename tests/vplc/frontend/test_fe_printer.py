@@ -33,7 +33,7 @@ def test_printer_parenthesises_only_where_precedence_requires():
 
 
 def _snippets():
-    from test_fe_rules import CASES
+    from rule_cases import CASES
     for code, failing, fixed in CASES:
         yield failing
         yield fixed
