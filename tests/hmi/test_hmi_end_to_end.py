@@ -230,13 +230,16 @@ def test_stop_page_stops_a_running_move_and_aborts_it(connected):
     browser.click("btn-execute")
     connected.wait(lambda: connected.robot_state()["moving"], "the slow move to start")
     browser = connected.open("stop")
-    browser.click("btn-preset")                                  # Stop Immediately
     since = connected.event_count()
-    execute_and_wait_done(connected, browser, "Stop")
+    browser.click("btn-preset")                                  # Stop Immediately: sends the stop at once
+    browser.wait_for(lambda d: any(word in browser.message() for word in ANSWERS), "the answer of Stop",
+                     timeout=MOVE_WAIT_S)
+    browser.wait_status("Stop_Done", "true", timeout=MOVE_WAIT_S)
+    assert browser.status("Stop_Error") == "false"
     browser.wait_for(lambda d: "Done – the robot stopped" in browser.message(), "Done on the message line")
     assert browser.status("Stop_Done") == "true"                 # held long enough to be seen
     assert [e["command"] for e in connected.events("priority", since)] == ["StopAndClearBuffer(0)"]
-    browser.wait_for(lambda d: browser.message() == "Stop Motion: Done – the robot stopped and its queue is cleared.",
+    browser.wait_for(lambda d: browser.message() == "Stop Immediately: Done – the robot stopped and its queue is cleared.",
                      "the push button to release")
     assert connected.read("Stop_Execute") is False and connected.read("Cobot.Stopping") is False
     browser.screenshot("e2e_stop_done")
@@ -316,11 +319,10 @@ def test_two_pnp_cycles_with_pause_and_resume(connected):
 
 
 def press_stop_motion(system) -> Browser:
-    """The Stop Motion page as the operator uses it: Stop Immediately, Execute; the page holds Stop until Done,
-    shows Done for 1.5 s, then releases it. Returns once the page has released Stop."""
+    """The Stop Motion page as the operator uses it: Stop Immediately sends the stop; the page holds Stop until
+    Done, shows Done for 1.5 s, then releases it. Returns once the page has released Stop."""
     browser = system.open("stop")
     browser.click("btn-preset")                                  # Stop Immediately
-    browser.click("btn-execute")
     system.wait(lambda: system.read("Stop_Done"), "the stop to be done")
     system.wait(lambda: not system.read("Stop_Execute"), "the page to release Stop")
     system.wait(lambda: not system.read("Cobot.Stopping"), "the robot released")

@@ -17,7 +17,7 @@ SIZES = [(800, 480), (1280, 800)]
 # the chroma (max - min of R, G, B) above which a background counts as coloured rather than grey
 GREY_CHROMA = 40
 NORMAL_STATE_ELEMENTS = ("#pill-role, #pill-robot, #pill-plc, #message, header a.menu, .area .tiles a, "
-                         "button:not(#btn-execute.danger), .lamp, .led")
+                         "button:not(#hdr-stop), .lamp, .led")
 
 COLOURS = """
     const rgba = (c) => (c.match(/[\\d.]+/g) || []).map(Number);
@@ -90,7 +90,7 @@ def test_the_panel_fills_the_screen_and_its_text_grows_with_it(stack, size):
 @pytest.mark.parametrize("name", ["index", "connect", "moveabs", "pnp"])
 def test_normal_states_are_grey(stack, name):
     """Robot connected and in its Listen node, PLC online, operator logged in, a command done: nothing is coloured
-    (ISA-101). Only the Stop command's own key keeps its red."""
+    (ISA-101). Only the header's Stop key keeps its red."""
     browser = open_sized(stack, name, "operator", (800, 480))
     browser.wait_for(lambda d: browser.driver.find_element("id", "pill-robot").text == "Robot ready", "the robot state")
     browser.driver.execute_script("message('Move Absolute: Done – the robot arrived at the target.', 'ok')")

@@ -66,6 +66,7 @@ const PAGES = {
   stop: { title: "Stop Motion", group: "Stop", param: "Stop_Param", legend: "Stop Settings", execLabel: "Stop",
     release: "the robot stopped and its queue is cleared",   // a push button: Execute is reset once the stop is
                              // done, which releases the robot
+    act: true,               // its presets send the stop when pressed (issue 25 item 2)
     presets: { "Stop Immediately": { Mode: 1 }, "Stop and Discard All": { Mode: 3 } } },
 };
 const DEFAULT_STATUS = ["Busy", "Done", "CommandAborted", "Error", "ErrorID", "ErrorDescrip", "CmdID_Ack"];
@@ -379,7 +380,7 @@ function showPlcState(pillPlc, pillRobot) {
 
 /* ---------- polling ---------- */
 function startPolling(names) {
-  names = [...new Set(names.filter((n) => MAP.variables[n]))];
+  names = [...new Set([...names, ...STOP_VARS].filter((n) => MAP.variables[n]))];   // the Stop key's answer
   const pillPlc = document.getElementById("pill-plc"), pillRobot = document.getElementById("pill-robot");
   async function tick() {
     try {
@@ -412,11 +413,30 @@ function frame(title, isMain) {
   document.title = "CBT HMI – " + title;
   document.body.innerHTML = `<div class="panel">
     <header>${isMain ? "" : '<a class="menu" id="btn-menu" href="index.html">◀ Main Menu</a>'}
-      <h1>${title}</h1><span class="pill" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span></header>
+      <h1>${title}</h1><span class="pill" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span>${stopKeyHtml()}</header>
     <main id="main"></main><div id="message">${ACCESS.role === "monitor" ?
       "Monitor mode (read only): open the operator address printed at start-up to operate." : "Ready."}</div></div>`;
   alarmBanner(document.querySelector(".panel"));
+  const key = document.getElementById("hdr-stop");
+  if (key) key.onclick = () => sendStop(STOP_IMMEDIATE, "Stop");
   return document.getElementById("main");
+}
+
+/* The Stop key: the last key of the header, so it sits in the top right corner of every page, and the only red
+   key of the panel (ISA-101). It sends the stop at once through the PLC's CBT_Stop instance (Stop_Execute with
+   Stop_Param.Mode), for the operator as for the engineer: a stop is never refused for the role. The PLC latches
+   it (the PnP cycle stays Stopped until a new Start), so releasing Execute afterwards never moves the robot. */
+const STOP_IMMEDIATE = 1, STOP_DISCARD_ALL = 3;          // eCBT_StopMode in mapping.json
+const STOP_VARS = ["Stop_Done", "Stop_Error", "Stop_ErrorID", "Stop_ErrorDescrip"];
+function stopKeyHtml() {
+  if (!MAP || !MAP.variables.Stop_Execute) return "";   // a user's program without CBT_Stop
+  return `<button class="danger" id="hdr-stop" title="Stop the robot now"${mayWrite("Stop_Execute") ? "" :
+    " disabled"}>■ Stop</button>`;
+}
+async function sendStop(mode, what) {
+  if (await executeCommand("Stop_Execute", { "Stop_Param.Mode": mode }, what)) {
+    releaseWhenFinished("Stop", what, "the robot stopped and its queue is cleared");
+  }
 }
 
 function mainPage() {
@@ -515,7 +535,13 @@ async function fbPage(key) {
   Object.keys(page.presets).forEach((name, i) => {
     const b = document.createElement("button");
     b.className = "wide"; b.id = i ? `btn-preset-${i + 1}` : "btn-preset"; b.textContent = name;
+    if (page.act) b.disabled = !mayWrite(`${group}_Execute`);
     b.onclick = () => {
+      if (page.act) {                          // Stop page: "Stop Immediately" stops now, not only fills the form
+        if (page.param) fillFrom(params, page.param, page.presets[name]);
+        sendStop(page.presets[name].Mode, name);
+        return;
+      }
       if (page.param) fillFrom(params, page.param, page.presets[name]);
       else for (const [v, val] of Object.entries(page.presets[name])) setInput(params.querySelector(`[data-path="${v}"]`), val);
       refreshLimits(params, page.param || "");
@@ -525,7 +551,7 @@ async function fbPage(key) {
     buttons.append(b);
   });
   const exec = document.createElement("button");
-  exec.className = (key === "stop" ? "danger" : "primary") + (key === "connect" ? "" : " wide");
+  exec.className = "primary" + (key === "connect" ? "" : " wide");     // red is the header's Stop key only
   exec.id = "btn-execute"; exec.textContent = page.execLabel || "Execute";
   exec.disabled = !mayWrite(`${group}_Execute`);
   exec.onclick = () => {
