@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 from .frontend import types as T
 from .compiler.codegen import CodeGen
+from .runtime import abi
 from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
 from .runtime.values import PathError, Resolver, parse_duration
@@ -150,9 +151,9 @@ class Plc:
         self.lock = threading.RLock()
         try:
             self.globals = module.globals_cls()
-            ns["G"] = self.globals
+            ns[abi.GLOBALS] = self.globals
             self.engine.bind_system_vars(self.globals)
-            self.instances: dict[str, object] = ns["_PROGRAMS"]
+            self.instances: dict[str, object] = ns[abi.PROGRAMS]
             self.type_named_instances: dict[str, list[str]] = {}   # see _setup_tasks
             self._setup_tasks(task, programs)
         except LoadError:

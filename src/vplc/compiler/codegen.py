@@ -14,6 +14,7 @@ from ..frontend import ast as A
 from ..frontend import types as T
 from .codegen_expr import ExprGen, attr, cut, is_scalar
 from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop_range, unguarded
+from ..runtime import abi
 from ..runtime.program import GEN_FILE, PouClass, Program
 from ..runtime.sysmac_fns import KEEPS_OUT_ON_ERROR
 
@@ -138,7 +139,7 @@ class CodeGen(ExprGen):
         # the copier: a structure passed or assigned by value, field by field without type dispatch
         self.emit(f"def C{name[1:]}(v):")
         self.ind += 1
-        self.emit(f"o = _new({name})")
+        self.emit(f"o = {abi.NEW}({name})")
         for f in t.fields.values():
             a = attr(f.name)
             self.emit(f"o.{a} = {self.field_copy(f'v.{a}', f.type)}")
@@ -173,7 +174,7 @@ class CodeGen(ExprGen):
                 self.emit(f"{name}.{attr(f.name)} = _uprop{layout!r}")
         self.emit(f"def C{name[1:]}(v):")
         self.ind += 1
-        self.emit(f"o = _new({name})")
+        self.emit(f"o = {abi.NEW}({name})")
         self.emit("o.i__m = [v.i__m[0]]")
         self.emit("return o")
         self.ind -= 1
@@ -186,7 +187,7 @@ class CodeGen(ExprGen):
         """Statement copying the structure or array value ``src`` into the existing ``dst`` of type ``t``."""
         u = T.unalias(t)
         entry = self.struct_names.get(id(u)) if isinstance(u, T.StructType) else None
-        return f"A{entry[1][1:]}({dst}, {src})" if entry is not None else f"_assign({dst}, {src})"
+        return f"A{entry[1][1:]}({dst}, {src})" if entry is not None else f"{abi.ASSIGN}({dst}, {src})"
 
     def field_assign(self, dst: str, src: str, t) -> str:
         u = T.unalias(t)
@@ -208,16 +209,16 @@ class CodeGen(ExprGen):
                 return f"{code}[:]"
             if isinstance(el, T.StructType):
                 return f"[{self.copy_code('x', el)} for x in {code}]"
-        return f"_copy({code})"
+        return f"{abi.COPY}({code})"
 
     # ---- globals ------------------------------------------------------------------------------
     def gen_globals(self) -> None:
-        self.emit("class Globals:")
+        self.emit(f"class {abi.GLOBALS_CLASS}:")
         self.ind += 1
         self.emit("def __init__(s):")
         self.ind += 1
         self.emit("s.i__path = 'GLOBAL'")
-        self.emit("G = s")
+        self.emit(f"{abi.GLOBALS} = {abi.SELF}")
         placed = [sym for sym in self.proj.globals.values() if getattr(sym, "at_address", None) is not None]
         if placed:
             self.emit("s.i__mem = _AreaMemory()")
@@ -298,7 +299,7 @@ class CodeGen(ExprGen):
         self.emit(f"def F{cname[1:]}({', '.join(n for _p, n in names.values())}):")
         self.ind += 1
         self.emit(f"path = {pt.qualified_name!r}")
-        self.emit(f"s = _new({cname})")
+        self.emit(f"s = {abi.NEW}({cname})")
         self.emit("s.i__path = path")
         for sec in pt.pou.sections:
             for d in sec.vars:
@@ -338,14 +339,14 @@ class CodeGen(ExprGen):
     def stmt(self, st) -> None:
         self.at(st.span)
         if self.count:
-            self.emit("_NST[0] += 1")
+            self.emit(f"{abi.STATEMENTS}[0] += 1")
         m = getattr(self, "st_" + type(st).__name__)
         self.spill_ok = isinstance(st, (A.Assign, A.CallStmt, A.Case, A.For))
         m(st)
         self.spill_ok = False
         if isinstance(st, (A.Assign, A.CallStmt)) and self.moves_bulk(st):
             # a scan of large copies and no loop still meets the watchdog
-            self.emit("if _pc() > _DL[0]: _watchdog('still copying large arrays or structures')")
+            self.emit(f"if {abi.PERF_COUNTER}() > {abi.DEADLINE}[0]: {abi.WATCHDOG}('still copying large arrays or structures')")
 
     def moves_bulk(self, st) -> bool:
         """Whether a statement reads, writes or passes a structured value of at least BULK_CELLS cells (a copy
@@ -377,7 +378,7 @@ class CodeGen(ExprGen):
         if pt is not None and pt.native and pt.name in KEEPS_OUT_ON_ERROR and isinstance(tt, T.StringType):
             # W502 2-269: on an error the instruction's Out, the variable assigned here, does not change
             self.emit(f"_k = {self.call_expr(v)}")            # whole, unconverted: a longer text is an error too
-            self.emit(f"if _stores_out(_k, {tt.capacity}, {pt.name!r}):")
+            self.emit(f"if {abi.STORES_OUT}(_k, {tt.capacity}, {pt.name!r}):")
             self.ind += 1
             self.store(st.target, "_k", v)
             self.ind -= 1
@@ -403,7 +404,7 @@ class CodeGen(ExprGen):
         elif isinstance(tt, T.ElementaryType) and tt.kind == "real" and tt.bits == 32:
             sb = T.base_of(st_ty) if st_ty is not None else None
             if not (isinstance(sb, T.ElementaryType) and sb is T.REAL):
-                code = f"_f32({code})"
+                code = f"{abi.F32}({code})"
         self.emit(f"{lv} = {code}")
 
     def st_If(self, st: A.If) -> None:
@@ -506,7 +507,7 @@ class CodeGen(ExprGen):
             self.ind -= 1
 
     def loop_guard(self) -> None:
-        self.emit("if _pc() > _DL[0]: _watchdog()")
+        self.emit(f"if {abi.PERF_COUNTER}() > {abi.DEADLINE}[0]: {abi.WATCHDOG}()")
 
     def st_For(self, st: A.For) -> None:
         var = self.lvalue(st.var)
@@ -521,7 +522,7 @@ class CodeGen(ExprGen):
             self.emit(f"{v} = {self.expr(st.start)}")
             self.emit(f"{e} = {self.expr(st.end)}")
             self.emit(f"{sp} = {self.expr(st.step) if st.step is not None else '1'}")
-            self.emit(f"if {sp} == 0: _fault('FOR loop with step 0')")
+            self.emit(f"if {sp} == 0: {abi.FAULT}('FOR loop with step 0')")
             self.emit(f"{var} = {v}")
             self.emit(f"for {v} in range({v}, {e} + (1 if {sp} > 0 else -1), {sp}):")
         self.ind += 1
@@ -529,7 +530,7 @@ class CodeGen(ExprGen):
         short = self.optimise and unguarded(st)
         unit = self.optimise and not short and (st.step is None or constant_step(st) in (1, -1))
         if unit:              # counting by one: check the watchdog every 64 iterations, and when the loop ends
-            self.emit(f"if not {v} & 63 and _pc() > _DL[0]: _watchdog()")
+            self.emit(f"if not {v} & 63 and {abi.PERF_COUNTER}() > {abi.DEADLINE}[0]: {abi.WATCHDOG}()")
         elif not short:
             self.loop_guard()
         known = loop_range(st) if self.optimise else None
@@ -579,7 +580,7 @@ class CodeGen(ExprGen):
         if b.kind == "fb":
             self.fb_call(b)
         elif b.kind == "program":
-            self.fb_call(b, f"_PROGRAMS[{b.pou.name.upper()!r}]")
+            self.fb_call(b, f"{abi.PROGRAMS}[{b.pou.name.upper()!r}]")
         else:
             self.emit(self.call_expr(call))
 

@@ -11,9 +11,11 @@ import re
 from ..frontend import ast as A
 from ..frontend import types as T
 from .inline import readonly_inputs
-from ..runtime import iec
+from ..runtime import abi, iec
 
-_PY_RESERVED = set(keyword.kwlist) | {"None", "True", "False", "s", "G"}
+_PY_RESERVED = set(keyword.kwlist) | {"None", "True", "False", abi.SELF, abi.GLOBALS}
+
+_G_MEMBERS = f"{abi.GLOBALS}.{abi.MEMBERS}"      # the container of memory-area globals
 
 
 def attr(name: str) -> str:
@@ -116,7 +118,7 @@ class ExprGen:
             return f"[{self.default(el, None, path)} for _ in range({n})]"
         if isinstance(u, T.PouType):
             if u.native:
-                return f"N_{u.name}({path})"
+                return f"{abi.NATIVE_FB}{u.name}({path})"
             return f"{self.cls_name(u)}({path})"
         return "None"
 
@@ -154,7 +156,7 @@ class ExprGen:
         if d.kind == "real":
             if isinstance(s, T.ElementaryType) and s.kind == "real" and (s.bits <= d.bits):
                 return code
-            return f"_f32({code})" if d.bits == 32 else f"float({code})"
+            return f"{abi.F32}({code})" if d.bits == 32 else f"float({code})"
         if isinstance(s, T.ElementaryType) and s.kind == "bool" and d.kind != "bool":
             return f"int({code})"
         if isinstance(s, T.ElementaryType) and s.kind == "real" and d.kind in ("int", "uint"):
@@ -173,7 +175,7 @@ class ExprGen:
         if isinstance(tt, T.ElementaryType) and tt.kind == "real":
             if isinstance(et, T.ElementaryType) and et.kind == "real" and et.bits <= tt.bits:
                 return code
-            return f"_f32({code})" if tt.bits == 32 else f"float({code})"
+            return f"{abi.F32}({code})" if tt.bits == 32 else f"float({code})"
         if isinstance(tt, (T.StructType, T.ArrayType)):
             return self.copy_code(code, tt)
         return _sign_cast(code, et, tt)
@@ -182,7 +184,7 @@ class ExprGen:
         """A fresh copy of the structure or array value ``code`` of type ``t``: a structure through the copier
         generated for its type (CodeGen.gen_struct), anything else through the generic deep copy."""
         entry = self.struct_names.get(id(t)) if isinstance(t, T.StructType) else None
-        return f"C{entry[1][1:]}({code})" if entry is not None else f"_copy({code})"
+        return f"C{entry[1][1:]}({code})" if entry is not None else f"{abi.COPY}({code})"
 
     def ex_Literal(self, e) -> str:
         t = T.base_of(e.ty) if e.ty is not None else None
@@ -217,11 +219,11 @@ class ExprGen:
             container, key = _cell(sym, self.self_name)
             if container.endswith(".__dict__"):            # plain attribute access: the fast path
                 return f"{container[:-len('.__dict__')]}.{key[1:-1]}"
-            if container == "G.i__members":
-                return f"G.{key[1:-1]}"
+            if container == _G_MEMBERS:
+                return f"{abi.GLOBALS}.{key[1:-1]}"
             return f"{container}[{key}]"
         if kind == "PouSymbol" and sym.type.kind == "program":
-            return f"_PROGRAMS[{sym.type.name.upper()!r}]"
+            return f"{abi.PROGRAMS}[{sym.type.name.upper()!r}]"
         raise NotImplementedError(f"name {e.name.text()}")
 
     def ex_Member(self, e) -> str:
@@ -249,7 +251,7 @@ class ExprGen:
         if not isinstance(at, T.ArrayType):
             raise NotImplementedError("indexing a non-array")
         if at.open:
-            return f"{base}[_ixo({idx[0]}, {base}, {what})]"
+            return f"{base}[{abi.IXO}({idx[0]}, {base}, {what})]"
         if len(at.dims) == 1:
             lo, hi = at.dims[0]
             first = e.indices[0]
@@ -259,10 +261,10 @@ class ExprGen:
             if known is not None and lo <= known[1] and known[2] <= hi:    # a FOR variable that stays in range
                 return f"{base}[{_offset(known[0], lo)}]"
             if isinstance(first, (A.Name, A.Member)) and _plain(idx[0]):   # cheap to read twice: check inline
-                return f"{base}[{_offset(idx[0], lo)} if {lo} <= {idx[0]} <= {hi} else _ix1({idx[0]}, {lo}, {hi}, {what})]"
-            return f"{base}[_ix1({idx[0]}, {lo}, {hi}, {what})]"
+                return f"{base}[{_offset(idx[0], lo)} if {lo} <= {idx[0]} <= {hi} else {abi.IX1}({idx[0]}, {lo}, {hi}, {what})]"
+            return f"{base}[{abi.IX1}({idx[0]}, {lo}, {hi}, {what})]"
         dims = self.const(tuple(at.dims), "_d")
-        return f"{base}[_ixn(({', '.join(idx)},), {dims}, {what})]"
+        return f"{base}[{abi.IXN}(({', '.join(idx)},), {dims}, {what})]"
 
     def ex_Unary(self, e) -> str:
         x = self.expr(e.operand)
@@ -296,16 +298,16 @@ class ExprGen:
         if t is None:
             return f"({a} {op} {b})"
         if op == "**":
-            r = f"_expt({a}, {b})"
-            return f"_f32({r})" if t.bits == 32 and t.kind == "real" else r
+            r = f"{abi.EXPT}({a}, {b})"
+            return f"{abi.F32}({r})" if t.bits == 32 and t.kind == "real" else r
         if t.kind == "real":
             if op == "/":
-                r = f"_rdiv({a}, {b})"
+                r = f"{abi.RDIV}({a}, {b})"
             elif op == "MOD":
                 r = f"_fmod({a}, {b})"
             else:
                 r = f"({a} {op} {b})"
-            return f"_f32({r})" if t.bits == 32 else r
+            return f"{abi.F32}({r})" if t.bits == 32 else r
         signed = t.kind in ("int", "time", "date", "tod", "dt")
         k = e.right.value if isinstance(e.right, A.Literal) and type(e.right.value) is int and e.right.conv is None \
             else 0
@@ -315,10 +317,10 @@ class ExprGen:
             return f"({a} {py} {k})" if not signed else f"({a} {py} {k} if {a} >= 0 else -(-{a} {py} {k}))"
         if op == "/":
             if t.kind == "time" and _width(e.right.ty) is not None and _width(e.right.ty).kind == "real":
-                return f"int(_rdiv({a}, {b}))"
-            r = f"_idiv({a}, {b})"
+                return f"int({abi.RDIV}({a}, {b}))"
+            r = f"{abi.IDIV}({a}, {b})"
         elif op == "MOD":
-            r = f"_imod({a}, {b})"
+            r = f"{abi.IMOD}({a}, {b})"
         elif op == "*" and t.kind == "time":
             r = f"int(round({a} * {b}))"
         else:
@@ -374,11 +376,11 @@ class ExprGen:
             ref = self.ref(ba.expr)
             if getattr(self, "optimise", False) and ref.endswith(", 0)"):
                 return ref[1:-len(", 0)")]          # from the first element: the array itself, no view
-            return f"_View(*{ref})"
+            return f"{abi.VIEW}(*{ref})"
         pt, at = T.unalias(ba.param.type), T.unalias(ba.expr.ty)
         if isinstance(pt, T.ArrayType) and pt.open and isinstance(at, T.ArrayType) and not at.open \
                 and len(at.dims) == 1 and at.dims[0][0] != 0:
-            return f"_View({self.expr_raw(ba.expr)}, 0, {at.dims[0][0]})"
+            return f"{abi.VIEW}({self.expr_raw(ba.expr)}, 0, {at.dims[0][0]})"
         return self.expr_raw(ba.expr)
 
     def input_value(self, ba, p) -> str:
@@ -387,8 +389,8 @@ class ExprGen:
         pt = T.unalias(p.type)
         if ba.from_element and isinstance(pt, T.ArrayType):
             n = pt.count() if not pt.open else None
-            view = f"_View(*{self.ref(ba.expr)})"
-            return f"_copy({view})" if n is None else f"_fill(_copy({view}), {n}, lambda: {self.default(pt.element, None, repr(p.name))})"
+            view = f"{abi.VIEW}(*{self.ref(ba.expr)})"
+            return f"{abi.COPY}({view})" if n is None else f"_fill({abi.COPY}({view}), {n}, lambda: {self.default(pt.element, None, repr(p.name))})"
         return self.store_conv(self.expr(ba.expr), ba.expr, p.type)
 
     def by_reference(self, pt, p, ba) -> bool:
@@ -404,7 +406,7 @@ class ExprGen:
             return gen_builtin(self, b)
         pt = b.pou
         if pt.native and pt.name == "VPLC_ScanTime":
-            return "_NOW[0]"                  # the scan time cell the engine sets once per scan
+            return f"{abi.SCAN_TIME}[0]"                  # the scan time cell the engine sets once per scan
         by_param = {ba.param.name.upper(): ba for ba in b.args}
         args = []
         for p in pt.params:
@@ -432,7 +434,7 @@ class ExprGen:
                 args.append(self.ref(ba.expr))
             if pt.native and generic:
                 args.append(self.const(ba.expr.ty, "_ty"))
-        fn = f"NF_{pt.name}" if pt.native else f"F{self.cls_name(pt)[1:]}"
+        fn = f"{abi.NATIVE_FUNCTION}{pt.name}" if pt.native else f"F{self.cls_name(pt)[1:]}"
         return f"{fn}({', '.join(args)})"
 
 
@@ -453,8 +455,8 @@ def _cell(sym, s: str = "s") -> tuple[str, str]:
     a = attr(sym.name)
     if sym.section in ("VAR_GLOBAL", "VAR_EXTERNAL"):
         if getattr(sym, "at_address", None) is not None:
-            return "G.i__members", repr(a)        # a memory-area variable: a property (runtime/at_memory.py)
-        return "G.__dict__", repr(a)
+            return _G_MEMBERS, repr(a)        # a memory-area variable: a property (runtime/at_memory.py)
+        return f"{abi.GLOBALS}.__dict__", repr(a)
     if sym.section == "VAR_IN_OUT" and is_scalar(sym.type):
         return f"{s}.{a}__r", f"{s}.{a}__k"
     return f"{s}.__dict__", repr(a)

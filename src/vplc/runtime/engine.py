@@ -16,6 +16,7 @@ import weakref
 from dataclasses import dataclass, field
 
 from ..frontend.types import StructType
+from . import abi
 from .faults import GEN_FILE, PlcFault, RuntimeFaultError, WatchdogError
 from .sockets import SocketManager
 
@@ -67,12 +68,12 @@ class Engine:
         self.clock_base_ns = clock_base_ns
         self.fault: PlcFault | None = None
         self.scan_count = 0
-        self.deadline = module.namespace["_DL"]
-        self.probation = module.namespace["_WDP"]       # watchdog probation: [deadline it set, CPU time]
-        module.namespace["_WDS"][0] = self.watchdog_s
+        self.deadline = module.namespace[abi.DEADLINE]
+        self.probation = module.namespace[abi.PROBATION]       # watchdog probation: [deadline it set, CPU time]
+        module.namespace[abi.WATCHDOG_LIMIT][0] = self.watchdog_s
         _ENGINES.add(self)
-        self.stmt_counter = module.namespace["_NST"]
-        self.now_cell = module.namespace["_NOW"]          # what VPLC_ScanTime() returns in generated code
+        self.stmt_counter = module.namespace[abi.STATEMENTS]
+        self.now_cell = module.namespace[abi.SCAN_TIME]          # what VPLC_ScanTime() returns in generated code
         self.system_vars = None           # (globals dict, first-run attrs, [(attr, period ns)]): see bind_system_vars
         self.system_vars_next = 0         # scan time at which a clock pulse changes next
         self.current_time = None          # (globals dict, attr) of _CurrentTime, set before every task execution

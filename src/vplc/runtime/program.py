@@ -14,7 +14,7 @@ import time
 from dataclasses import dataclass, field
 from types import CodeType
 
-from . import iec, natives, stdlib, sysmac_fns
+from . import abi, iec, natives, stdlib, sysmac_fns
 from .faults import GEN_FILE, RuntimeFaultError, WatchdogError
 
 __all__ = ["GEN_FILE", "HELPERS", "Image", "PouClass", "Program"]
@@ -43,10 +43,10 @@ def fault(message: str) -> None:
 
 # helpers every generated module calls by these names
 HELPERS = {
-    "_f32": iec.f32, "_idiv": iec.idiv, "_imod": iec.imod, "_rdiv": iec.rdiv, "_expt": iec.expt,
-    "_ix1": iec.ix1, "_ixn": iec.ixn, "_ixo": iec.ixo, "_View": iec.ArrView,
-    "_assign": iec.assign_into, "_copy": iec.copy_value,
-    "_pc": time.perf_counter, "_fault": fault, "_new": object.__new__,
+    abi.F32: iec.f32, abi.IDIV: iec.idiv, abi.IMOD: iec.imod, abi.RDIV: iec.rdiv, abi.EXPT: iec.expt,
+    abi.IX1: iec.ix1, abi.IXN: iec.ixn, abi.IXO: iec.ixo, abi.VIEW: iec.ArrView,
+    abi.ASSIGN: iec.assign_into, abi.COPY: iec.copy_value,
+    abi.PERF_COUNTER: time.perf_counter, abi.FAULT: fault, abi.NEW: object.__new__,
 }
 
 
@@ -76,9 +76,9 @@ class Program:
         ns = dict(stdlib.NAMESPACE)
         ns.update(HELPERS)
         ns.update(self.consts)
-        ns.update({"_DL": [math.inf], "_WDP": [math.nan, 0.0], "_WDS": [0.5], "_NST": [0], "_NOW": [0],
-                   "_PROGRAMS": {}})
-        ns["_watchdog"] = make_watchdog(ns["_DL"], ns["_WDP"], ns["_WDS"])
+        ns.update({abi.DEADLINE: [math.inf], abi.PROBATION: [math.nan, 0.0], abi.WATCHDOG_LIMIT: [0.5],
+                   abi.STATEMENTS: [0], abi.SCAN_TIME: [0], abi.PROGRAMS: {}})
+        ns[abi.WATCHDOG] = make_watchdog(ns[abi.DEADLINE], ns[abi.PROBATION], ns[abi.WATCHDOG_LIMIT])
         exec(self.code, ns)
         image = Image(self, ns)
         for key, info in self.pous.items():
@@ -96,7 +96,7 @@ class Program:
                 image.bodies[key] = ns[info.body_name]
         for name, fields, t in self.structs:
             ns[name].i__vars, ns[name].i__type = fields, t
-        image.globals_cls = ns["Globals"]
+        image.globals_cls = ns[abi.GLOBALS_CLASS]
         image.globals_cls.i__vars = self.globals_vars
         return image
 
@@ -122,7 +122,7 @@ class Image:
         """Make the native POUs of this image use the controller ``rt`` (sockets, clock)."""
         ns = self.namespace
         for name, cls in natives.NATIVE_FBS.items():
-            ns["N_" + name] = functools.partial(cls, rt)
+            ns[abi.NATIVE_FB + name] = functools.partial(cls, rt)
         for name, fn in natives.NATIVE_FUNCTIONS.items():
-            ns["NF_" + name] = functools.partial(fn, rt)
-        ns["_stores_out"] = functools.partial(sysmac_fns.stores_out, rt)
+            ns[abi.NATIVE_FUNCTION + name] = functools.partial(fn, rt)
+        ns[abi.STORES_OUT] = functools.partial(sysmac_fns.stores_out, rt)
