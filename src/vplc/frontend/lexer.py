@@ -16,6 +16,7 @@ import re
 
 from .diagnostics import DiagnosticBag
 from .source import SourceFile, Span
+from . import codes
 
 _DURATION = r"[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]+)?(?i:ms|us|ns|d|h|m|s)_?)++"
 _CLOCK = r"[0-9]+:[0-9]+(?::[0-9]+(?:\.[0-9]+)?)?"
@@ -116,7 +117,7 @@ def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None
             continue
         if bad_start >= 0:
             chunk = text[bad_start:pos]
-            diags.error("ST0101", f"unexpected character {chunk[0]!r} (U+{ord(chunk[0]):04X}); "
+            diags.error(codes.BAD_CHARACTER, f"unexpected character {chunk[0]!r} (U+{ord(chunk[0]):04X}); "
                         "remove it or put it inside a comment or string", Span(src, bad_start, pos))
             bad_start = -1
         if kind == "WS":
@@ -130,7 +131,7 @@ def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None
         if kind == "COMMENT":
             stop = _skip_comment(text, pos)
             if stop < 0:
-                diags.error("ST0102", "comment is never closed; add `*)` at its end",
+                diags.error(codes.UNCLOSED_COMMENT, "comment is never closed; add `*)` at its end",
                             Span(src, pos, pos + 2))
                 break
             if comments is not None:
@@ -140,13 +141,13 @@ def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None
         if kind == "PRAGMA":
             stop = text.find("}", pos)
             if stop < 0:
-                diags.error("ST0105", "pragma is never closed; add `}`", Span(src, pos, pos + 1))
+                diags.error(codes.UNCLOSED_PRAGMA, "pragma is never closed; add `}`", Span(src, pos, pos + 1))
                 break
             append(Token("PRAGMA", text[pos:stop + 1], pos, stop + 1))
             pos = stop + 1
             continue
         if kind == "BADSTRING":
-            diags.error("ST0103", "string literal is not closed on this line; add the closing quote",
+            diags.error(codes.UNCLOSED_STRING, "string literal is not closed on this line; add the closing quote",
                         Span(src, pos, end))
             append(Token("STRING" if text[pos] == "'" else "WSTRING", text[pos:end] + text[pos], pos, end))
             pos = end
@@ -155,7 +156,7 @@ def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None
         pos = end
     if bad_start >= 0:
         ch = text[bad_start]
-        diags.error("ST0101", f"unexpected character {ch!r} (U+{ord(ch):04X}); "
+        diags.error(codes.BAD_CHARACTER, f"unexpected character {ch!r} (U+{ord(ch):04X}); "
                     "remove it or put it inside a comment or string", Span(src, bad_start, n))
     tokens.append(Token("EOF", "", n, n))
     return tokens

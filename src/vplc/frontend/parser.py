@@ -8,6 +8,7 @@ from __future__ import annotations
 import sys
 
 from . import ast as A
+from . import codes
 from .diagnostics import DiagnosticBag
 from .lexer import tokenize
 from .parser_base import DepthExceeded, ParseError, ParserBase
@@ -37,14 +38,15 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                 if t.kind == "IDENT" and t.up == "VAR_GLOBAL":
                     if spaces:
                         self.fail("global variables belong to no namespace; declare VAR_GLOBAL outside NAMESPACE",
-                                  "ST0206")
+                                  codes.STRAY_TEXT)
                     gstart = t.start if gstart is None else gstart
                     globals_sections.append(self.var_section())
                     continue
                 if t.kind == "IDENT" and t.up == "NAMESPACE":
                     if len(spaces) >= MAX_NAMESPACE_DEPTH:
                         if not too_deep:
-                            self.diags.error("ST0203", f"namespaces nested deeper than {MAX_NAMESPACE_DEPTH} "
+                            self.diags.error(codes.NESTING_TOO_DEEP,
+                                             f"namespaces nested deeper than {MAX_NAMESPACE_DEPTH} "
                                              "levels", self.tok_span(t))
                         too_deep += 1
                         self.namespace_name()
@@ -58,7 +60,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                     if too_deep:
                         too_deep -= 1
                     elif not spaces:
-                        self.diags.error("ST0206", "`END_NAMESPACE` without NAMESPACE", self.tok_span(t))
+                        self.diags.error(codes.STRAY_TEXT, "`END_NAMESPACE` without NAMESPACE", self.tok_span(t))
                     else:
                         spaces.pop()
                         current = "\\".join(spaces)
@@ -69,11 +71,12 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                     items.append(self.type_block())
                 elif t.kind == "IDENT" and t.up == "CONFIGURATION":
                     if spaces:
-                        self.fail("a CONFIGURATION belongs to no namespace; declare it outside NAMESPACE", "ST0206")
+                        self.fail("a CONFIGURATION belongs to no namespace; declare it outside NAMESPACE",
+                                  codes.STRAY_TEXT)
                     items.append(self.configuration())
                 else:
                     self.fail(f"expected FUNCTION, FUNCTION_BLOCK, PROGRAM, TYPE, VAR_GLOBAL or CONFIGURATION, "
-                              f"found {self.describe(t)}", "ST0206")
+                              f"found {self.describe(t)}", codes.STRAY_TEXT)
                 if spaces:
                     items[-1].declared_namespace = current
             except (ParseError, DepthExceeded):
@@ -82,7 +85,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                     self.advance()
                 self.sync_item()
         if spaces:
-            self.diags.error("ST0202", f"missing `END_NAMESPACE` of `{spaces[-1]}`", self.tok_span())
+            self.diags.error(codes.MISSING_END, f"missing `END_NAMESPACE` of `{spaces[-1]}`", self.tok_span())
         if globals_sections:
             stem = self.src.path.replace("\\", "/").rsplit("/", 1)[-1].rsplit(".", 1)[0]
             items.append(A.GlobalVarList(globals_sections, stem, span=Span(self.src, gstart, self.tok.start)))
@@ -101,7 +104,8 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
     def report_pragmas(self) -> None:
         for p in self.pragmas:
             if p.text[1:-1].strip().lower() != "native":
-                self.diags.note("ST0107", "pragma ignored: vplc does not interpret pragmas", self.tok_span(p))
+                self.diags.note(codes.PRAGMA_IGNORED,
+                                "pragma ignored: vplc does not interpret pragmas", self.tok_span(p))
 
     def pragmas_before(self, offset: int, after: int) -> list[str]:
         return [p.text[1:-1].strip() for p in self.pragmas if after <= p.start < offset]
@@ -120,7 +124,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                 ret = self.type_spec()
         elif self.at_kw("EXTENDS") or self.at_kw("IMPLEMENTS"):
             self.fail(f"`{self.tok.text}` (object-oriented extension) is not supported: IEC 61131-3 2nd edition "
-                      "and Sysmac function blocks have no inheritance", "ST0207")
+                      "and Sysmac function blocks have no inheritance", codes.UNSUPPORTED_EXTENSION)
         sections: list[A.VarSection] = []
         while self.at_any_kw(SECTION_WORDS):
             try:
@@ -129,12 +133,12 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
                 self.sync_to_end_var()
         if self.at_kw("METHOD") or self.at_kw("PROPERTY"):
             self.fail(f"`{self.tok.text}` is not supported: IEC 61131-3 2nd edition and Sysmac have no "
-                      "methods or properties", "ST0207")
+                      "methods or properties", codes.UNSUPPORTED_EXTENSION)
         self.end_stack = [end_word]
         body = self.statement_list(frozenset((end_word,)))
         while self.tok.kind == "IDENT" and self.tok.up in ("END_IF", "END_CASE", "END_FOR", "END_WHILE",
                                                            "END_REPEAT", "ELSIF", "ELSE", "UNTIL"):
-            self.diags.error("ST0201", f"`{self.tok.text}` has no matching opening statement; remove it",
+            self.diags.error(codes.UNEXPECTED_TOKEN, f"`{self.tok.text}` has no matching opening statement; remove it",
                              self.tok_span())
             self.advance()
             self.accept_op(";")
@@ -143,7 +147,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
             self.accept_op(";")
         else:
             line, _ = self.src.line_col(kw.start)
-            self.diags.error("ST0202", f"missing `{end_word}` for {kind} {name_tok.text} (line {line}); "
+            self.diags.error(codes.MISSING_END, f"missing `{end_word}` for {kind} {name_tok.text} (line {line}); "
                              f"found {self.describe(self.tok)}", self.tok_span())
             if not (self.at_any_kw(POU_END) or self.at_kw("TYPE") or self.tok.kind == "EOF"):
                 self.advance()
@@ -175,7 +179,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
         while not self.at_kw("END_VAR"):
             if self.tok.kind == "EOF" or self.at_any_kw(POU_END) or (
                     self.tok.kind == "IDENT" and self.tok.up in SECTION_WORDS):
-                self.diags.error("ST0202", f"missing `END_VAR` for the {kw.up} section; found "
+                self.diags.error(codes.MISSING_END, f"missing `END_VAR` for the {kw.up} section; found "
                                  f"{self.describe(self.tok)}", self.tok_span())
                 section.span = self.span_from(kw.start)
                 return section
@@ -200,7 +204,8 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
             if self.tok.kind == "IOPORT":
                 # W501 AT specification of an I/O port (ECAT://node#1/..., IOBus://...): vplc has no I/O ports
                 port = self.advance()
-                self.diags.error("ST1007", f"AT `{port.text.strip()}`: Sysmac I/O ports are not modelled by vplc; "
+                self.diags.error(codes.SYSMAC_NOT_MODELLED,
+                                 f"AT `{port.text.strip()}`: Sysmac I/O ports are not modelled by vplc; "
                                  "declare the variable without AT (vplc models the memory areas %W, %H, %D, %E "
                                  "and CIO)", self.tok_span(port))
             elif self.tok.kind != "ADDRESS":
@@ -217,7 +222,8 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
     def end_declaration(self) -> None:
         if self.accept_op(";"):
             return
-        self.diags.error("ST0205", f"missing `;` after this declaration (found {self.describe(self.tok)})",
+        self.diags.error(codes.MISSING_SEMICOLON,
+                         f"missing `;` after this declaration (found {self.describe(self.tok)})",
                          self.tok_span(self.toks[self.i - 1]))
         if not (self.tok.kind == "IDENT" and self.peek().kind == "OP" and self.peek().text in (":", ",")):
             raise ParseError()
@@ -257,7 +263,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
             fields: list[A.VarDecl] = []
             while not self.at_kw(end):
                 if self.tok.kind == "EOF" or self.at_kw("END_TYPE"):
-                    self.diags.error("ST0202", f"missing `{end}`; found {self.describe(self.tok)}",
+                    self.diags.error(codes.MISSING_END, f"missing `{end}`; found {self.describe(self.tok)}",
                                      self.tok_span())
                     return A.StructTypeRef(fields, span=self.span_from(start), union=union)
                 before = self.i
@@ -275,7 +281,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
             return A.EnumTypeRef(values, base, span=self.span_from(start))
         if t.kind == "IDENT" and t.up in ("POINTER", "REFERENCE"):
             self.fail(f"`{t.text} TO` is not supported: the library must compile on any IEC 61131-3 2nd "
-                      "edition controller, which has no pointers or references", "ST0207")
+                      "edition controller, which has no pointers or references", codes.UNSUPPORTED_EXTENSION)
         name, _ = self.qualname("a type name")
         ref = A.NamedTypeRef(name, span=self.span_from(start))
         if self.at_op("("):
@@ -384,7 +390,8 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
         decls: list[A.TypeDecl] = []
         while not self.at_kw("END_TYPE"):
             if self.tok.kind == "EOF" or self.at_any_kw(POU_END) or self.at_kw("TYPE"):
-                self.diags.error("ST0202", f"missing `END_TYPE`; found {self.describe(self.tok)}", self.tok_span())
+                self.diags.error(codes.MISSING_END,
+                                 f"missing `END_TYPE`; found {self.describe(self.tok)}", self.tok_span())
                 return A.TypeBlock(decls, span=self.span_from(kw.start))
             before = self.i
             try:
@@ -411,7 +418,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
         implicit = A.Resource(None, None, [], [], [], span=self.tok_span())
         while not self.accept_kw("END_CONFIGURATION"):
             if self.tok.kind == "EOF" or self.at_any_kw(POU_END) or self.at_kw("TYPE"):
-                self.diags.error("ST0202", "missing `END_CONFIGURATION`", self.tok_span())
+                self.diags.error(codes.MISSING_END, "missing `END_CONFIGURATION`", self.tok_span())
                 break
             before = self.i
             try:
@@ -438,7 +445,7 @@ class Parser(StatementsMixin, ExpressionsMixin, ParserBase):
         res = A.Resource(name.text, on, [], [], [], span=None)
         while not self.accept_kw("END_RESOURCE"):
             if self.tok.kind == "EOF" or self.at_kw("END_CONFIGURATION"):
-                self.diags.error("ST0202", "missing `END_RESOURCE`", self.tok_span())
+                self.diags.error(codes.MISSING_END, "missing `END_RESOURCE`", self.tok_span())
                 break
             if self.at_any_kw(SECTION_WORDS):
                 res.sections.append(self.var_section())

@@ -4,6 +4,7 @@ from __future__ import annotations
 from .diagnostics import DiagnosticBag
 from .lexer import Token
 from .source import SourceFile, Span
+from . import codes
 
 # Words that can never be identifiers (IEC 61131-3 keywords the parser relies on).
 RESERVED = frozenset("""
@@ -117,21 +118,22 @@ class ParserBase:
         text = t.text if len(t.text) <= 40 else t.text[:37] + "..."
         return f"`{text}`"
 
-    def fail(self, message: str, code: str = "ST0201", t: Token | None = None):
+    def fail(self, message: str, code: str = codes.UNEXPECTED_TOKEN, t: Token | None = None):
         self.diags.error(code, message, self.tok_span(t))
         raise ParseError()
 
     def fail_expected(self, what: str, context: str = ""):
         found = self.describe(self.tok)
         ctx = f" {context}" if context else ""
-        code = "ST0202" if self.tok.kind == "EOF" or self.at_any_kw(BLOCK_END) else "ST0201"
+        code = codes.MISSING_END if self.tok.kind == "EOF" or self.at_any_kw(BLOCK_END) else codes.UNEXPECTED_TOKEN
         self.fail(f"expected {what}{ctx}, found {found}", code)
 
     def enter(self) -> None:
         self.depth += 1
         if self.depth > MAX_DEPTH:
             self.depth = 0
-            self.diags.error("ST0203", f"nesting is deeper than {MAX_DEPTH} levels; split the expression or "
+            self.diags.error(codes.NESTING_TOO_DEEP,
+                             f"nesting is deeper than {MAX_DEPTH} levels; split the expression or "
                              "statement using intermediate variables", self.tok_span())
             raise DepthExceeded()
 

@@ -9,6 +9,7 @@ import math
 import re
 
 from . import ast as A
+from . import codes
 from .lexer import decode_string
 from .parser_base import RESERVED
 
@@ -97,7 +98,7 @@ class ExpressionsMixin:
             chain += 1
             if chain + self.depth > 2 * 200:
                 self.fail("expression has too many operators in a row (over 400); split it using "
-                          "intermediate variables", "ST0203")
+                          "intermediate variables", codes.NESTING_TOO_DEEP)
             left = A.Binary("AND" if op == "&" else op, left, right, span=self.span_from(start))
         self.leave()
         return left
@@ -229,7 +230,7 @@ class ExpressionsMixin:
             self.advance()
             value, err = decode_string(t.text[1:-1], kind == "WSTRING")
             if err:
-                self.diags.error("ST0104", err, self.tok_span(t))
+                self.diags.error(codes.BAD_ESCAPE, err, self.tok_span(t))
             return A.Literal(kind.lower(), value, None, t.text, span=self.tok_span(t))
         if kind in ("TIME", "DATE", "TOD", "DT"):
             self.advance()
@@ -266,7 +267,7 @@ class ExpressionsMixin:
         it (more than 4,300 digits), and the checker's range rule does the rest."""
         digits = t.text.replace("_", "")
         if len(digits) > MAX_INT_DIGITS:
-            self.diags.error("ST0106", f"integer literal of {len(digits):,} digits: the largest integer types "
+            self.diags.error(codes.BAD_LITERAL, f"integer literal of {len(digits):,} digits: the largest integer types "
                              f"(LINT, ULINT, LWORD) hold at most 20 digits", self.tok_span(t))
             return 0
         return int(digits)
@@ -276,13 +277,13 @@ class ExpressionsMixin:
         base = int(base_text)
         digits = digits.replace("_", "")
         if base not in (2, 8, 16):
-            self.diags.error("ST0106", f"base {base} is not allowed in `{t.text}`; use 2#, 8# or 16#",
+            self.diags.error(codes.BAD_LITERAL, f"base {base} is not allowed in `{t.text}`; use 2#, 8# or 16#",
                              self.tok_span(t))
             return 0
         try:
             return int(digits, base)
         except ValueError:
-            self.diags.error("ST0106", f"`{t.text}` contains digits that are not valid in base {base}",
+            self.diags.error(codes.BAD_LITERAL, f"`{t.text}` contains digits that are not valid in base {base}",
                              self.tok_span(t))
             return 0
 
@@ -298,7 +299,7 @@ class ExpressionsMixin:
             self.advance()
             if t.kind == "REAL":
                 if prefix not in REAL_PREFIXES:
-                    self.fail(f"`{text}`: a {prefix} literal cannot have a fraction", "ST0106", t)
+                    self.fail(f"`{text}`: a {prefix} literal cannot have a fraction", codes.BAD_LITERAL, t)
                 value = float(t.text.replace("_", ""))
             else:
                 value = self.based_value(t) if t.kind == "BASED" else self.decimal_value(t)
@@ -308,7 +309,7 @@ class ExpressionsMixin:
                 return A.Literal("real", float(value), prefix, text, span=self.span_from(start))
             if prefix == "BOOL":
                 if value not in (0, 1):
-                    self.fail(f"`{text}`: BOOL literals are 0, 1, TRUE or FALSE", "ST0106", t)
+                    self.fail(f"`{text}`: BOOL literals are 0, 1, TRUE or FALSE", codes.BAD_LITERAL, t)
                 return A.Literal("bool", bool(value), prefix, text, span=self.span_from(start))
             return A.Literal("int", value, prefix, text, span=self.span_from(start))
         if t.kind == "IDENT" and t.up in ("TRUE", "FALSE") and prefix == "BOOL" and not sign:
@@ -318,7 +319,7 @@ class ExpressionsMixin:
             self.advance()
             value, err = decode_string(t.text[1:-1], prefix == "WSTRING")
             if err:
-                self.diags.error("ST0104", err, self.tok_span(t))
+                self.diags.error(codes.BAD_ESCAPE, err, self.tok_span(t))
             return A.Literal(prefix.lower(), value, prefix, text, span=self.span_from(start))
         self.fail_expected(f"a {prefix} value after `{prefix_tok.text}`")
 
@@ -341,9 +342,10 @@ class ExpressionsMixin:
             value = None if day is None or tod is None else day * 1_000_000_000 + tod
             kind = "dt"
         if value is None:
-            self.diags.error("ST0106", f"`{t.text}` is not a valid {kind.upper()} literal", span)
+            self.diags.error(codes.BAD_LITERAL, f"`{t.text}` is not a valid {kind.upper()} literal", span)
             value = 0
         elif not -(1 << 63) <= value < (1 << 63):
-            self.diags.error("ST0106", f"`{t.text}` is outside the range of {kind.upper()} (64-bit nanoseconds, "
+            self.diags.error(codes.BAD_LITERAL,
+                             f"`{t.text}` is outside the range of {kind.upper()} (64-bit nanoseconds, "
                              "about ±106751 days)", span)
         return A.Literal(kind, value, None, t.text, span=span)

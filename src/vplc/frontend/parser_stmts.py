@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from . import ast as A
+from . import codes
 from .parser_base import BLOCK_END, ITEM_START, ParseError
 
 
@@ -51,7 +52,7 @@ class StatementsMixin:
         if isinstance(target, (A.Literal, A.EnumLiteral)):
             text = self.src.text[target.span.start:target.span.end]
             self.fail(f"a statement cannot start with the value `{text}`; if it is a CASE label, put `:` after it",
-                      "ST0201", t)
+                      codes.UNEXPECTED_TOKEN, t)
         if self.at_op(":="):
             self.advance()
             value = self.expression()
@@ -61,7 +62,7 @@ class StatementsMixin:
             self.end_statement()
             return A.CallStmt(target, span=self.span_from(start))
         if self.at_op("=") :
-            self.fail("`=` compares values; use `:=` to assign", "ST0204")
+            self.fail("`=` compares values; use `:=` to assign", codes.EQUALS_TO_ASSIGN)
         if isinstance(target, (A.Name, A.Member, A.Index)) and self.tok.kind in ("IDENT", "INT", "REAL"):
             self.fail_expected("`:=` or `;`", f"after `{self.src.text[target.span.start:target.span.end]}` "
                                "(missing `;` on the previous line?)")
@@ -72,7 +73,7 @@ class StatementsMixin:
             self.advance()
             return
         prev = self.toks[self.i - 1]
-        self.diags.error("ST0205", f"missing `;` after this statement (found {self.describe(self.tok)})",
+        self.diags.error(codes.MISSING_SEMICOLON, f"missing `;` after this statement (found {self.describe(self.tok)})",
                          self.tok_span(prev))
         raise ParseError()
 
@@ -107,7 +108,7 @@ class StatementsMixin:
             return
         line, col = self.src.line_col(start)
         t = self.tok
-        self.diags.error("ST0202", f"missing `{word}` for the {opener} at line {line}; found "
+        self.diags.error(codes.MISSING_END, f"missing `{word}` for the {opener} at line {line}; found "
                          f"{self.describe(t)}", self.tok_span())
         if t.kind == "IDENT" and t.up.startswith("END_") and t.up not in self.end_stack:
             self.advance()          # a mistyped END_xxx that nothing encloses: take it as this one's end
