@@ -13,6 +13,7 @@ Failing::
 from __future__ import annotations
 
 from .consteval import const_int
+from ..frontend import codes
 
 
 def check(ck, e, array_type) -> None:
@@ -21,7 +22,7 @@ def check(ck, e, array_type) -> None:
             continue
         value = const_int(ix, ck.ctx, ck.scope)
         if value is not None and not lo <= value <= hi:
-            ck.ctx.diags.error("ST1501", f"index {value} is outside the bounds {lo}..{hi} of "
+            ck.ctx.diags.error(codes.OUT_OF_BOUNDS, f"index {value} is outside the bounds {lo}..{hi} of "
                                f"`{ck.text(e.base)}`", ix.span)
 
 
@@ -37,5 +38,5 @@ def check_slice(ck, element, param_type, param_name: str) -> None:
     lo, hi = base.dims[0]
     remaining = hi - index + 1
     if 0 < remaining < param_type.count():
-        ck.ctx.diags.error("ST1501", f"only {remaining} element(s) of `{ck.text(element.base)}` remain from "
+        ck.ctx.diags.error(codes.OUT_OF_BOUNDS, f"only {remaining} element(s) of `{ck.text(element.base)}` remain from "
                            f"index {index}, but parameter `{param_name}` needs {param_type.count()}", element.span)

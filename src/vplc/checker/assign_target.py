@@ -20,6 +20,7 @@ Failing::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 from .symbols import VarSymbol
 
@@ -34,24 +35,29 @@ def check_write(ck, target: A.Expr, what: str = "assignment") -> None:
     ctx = ck.ctx
     root = root_name(target)
     if root is None:
-        ctx.diags.error("ST1205", f"cannot assign to `{ck.text(target)}`; the target must be a variable", target.span)
+        ctx.diags.error(codes.NOT_A_VARIABLE,
+                        f"cannot assign to `{ck.text(target)}`; the target must be a variable", target.span)
         return
     sym = root.sym
     if not isinstance(sym, VarSymbol):
         if sym is not None:
-            ctx.diags.error("ST1205", f"cannot assign to `{ck.text(target)}`; it is not a variable", target.span)
+            ctx.diags.error(codes.NOT_A_VARIABLE,
+                            f"cannot assign to `{ck.text(target)}`; it is not a variable", target.span)
         return
     effective = sym.target if sym.section == "VAR_EXTERNAL" and sym.target is not None else sym
     if id(effective) in ctx.vendor_objects:
-        ctx.diags.error("ST1301", f"`{sym.name}` is a Sysmac system-defined variable and is read-only; use a "
+        ctx.diags.error(codes.WRITE_CONSTANT,
+                        f"`{sym.name}` is a Sysmac system-defined variable and is read-only; use a "
                         "variable of your own", target.span)
         return
     if sym.constant or effective.constant:
-        ctx.diags.error("ST1301", f"`{sym.name}` is a CONSTANT and cannot be written; remove CONSTANT from its "
+        ctx.diags.error(codes.WRITE_CONSTANT,
+                        f"`{sym.name}` is a CONSTANT and cannot be written; remove CONSTANT from its "
                         "section or use another variable", target.span)
         return
     if target is root and any(v is sym for v in ck.for_vars):
-        ctx.diags.error("ST1304", f"`{sym.name}` is the variable of an enclosing FOR loop and must not be written "
+        ctx.diags.error(codes.WRITE_FOR_VARIABLE,
+                        f"`{sym.name}` is the variable of an enclosing FOR loop and must not be written "
                         "inside the loop; use a WHILE loop or another variable", target.span)
         return
     if isinstance(target, A.Member):
@@ -59,12 +65,14 @@ def check_write(ck, target: A.Expr, what: str = "assignment") -> None:
         if isinstance(base_t, T.PouType) and base_t.kind == "fb":
             p = base_t.param(target.member)
             if p is not None and p.direction == "out":
-                ctx.diags.error("ST1302", f"`{target.member}` is an output of {base_t.name}; only the function block "
+                ctx.diags.error(codes.WRITE_FB_OUTPUT,
+                                f"`{target.member}` is an output of {base_t.name}; only the function block "
                                 "itself writes its outputs", target.span)
                 return
             key = ck.text(target.base).upper()
             if p is not None and p.direction == "in" and key in ck.called_instances:
-                ctx.diags.warning("ST1303", f"input `{target.member}` of `{ck.text(target.base)}` is written after "
+                ctx.diags.warning(codes.WRITE_INPUT_AFTER_CALL,
+                                  f"input `{target.member}` of `{ck.text(target.base)}` is written after "
                                   "the instance was called; the value takes effect only at the next call. Pass it "
                                   f"in the call instead (`{ck.text(target.base)}({target.member} := ...)`)",
                                   target.span)

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import re
 
+from ..frontend import codes
 from ..frontend import types as T
 
 # words per area (the CJ-compatible sizes of the NJ's memory for CJ units: CIO 6,144, W 512, H 1,536, D and each EM
@@ -61,34 +62,36 @@ def check_global(ctx, decl, vt: T.Type):
     if T.is_error(vt):
         return None
     if area == "A":
-        ctx.diags.error("ST1110", f"{where}: the Auxiliary Area is not modelled by vplc", decl.name_span)
+        ctx.diags.error(codes.AT_ADDRESS, f"{where}: the Auxiliary Area is not modelled by vplc", decl.name_span)
         return None
     layout = T.union_layout(vt)
     if layout is None:
-        ctx.diags.error("ST1110", f"{where}: a variable of type {vt.name} is not placed in a memory area by vplc "
+        ctx.diags.error(codes.AT_ADDRESS,
+                        f"{where}: a variable of type {vt.name} is not placed in a memory area by vplc "
                         "(BOOL, bit strings, integers, REAL/LREAL, TIME and one-dimensional arrays of them are)",
                         decl.name_span)
         return None
     is_bool = layout[0] == "bool"
     if is_bool and bit is None:
-        ctx.diags.error("ST1110", f"{where}: a BOOL is placed at a bit of a word; write the bit "
+        ctx.diags.error(codes.AT_ADDRESS, f"{where}: a BOOL is placed at a bit of a word; write the bit "
                         f"(`{decl.at}.00`)", decl.name_span)
         return None
     if not is_bool and bit is not None:
-        ctx.diags.error("ST1110", f"{where}: only a BOOL is placed at a bit; write the word "
+        ctx.diags.error(codes.AT_ADDRESS, f"{where}: only a BOOL is placed at a bit; write the word "
                         f"(`{decl.at.split('.')[0]}`)", decl.name_span)
         return None
     if bit is not None and bit > 15:
-        ctx.diags.error("ST1110", f"{where}: bit {bit} of a word; the bits are 00 to 15", decl.name_span)
+        ctx.diags.error(codes.AT_ADDRESS, f"{where}: bit {bit} of a word; the bits are 00 to 15", decl.name_span)
         return None
     if area == "E" and bank >= EM_BANKS:
-        ctx.diags.error("ST1110", f"{where}: EM bank {bank:X}; the banks are 0 to {EM_BANKS - 1:X}", decl.name_span)
+        ctx.diags.error(codes.AT_ADDRESS,
+                        f"{where}: EM bank {bank:X}; the banks are 0 to {EM_BANKS - 1:X}", decl.name_span)
         return None
     kind, bits, count = layout
     span_bits = (bit or 0) + (count or 1) * (1 if is_bool else bits)
     last = word + -(-span_bits // 16) - 1
     if last >= AREA_WORDS[area]:
-        ctx.diags.error("ST1110", f"{where}: reaches word {last} of the {area} area, which has "
+        ctx.diags.error(codes.AT_ADDRESS, f"{where}: reaches word {last} of the {area} area, which has "
                         f"{AREA_WORDS[area]} words (0 to {AREA_WORDS[area] - 1})", decl.name_span)
         return None
     ctx.note_edition3(f"AT {decl.at} (a Sysmac memory area)", decl.name_span)
@@ -98,5 +101,6 @@ def check_global(ctx, decl, vt: T.Type):
 def check_local(ctx, decl) -> None:
     """vplc places global variables in memory areas; an AT of a Sysmac area on a POU's variable is refused."""
     if decl.at is not None and parse(decl.at) is not None:
-        ctx.diags.error("ST1110", f"`{decl.name}` AT {decl.at}: vplc places only global variables in memory areas; "
+        ctx.diags.error(codes.AT_ADDRESS,
+                        f"`{decl.name}` AT {decl.at}: vplc places only global variables in memory areas; "
                         "declare it in VAR_GLOBAL (and VAR_EXTERNAL where it is used)", decl.name_span)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 from . import assign_target, calls, case_labels, duplicates, external_globals, function_result, unused
 from .exprs import ExprChecker
@@ -37,23 +38,26 @@ class BodyChecker(ExprChecker):
                 if section.kind == "VAR_EXTERNAL":
                     g = self.ctx.tables.globals.get(decl.name.upper())
                     if g is None:
-                        self.ctx.diags.error("ST1001", f"VAR_EXTERNAL `{decl.name}` has no matching VAR_GLOBAL",
+                        self.ctx.diags.error(codes.UNDECLARED, f"VAR_EXTERNAL `{decl.name}` has no matching VAR_GLOBAL",
                                              decl.name_span)
                     else:
                         sym.target = g
                         g.used = True
                         if not T.same_type(g.type, sym.type) and not T.is_error(g.type):
-                            self.ctx.diags.error("ST1101", f"VAR_EXTERNAL `{decl.name}` is declared {sym.type.name} "
+                            self.ctx.diags.error(codes.TYPE_MISMATCH,
+                                                 f"VAR_EXTERNAL `{decl.name}` is declared {sym.type.name} "
                                                  f"but the global is {g.type.name}", decl.name_span)
                 # a CONSTANT input or in-out is a parameter the POU only reads: its value comes from the caller
                 # (W501, variable attributes: Constant for input and in-out variables)
                 if section.constant and decl.init is None and section.kind not in ("VAR_EXTERNAL", "VAR_INPUT",
                                                                                    "VAR_IN_OUT"):
-                    self.ctx.diags.error("ST1301", f"CONSTANT `{decl.name}` needs an initial value", decl.name_span)
+                    self.ctx.diags.error(codes.WRITE_CONSTANT,
+                                         f"CONSTANT `{decl.name}` needs an initial value", decl.name_span)
                 if decl.init is not None:
                     self.initial_value(decl.init, sym.type, f"initial value of {decl.name}")
                 if section.kind == "VAR_IN_OUT" and decl.init is not None:
-                    self.ctx.diags.error("ST1101", f"in-out parameter `{decl.name}` cannot have an initial value",
+                    self.ctx.diags.error(codes.TYPE_MISMATCH,
+                                         f"in-out parameter `{decl.name}` cannot have an initial value",
                                          decl.init.span)
         self.block(pou.body)
         function_result.check(self, pou)
@@ -82,7 +86,7 @@ class BodyChecker(ExprChecker):
     def condition(self, e: A.Expr, what: str) -> None:
         t = self.expr(e, T.BOOL)
         if not T.is_error(t) and T.base_of(t) is not T.BOOL:
-            self.ctx.diags.error("ST1105", f"the {what} condition must be BOOL, not {t.name}", e.span)
+            self.ctx.diags.error(codes.CONDITION_TYPE, f"the {what} condition must be BOOL, not {t.name}", e.span)
 
     def branches(self, bodies) -> None:
         """Check alternative statement lists: an FB called in one branch is not 'already called' in a sibling
@@ -109,7 +113,8 @@ class BodyChecker(ExprChecker):
         vt = self.expr(s.var)
         sym = s.var.sym
         if not T.is_error(vt) and not T.is_int(vt):
-            self.ctx.diags.error("ST1105", f"the FOR variable must be an integer, not {vt.name}", s.var.span)
+            self.ctx.diags.error(codes.CONDITION_TYPE,
+                                 f"the FOR variable must be an integer, not {vt.name}", s.var.span)
         elif isinstance(sym, VarSymbol):
             assign_target.check_write(self, s.var)
         for e in (s.start, s.end, s.step):
@@ -136,11 +141,12 @@ class BodyChecker(ExprChecker):
 
     def s_Exit(self, s):
         if self.loop_depth == 0:
-            self.ctx.diags.error("ST1208", "EXIT is only allowed inside FOR, WHILE or REPEAT", s.span)
+            self.ctx.diags.error(codes.EXIT_OUTSIDE_LOOP, "EXIT is only allowed inside FOR, WHILE or REPEAT", s.span)
 
     def s_Continue(self, s):
         if self.loop_depth == 0:
-            self.ctx.diags.error("ST1208", "CONTINUE is only allowed inside FOR, WHILE or REPEAT", s.span)
+            self.ctx.diags.error(codes.EXIT_OUTSIDE_LOOP,
+                                 "CONTINUE is only allowed inside FOR, WHILE or REPEAT", s.span)
 
     def s_Return(self, s):
         pass

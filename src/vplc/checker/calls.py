@@ -17,6 +17,7 @@ import difflib
 
 from ..frontend import ast as A
 from ..frontend import builtins as B
+from ..frontend import codes
 from ..frontend import types as T
 from . import array_bounds, assign_target
 from .scope import Ambiguous, is_generic
@@ -54,11 +55,12 @@ def check_call(ck, e: A.Call, expected, statement: bool) -> T.Type:
                 ctx.note_vendor(pou, callee.span)
                 ck.calls_made.append((pou, e.span))
                 if pou.kind == "fb":
-                    ctx.diags.error("ST1006", f"{pou.name} is a function block type; declare an instance "
+                    ctx.diags.error(codes.NOT_CALLABLE, f"{pou.name} is a function block type; declare an instance "
                                     f"(`my{pou.name} : {pou.name};`) and call the instance", callee.span)
                     return _skip_args(ck, e)
                 if pou.kind == "program" and not statement:
-                    ctx.diags.error("ST1006", f"PROGRAM {pou.name} can only be called as a statement", callee.span)
+                    ctx.diags.error(codes.NOT_CALLABLE,
+                                    f"PROGRAM {pou.name} can only be called as a statement", callee.span)
                     return _skip_args(ck, e)
                 return bind_pou(ck, e, pou, "function" if pou.kind == "function" else "program", None)
             builtin = B.lookup(qn.name) if not qn.namespace else None
@@ -73,13 +75,14 @@ def check_call(ck, e: A.Call, expected, statement: bool) -> T.Type:
         return _skip_args(ck, e)
     if isinstance(t, T.PouType) and t.kind == "fb":
         if not statement:
-            ctx.diags.error("ST1006", f"a function block call is a statement; call `{ck.text(callee)}(...)` on its "
+            ctx.diags.error(codes.NOT_CALLABLE,
+                            f"a function block call is a statement; call `{ck.text(callee)}(...)` on its "
                             "own line and read its outputs afterwards", e.span)
             _skip_args(ck, e)
             return T.ERROR
         ck.calls_made.append((t, e.span))
         return bind_pou(ck, e, t, "fb", callee)
-    ctx.diags.error("ST1006", f"`{ck.text(callee)}` is of type {t.name} and cannot be called", callee.span)
+    ctx.diags.error(codes.NOT_CALLABLE, f"`{ck.text(callee)}` is of type {t.name} and cannot be called", callee.span)
     return _skip_args(ck, e)
 
 
@@ -103,12 +106,13 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
     for arg in e.args:
         if arg.name is None:
             if formal_seen:
-                ctx.diags.error("ST1206", "a non-formal argument cannot follow formal ones (`Name := value`); "
+                ctx.diags.error(codes.NON_FORMAL_AFTER_FORMAL,
+                                "a non-formal argument cannot follow formal ones (`Name := value`); "
                                 "name every argument", arg.span)
                 ck.expr(arg.value)
                 continue
             if pos >= len(positional):
-                ctx.diags.error("ST1204", f"too many arguments: {pt.name} takes {len(positional)} "
+                ctx.diags.error(codes.ARGUMENT_COUNT, f"too many arguments: {pt.name} takes {len(positional)} "
                                 f"{'inputs and outputs' if kind == 'fb' and ctx.dialect == 'sysmac' else 'input(s)'}",
                                 arg.span)
                 ck.expr(arg.value)
@@ -124,21 +128,23 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
                 _unknown_param(ck, arg, pt)
                 continue
             if arg.output and p.direction != "out":
-                ctx.diags.error("ST1203", f"`{p.name}` is {DIR_TEXT[p.direction]} of {pt.name}; use `:=` to pass it",
+                ctx.diags.error(codes.WRONG_DIRECTION,
+                                f"`{p.name}` is {DIR_TEXT[p.direction]} of {pt.name}; use `:=` to pass it",
                                 arg.span)
                 if arg.value is not None:
                     ck.expr(arg.value)
                 continue
             if not arg.output and p.direction == "out":
-                ctx.diags.error("ST1203", f"`{p.name}` is an output of {pt.name}; use `=>` to read it", arg.span)
+                ctx.diags.error(codes.WRONG_DIRECTION,
+                                f"`{p.name}` is an output of {pt.name}; use `=>` to read it", arg.span)
                 ck.expr(arg.value)
                 continue
         if p.index in bound:
-            ctx.diags.error("ST1207", f"parameter `{p.name}` of {pt.name} is given twice", arg.span)
+            ctx.diags.error(codes.PARAMETER_TWICE, f"parameter `{p.name}` of {pt.name} is given twice", arg.span)
         bound[p.index] = bind_arg(ck, arg, p, pt)
     for p in pt.params:
         if p.direction == "inout" and p.index not in bound:
-            ctx.diags.error("ST1202", f"in-out parameter `{p.name}` of {pt.name} must be given "
+            ctx.diags.error(codes.MISSING_IN_OUT, f"in-out parameter `{p.name}` of {pt.name} must be given "
                             f"(`{p.name} := <variable>`)", e.span)
     e.binding = CallBinding(kind, pt.ret if kind == "function" else T.VOID, pou=pt, instance=instance,
                             args=[bound[i] for i in sorted(bound)])
@@ -159,7 +165,7 @@ def _unknown_param(ck, arg: A.Arg, pt: T.PouType) -> None:
     close = difflib.get_close_matches(arg.name.upper(), [n.upper() for n in names], n=1, cutoff=0.7)
     notes = [f"did you mean `{names[[n.upper() for n in names].index(close[0])]}`?"] if close else []
     notes.append(f"parameters of {pt.name}: " + (", ".join(names) or "none"))
-    ck.ctx.diags.error("ST1201", f"{pt.name} has no parameter `{arg.name}`", arg.span, notes)
+    ck.ctx.diags.error(codes.UNKNOWN_PARAMETER, f"{pt.name} has no parameter `{arg.name}`", arg.span, notes)
     if arg.value is not None:
         ck.expr(arg.value)
 
@@ -175,10 +181,11 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
     if p.direction == "out":
         have = ck.expr(value)
         if not is_lvalue(value):
-            ctx.diags.error("ST1205", f"the output `{p.name}` must be read into a variable", value.span)
+            ctx.diags.error(codes.NOT_A_VARIABLE, f"the output `{p.name}` must be read into a variable", value.span)
         elif not T.is_error(have) and not _compatible(p.type, have) and not (
                 ctx.dialect == "sysmac" and T.sysmac_assignable(p.type, have)):
-            ctx.diags.error("ST1103", f"{what}: output of type {p.type.name} cannot be stored in `{ck.text(value)}` "
+            ctx.diags.error(codes.ARGUMENT_TYPE,
+                            f"{what}: output of type {p.type.name} cannot be stored in `{ck.text(value)}` "
                             f"of type {have.name}", value.span)
         else:
             assign_target.check_write(ck, value, f"output {p.name}")
@@ -195,11 +202,12 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
             return ba
     if p.direction == "inout":
         if not is_lvalue(value):
-            ctx.diags.error("ST1205", f"in-out parameter `{p.name}` of {pt.name} needs a variable (it is passed by "
+            ctx.diags.error(codes.NOT_A_VARIABLE,
+                            f"in-out parameter `{p.name}` of {pt.name} needs a variable (it is passed by "
                             "reference), not an expression", value.span)
             return ba
         if not T.is_error(have) and not _inout_compatible(have, p.type):
-            ctx.diags.error("ST1103", f"{what}: in-out parameter of type {p.type.name} cannot refer to "
+            ctx.diags.error(codes.ARGUMENT_TYPE, f"{what}: in-out parameter of type {p.type.name} cannot refer to "
                             f"`{ck.text(value)}` of type {have.name}; the types must be identical", value.span)
             return ba
         if getattr(T.base_of(p.type), "name", "").upper() != "_SAXIS_REF":
@@ -236,7 +244,7 @@ def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
     by_name: dict[int, A.Expr] = {}
     for arg in e.args:
         if arg.output:
-            ctx.diags.error("ST1203", f"{b.name} has no outputs; `=>` cannot be used", arg.span)
+            ctx.diags.error(codes.WRONG_DIRECTION, f"{b.name} has no outputs; `=>` cannot be used", arg.span)
             continue
         if arg.name is None:
             values.append(arg.value)
@@ -247,19 +255,20 @@ def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
         elif up.startswith("IN") and up[2:].isdigit() and b.max_args is None:
             by_name[int(up[2:]) - 1] = arg.value
         else:
-            ctx.diags.error("ST1201", f"{b.name} has no parameter `{arg.name}`"
+            ctx.diags.error(codes.UNKNOWN_PARAMETER, f"{b.name} has no parameter `{arg.name}`"
                             + (f"; its parameters are {', '.join(b.formal_names)}" if b.formal_names else ""),
                             arg.span)
             ck.expr(arg.value)
     if by_name:
         if values:
-            ctx.diags.error("ST1206", f"mix of formal and non-formal arguments in the call of {b.name}", e.span)
+            ctx.diags.error(codes.NON_FORMAL_AFTER_FORMAL,
+                            f"mix of formal and non-formal arguments in the call of {b.name}", e.span)
         values = [by_name[i] for i in sorted(by_name)]
     n = len(values)
     if n < b.min_args or (b.max_args is not None and n > b.max_args):
         want = f"{b.min_args}" if b.max_args == b.min_args else (
             f"at least {b.min_args}" if b.max_args is None else f"{b.min_args} to {b.max_args}")
-        ctx.diags.error("ST1204", f"{b.name} takes {want} argument(s), {n} given", e.span)
+        ctx.diags.error(codes.ARGUMENT_COUNT, f"{b.name} takes {want} argument(s), {n} given", e.span)
         for v in values:
             ck.expr(v)
         return T.ERROR
@@ -283,7 +292,7 @@ def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
         ret, convs = b.resolve(types_, ctx.dialect)
     except B.SignatureError as err:
         span = values[err.arg_index].span if err.arg_index is not None and err.arg_index < n else e.span
-        ctx.diags.error("ST1103", f"{b.name}: {err}", span)
+        ctx.diags.error(codes.ARGUMENT_TYPE, f"{b.name}: {err}", span)
         return T.ERROR
     args = []
     for i, (v, conv) in enumerate(zip(values, convs)):

@@ -18,6 +18,7 @@ Failing::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 from .consteval import const_int
 from .symbols import EnumValueSymbol
@@ -36,7 +37,8 @@ def check(ck, stmt: A.Case, sel_type: T.Type) -> None:
     ok_sel = T.is_error(sel) or T.is_int(sel) or isinstance(sel, T.EnumType) or (
         isinstance(sel, T.ElementaryType) and sel.kind == "bit")
     if not ok_sel:
-        ctx.diags.error("ST1401", f"the CASE selector must be an integer or enumeration, not {sel_type.name}",
+        ctx.diags.error(codes.CASE_LABEL_TYPE,
+                        f"the CASE selector must be an integer or enumeration, not {sel_type.name}",
                         stmt.selector.span)
     ranges: list[tuple[int, int, int, A.Node]] = []      # lo, hi, position in the source, label
     for branch in stmt.branches:
@@ -48,11 +50,12 @@ def check(ck, stmt: A.Case, sel_type: T.Type) -> None:
                 if not T.is_error(lt) and not T.is_error(sel) and ok_sel and not (
                         T.same_type(T.base_of(lt), sel) or (T.is_int(lt) and T.is_int(sel)) or
                         (T.is_int(lt) and sel.kind == "bit")):
-                    ctx.diags.error("ST1401", f"CASE label of type {lt.name} does not match the selector type "
+                    ctx.diags.error(codes.CASE_LABEL_TYPE,
+                                    f"CASE label of type {lt.name} does not match the selector type "
                                     f"{sel_type.name}", p.span)
                 v = _value(ck, p)
                 if v is None and not T.is_error(lt):
-                    ctx.diags.error("ST1401", "CASE labels must be constants", p.span)
+                    ctx.diags.error(codes.CASE_LABEL_TYPE, "CASE labels must be constants", p.span)
                 values.append(v)
             if all(v is not None for v in values):
                 ranges.append((values[0], values[-1], len(ranges), label))
@@ -67,7 +70,8 @@ def _report_overlaps(ck, ranges) -> None:
         if reach is not None and current[0] <= reach[1]:
             later, earlier = (current, reach) if current[2] > reach[2] else (reach, current)
             line, _ = earlier[3].span.file.line_col(earlier[3].span.start)
-            ck.ctx.diags.error("ST1402", f"CASE label `{ck.text(later[3])}` repeats a value already handled at "
+            ck.ctx.diags.error(codes.CASE_LABEL_TWICE,
+                               f"CASE label `{ck.text(later[3])}` repeats a value already handled at "
                                f"line {line}", later[3].span)
         if reach is None or current[1] > reach[1]:
             reach = current

@@ -18,6 +18,7 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import codes
 from ..frontend import types as T
 
 MAX_CELLS = 4 * 1024 * 1024
@@ -29,7 +30,8 @@ def cells(t: T.Type, memo: dict) -> int:
 
 def _report(ctx, what: str, n: int, span) -> None:
     size = f"{n:,} cells" if n <= MAX_CELLS else f"more than {MAX_CELLS:,} cells"
-    ctx.diags.error("ST1502", f"{what} holds {size} (values plus the arrays, structures and instances that hold "
+    ctx.diags.error(codes.DATA_TOO_LARGE,
+                    f"{what} holds {size} (values plus the arrays, structures and instances that hold "
                     f"them); vplc models at most {MAX_CELLS:,}: make the arrays smaller", span)
 
 

@@ -5,6 +5,7 @@ Runs before any body is checked, so declarations may appear in any order and any
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 from ..frontend.builtins import default_string
 from . import data_size, duplicates, undeclared
@@ -100,7 +101,7 @@ class Declarer:
                 seen, t = set(), shell
                 while isinstance(t, T.AliasType):
                     if id(t) in seen:
-                        self.ctx.diags.error("ST1004", f"data type {decl.name} is defined in terms of itself",
+                        self.ctx.diags.error(codes.UNKNOWN_TYPE, f"data type {decl.name} is defined in terms of itself",
                                              decl.name_span)
                         shell.target = T.ERROR
                         break
@@ -117,7 +118,8 @@ class Declarer:
             if v.value is not None:
                 val = const_int(v.value, self.ctx, None)
                 if val is None:
-                    self.ctx.diags.error("ST1107", f"the value of {v.name} must be a constant integer", v.value.span)
+                    self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
+                                         f"the value of {v.name} must be a constant integer", v.value.span)
                 else:
                     next_value = val
             if enum.lookup(v.name) is not None:
@@ -152,7 +154,7 @@ class Declarer:
                     continue
                 if inner is shell:
                     names = " → ".join(t.name for t in path + [shell])
-                    self.ctx.diags.error("ST1004", f"structure {shell.name} contains itself ({names}, member "
+                    self.ctx.diags.error(codes.UNKNOWN_TYPE, f"structure {shell.name} contains itself ({names}, member "
                                          f"{f.name}); a value of it would be infinitely large", f.decl.name_span)
                     for t in path:
                         reported.add(id(t))
@@ -167,7 +169,8 @@ class Declarer:
         for f in spec.fields:
             ftype = self.resolve(f.type, unit, None)
             if ftype is st:
-                self.ctx.diags.error("ST1004", f"structure {st.name} cannot contain itself (member {f.name})", f.name_span)
+                self.ctx.diags.error(codes.UNKNOWN_TYPE,
+                                     f"structure {st.name} cannot contain itself (member {f.name})", f.name_span)
                 ftype = T.ERROR
             if st.field(f.name) is not None:
                 duplicates.report(self.ctx, "member", f.name, f.span, None)
@@ -197,7 +200,7 @@ class Declarer:
                 if found is None:
                     found = self.tables.pous.lookup(name.name, name.namespace, unit.namespace if unit else None)
                     if found is not None and found.kind == "function":
-                        ctx.diags.error("ST1004", f"{found.name} is a FUNCTION, not a type; only function "
+                        ctx.diags.error(codes.UNKNOWN_TYPE, f"{found.name} is a FUNCTION, not a type; only function "
                                         "blocks can be instantiated", ref.span)
                         return T.ERROR
             except Ambiguous as amb:
@@ -213,7 +216,8 @@ class Declarer:
                 return default_string(ctx.dialect, ref.wide)
             n = const_int(ref.length, ctx, scope)
             if n is None or n < 1:
-                ctx.diags.error("ST1107", "the string length must be a positive constant integer", ref.length.span)
+                ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
+                                "the string length must be a positive constant integer", ref.length.span)
                 return default_string(ctx.dialect, ref.wide)
             cap = n - 1 if ctx.dialect == "sysmac" else n
             return T.StringType(n, ref.wide, capacity=cap)
@@ -226,10 +230,11 @@ class Declarer:
                     continue
                 lo, hi = const_int(d.lo, ctx, scope), const_int(d.hi, ctx, scope)
                 if lo is None or hi is None:
-                    ctx.diags.error("ST1107", "array bounds must be constant integers", d.span)
+                    ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE, "array bounds must be constant integers", d.span)
                     lo, hi = 0, 0
                 elif hi < lo:
-                    ctx.diags.error("ST1107", f"array upper bound {hi} is below the lower bound {lo}", d.span)
+                    ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
+                                    f"array upper bound {hi} is below the lower bound {lo}", d.span)
                     hi = lo
                 dims.append((lo, hi))
             return T.ArrayType(dims, self.resolve(ref.element, unit, scope))
@@ -237,7 +242,8 @@ class Declarer:
             base = T.base_of(self.resolve(ref.base, unit, scope))
             lo, hi = const_int(ref.lo, ctx, scope), const_int(ref.hi, ctx, scope)
             if not T.is_int(base) or lo is None or hi is None or hi < lo:
-                ctx.diags.error("ST1107", "a subrange needs an integer base type and constant bounds lo..hi",
+                ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
+                                "a subrange needs an integer base type and constant bounds lo..hi",
                                 ref.span)
                 return base if T.is_int(base) else T.ERROR
             return T.SubrangeType(base, lo, hi)
@@ -277,7 +283,8 @@ class Declarer:
     def declare_globals(self, sections, unit, list_name: str | None) -> None:
         for section in sections:
             if section.kind != "VAR_GLOBAL":
-                self.ctx.diags.error("ST0206", f"{section.kind} is not allowed here; only VAR_GLOBAL sections may "
+                self.ctx.diags.error(codes.STRAY_TEXT,
+                                     f"{section.kind} is not allowed here; only VAR_GLOBAL sections may "
                                      "appear outside a POU", section.span)
                 continue
             for decl in section.vars:

@@ -10,7 +10,9 @@ Failing::
 """
 from __future__ import annotations
 
-CODE = "ST1002"
+from ..frontend import codes
+
+CODE = codes.DUPLICATE_NAME
 
 
 def report(ctx, what: str, name: str, span, previous) -> None:

@@ -5,6 +5,7 @@ import math
 
 from ..frontend import ast as A
 from ..frontend import builtins as B
+from ..frontend import codes
 from ..frontend import types as T
 from . import array_bounds, calls, undeclared
 from .scope import Ambiguous, is_generic
@@ -88,7 +89,8 @@ class ExprChecker:
                     self.ctx.note_vendor(pick[0].enum, e.span)
                     return pick[0].enum
                 names = ", ".join(f"{v.enum.name}#{v.name}" for v in vals)
-                self.ctx.diags.error("ST1003", f"enumeration value `{qn.name}` is ambiguous here ({names}); "
+                self.ctx.diags.error(codes.AMBIGUOUS_NAME,
+                                     f"enumeration value `{qn.name}` is ambiguous here ({names}); "
                                      f"write it with its type, e.g. `{vals[0].enum.name}#{vals[0].name}`", e.span)
                 return T.ERROR
         try:
@@ -98,7 +100,7 @@ class ExprChecker:
             return T.ERROR
         if pou is not None:
             e.sym = PouSymbol(pou)
-            self.ctx.diags.error("ST1006", f"{pou.name} is a {calls.KIND_TEXT[pou.kind]}; call it with "
+            self.ctx.diags.error(codes.NOT_CALLABLE, f"{pou.name} is a {calls.KIND_TEXT[pou.kind]}; call it with "
                                  f"`{pou.name}(...)`" if pou.kind == "function" else
                                  f"{pou.name} is a {calls.KIND_TEXT[pou.kind]} type, not a variable; declare an "
                                  f"instance (`my{pou.name} : {pou.name};`) and use that", e.span)
@@ -130,7 +132,8 @@ class ExprChecker:
         if e.type_prefix:
             t = T.ELEMENTARY[e.type_prefix]
             if e.kind == "int" and not T.literal_fits(e.value, t):
-                self.ctx.diags.error("ST1107", f"{e.value} does not fit in {t.name} ({t.lo}..{t.hi})", e.span)
+                self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
+                                     f"{e.value} does not fit in {t.name} ({t.lo}..{t.hi})", e.span)
             elif e.kind == "real":
                 self.real_fits(e, t)
             return t
@@ -142,7 +145,8 @@ class ExprChecker:
         limit = _REAL_ROUNDS_TO_MAX if T.is_real(t) and T.base_of(t).bits == 32 else math.inf
         if isinstance(value, float) and (math.isinf(value) or abs(value) >= limit):
             rt = T.base_of(t) if T.is_real(t) else T.LREAL
-            self.ctx.diags.error("ST1107", f"{e.text or value} does not fit in {rt.name} (±{rt.hi:.8g})", e.span)
+            self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
+                                 f"{e.text or value} does not fit in {rt.name} (±{rt.hi:.8g})", e.span)
 
     def untyped_number(self, e, value, expected):
         exp = T.unalias(expected) if expected is not None else None
@@ -155,12 +159,12 @@ class ExprChecker:
                 T.base_of(exp).kind in ("int", "uint", "bit", "real"):
             if not T.literal_fits(value, exp):
                 rng = f"{exp.lo}..{exp.hi}" if not isinstance(exp, T.SubrangeType) else f"{exp.lo}..{exp.hi}"
-                self.ctx.diags.error("ST1107", f"{value} does not fit in {exp.name} ({rng})", e.span)
+                self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE, f"{value} does not fit in {exp.name} ({rng})", e.span)
             return T.base_of(exp)
         for t in (T.DINT, T.LINT, T.ULINT):
             if T.literal_fits(value, t):
                 return t
-        self.ctx.diags.error("ST1107", f"{value} is too large for any integer type", e.span)
+        self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE, f"{value} is too large for any integer type", e.span)
         return T.ERROR
 
     def x_Name(self, e: A.Name, expected):
@@ -178,11 +182,11 @@ class ExprChecker:
             if t is None:
                 undeclared.report_type(self.ctx, qn.text(), qn.span or e.span)
             else:
-                self.ctx.diags.error("ST1004", f"{t.name} is not an enumeration type", e.span)
+                self.ctx.diags.error(codes.UNKNOWN_TYPE, f"{t.name} is not an enumeration type", e.span)
             return T.ERROR
         key = enum.lookup(e.value)
         if key is None:
-            self.ctx.diags.error("ST1001", f"enumeration {enum.name} has no value `{e.value}`; its values are "
+            self.ctx.diags.error(codes.UNDECLARED, f"enumeration {enum.name} has no value `{e.value}`; its values are "
                                  + ", ".join(enum.values), e.span)
             return T.ERROR
         e.sym = EnumValueSymbol(enum, key, enum.values[key])
@@ -196,7 +200,8 @@ class ExprChecker:
         if isinstance(bt, T.StructType):
             f = bt.field(e.member)
             if f is None:
-                self.ctx.diags.error("ST1005", f"structure {bt.name} has no member `{e.member}`; its members are "
+                self.ctx.diags.error(codes.NO_SUCH_MEMBER,
+                                     f"structure {bt.name} has no member `{e.member}`; its members are "
                                      + ", ".join(x.name for x in bt.fields.values()), e.span)
                 return T.ERROR
             e.sym = f.decl.sym if f.decl is not None and f.decl.sym is not None else VarSymbol(f.name, f.type, "MEMBER")
@@ -214,12 +219,15 @@ class ExprChecker:
             inner = bt.pou is not None and any(d.name.upper() == e.member.upper()
                                                for s in bt.pou.sections for d in s.vars)
             if p is None and not inner:
-                self.ctx.diags.error("ST1005", f"function block {bt.name} has no parameter `{e.member}`", e.span)
+                self.ctx.diags.error(codes.NO_SUCH_MEMBER,
+                                     f"function block {bt.name} has no parameter `{e.member}`", e.span)
             else:
-                self.ctx.diags.error("ST1005", f"`{e.member}` is {what} of {bt.name}; only inputs and outputs can "
+                self.ctx.diags.error(codes.NO_SUCH_MEMBER,
+                                     f"`{e.member}` is {what} of {bt.name}; only inputs and outputs can "
                                      "be accessed from outside the function block", e.span)
             return T.ERROR
-        self.ctx.diags.error("ST1005", f"`{self.text(e.base)}` is of type {bt.name}, which has no members", e.span)
+        self.ctx.diags.error(codes.NO_SUCH_MEMBER,
+                             f"`{self.text(e.base)}` is of type {bt.name}, which has no members", e.span)
         return T.ERROR
 
     def x_BitAccess(self, e: A.BitAccess, expected):
@@ -227,10 +235,11 @@ class ExprChecker:
         if T.is_error(bt):
             return T.BOOL
         if not isinstance(bt, T.ElementaryType) or bt.kind not in ("int", "uint", "bit") or bt is T.BOOL:
-            self.ctx.diags.error("ST1102", f"bit access `.{e.bit}` needs an integer or bit-string variable, "
+            self.ctx.diags.error(codes.OPERATOR_TYPE, f"bit access `.{e.bit}` needs an integer or bit-string variable, "
                                  f"not {bt.name}", e.span)
         elif e.bit >= bt.bits:
-            self.ctx.diags.error("ST1501", f"bit {e.bit} does not exist in {bt.name} (bits 0..{bt.bits - 1})",
+            self.ctx.diags.error(codes.OUT_OF_BOUNDS,
+                                 f"bit {e.bit} does not exist in {bt.name} (bits 0..{bt.bits - 1})",
                                  e.span)
         return T.BOOL
 
@@ -239,22 +248,24 @@ class ExprChecker:
         for ix in e.indices:
             it = self.expr(ix, T.DINT)
             if not T.is_error(it) and not T.is_int(it) and not isinstance(T.unalias(it), T.EnumType):
-                self.ctx.diags.error("ST1106", f"array index must be an integer, not {it.name}", ix.span)
+                self.ctx.diags.error(codes.BAD_INDEXING, f"array index must be an integer, not {it.name}", ix.span)
         if T.is_error(bt):
             return T.ERROR
         if not isinstance(bt, T.ArrayType):
-            self.ctx.diags.error("ST1106", f"`{self.text(e.base)}` is of type {bt.name}, not an array; it cannot "
+            self.ctx.diags.error(codes.BAD_INDEXING,
+                                 f"`{self.text(e.base)}` is of type {bt.name}, not an array; it cannot "
                                  "be indexed", e.span)
             return T.ERROR
         if len(e.indices) != len(bt.dims):
-            self.ctx.diags.error("ST1106", f"`{self.text(e.base)}` has {len(bt.dims)} dimension(s) but "
+            self.ctx.diags.error(codes.BAD_INDEXING, f"`{self.text(e.base)}` has {len(bt.dims)} dimension(s) but "
                                  f"{len(e.indices)} index(es) were given", e.span)
             return bt.element
         array_bounds.check(self, e, bt)
         output = getattr(e.base, "fb_array_output", None)
         if output is not None and self.ctx.dialect == "sysmac":
             # Sysmac Studio: "Cannot use an element of array" output of a function block instance
-            self.ctx.diags.error("ST1008", f"`{self.text(e)}`: Sysmac Studio does not allow an element of the array "
+            self.ctx.diags.error(codes.SYSMAC_ARRAY_OUTPUT_ELEMENT,
+                                 f"`{self.text(e)}`: Sysmac Studio does not allow an element of the array "
                                  f"output {output} of a function block instance; copy the whole output into an "
                                  f"array variable (`Buf := {self.text(e.base)};`) and index that", e.span)
         return bt.element
@@ -263,7 +274,7 @@ class ExprChecker:
         if e.op == "NOT":
             t = self.expr(e.operand, expected)
             if not T.is_error(t) and not T.is_bits(t):
-                self.ctx.diags.error("ST1102", f"NOT needs BOOL or a bit string, not {t.name}", e.span)
+                self.ctx.diags.error(codes.OPERATOR_TYPE, f"NOT needs BOOL or a bit string, not {t.name}", e.span)
                 return T.ERROR
             return T.base_of(t)
         if isinstance(e.operand, A.Literal) and e.operand.kind == "int" and e.operand.type_prefix is None:
@@ -275,7 +286,8 @@ class ExprChecker:
         if T.is_error(t):
             return t
         if not (T.is_num(t) or T.is_time(t)) or (e.op == "-" and T.base_of(t).kind == "uint"):
-            self.ctx.diags.error("ST1102", f"unary `{e.op}` needs a signed number or TIME, not {t.name}", e.span)
+            self.ctx.diags.error(codes.OPERATOR_TYPE,
+                                 f"unary `{e.op}` needs a signed number or TIME, not {t.name}", e.span)
             return T.ERROR
         e.sysmac_ty = e.operand.sysmac_ty
         return T.base_of(t)
@@ -376,7 +388,8 @@ class ExprChecker:
             real = next((t for t in (sa, sb) if T.is_real(t)), None)
             if real is not None:                     # an inner expression already warned otherwise
                 self.ctx.diags.warning(
-                    "ST1108", f"Sysmac types this {sa.name} {e.op} {sb.name} expression as {s.name} (W501 6-106: "
+                    codes.SYSMAC_INTEGER_RANK,
+                    f"Sysmac types this {sa.name} {e.op} {sb.name} expression as {s.name} (W501 6-106: "
                     f"{s.name} ranks above {real.name}) and computes it in {s.name}; vplc computes it in LREAL "
                     f"(stored into an integer, the result is rounded to nearest): convert explicitly so both agree",
                     e.span)
@@ -416,7 +429,8 @@ class ExprChecker:
         return self.op_error(e, lt, rt, "numbers of compatible types")
 
     def op_error(self, e, lt, rt, needs: str):
-        self.ctx.diags.error("ST1102", f"operator {e.op} cannot combine {lt.name} and {rt.name}; it needs {needs}",
+        self.ctx.diags.error(codes.OPERATOR_TYPE,
+                             f"operator {e.op} cannot combine {lt.name} and {rt.name}; it needs {needs}",
                              e.span)
         return T.BOOL if e.op in COMPARE else T.ERROR
 
@@ -432,11 +446,13 @@ class ExprChecker:
         return calls.check_call(self, e, expected, statement=False)
 
     def x_ArrayInit(self, e, expected):
-        self.ctx.diags.error("ST0201", "an array initializer `[...]` is only allowed as an initial value", e.span)
+        self.ctx.diags.error(codes.UNEXPECTED_TOKEN,
+                             "an array initializer `[...]` is only allowed as an initial value", e.span)
         return T.ERROR
 
     def x_StructInit(self, e, expected):
-        self.ctx.diags.error("ST0201", "a structure initializer `(...)` is only allowed as an initial value", e.span)
+        self.ctx.diags.error(codes.UNEXPECTED_TOKEN,
+                             "a structure initializer `(...)` is only allowed as an initial value", e.span)
         return T.ERROR
 
     def text(self, e: A.Expr) -> str:
@@ -448,7 +464,7 @@ class ExprChecker:
         if T.is_error(have) or T.is_error(want):
             return
         if isinstance(T.unalias(want), T.PouType) or isinstance(T.unalias(have), T.PouType):
-            self.ctx.diags.error("ST1101", f"{what}: function block instances cannot be assigned or copied",
+            self.ctx.diags.error(codes.TYPE_MISMATCH, f"{what}: function block instances cannot be assigned or copied",
                                  value.span)
             return
         sysmac = getattr(value, "sysmac_ty", None)
@@ -463,7 +479,8 @@ class ExprChecker:
                 hint = f"; convert explicitly with {a.name}_TO_{b.name}"
             elif isinstance(a, T.StringType) != isinstance(b, T.StringType):
                 hint = ""
-            self.ctx.diags.error("ST1101", f"{what}: cannot use a value of type {have.name} where {want.name} is "
+            self.ctx.diags.error(codes.TYPE_MISMATCH,
+                                 f"{what}: cannot use a value of type {have.name} where {want.name} is "
                                  f"expected{hint}", value.span)
             return
         if not is_generic(want):
@@ -478,7 +495,8 @@ class ExprChecker:
             init.ty = want
             if not isinstance(t, T.ArrayType):
                 if not T.is_error(t):
-                    self.ctx.diags.error("ST1101", f"{what}: an array initializer needs an array, not {want.name}",
+                    self.ctx.diags.error(codes.TYPE_MISMATCH,
+                                         f"{what}: an array initializer needs an array, not {want.name}",
                                          init.span)
                 return
             count = 0
@@ -491,7 +509,7 @@ class ExprChecker:
                     self.initial_value(item.value, t.element, what)
                 count += n
             if not t.open and count > t.count():
-                self.ctx.diags.error("ST1501", f"{what}: {count} initial values for an array of {t.count()} "
+                self.ctx.diags.error(codes.OUT_OF_BOUNDS, f"{what}: {count} initial values for an array of {t.count()} "
                                      "elements", init.span)
             return
         if isinstance(init, A.StructInit):
@@ -500,7 +518,8 @@ class ExprChecker:
                 for fi in init.fields:
                     f = t.field(fi.name)
                     if f is None:
-                        self.ctx.diags.error("ST1005", f"structure {t.name} has no member `{fi.name}`", fi.span)
+                        self.ctx.diags.error(codes.NO_SUCH_MEMBER,
+                                             f"structure {t.name} has no member `{fi.name}`", fi.span)
                         continue
                     self.initial_value(fi.value, f.type, f"initial value of {fi.name}")
                 return
@@ -508,12 +527,14 @@ class ExprChecker:
                 for fi in init.fields:
                     p = t.param(fi.name)
                     if p is None or p.direction != "in":
-                        self.ctx.diags.error("ST1201", f"`{fi.name}` is not an input of {t.name}", fi.span)
+                        self.ctx.diags.error(codes.UNKNOWN_PARAMETER,
+                                             f"`{fi.name}` is not an input of {t.name}", fi.span)
                         continue
                     self.initial_value(fi.value, p.type, f"initial value of {fi.name}")
                 return
             if not T.is_error(t):
-                self.ctx.diags.error("ST1101", f"{what}: a structure initializer needs a structure, not {want.name}",
+                self.ctx.diags.error(codes.TYPE_MISMATCH,
+                                     f"{what}: a structure initializer needs a structure, not {want.name}",
                                      init.span)
             return
         have = self.expr(init, want)

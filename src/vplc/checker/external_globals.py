@@ -18,6 +18,8 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import codes
+
 SHOWN = 8           # names listed in the message; the rest are counted
 
 
@@ -39,7 +41,8 @@ def check(ck, pou) -> None:
         return
     shown = ", ".join(f"`{n}`" for n in names[:SHOWN]) + (f" and {len(names) - SHOWN} more" if len(names) > SHOWN
                                                           else "")
-    ck.ctx.diags.warning("ST1009", f"{pou.name} uses the global variable{'s' if len(names) > 1 else ''} {shown} "
+    ck.ctx.diags.warning(codes.SYSMAC_MISSING_EXTERNAL,
+                         f"{pou.name} uses the global variable{'s' if len(names) > 1 else ''} {shown} "
                          "without VAR_EXTERNAL; Sysmac Studio refuses a global that the POU does not declare as an "
                          "external variable", pou.name_span or pou.span,
                          ["declare each in `VAR_EXTERNAL ... END_VAR` with the global's type"])

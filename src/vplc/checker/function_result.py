@@ -17,6 +17,7 @@ Failing::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 
 
@@ -44,5 +45,6 @@ def check(ck, pou: A.Pou) -> None:
     if pou.kind != "FUNCTION" or pou.native or ck.result_sym is None or ck.result_sym.type is T.VOID:
         return
     if not _assigns(pou.body, ck.result_sym):
-        ck.ctx.diags.warning("ST1801", f"FUNCTION {pou.name} does not assign its result `{pou.name}` on every path; "
+        ck.ctx.diags.warning(codes.RESULT_NOT_ASSIGNED,
+                             f"FUNCTION {pou.name} does not assign its result `{pou.name}` on every path; "
                              "the result is then 0 / empty", pou.name_span or pou.span)

@@ -22,6 +22,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend.source import Span
 from . import (portable_array_types, portable_case_labels, portable_discarded_result, portable_empty_call,
                portable_enum_order, portable_enum_values, portable_keywords, portable_len_type)
@@ -43,23 +44,28 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
         rule.check_unit(ctx, unit)
     for node in A.walk(unit):
         if isinstance(node, A.QualName) and node.namespace:
-            ctx.diags.warning("ST2002", f"namespace qualifier in `{node.text()}` is a vendor extension; use the bare "
+            ctx.diags.warning(codes.PORTABLE_NAMESPACE,
+                              f"namespace qualifier in `{node.text()}` is a vendor extension; use the bare "
                               f"name `{node.name}` for portable code", node.span)
         elif isinstance(node, A.Continue):
-            ctx.diags.warning("ST2003", "CONTINUE is IEC 61131-3 3rd edition only; restructure the loop with IF",
+            ctx.diags.warning(codes.PORTABLE_NOT_EDITION_2,
+                              "CONTINUE is IEC 61131-3 3rd edition only; restructure the loop with IF",
                               node.span)
         elif isinstance(node, A.Literal) and node.kind == "ltime":
-            ctx.diags.warning("ST2003", "LTIME is IEC 61131-3 3rd edition only; use TIME", node.span)
+            ctx.diags.warning(codes.PORTABLE_NOT_EDITION_2,
+                              "LTIME is IEC 61131-3 3rd edition only; use TIME", node.span)
         elif isinstance(node, A.VarSection) and node.kind == "VAR_STAT":
-            ctx.diags.warning("ST2003", "VAR_STAT is not IEC 61131-3 2nd edition; use VAR", node.span)
+            ctx.diags.warning(codes.PORTABLE_NOT_EDITION_2,
+                              "VAR_STAT is not IEC 61131-3 2nd edition; use VAR", node.span)
     for style, start, end in unit.comments or ():
         if style != "(*":
-            ctx.diags.warning("ST2003", f"`{style}` comments are not IEC 61131-3 2nd edition; write (* ... *)",
+            ctx.diags.warning(codes.PORTABLE_NOT_EDITION_2,
+                              f"`{style}` comments are not IEC 61131-3 2nd edition; write (* ... *)",
                               Span(unit.span.file, start, start + 2))
     for span, what in ctx.edition3_uses:
         if span.file is unit.span.file:
-            ctx.diags.warning("ST2003", f"{what} is not IEC 61131-3 2nd edition", span)
+            ctx.diags.warning(codes.PORTABLE_NOT_EDITION_2, f"{what} is not IEC 61131-3 2nd edition", span)
     for span, name, what in ctx.vendor_uses:
         if span.file is unit.span.file:
-            ctx.diags.warning("ST2001", f"`{name}` is an Omron Sysmac {what}, not IEC 61131-3; keep "
+            ctx.diags.warning(codes.PORTABLE_VENDOR_NAME, f"`{name}` is an Omron Sysmac {what}, not IEC 61131-3; keep "
                               "vendor calls in the library's platform/ folder", span)

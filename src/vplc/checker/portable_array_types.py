@@ -18,6 +18,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 
 
@@ -26,7 +27,8 @@ def _anonymous_array(t) -> bool:
 
 
 def _warn(ctx, span, what: str) -> None:
-    ctx.diags.warning("ST2011", f"{what}: two separately written ARRAY types are different types in IEC 61131-3 "
+    ctx.diags.warning(codes.PORTABLE_ARRAY_TYPES,
+                      f"{what}: two separately written ARRAY types are different types in IEC 61131-3 "
                       "2nd edition; declare the array once as a named type (a STRUCT member for Sysmac Studio) "
                       "and use it on both sides", span)
 

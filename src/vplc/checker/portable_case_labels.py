@@ -18,6 +18,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from .symbols import EnumValueSymbol
 
 
@@ -46,5 +47,6 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
                     parts = [label.lo, label.hi] if isinstance(label, A.CaseRange) else [label]
                     for p in parts:
                         if not _portable(p):
-                            ctx.diags.warning("ST2006", "IEC 61131-3 CASE labels are signed decimal integers, "
+                            ctx.diags.warning(codes.PORTABLE_CASE_LABEL,
+                                              "IEC 61131-3 CASE labels are signed decimal integers, "
                                               f"enumeration values or subranges, not {_label_text(p)}", p.span)

@@ -14,6 +14,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 
 
@@ -24,6 +25,7 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
             if b is None or b.kind not in ("function", "builtin") or b.ty is T.VOID or T.is_error(b.ty):
                 continue
             name = b.pou.name if b.pou is not None else b.builtin.name
-            ctx.diags.warning("ST2007", f"the result of function {name} is thrown away; IEC 61131-3 calls a "
+            ctx.diags.warning(codes.PORTABLE_DISCARDED_RESULT,
+                              f"the result of function {name} is thrown away; IEC 61131-3 calls a "
                               f"function only inside an expression: assign it (`x := {name}(...);`)",
                               node.call.span)

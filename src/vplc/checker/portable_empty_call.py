@@ -15,6 +15,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 
 
 def check_unit(ctx, unit: A.CompilationUnit) -> None:
@@ -23,5 +24,6 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
             b = node.binding
             if b is not None and b.kind in ("function", "builtin"):
                 name = b.pou.name if b.pou is not None else b.builtin.name
-                ctx.diags.warning("ST2009", f"`{name}()`: IEC 61131-3 2nd edition has no function call without "
+                ctx.diags.warning(codes.PORTABLE_EMPTY_CALL,
+                                  f"`{name}()`: IEC 61131-3 2nd edition has no function call without "
                                   "arguments; pass an input, or make it a function block", node.span)

@@ -14,6 +14,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 
 ORDERING = ("<", ">", "<=", ">=")
@@ -25,5 +26,6 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
             enum = next((T.base_of(o.ty) for o in (node.left, node.right)
                          if o.ty is not None and isinstance(T.base_of(o.ty), T.EnumType)), None)
             if enum is not None:
-                ctx.diags.warning("ST2008", f"`{node.op}` on values of the enumeration {enum.name}: IEC 61131-3 "
+                ctx.diags.warning(codes.PORTABLE_ENUM_ORDER,
+                                  f"`{node.op}` on values of the enumeration {enum.name}: IEC 61131-3 "
                                   "enumerations have no order; compare with `=` / `<>` for each state", node.span)

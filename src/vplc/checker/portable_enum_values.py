@@ -15,6 +15,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 
 
 def check_unit(ctx, unit: A.CompilationUnit) -> None:
@@ -26,5 +27,6 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
             for v in explicit:
                 fix = (f"write `{v.name}` without `:= ...`; the values are already in number order from 0"
                        if in_order else "declare the values in number order from 0 without `:= ...`")
-                ctx.diags.warning("ST2004", f"enumeration value `{v.name}` has an explicit number, which is IEC "
+                ctx.diags.warning(codes.PORTABLE_ENUM_NUMBER,
+                                  f"enumeration value `{v.name}` has an explicit number, which is IEC "
                                   f"61131-3 3rd edition only; {fix}", v.span)

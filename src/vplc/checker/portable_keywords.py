@@ -16,6 +16,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 
 SFC = "STEP END_STEP INITIAL_STEP TRANSITION END_TRANSITION FROM ACTION END_ACTION".split()
 CONFIG = "TASK ON WITH READ_ONLY READ_WRITE SINGLE INTERVAL PRIORITY AT VAR_ACCESS".split()
@@ -40,5 +41,6 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
         for name, span in _names(node):
             kind = KIND.get(name.upper())
             if kind is not None:
-                ctx.diags.warning("ST2005", f"`{name}` is {kind} in IEC 61131-3 and cannot be a name in other "
+                ctx.diags.warning(codes.PORTABLE_KEYWORD,
+                                  f"`{name}` is {kind} in IEC 61131-3 and cannot be a name in other "
                                   "compilers; rename it (e.g. with a prefix that says what it is)", span)

@@ -17,6 +17,7 @@ Failing (portable)::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 from .scope import is_generic
 
@@ -51,7 +52,8 @@ def _is_int_type(e) -> bool:
 
 
 def _report(ctx, e, where: str) -> None:
-    ctx.diags.warning("ST2010", f"LEN and FIND return INT in IEC 61131-3 (UINT only in Sysmac), so this value is "
+    ctx.diags.warning(codes.PORTABLE_LEN_TYPE,
+                      f"LEN and FIND return INT in IEC 61131-3 (UINT only in Sysmac), so this value is "
                       f"INT where {where}; use an INT variable or an INT_TO_... conversion", e.span)
 
 

@@ -15,6 +15,7 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import codes
 from ..frontend import types as T
 
 
@@ -44,7 +45,7 @@ def check(ctx, edges: dict) -> None:
                 if key not in reported:
                     reported.add(key)
                     chain = " → ".join(p.name for p in cycle + [callee])
-                    ctx.diags.error("ST1701", f"recursion is not allowed in IEC 61131-3: {chain}", span)
+                    ctx.diags.error(codes.RECURSION, f"recursion is not allowed in IEC 61131-3: {chain}", span)
             elif c == 0:
                 color[id(callee)] = 1
                 path.append(callee)

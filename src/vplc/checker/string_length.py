@@ -14,6 +14,7 @@ Failing::
 from __future__ import annotations
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend import types as T
 
 
@@ -25,5 +26,6 @@ def check(ck, value, want) -> None:
         n = len(value.value)
         if n > t.capacity:
             extra = " (the size counts the terminating NUL)" if ck.ctx.dialect == "sysmac" else ""
-            ck.ctx.diags.error("ST1601", f"the text has {n} characters but {t.name} holds at most {t.capacity}"
+            ck.ctx.diags.error(codes.STRING_TOO_LONG,
+                               f"the text has {n} characters but {t.name} holds at most {t.capacity}"
                                f"{extra}; shorten the text or enlarge the string", value.span)

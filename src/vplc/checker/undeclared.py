@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import difflib
 
+from ..frontend import codes
 from ..frontend import sysmac_names
 
 
@@ -32,7 +33,7 @@ def _suggest(name: str, candidates) -> list[str]:
 def report(ctx, name: str, span, candidates=()) -> None:
     if _not_modelled(ctx, name, span):
         return
-    ctx.diags.error("ST1001", f"`{name}` is not declared; declare it in a VAR section or check the spelling",
+    ctx.diags.error(codes.UNDECLARED, f"`{name}` is not declared; declare it in a VAR section or check the spelling",
                     span, _suggest(name, candidates))
 
 
@@ -43,7 +44,7 @@ def _not_modelled(ctx, name: str, span) -> bool:
     text = sysmac_names.describe(name)
     if text is None:
         return False
-    ctx.diags.error("ST1007", text, span, ["write the POU without it, or model it in vplc's prelude "
+    ctx.diags.error(codes.SYSMAC_NOT_MODELLED, text, span, ["write the POU without it, or model it in vplc's prelude "
                                            "(src/vplc/prelude) and runtime"])
     return True
 
@@ -58,9 +59,10 @@ def report_type(ctx, name: str, span) -> None:
         spaces = {k[0] for k in ctx.tables.types.entries} | {k[0] for k in ctx.tables.pous.entries}
         if ns.upper() not in spaces:
             notes.append(f"no library `{ns}` is loaded; add its folder (e.g. lib/{ns}) to the paths checked")
-    ctx.diags.error("ST1004", f"unknown data type `{name}`", span, notes)
+    ctx.diags.error(codes.UNKNOWN_TYPE, f"unknown data type `{name}`", span, notes)
 
 
 def report_ambiguous(ctx, name: str, candidates: list[str], span) -> None:
-    ctx.diags.error("ST1003", f"`{name}` is ambiguous: it is declared in {', '.join(candidates)}; qualify it "
+    ctx.diags.error(codes.AMBIGUOUS_NAME,
+                    f"`{name}` is ambiguous: it is declared in {', '.join(candidates)}; qualify it "
                     f"with its namespace (e.g. `{candidates[0]}`)", span)

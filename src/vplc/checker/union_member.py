@@ -21,14 +21,17 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import codes
 from ..frontend import types as T
 
 
 def check(ctx, st: T.StructType, f, ftype: T.Type) -> None:
     if f.init is not None:
-        ctx.diags.error("ST1109", f"member `{f.name}` of UNION {st.name} has an initial value; a union's members "
+        ctx.diags.error(codes.UNION_MEMBER,
+                        f"member `{f.name}` of UNION {st.name} has an initial value; a union's members "
                         "share one memory image, which starts at 0", f.init.span)
     if not T.is_error(ftype) and T.union_layout(ftype) is None:
-        ctx.diags.error("ST1109", f"member `{f.name}` of UNION {st.name} is of type {ftype.name}: vplc overlays "
+        ctx.diags.error(codes.UNION_MEMBER,
+                        f"member `{f.name}` of UNION {st.name} is of type {ftype.name}: vplc overlays "
                         "only BOOL, bit strings, integers, REAL/LREAL, TIME and one-dimensional arrays of them "
                         "(W501 6-3-6)", f.name_span)

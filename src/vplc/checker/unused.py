@@ -12,6 +12,8 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import codes
+
 
 def check(ck, pou) -> None:
     if pou.native or ck.in_prelude:
@@ -22,4 +24,5 @@ def check(ck, pou) -> None:
         for decl in section.vars:
             sym = decl.sym
             if sym is not None and not sym.used:
-                ck.ctx.diags.warning("ST1901", f"`{decl.name}` is declared but never used; remove it", decl.name_span)
+                ck.ctx.diags.warning(codes.UNUSED_VARIABLE,
+                                     f"`{decl.name}` is declared but never used; remove it", decl.name_span)
