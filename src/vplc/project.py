@@ -6,6 +6,7 @@ import os
 from dataclasses import dataclass, field
 
 from .frontend import ast as A
+from .frontend import codes
 from .frontend import types as T
 from .checker import calls, portable as portable_rule, recursion
 from .checker.body import BodyChecker
@@ -103,12 +104,13 @@ def collect_files(paths, diags: DiagnosticBag) -> list[str]:
                 found += [os.path.join(root, n) for n in sorted(names)
                           if n.lower().endswith(".st") or (is_xml(n) and is_project_xml(os.path.join(root, n)))]
             if not found:
-                diags.warning("ST0004", f"folder `{p}` contains no .st or .xml files", Span(SourceFile(p, ""), 0, 0))
+                diags.warning(codes.FILE_EMPTY,
+                              f"folder `{p}` contains no .st or .xml files", Span(SourceFile(p, ""), 0, 0))
             files += found
         elif os.path.exists(p):
             files.append(p)
         else:
-            diags.error("ST0001", f"file or folder `{p}` does not exist", Span(SourceFile(p, ""), 0, 0))
+            diags.error(codes.FILE_NOT_FOUND, f"file or folder `{p}` does not exist", Span(SourceFile(p, ""), 0, 0))
     seen, out = set(), []
     for f in files:
         key = os.path.abspath(f)
@@ -124,21 +126,22 @@ def read_source(path: str, diags: DiagnosticBag) -> SourceFile | None:
         with open(path, "rb") as fh:
             data = fh.read()
     except OSError as exc:
-        diags.error("ST0005", f"cannot read `{path}`: {exc.strerror or exc}", empty)
+        diags.error(codes.FILE_UNREADABLE, f"cannot read `{path}`: {exc.strerror or exc}", empty)
         return None
     if b"\x00" in data[:8192]:
-        diags.error("ST0003", f"`{path}` is a binary file, not Structured Text source", empty)
+        diags.error(codes.FILE_BINARY, f"`{path}` is a binary file, not Structured Text source", empty)
         return None
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = data[:exc.start].count(b"\n") + 1
-        diags.error("ST0002", f"`{path}` is not valid UTF-8 (invalid byte 0x{data[exc.start]:02X} on line {line}); "
+        diags.error(codes.FILE_NOT_UTF8,
+                    f"`{path}` is not valid UTF-8 (invalid byte 0x{data[exc.start]:02X} on line {line}); "
                     "save the file as UTF-8", empty)
         return None
     src = SourceFile(path, text)
     if not text.strip():
-        diags.error("ST0004", f"`{path}` is empty; it declares nothing", Span(src, 0, 0))
+        diags.error(codes.FILE_EMPTY, f"`{path}` is empty; it declares nothing", Span(src, 0, 0))
         return None
     return src
 
@@ -260,26 +263,27 @@ def check_configuration(ctx: Context, cfg: A.Configuration, unit) -> None:
         tasks = {}
         for task in res.tasks:
             if task.name.upper() in tasks:
-                ctx.diags.error("ST1002", f"task `{task.name}` is declared more than once", task.span)
+                ctx.diags.error(codes.DUPLICATE_NAME, f"task `{task.name}` is declared more than once", task.span)
             tasks[task.name.upper()] = task
             for prop in task.props:
                 want = {"INTERVAL": T.TIME, "PRIORITY": T.UINT, "SINGLE": T.BOOL}.get(prop.name)
                 if want is None:
-                    ctx.diags.error("ST1201", f"unknown task property `{prop.name}`; use INTERVAL, PRIORITY or SINGLE",
+                    ctx.diags.error(codes.UNKNOWN_PARAMETER,
+                                    f"unknown task property `{prop.name}`; use INTERVAL, PRIORITY or SINGLE",
                                     prop.span)
                     continue
                 have = ck.expr(prop.value, want)
                 ck.coerce(prop.value, have, want, f"task property {prop.name}")
         for inst in res.programs:
             if inst.task is not None and inst.task.upper() not in tasks:
-                ctx.diags.error("ST1001", f"task `{inst.task}` is not declared in this resource", inst.span)
+                ctx.diags.error(codes.UNDECLARED, f"task `{inst.task}` is not declared in this resource", inst.span)
             pt = None
             try:
                 pt = ctx.tables.pous.lookup(inst.program.name, inst.program.namespace, unit.namespace)
             except Ambiguous:
                 pass
             if pt is None or pt.kind != "program":
-                ctx.diags.error("ST1001", f"`{inst.program.text()}` is not a PROGRAM", inst.span)
+                ctx.diags.error(codes.UNDECLARED, f"`{inst.program.text()}` is not a PROGRAM", inst.span)
                 continue
             call = A.Call(A.Name(inst.program, span=inst.program.span), inst.args, span=inst.span)
             calls.bind_pou(ck, call, pt, "program", None)

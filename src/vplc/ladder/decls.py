@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .model import LadderBody
+from ..frontend import codes
 
 
 @dataclass
@@ -61,7 +62,7 @@ class FormatError(Exception):
     """The XML is well formed but describes something we cannot run; ``where`` names the place, ``code`` is
     the diagnostic code (docs/toolchain/diagnostics.md, ST21xx)."""
 
-    def __init__(self, where: str, message: str, code: str = "ST2102") -> None:
+    def __init__(self, where: str, message: str, code: str = codes.LADDER_UNKNOWN_ELEMENT) -> None:
         super().__init__(f"{where}: {message}" if where else message)
         self.where = where
         self.message = message

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 
 from ..frontend import ast as A
+from ..frontend import codes
 from ..frontend.source import SourceFile, Span
 from . import iec10_read, plcopen_read
 from .decls import FormatError
@@ -41,14 +42,15 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
         text, root = read_safely(path)
     except XmlError as exc:
         src = SourceFile(path, _raw_text(path))
-        diags.error("ST2101", f"`{path}` cannot be loaded: {exc}", Span(src, exc.offset, exc.offset + 1))
+        diags.error(codes.XML_REFUSED, f"`{path}` cannot be loaded: {exc}", Span(src, exc.offset, exc.offset + 1))
         return []
     if root.tag == "project":
         reader = plcopen_read.read
     elif root.tag == "Project":
         reader = iec10_read.read
     else:
-        diags.error("ST2101", f"`{path}` is not a PLCopen XML (TC6) or IEC 61131-10 project: its root element is "
+        diags.error(codes.XML_REFUSED,
+                    f"`{path}` is not a PLCopen XML (TC6) or IEC 61131-10 project: its root element is "
                     f"<{root.tag}>", Span(SourceFile(path, text), 0, 1))
         return []
     try:
@@ -61,7 +63,8 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
         for message, places in rules.items():            # one warning per rule, at its first place
             more = f" ({len(places)} places)" if len(places) > 1 else ""
             place = LadderSource(path, "", [(0, 1, places[0] or "project")])
-            diags.warning("ST2108", f"{message}{more}; this spelling of an earlier vplc export breaks Omron's "
+            diags.warning(codes.XML_OLD_SPELLING,
+                          f"{message}{more}; this spelling of an earlier vplc export breaks Omron's "
                           "schema: export the file again", Span(place, 0, 1))
         for unit in units:
             src = unit_source(path, unit)
@@ -76,15 +79,16 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
         return []
     except (ValueError, TypeError, AttributeError) as exc:      # numbers or attributes malformed in the file
         place = LadderSource(path, "", [(0, 1, "project")])
-        diags.error("ST2102", f"the XML does not follow the format: {exc}", Span(place, 0, 1))
+        diags.error(codes.LADDER_UNKNOWN_ELEMENT, f"the XML does not follow the format: {exc}", Span(place, 0, 1))
         return []
     except RecursionError:
         place = LadderSource(path, "", [(0, 1, "project")])
-        diags.error("ST2101", "the XML is nested too deeply to be a project file", Span(place, 0, 1))
+        diags.error(codes.XML_REFUSED, "the XML is nested too deeply to be a project file", Span(place, 0, 1))
         return []
     except Exception as exc:  # noqa: BLE001 - a loader defect must not show a traceback
         place = LadderSource(path, "", [(0, 1, "project")])
-        diags.error("ST2102", f"internal error of the ladder loader ({type(exc).__name__}: {exc}); please report it "
+        diags.error(codes.LADDER_UNKNOWN_ELEMENT,
+                    f"internal error of the ladder loader ({type(exc).__name__}: {exc}); please report it "
                     "with the XML file", Span(place, 0, 1))
         return []
 
@@ -129,8 +133,9 @@ def check_operands(ctx, units) -> None:
                 stmt = next(((s, e) for s, e in src.statements if s <= node.span.start < e), None)
                 if stmt is not None:
                     bad_statements.append((src, stmt))
-                ctx.diags.error("ST2105", f"the {operand}'s operand `{node.span.file.text[node.span.start:node.span.end]}`"
+                ctx.diags.error(codes.LADDER_PIN_TYPE,
+                                f"the {operand}'s operand `{node.span.file.text[node.span.start:node.span.end]}`"
                                 f" is {ty.name}; a {operand} needs a BOOL variable", node.span)
     if bad_statements:
-        ctx.diags.items = [d for d in ctx.diags.items if d.code == "ST2105" or not any(
+        ctx.diags.items = [d for d in ctx.diags.items if d.code == codes.LADDER_PIN_TYPE or not any(
             d.span.file is src and s <= d.span.start < e for src, (s, e) in bad_statements)]

@@ -16,6 +16,7 @@ import xml.etree.ElementTree as ET
 from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit
 from .model import EDGES, STORAGES, Conn, Element, LadderBody, Pin, Rung
 from .xmlsafe import text_of
+from ..frontend import codes
 
 POU_KINDS = {"program": "PROGRAM", "functionBlock": "FUNCTION_BLOCK", "function": "FUNCTION"}
 VAR_LISTS = {"inputVars": "VAR_INPUT", "outputVars": "VAR_OUTPUT", "inOutVars": "VAR_IN_OUT",
@@ -231,7 +232,8 @@ def read_ld(ld: ET.Element, pou: str) -> LadderBody:
             e = _element(el, pou)
             if e.id in seen:
                 raise FormatError(f"{pou}:element {e.id}", f"localId {e.id} is used by two elements; every "
-                                  "element needs its own id for the wires to be unambiguous", "ST2103")
+                                  "element needs its own id for the wires to be unambiguous",
+                                  codes.LADDER_MISSING_CONNECTION)
             seen.add(e.id)
             elements.append(e)
         elif el.tag not in ("addData", "documentation"):

@@ -23,6 +23,7 @@ import heapq
 from ..frontend.source import SourceFile
 from .decls import FormatError, PouText, SectionText, XmlUnit
 from .model import Conn, Element, LadderBody, Pin, Rung
+from ..frontend import codes
 
 TRUE = "TRUE"
 SERIES_MARKS = 128        # marked ranges in one series expression before a helper variable carries its power on
@@ -216,7 +217,7 @@ class RungCompiler:
             if rung.label:
                 if rung.label.upper() in labels:
                     self.errors.append(_error(f"{self.pou}:rung {n + 1}", f"label `{rung.label}` is defined twice",
-                                              "ST2106"))
+                                              codes.LADDER_BAD_JUMP))
                 labels.setdefault(rung.label.upper(), n)
         self.jump_flags: dict[int, str] = {}
         for n, rung in enumerate(ladder.rungs):
@@ -226,11 +227,11 @@ class RungCompiler:
                     where = f"{self.pou}:rung {n + 1}:jump {el.var}"
                     if target is None:
                         self.errors.append(_error(where, f"jump to label `{el.var}`, which no rung of {self.pou} "
-                                                         "has", "ST2106"))
+                                                         "has", codes.LADDER_BAD_JUMP))
                     elif target <= n:
                         self.errors.append(_error(where, f"jump back to label `{el.var}` (rung {target + 1}); a "
                                                          "jump may only skip rungs below it, so a scan always ends",
-                                                  "ST2106"))
+                                                  codes.LADDER_BAD_JUMP))
                     else:
                         self.jump_flags[id(el)] = self.new("J")
         for flag in self.jump_flags.values():
@@ -286,10 +287,11 @@ class RungCompiler:
                         if src is None:
                             raise _error(f"{self.where}:{e.describe()}",
                                          f"input `{pin.name or 'power'}` is connected to element "
-                                         f"{c.ref.lstrip('?')}, which is not in this rung", "ST2103")
+                                         f"{c.ref.lstrip('?')}, which is not in this rung",
+                                         codes.LADDER_MISSING_CONNECTION)
                         if src.kind == "right_rail":
                             raise _error(f"{self.where}:{e.describe()}", "a wire starts at the right power rail",
-                                         "ST2103")
+                                         codes.LADDER_MISSING_CONNECTION)
                         key = (src.id, self._pin_name(src, c, e))
                     except FormatError as exc:
                         problems.append(exc)
@@ -303,7 +305,7 @@ class RungCompiler:
         if stuck:
             problems.append(_error(self.where, "the rung is wired in a loop (" + ", ".join(stuck[:6])
                                    + "); power must flow from the left rail to the right without coming back",
-                                   "ST2104"))
+                                   codes.LADDER_LOOP))
         mark, hidden = len(self.lines), len(self.hidden)
         bad_jump = any(e.kind == "jump" and id(e) not in self.jump_flags for e in rung.elements)   # reported above
         if not problems and not bad_jump:
@@ -348,11 +350,13 @@ class RungCompiler:
         if c.pin is None:
             first = next((p.name for p in src.outputs if p.name.upper() != "ENO"), None)
             if first is None:
-                raise _error(f"{self.where}:{user.describe()}", f"is wired to {src.describe()}, which has no output", "ST2103")
+                raise _error(f"{self.where}:{user.describe()}", f"is wired to {src.describe()}, which has no output",
+                             codes.LADDER_MISSING_CONNECTION)
             return first
         if c.pin.upper() not in (n.upper() for n in names):
             raise _error(f"{self.where}:{user.describe()}",
-                         f"is wired to output `{c.pin}` of {src.describe()}, which has no such pin", "ST2103")
+                         f"is wired to output `{c.pin}` of {src.describe()}, which has no such pin",
+                         codes.LADDER_MISSING_CONNECTION)
         return next(n for n in names if n.upper() == c.pin.upper())
 
     def label(self, e: Element) -> str:
@@ -365,16 +369,17 @@ class RungCompiler:
         pin = self._pin_name(src, c, e)
         if src.id in self.guard and (pin or "").upper() != "ENO" and e.kind not in ("out_var", "inout_var"):
             raise _error(self.label(e), f"reads the result of {src.describe()}, a function with EN; wire the "
-                                        "result to a variable and read the variable", "ST2107")
+                                        "result to a variable and read the variable", codes.LADDER_FUNCTION_WIRING)
         value = self.out.get((src.id, pin))
         if value is None:
-            raise _error(self.label(e), f"is wired to {src.describe()}, which has no output to read", "ST2103")
+            raise _error(self.label(e), f"is wired to {src.describe()}, which has no output to read",
+                         codes.LADDER_MISSING_CONNECTION)
         return value
 
     def power(self, e: Element, pin: Pin) -> Txt:
         if not pin.conns:
             raise _error(self.label(e), "nothing is connected to its input" if pin.name == "" else
-                         f"input `{pin.name}` is not connected", "ST2103")
+                         f"input `{pin.name}` is not connected", codes.LADDER_MISSING_CONNECTION)
         terms = [self.source(e, c) for c in pin.conns]
         if any(t.text == TRUE for t in terms):
             return Txt(TRUE)
@@ -494,7 +499,8 @@ class RungCompiler:
     def comparison(self, e: Element, values: list[Txt], lab: str) -> Txt:
         """GT, GE, EQ, LT, LE, NE blocks are ST operators: ``IN1 > IN2 AND IN2 > IN3 ...``."""
         if len(values) < 2:
-            raise _error(lab, f"a {e.type_name.upper()} block needs at least two connected inputs", "ST2103")
+            raise _error(lab, f"a {e.type_name.upper()} block needs at least two connected inputs",
+                         codes.LADDER_MISSING_CONNECTION)
         op = COMPARE[e.type_name.upper()]
         terms = [("(" + a + f" {op} " + b + ")") for a, b in zip(values, values[1:])]
         out = terms[0]
@@ -549,11 +555,11 @@ class RungCompiler:
                       and self.consumers.get((e.id, p.name), 0)]
             if others:
                 raise _error(lab, f"output `{others[0].name}` of a function is wired; only the result of a "
-                                  "function can be wired in a ladder", "ST2107")
+                                  "function can be wired in a ladder", codes.LADDER_FUNCTION_WIRING)
             if result is not None:
                 if self.consumers.get((e.id, result.name), 0) > 1:
                     raise _error(lab, "the result of a function feeds several elements; write it to a variable "
-                                      "and read that variable where it is needed", "ST2107")
+                                      "and read that variable where it is needed", codes.LADDER_FUNCTION_WIRING)
                 call = (self.comparison(e, values, lab) if e.type_name.upper() in COMPARE
                         else (e.type_name + "(" + call_args + ")").marked(lab))
                 self.out[(e.id, result.name)] = ("NOT " + call) if result.negated else call

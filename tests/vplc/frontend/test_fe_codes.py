@@ -114,3 +114,8 @@ def test_lexer_and_parser_codes_come_from_their_failing_example(code):
     failing, fixed = FRONT_END[code]
     assert code in [d.code for d in parse_text(failing)[1]]
     assert code not in [d.code for d in parse_text(fixed)[1]]
+
+
+def test_no_module_writes_a_code_as_a_literal():
+    literals = {rel: sorted(set(LITERAL.findall(text))) for rel, text in sources() if LITERAL.search(text)}
+    assert literals == {}, "use the names of vplc.frontend.codes"
