@@ -87,3 +87,28 @@ def move_abs(**kw):
              ExitNode=False)
     p.update(kw)
     return p
+
+
+def run(rig, fb, exec_, param, values, seconds=5):
+    """Set the FB's parameter structure, raise its Execute, wait for Done or Error; the last script the robot got."""
+    rig.set_struct(param, values)
+    rig.write(exec_, True)
+    assert rig.until(lambda: rig.read(f"{fb}.Done") or rig.read(f"{fb}.Error"), seconds)
+    return rig.scripts_in()[-1][1] if rig.scripts_in() else None
+
+
+def rel(**kw):
+    """stCBT_MovRelParam values: a 20.5 mm line down in the base, 50 %, unless overridden."""
+    p = dict(MovementCommand=0, DataFormat=1, TargetPosition=dict(X=0, Y=0, Z=-20.5, RX=0, RY=0, RZ=0),
+             Speed=50, AccelTime=200, BlendingEnable=False, BlendingValue=0, PrecisePositioning=True, ExitNode=False)
+    p.update(kw)
+    return p
+
+
+def circ(**kw):
+    """stCBT_MovCircleParam values: an arc through two Cartesian points at 100 %, unless overridden."""
+    p = dict(DataFormat=1, ArcPoint=dict(X=417.5, Y=-72.3, Z=359.7, RX=180, RY=0, RZ=90),
+             EndPoint=dict(X=467.5, Y=-122.3, Z=359.7, RX=180, RY=0, RZ=90), Speed=100, AccelTime=200,
+             BlendingEnable=False, BlendingValue=0, ArcAngle=0, PrecisePositioning=False, ExitNode=False)
+    p.update(kw)
+    return p

@@ -7,8 +7,7 @@ import itertools
 
 import pytest
 
-from rig import Rig, move_abs
-from test_lib_commands import circ, rel
+from rig import Rig, circ, move_abs, rel
 
 FAR = dict(X=90, Y=0, Z=90, RX=0, RY=90, RZ=0)
 BACK = dict(X=-90, Y=0, Z=90, RX=0, RY=90, RZ=0)

@@ -2,29 +2,7 @@
 CBT_ReadActualPosition: normal end, script sent, parameter errors."""
 import pytest
 
-from rig import move_abs
-
-
-def run(rig, fb, exec_, param, values, seconds=5):
-    rig.set_struct(param, values)
-    rig.write(exec_, True)
-    assert rig.until(lambda: rig.read(f"{fb}.Done") or rig.read(f"{fb}.Error"), seconds)
-    return rig.scripts_in()[-1][1] if rig.scripts_in() else None
-
-
-def rel(**kw):
-    p = dict(MovementCommand=0, DataFormat=1, TargetPosition=dict(X=0, Y=0, Z=-20.5, RX=0, RY=0, RZ=0),
-             Speed=50, AccelTime=200, BlendingEnable=False, BlendingValue=0, PrecisePositioning=True, ExitNode=False)
-    p.update(kw)
-    return p
-
-
-def circ(**kw):
-    p = dict(DataFormat=1, ArcPoint=dict(X=417.5, Y=-72.3, Z=359.7, RX=180, RY=0, RZ=90),
-             EndPoint=dict(X=467.5, Y=-122.3, Z=359.7, RX=180, RY=0, RZ=90), Speed=100, AccelTime=200,
-             BlendingEnable=False, BlendingValue=0, ArcAngle=0, PrecisePositioning=False, ExitNode=False)
-    p.update(kw)
-    return p
+from rig import circ, move_abs, rel, run
 
 
 def test_move_relative_line_in_base_arrives(rig):

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from doc_steps import STEPS
 from rig import LIB, ROOT, SEC
 from tmsim.robot.camera import camera_of
 from tmsim.net.server import SimServer
@@ -17,31 +18,6 @@ from vplc.api import load_plc
 DOCS = ROOT / "docs" / "library"
 EXAMPLE = re.compile(r"^## Example\n```\n(.*?)```\n(.*?)(?=^## |\Z)", re.S | re.M)
 SCRIPT = re.compile(r"^- `(.*)`$", re.M)
-
-# page -> (BOOL inputs raised one after the other once connected, output that ends each step)
-STEPS = {
-    "CBT_Connect": [("ConnectSwitch", "RobotReady")],
-    "CBT_MoveAbsolute": [("MoveAbsExec", "fbMoveAbs.Done")],
-    "CBT_MoveRelative": [("MoveRelExec", "fbMoveRel.Done")],
-    "CBT_MoveCircle": [("MoveCircleExec", "fbMoveCircle.Done")],
-    "CBT_ChangeBase": [("ChangeBaseExec", "fbChangeBase.Done")],
-    "CBT_ChangeTCP": [("ChangeTCPExec", "fbChangeTCP.Done")],
-    "CBT_ProgramControl": [("PauseButton", "fbPause.Done"), ("ResumeButton", "fbResume.Done")],
-    "CBT_Stop": [("StopButton", "fbStop.Done")],
-    "CBT_SetOutput": [("CloseGripper", "fbGripper.Done")],
-    "CBT_ReadActualPosition": [(None, "fbReadPos.Valid")],
-    "CBT_RobotStatus": [(None, "fbStatus.Valid")],
-    "CBT_ProjectControl": [("PlayButton", "fbPlay.Done")],
-    "CBT_ReadIO": [(None, "fbIO.Valid")],
-    "CBT_SetOverride": [("SlowButton", "fbOverride.Done")],
-    "CBT_WaitQueue": [("MoveExec", "fbMove.Done"), ("SyncExec", "fbSync.Done")],
-    "CBT_ReadVariable": [("ReadExec", "fbRead.Done")],
-    "CBT_WriteVariable": [("WriteExec", "fbWrite.Done")],
-    "CBT_Jog": [("JogPlusButton", "fbJog.Active")],
-    "CBT_Teach": [("TeachButton", "fbTeach.Done")],
-    "CBT_VisionJob": [("CameraButton", "fbVision.Done"), ("PickButton", "fbApproach.Done")],
-}
-
 
 # the global variables of the robot's project that the pages' examples read and write (simulator: --svr-var)
 SVR_VARIABLES = ("g_PartCount:int=17", "g_Recipe:string=\"Flange\"", "g_Offset:float[3]={0.5,-1.25,0}")

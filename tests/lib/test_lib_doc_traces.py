@@ -6,8 +6,8 @@ import filecmp
 import importlib.util
 import re
 
+from doc_steps import STEPS
 from rig import ROOT
-from test_lib_doc_examples import STEPS
 
 DOCS = ROOT / "docs" / "library"
 

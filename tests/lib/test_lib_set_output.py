@@ -2,8 +2,7 @@
 motions, parameter errors, abort by CBT_Stop."""
 import pytest
 
-from rig import move_abs
-from test_lib_commands import run
+from rig import move_abs, run
 
 
 LONG_MOVE = move_abs(BlendingEnable=True, BlendingValue=0, Speed=20,
