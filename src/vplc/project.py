@@ -268,7 +268,7 @@ def check_configuration(ctx: Context, cfg: A.Configuration, unit) -> None:
             for prop in task.props:
                 want = {"INTERVAL": T.TIME, "PRIORITY": T.UINT, "SINGLE": T.BOOL}.get(prop.name)
                 if want is None:
-                    ctx.diags.error(codes.UNKNOWN_PARAMETER,
+                    ctx.diags.error(codes.UNKNOWN_TASK_PROPERTY,
                                     f"unknown task property `{prop.name}`; use INTERVAL, PRIORITY or SINGLE",
                                     prop.span)
                     continue

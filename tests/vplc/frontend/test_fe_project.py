@@ -154,6 +154,23 @@ def test_crlf_tabs_and_bom_render_with_the_caret_under_the_error(tmp_path):
     assert lines[2].index("^") == lines[1].index("y;")
 
 
+def test_an_unknown_task_property_has_its_own_code(tmp_path):
+    """ST1010, not ST1201: a task property is not a formal parameter of a call."""
+    proj = check_text(tmp_path, """
+        PROGRAM Main
+        END_PROGRAM
+        CONFIGURATION C
+            RESOURCE R ON PLC
+                TASK Fast(INTERVL := T#10ms, PRIORITY := 1);
+                PROGRAM P WITH Fast : Main;
+            END_RESOURCE
+        END_CONFIGURATION
+        """)
+    errors = [d for d in proj.diagnostics if d.is_error]
+    assert [d.code for d in errors] == ["ST1010"]
+    assert errors[0].message == "unknown task property `INTERVL`; use INTERVAL, PRIORITY or SINGLE"
+
+
 def test_program_instance_arguments_are_bound_to_program_inputs(tmp_path):
     proj = check_text(tmp_path, """
         PROGRAM Main
