@@ -15,31 +15,25 @@ import threading
 
 import pytest
 
-from fake_plc import FakePlc, command_program, scanning, serving
+from fake_plc import FakePlc, command_program, serving
 from hmi_http import Client
 from cbt_hmi.web import front
 from cbt_hmi.web import server as hmi_server
-from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer  # noqa: E402
 
 MOVE = {"execute": "MoveAbs_Execute", "values": {"MoveAbs_Param.TargetPosition.Z": 300.0}}
 
 
-@pytest.fixture(scope="module")
-def mapping():
-    return Mapping.load()
+@pytest.fixture
+def plc(fake_plc):
+    """The scanning fake PLC of conftest.py under this module's name for it."""
+    return fake_plc
 
 
 @pytest.fixture
-def plc(mapping):
-    with scanning(FakePlc(mapping, command_program)) as scanned:
-        yield scanned
-
-
-@pytest.fixture
-def hmi(plc, mapping):
-    with serving(plc, mapping) as server:
-        yield server
+def hmi(server):
+    """The HMI server of conftest.py (on the fake PLC above) under this module's name for it."""
+    return server
 
 
 @contextlib.contextmanager
