@@ -1,5 +1,6 @@
 """The shipped examples on the virtual PLC (virtual time) and a simulator robot with its Ethernet Slave, in one
-thread: the plant of the PnP end-to-end tests (test_pnp_states.py, test_recovery_e2e.py)."""
+thread: the plant of the example tests (test_example_programs.py) and of the PnP end-to-end tests
+(test_pnp_states.py, test_recovery_e2e.py)."""
 from __future__ import annotations
 
 import pathlib
@@ -43,6 +44,27 @@ class Plant:
     def run_for(self, seconds):
         end = self.plc.now_ns + int(seconds * SECOND)
         self.until(lambda: self.plc.now_ns >= end, f"{seconds} s to pass", seconds + 1)
+
+    def scripts(self, since: int = 0) -> list[str]:
+        """Script lines the robot executed, without the position polling of CBT_ReadActualPosition."""
+        return [e["text"] for e in self.robot.events[since:]
+                if e["kind"] == "script_line" and not e["text"].startswith("ListenSend(")]
+
+    def connect(self):
+        self.plc.write("Connect_Execute", True)
+        self.until(lambda: self.read("Connect_Connected"), "the connection")
+
+    def command(self, group: str, seconds: float = 15) -> list[str]:
+        """Rising edge on <group>_Execute, wait for Done (or fail on Error); return the scripts it sent."""
+        since = len(self.robot.events)
+        self.plc.write(f"{group}_Execute", False)
+        self.run_for(0.002)
+        self.plc.write(f"{group}_Execute", True)
+        self.until(lambda: self.read(f"{group}_Done") or self.read(f"{group}_Error"), f"{group} to finish",
+                   seconds)
+        assert not self.read(f"{group}_Error"), self.read(f"{group}_ErrorDescrip")
+        self.plc.write(f"{group}_Execute", False)
+        return self.scripts(since)
 
     def pulse(self, name, done, what):
         """A rising edge of ``name``, held until ``done``, then released."""

@@ -3,73 +3,16 @@
 Pause/Resume and clean end (stop, fault and recovery of the PnP cycle: test_pnp_states.py)."""
 from __future__ import annotations
 
-import pathlib
-
 import pytest
 
-from tmsim.net.server import SimServer
-from vplc.api import load_plc
+from pnp_plant import SECOND, SOURCES, Plant
 from cbt_hmi.web.mapping import Mapping
 from vplc.project import load_project
-
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
-SECOND = 1_000_000_000
-
-
-class Rig:
-    """PLC + simulator in one thread; the simulator is polled before every scan at the PLC's time."""
-
-    def __init__(self):
-        self.sim = SimServer(port=0, robots=1, svr_port=0)
-        self.sim.start()
-        self.robot = self.sim.robots[0]
-        self.plc = load_plc(SOURCES)
-        self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
-        self.plc.write("Connect_SvrPort", self.robot.svr_port)
-        self.plc.write("Connect_AddressIP", "127.0.0.1")
-
-    def close(self):
-        self.plc.close()
-        self.sim.close()
-
-    def until(self, predicate, what: str, seconds: float = 10) -> None:
-        ok = self.plc.run_until(predicate, timeout_ns=int(seconds * SECOND),
-                                on_scan=lambda now_ns: self.sim.poll(now_ns / 1e9))
-        assert ok, f"{what} did not happen within {seconds} s of PLC time"
-
-    def run_for(self, seconds: float) -> None:
-        end = self.plc.now_ns + int(seconds * SECOND)
-        self.until(lambda: self.plc.now_ns >= end, f"{seconds} s to pass", seconds + 1)
-
-    def read(self, name):
-        return self.plc.read(name)
-
-    def scripts(self, since: int = 0) -> list[str]:
-        """Script lines the robot executed, without the position polling of CBT_ReadActualPosition."""
-        return [e["text"] for e in self.robot.events[since:]
-                if e["kind"] == "script_line" and not e["text"].startswith("ListenSend(")]
-
-    def connect(self):
-        self.plc.write("Connect_Execute", True)
-        self.until(lambda: self.read("Connect_Connected"), "the connection")
-
-    def command(self, group: str, seconds: float = 15) -> list[str]:
-        """Rising edge on <group>_Execute, wait for Done (or fail on Error); return the scripts it sent."""
-        since = len(self.robot.events)
-        self.plc.write(f"{group}_Execute", False)
-        self.run_for(0.002)
-        self.plc.write(f"{group}_Execute", True)
-        self.until(lambda: self.read(f"{group}_Done") or self.read(f"{group}_Error"), f"{group} to finish",
-                   seconds)
-        assert not self.read(f"{group}_Error"), self.read(f"{group}_ErrorDescrip")
-        self.plc.write(f"{group}_Execute", False)
-        return self.scripts(since)
 
 
 @pytest.fixture
 def rig():
-    r = Rig()
+    r = Plant()
     yield r
     r.close()
 
