@@ -20,8 +20,8 @@ HMI_STOP_HOLD_S = 1.5            # the HMI's Stop Motion page releases Stop 1.5 
 class Plant:
     """The examples on the virtual PLC and a simulator robot with its Ethernet Slave, one thread."""
 
-    def __init__(self):
-        self.sim = SimServer(port=0, robots=1, svr_port=0)
+    def __init__(self, **sim_args):
+        self.sim = SimServer(port=0, robots=1, svr_port=0, **sim_args)
         self.sim.start()
         self.robot = self.sim.robots[0]
         self.plc = load_plc(SOURCES)

@@ -4,29 +4,20 @@ by itself when the beat stops (a browser or network that died with the button he
 position into the examples' TeachTable."""
 from __future__ import annotations
 
-import pathlib
-
 import pytest
 
-from tmsim.net.server import SimServer
-from vplc.api import load_plc
+from pnp_plant import Plant
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
 SEC = 1_000_000_000
 BEAT_S = 0.05                       # the panel counts Jog_Beat up with every poll while a button is held
 WATCHDOG_S = 0.3                    # JogTeach_Example: BeatAge PT
 
 
-class Cell:
+class Cell(Plant):
+    """The examples' plant, the robot in its Listen node from the start, connected with a valid position."""
+
     def __init__(self):
-        self.sim = SimServer(port=0, robots=1, svr_port=0, auto_enter=True)
-        self.sim.start()
-        self.robot = self.sim.robots[0]
-        self.plc = load_plc(SOURCES)
-        self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
-        self.plc.write("Connect_SvrPort", self.robot.svr_port)
-        self.plc.write("Connect_AddressIP", "127.0.0.1")
+        super().__init__(auto_enter=True)
         self.plc.write("Connect_Execute", True)
         assert self.run(lambda: self.plc.read("Connect_Connected") and self.plc.read("ReadPos_Valid"), 5)
 
@@ -42,13 +33,6 @@ class Cell:
                 self.plc.write("Jog_Beat", self.plc.read("Jog_Beat") + 1)
                 next_beat[0] += BEAT_S
         return self.plc.run_until(pred, timeout_ns=int(seconds * SEC), on_scan=hook)
-
-    def events(self, kind):
-        return [e for e in self.robot.events if e["kind"] == kind]
-
-    def close(self):
-        self.plc.close()
-        self.sim.close()
 
 
 @pytest.fixture
