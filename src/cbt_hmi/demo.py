@@ -1,7 +1,7 @@
 """`make demo`: robot simulator + virtual PLC running the examples in real time + web HMI, stopped by Ctrl-C.
 
     cbt-demo [--host 127.0.0.1] [--robot-port 5890] [--svr-port 5891] [--hmi-port 8080] [--control-port 5889]
-             [--alarm-log FILE] [--project DIR]
+             [--alarm-log FILE] [--project DIR] [--pages DIR]
 
 Also `python3 -m cbt_hmi` and, from a checkout, `python3 examples/run_demo.py` (the launcher kept for existing
 users). The demo runs the library and the examples of a project folder: --project, else the current folder when
@@ -21,6 +21,7 @@ import threading
 from tmsim.net.control import robot_numbering
 from tmsim.net.server import SimServer
 from cbt_hmi.web.mapping import Mapping, MappingError
+from cbt_hmi.web.pagedesc import load_pages, program_table
 from cbt_hmi.web.server import HmiServer
 
 LIBRARY, EXAMPLES = pathlib.Path("lib", "CBT_Commands_Lib"), pathlib.Path("examples")
@@ -170,14 +171,45 @@ def parse_args(argv):
     parser.add_argument("--project", metavar="DIR", default=None,
                         help="folder holding lib/CBT_Commands_Lib and examples/ (default: the current folder, else "
                              "the checkout this program is installed from)")
+    parser.add_argument("--pages", metavar="DIR", default=None,
+                        help="folder of page description files (*.json) over the demo program's global variables: "
+                             "their pages show on Main next to the shipped ones (docs/hmi.md, \"Pages for your own "
+                             "program\")")
     return parser.parse_args(argv)
+
+
+def with_user_pages(mapping: Mapping, plc, directory: str) -> tuple[Mapping, list[str]]:
+    """The shipped variable table plus the pages described in ``directory`` (cbt_hmi.web.pagedesc) and the
+    variables they use; one error text per page left out. A page may show any global variable, but writes (inputs,
+    command) only variables the shipped table does not hold: the shipped pages keep their limits and roles."""
+    folder = pathlib.Path(directory)
+    if not folder.is_dir():
+        raise DemoError(f"error: --pages {directory}: not a folder of page description files")
+    pages, errors = load_pages(folder, plc)
+    table = program_table(plc, pages)           # also gives each item the variable's declared spelling
+    shipped = mapping.document
+    variables, kept = dict(shipped["variables"]), {}
+    for name, page in pages.items():
+        written = [item["variable"] for item in page["inputs"] + ([page["command"]] if page["command"] else [])]
+        taken = [variable for variable in written if variable in shipped["variables"]]
+        if taken:
+            errors.append(f"{folder / (name + '.json')}: '{taken[0]}' belongs to the shipped pages: a page of your "
+                          "own may show it under 'status', not write it")
+            continue
+        kept[name] = page
+        for item in page["inputs"] + page["status"] + ([page["command"]] if page["command"] else []):
+            variables.setdefault(item["variable"], table["variables"][item["variable"]])
+    document = {**shipped, "variables": variables, "pages": [*shipped.get("pages", ["index"]), *kept],
+                "custom_pages": kept}
+    return Mapping(document, f"{mapping.source} + {folder}"), errors
 
 
 class Demo:
     def __init__(self, host: str, robot_port: int, hmi_port: int, svr_port: int | None = None,
                  control_port: int | None = None, project: pathlib.Path | None = None,
-                 alarm_log: str | None = None):
+                 alarm_log: str | None = None, pages: str | None = None):
         self.project, self.alarm_log = project, alarm_log
+        self.pages, self.page_errors = pages, []     # --pages: the user's page descriptions, the ones left out
         self.host, self.robot_port, self.hmi_port = host, robot_port, hmi_port
         self.svr_port = svr_port or (robot_port + 1 if robot_port < 65535 else robot_port - 1)
         self.control_port = control_port          # None: derived from the robot port at start
@@ -215,6 +247,8 @@ class Demo:
         except LoadError as exc:
             raise DemoError(f"error: the example programs do not compile:\n{exc}") from None
         try:
+            if self.pages is not None:
+                mapping, self.page_errors = with_user_pages(mapping, self.plc, self.pages)
             mapping.check_against_plc(self.plc)
         except MappingError as exc:
             raise DemoError(f"error: {exc}") from None
@@ -269,6 +303,8 @@ class Demo:
             "   (also robot address, base, tool, outputs)",
             "The keys are new at every start; keep them to the people who may move the robot.",
             "The Program (Ladder) page shows Commands_Example's rungs live.",
+            *([f"Your pages from {self.pages}: {', '.join(self.hmi.mapping.document['custom_pages']) or 'none'} "
+               "(tiles under \"Your cell\" on Main)."] if self.pages is not None else []),
             "Robot-side events (robot error, project stopped, Listen node left) are printed below as they happen.",
             "Stop the robot's project from another terminal (then press Play on the main page):",
             f"  {control_line(self.sim.control.port)}",
@@ -316,13 +352,16 @@ def main(argv=None) -> int:
     except DemoError as exc:
         print(exc, file=sys.stderr)
         return 2
-    demo = Demo(args.host, args.robot_port, args.hmi_port, args.svr_port, args.control_port, project, args.alarm_log)
+    demo = Demo(args.host, args.robot_port, args.hmi_port, args.svr_port, args.control_port, project, args.alarm_log,
+                args.pages)
     signal.signal(signal.SIGTERM, lambda *_: demo.stop_event.set())
     try:
         demo.start()
         # From here Ctrl-C only sets the stop event: a KeyboardInterrupt raised inside Event.wait can leave its
         # lock held, and the shutdown would then wait on it for ever
         signal.signal(signal.SIGINT, lambda *_: demo.stop_event.set())
+        for error in demo.page_errors:             # a bad page description: left out, the others are served
+            print(f"error: {error}", file=sys.stderr, flush=True)
         print(demo.banner(), flush=True)
         while not demo.stop_event.wait(0.5):
             for line in demo.console_lines():

@@ -56,12 +56,14 @@ def test_port_outside_the_tcp_range_is_refused():
     assert result.returncode == 2 and "70000 is not a TCP port (1..65535)" in result.stderr
 
 
-def start_demo(robot_port: int, hmi_port: int, svr_port: int, control_port: int):
-    """The demo as `make demo` starts it; returns (process, banner text, queue of further stdout lines)."""
+def start_demo(robot_port: int, hmi_port: int, svr_port: int, control_port: int, *extra: str):
+    """The demo as `make demo` starts it (``extra``: further options); returns (process, banner text, queue of
+    further stdout lines)."""
     import queue
     import threading
     demo = subprocess.Popen([sys.executable, str(DEMO), "--robot-port", str(robot_port), "--hmi-port",
-                             str(hmi_port), "--svr-port", str(svr_port), "--control-port", str(control_port)],
+                             str(hmi_port), "--svr-port", str(svr_port), "--control-port", str(control_port),
+                             *extra],
                             stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, cwd=ROOT)
     lines: queue.Queue = queue.Queue()
@@ -207,3 +209,56 @@ def test_robot_side_events_print_one_console_line_each():
                      "flow entered the Listen node", "stick button Stop pressed through the Ethernet Slave",
                      "project stopped"]
     assert all(line.startswith("[") and "] robot 1: " in line for line in lines)
+
+
+CELL_PAGE = """{
+  "title": "Gripper Cell",
+  "status": [
+    {"variable": "PnP_GripperClosed", "label": "Gripper closed"},
+    {"variable": "PnP_CycleCount", "label": "Cycles done"}
+  ]
+}
+"""
+
+
+def test_demo_serves_the_users_page_descriptions_next_to_the_shipped_pages(tmp_path):
+    """--pages DIR: the good page is served (Main lists it, its address answers, its values are read); a page with
+    an unknown variable and one writing a variable of the shipped pages are named with file and line, and left
+    out; the demo runs on."""
+    import json
+    import urllib.request
+    (tmp_path / "gripper.json").write_text(CELL_PAGE)
+    (tmp_path / "typo.json").write_text('{"title": "Typo",\n "status": [{"variable": "PnP_CycleCont", '
+                                        '"label": "Cycles"}]}\n')
+    (tmp_path / "taken.json").write_text('{"title": "Taken", "command": {"variable": "Connect_Execute", '
+                                         '"label": "Connect"}}\n')
+    ports = []
+    while len(ports) < 4:
+        port = free_port()
+        if port not in ports:
+            ports.append(port)
+    demo, text, lines = start_demo(*ports, "--pages", str(tmp_path))
+    hmi = f"http://127.0.0.1:{ports[1]}"
+    try:
+        assert f"Your pages from {tmp_path}: gripper" in text, text
+        with urllib.request.urlopen(hmi + "/api/mapping", timeout=5) as r:
+            table = json.loads(r.read())
+        assert list(table["custom_pages"]) == ["gripper"]
+        assert {"gripper", "pnp", "stop"} <= set(table["pages"])
+        with urllib.request.urlopen(hmi + "/gripper.html", timeout=5) as r:
+            assert r.status == 200
+        with urllib.request.urlopen(hmi + "/api/read?names=PnP_CycleCount,PnP_GripperClosed", timeout=5) as r:
+            assert json.loads(r.read())["ok"] is True
+    finally:
+        out, err = stop_demo(demo, lines)
+    assert demo.returncode == 0, (out, err)
+    assert f"error: {tmp_path / 'typo.json'}:2: unknown variable 'PnP_CycleCont'" in err, err
+    assert f"error: {tmp_path / 'taken.json'}: 'Connect_Execute' belongs to the shipped pages" in err, err
+    assert "Traceback" not in err
+
+
+def test_demo_pages_option_names_a_missing_folder():
+    result = run_demo("--pages", "no/such/folder")
+    assert result.returncode == 2
+    assert "error: --pages no/such/folder: not a folder of page description files" in result.stderr
+    assert "Traceback" not in result.stderr

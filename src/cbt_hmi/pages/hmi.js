@@ -448,14 +448,25 @@ function mainPage() {
     <div class="area"><h2>Motion</h2><div class="tiles">
       <a href="moverel.html" id="nav-moverel">Move Relative</a><a href="moveabs.html" id="nav-moveabs">Move Absolute</a>
       <a href="movecircle.html" id="nav-movecircle">Move Circle</a><a href="pnp.html" id="nav-pnp">PnP Sequence</a>
-      <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>
+      <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>${cellArea()}
     </div><div class="viewcol"><div id="robotview"></div>${robotStatusStrip()}</div>`;
+  for (const [key, page] of Object.entries(MAP.custom_pages || {})) {
+    document.getElementById(`nav-${key}`).textContent = page.title;     // the user's text, never as HTML
+  }
   robotView(document.getElementById("robotview"));
   robotTile(document.getElementById("robotview"));
   document.querySelector("header h1").insertAdjacentHTML("afterend",
     '<a class="menu" id="nav-jog" href="jog.html">Jog / Teach</a>' +
     '<a class="menu" id="nav-program" href="program.html">Ladder</a>');
   startPolling(["Connect_Connected", "ReadPos_Valid", "ReadPos_Position", ...ROBOT_STATUS, ...ROBOT_TILE_VARS]);
+}
+
+/* make demo --pages: the pages described for the user's cell (custom.js), one tile each beside the shipped ones */
+function cellArea() {
+  const pages = Object.entries(MAP.custom_pages || {});
+  if (!pages.length) return "";
+  const tile = ([key, page]) => `<a href="${key}.html" id="nav-${key}"></a>`;
+  return `<div class="area" id="cell-area"><h2>Your cell</h2><div class="tiles">${pages.map(tile).join("")}</div></div>`;
 }
 
 /* the robot's state on every page: In Listen node, Paused, Stopping, queue depth, last ErrorID */
