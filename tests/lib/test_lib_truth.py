@@ -227,7 +227,7 @@ def delay_data_tables(rig, hold):
     original = slave._flush
 
     def flush(robot):
-        if hold(rig.srv._now):
+        if hold(rig.srv.now):
             return
         for client in robot.svr.clients.values():
             rest, client.outbox = client.outbox[1:], client.outbox[:1]
