@@ -12,8 +12,8 @@ Failing::
 """
 from __future__ import annotations
 
-from .consteval import const_int
 from ..frontend import codes
+from .consteval import const_int
 
 
 def check(ck, e, array_type) -> None:

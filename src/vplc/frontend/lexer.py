@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import re
 
+from . import codes
 from .diagnostics import DiagnosticBag
 from .source import SourceFile, Span
-from . import codes
 
 _DURATION = r"[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]+)?(?i:ms|us|ns|d|h|m|s)_?)++"
 _CLOCK = r"[0-9]+:[0-9]+(?::[0-9]+(?:\.[0-9]+)?)?"

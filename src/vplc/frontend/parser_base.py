@@ -1,10 +1,10 @@
 """Token cursor, error reporting and recovery shared by the parser modules."""
 from __future__ import annotations
 
+from . import codes
 from .diagnostics import DiagnosticBag
 from .lexer import Token
 from .source import SourceFile, Span
-from . import codes
 
 # Words that can never be identifiers (IEC 61131-3 keywords the parser relies on).
 RESERVED = frozenset("""

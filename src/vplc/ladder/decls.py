@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .model import LadderBody
 from ..frontend import codes
+from .model import LadderBody
 
 
 @dataclass

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from ..frontend import codes
 from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit
 from .model import EDGES, STORAGES, Conn, Element, LadderBody, Pin, Rung
 from .xmlsafe import text_of
-from ..frontend import codes
 
 POU_KINDS = {"program": "PROGRAM", "functionBlock": "FUNCTION_BLOCK", "function": "FUNCTION"}
 VAR_LISTS = {"inputVars": "VAR_INPUT", "outputVars": "VAR_OUTPUT", "inOutVars": "VAR_IN_OUT",

@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import heapq
 
+from ..frontend import codes
 from ..frontend.source import SourceFile
 from .decls import FormatError, PouText, SectionText, XmlUnit
 from .model import Conn, Element, LadderBody, Pin, Rung
-from ..frontend import codes
 
 TRUE = "TRUE"
 SERIES_MARKS = 128        # marked ranges in one series expression before a helper variable carries its power on
