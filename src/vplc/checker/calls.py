@@ -20,6 +20,7 @@ from ..frontend import builtins as B
 from ..frontend import codes
 from ..frontend import types as T
 from . import array_bounds, assign_target
+from .compatibility import compatible
 from .scope import Ambiguous, is_generic
 from .symbols import BoundArg, BuiltinSymbol, CallBinding, PouSymbol, VarSymbol
 
@@ -182,7 +183,7 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
         have = ck.expr(value)
         if not is_lvalue(value):
             ctx.diags.error(codes.NOT_A_VARIABLE, f"the output `{p.name}` must be read into a variable", value.span)
-        elif not T.is_error(have) and not _compatible(p.type, have) and not (
+        elif not T.is_error(have) and not compatible(p.type, have) and not (
                 ctx.dialect == "sysmac" and T.sysmac_assignable(p.type, have)):
             ctx.diags.error(codes.ARGUMENT_TYPE,
                             f"{what}: output of type {p.type.name} cannot be stored in `{ck.text(value)}` "
@@ -194,7 +195,7 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
     if isinstance(pty, T.ArrayType) and isinstance(value, A.Index) and not isinstance(T.unalias(have), T.ArrayType) \
             and not T.is_error(have):
         if (is_generic(pty.element) and pty.element.accepts(have)) or (
-                _compatible(have, pty.element) and T.same_type(T.base_of(have), T.base_of(pty.element))):
+                compatible(have, pty.element) and T.same_type(T.base_of(have), T.base_of(pty.element))):
             ba.from_element = True
             array_bounds.check_slice(ck, value, pty, p.name)
             if p.direction == "inout":
@@ -219,11 +220,6 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
     return ba
 
 
-def _compatible(src, dst) -> bool:
-    from .exprs import compatible
-    return compatible(src, dst)
-
-
 def _inout_compatible(have: T.Type, want: T.Type) -> bool:
     if is_generic(want):
         return want.accepts(have)
@@ -233,7 +229,7 @@ def _inout_compatible(have: T.Type, want: T.Type) -> bool:
     if isinstance(h, T.ArrayType) and isinstance(w, T.ArrayType):
         if is_generic(w.element):       # ARRAY[*] OF ANY: Sysmac's array instructions (W502 AryMove, SizeOfAry)
             return w.open and w.element.accepts(h.element)
-        return _compatible(h, w) and T.same_type(T.base_of(h.element), T.base_of(w.element))
+        return compatible(h, w) and T.same_type(T.base_of(h.element), T.base_of(w.element))
     return T.same_type(h, w)
 
 

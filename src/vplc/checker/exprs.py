@@ -8,6 +8,7 @@ from ..frontend import builtins as B
 from ..frontend import codes
 from ..frontend import types as T
 from . import array_bounds, calls, undeclared
+from .compatibility import compatible
 from .scope import Ambiguous, is_generic
 from .symbols import EnumValueSymbol, PouSymbol, VarSymbol
 
@@ -26,24 +27,6 @@ def is_untyped_literal(e: A.Expr) -> bool:
 
 def lit_string_type(value: str, wide: bool) -> T.StringType:
     return T.StringType(max(1, len(value)), wide, capacity=len(value), explicit=False)
-
-
-def compatible(src: T.Type, dst: T.Type) -> bool:
-    """May a value of ``src`` be stored in ``dst`` (assignment / input argument)?"""
-    if T.is_error(src) or T.is_error(dst):
-        return True
-    if is_generic(dst):
-        return dst.accepts(src)
-    if T.widens_to(src, dst) or T.same_type(src, dst):
-        return True
-    s, d = T.unalias(src), T.unalias(dst)
-    if isinstance(d, T.SubrangeType):
-        return T.widens_to(s, d.base) or T.same_type(s, d.base)
-    if isinstance(s, T.ArrayType) and isinstance(d, T.ArrayType):
-        if len(s.dims) != len(d.dims) or not compatible(s.element, d.element):
-            return False
-        return d.open or all((sh - sl) == (dh - dl) for (sl, sh), (dl, dh) in zip(s.dims, d.dims))
-    return False
 
 
 class ExprChecker:
