@@ -3,6 +3,10 @@ from __future__ import annotations
 
 import pytest
 
+from vplc.frontend import codes
+from vplc.frontend.diagnostics import DiagnosticBag
+from vplc.project import read_source
+
 
 def _write(tmp_path, name, data):
     p = tmp_path / name
@@ -44,3 +48,12 @@ def test_one_million_character_line_of_valid_code_checks(tmp_path, run_cli):
     path = _write(tmp_path, "wide.st", "PROGRAM P VAR x : INT; END_VAR x := 1;" + " " * 1_000_000 + "x := x; END_PROGRAM")
     result = run_cli("check", path)
     assert result.returncode == 0, result.stdout
+
+
+def test_a_path_that_cannot_be_read_gives_st0005(tmp_path):
+    """A directory handed to the reader as a file: the OS refuses to read it; an error, not a traceback."""
+    diags = DiagnosticBag()
+    assert read_source(str(tmp_path), diags) is None
+    [d] = diags.items
+    assert d.code == codes.FILE_UNREADABLE == "ST0005" and d.is_error
+    assert d.message.startswith("cannot read `") and "`: " in d.message   # then the OS's reason
