@@ -303,8 +303,8 @@ class Demo:
             "   (also robot address, base, tool, outputs)",
             "The keys are new at every start; keep them to the people who may move the robot.",
             "The Program (Ladder) page shows Commands_Example's rungs live.",
-            *([f"Your pages from {self.pages}: {', '.join(self.hmi.mapping.document['custom_pages']) or 'none'} "
-               "(tiles under \"Your cell\" on Main)."] if self.pages is not None else []),
+            *([(f"Your pages from {self.pages}: {', '.join(self.hmi.mapping.document['custom_pages']) or 'none'} "
+                "(tiles under \"Your cell\" on Main).")] if self.pages is not None else []),
             "Robot-side events (robot error, project stopped, Listen node left) are printed below as they happen.",
             "Stop the robot's project from another terminal (then press Play on the main page):",
             f"  {control_line(self.sim.control.port)}",

@@ -239,8 +239,8 @@ def test_stop_page_stops_a_running_move_and_aborts_it(connected):
     browser.wait_for(lambda d: "Done – the robot stopped" in browser.message(), "Done on the message line")
     assert browser.status("Stop_Done") == "true"                 # held long enough to be seen
     assert [e["command"] for e in connected.events("priority", since)] == ["StopAndClearBuffer(0)"]
-    browser.wait_for(lambda d: browser.message() == "Stop Immediately: Done – the robot stopped and its queue is cleared.",
-                     "the push button to release")
+    released = "Stop Immediately: Done – the robot stopped and its queue is cleared."
+    browser.wait_for(lambda d: browser.message() == released, "the push button to release")
     assert connected.read("Stop_Execute") is False and connected.read("Cobot.Stopping") is False
     browser.screenshot("e2e_stop_done")
     connected.wait(lambda: connected.read("MoveAbs_CommandAborted"), "the move to be aborted")
