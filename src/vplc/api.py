@@ -19,6 +19,7 @@ from .compiler.codegen import CodeGen
 from .runtime import abi
 from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
+from .runtime.program import program_key
 from .runtime.values import PathError, Resolver, parse_duration
 
 __all__ = ["load_plc", "compile_program", "LoadError", "PlcFault", "Plc", "LadderProgram", "integer_ranges"]
@@ -185,66 +186,66 @@ class Plc:
         return ctl
 
     # ---- tasks --------------------------------------------------------------------------------
-    def _program(self, name: str):
-        pt = self.project.lookup_pou(name)
-        if pt is None or pt.kind != "program":
+    # The compiled program carries its task table and its PROGRAMs by name (runtime/program.py): setting up the
+    # tasks reads no syntax tree and finds every POU by its key.
+    def _program(self, name: str) -> str:
+        key = self.program.program_names.get(program_key(name))
+        if key is None:
             raise LoadError(f"error: no PROGRAM named `{name}` in the loaded sources")
-        return pt
+        return key
 
-    def _instance(self, inst_name: str, pt):
-        key = self.project.pous and next(k for k, v in self.project.pous.items() if v is pt)
+    def _instance(self, inst_name: str, key: str):
         inst = self.module.classes[key](inst_name)
         self.instances[inst_name.upper()] = inst
         return inst, self.module.bodies[key]
 
     def _setup_tasks(self, task, programs) -> None:
-        configs = self.project.configurations
-        if configs:
+        program = self.program
+        if program.configured:
             wanted = {p.upper() for p in programs or ()}      # --program: instance or PROGRAM type names
             found: set[str] = set()
-            for cfg in configs:
-                for res in cfg.resources:
-                    by_name = {}
-                    for td in res.tasks:
-                        props = {p.name.upper(): p.value for p in td.props}
-                        iv = props.get("INTERVAL")
-                        pr = props.get("PRIORITY")
-                        t = Task(td.name, int(iv.value) if iv is not None else 10_000_000,
-                                 int(pr.value) if pr is not None else 0)
-                        by_name[td.name.upper()] = t
-                        self.engine.tasks.append(t)
-                    for pi in res.programs:
-                        if programs and not {pi.name.upper(), pi.program.text().upper()} & wanted:
-                            continue
-                        found.update({pi.name.upper(), pi.program.text().upper()} & wanted)
-                        t = by_name.get((pi.task or "").upper())
-                        if t is None:
-                            if not self.engine.tasks:
-                                self.engine.tasks.append(Task("Default", 10_000_000, 0))
-                            t = self.engine.tasks[0]
-                        t.programs.append(self._instance(pi.name, self._program(pi.program.text())))
+            for task_specs, instance_specs in program.resources:
+                by_name = {}
+                for spec in task_specs:
+                    t = Task(spec.name, spec.period_ns, spec.priority)
+                    by_name[spec.name.upper()] = t
+                    self.engine.tasks.append(t)
+                for pi in instance_specs:
+                    names = {pi.name.upper(), pi.type_text.upper()}
+                    if programs and not names & wanted:
+                        continue
+                    found.update(names & wanted)
+                    t = by_name.get(pi.task)
+                    if t is None:
+                        if not self.engine.tasks:
+                            self.engine.tasks.append(Task("Default", 10_000_000, 0))
+                        t = self.engine.tasks[0]
+                    if pi.key is None:
+                        raise LoadError(f"error: no PROGRAM named `{pi.type_text}` in the loaded sources")
+                    t.programs.append(self._instance(pi.name, pi.key))
             missing = [p for p in programs or () if p.upper() not in found]
             if missing:
                 raise LoadError(f"error: the CONFIGURATION runs no PROGRAM named `{missing[0]}` (give a program "
                                 f"instance or PROGRAM type that one of its tasks runs)")
         else:
             t = Task(*parse_task(task), 0)
-            pts = [self._program(p) for p in programs] if programs else list(self.project.programs)
-            if not pts:
+            keys = [self._program(p) for p in programs] if programs else list(program.programs)
+            if not keys:
                 raise LoadError("error: the sources contain no PROGRAM to run")
-            for pt in pts:
-                t.programs.append(self._instance(pt.name, pt))
+            for key in keys:
+                t.programs.append(self._instance(program.pous[key].pou.name, key))
             self.engine.tasks.append(t)
         self.engine.tasks.sort(key=lambda t: t.priority)
         scheduled: dict[str, list[str]] = {}        # PROGRAM type -> names of its instances in the tasks
         for task in self.engine.tasks:
             for inst, _body in task.programs:
                 scheduled.setdefault(inst.i__type.name.upper(), []).append(inst.i__path)
-        for pt in self.project.programs:            # programs called from other programs need an instance
-            if pt.name.upper() not in self.instances:
-                self._instance(pt.name, pt)
-                if pt.name.upper() in scheduled:    # reading it by the type name is a mistake: say so
-                    self.type_named_instances[pt.name.upper()] = scheduled[pt.name.upper()]
+        for key in program.programs:                # programs called from other programs need an instance
+            name = program.pous[key].pou.name
+            if name.upper() not in self.instances:
+                self._instance(name, key)
+                if name.upper() in scheduled:       # reading it by the type name is a mistake: say so
+                    self.type_named_instances[name.upper()] = scheduled[name.upper()]
 
     # ---- Contract A -----------------------------------------------------------------------------
     @property

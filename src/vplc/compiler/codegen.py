@@ -15,7 +15,7 @@ from ..frontend import types as T
 from .codegen_expr import ExprGen, attr, cut, is_scalar
 from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop_range, unguarded
 from ..runtime import abi
-from ..runtime.program import GEN_FILE, PouClass, Program
+from ..runtime.program import GEN_FILE, InstanceSpec, PouClass, Program, TaskSpec, program_key
 from ..runtime.sysmac_fns import KEEPS_OUT_ON_ERROR
 
 BULK_CELLS = 1024         # a statement copying a structured value this large checks the watchdog after it
@@ -75,7 +75,32 @@ class CodeGen(ExprGen):
         for t, name in self.struct_names.values():
             prog.structs.append((name, {k.upper(): (attr(f.name), f.type) for k, f in t.fields.items()}, t))
         prog.globals_vars = {s.name.upper(): (attr(s.name), s.type) for s in proj.globals.values()}
+        self.task_tables(prog)
         return prog
+
+    def task_tables(self, prog: Program) -> None:
+        """What a PLC instance needs to set up its tasks, so that loading one reads no syntax tree: the user's
+        PROGRAMs, every name a user may give one by (resolved as the project's namespaces resolve it), and the
+        TASKs and program instances of every RESOURCE of the CONFIGURATION."""
+        proj = self.proj
+        keys = {id(pt): key for key, pt in proj.pous.items()}
+        prog.programs = tuple(keys[id(pt)] for pt in proj.programs)
+        for key in proj.pous:
+            for text in (key, key.rsplit("\\", 1)[-1]):
+                pt = proj.lookup_pou(text)
+                if pt is not None and pt.kind == "program":
+                    prog.program_names[program_key(text)] = keys[id(pt)]
+        prog.configured = bool(proj.configurations)
+        resources = []
+        for cfg in proj.configurations:
+            for res in cfg.resources:
+                tasks = tuple(TaskSpec(td.name, _task_number(td, "INTERVAL", 10_000_000),
+                                       _task_number(td, "PRIORITY", 0)) for td in res.tasks)
+                insts = tuple(InstanceSpec(pi.name, pi.program.text(),
+                                           prog.program_names.get(program_key(pi.program.text())),
+                                           (pi.task or "").upper()) for pi in res.programs)
+                resources.append((tasks, insts))
+        prog.resources = tuple(resources)
 
     def all_struct_types(self):
         seen = {}
@@ -646,3 +671,14 @@ class CodeGen(ExprGen):
             if ba.negated:
                 code = f"(not {code})"
             self.store(ba.expr, code, None, src_type=ba.param.type)
+
+
+def _task_number(td, prop: str, default: int) -> int:
+    """INTERVAL (ns) or PRIORITY of a TASK declaration: a literal, or ``default`` when it is not given."""
+    expr = {p.name.upper(): p.value for p in td.props}.get(prop)      # the last one given counts
+    if expr is None:
+        return default
+    try:
+        return int(expr.value)
+    except (AttributeError, TypeError, ValueError):
+        raise NotImplementedError(f"TASK {td.name}: {prop} must be a literal") from None

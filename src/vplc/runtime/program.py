@@ -17,7 +17,7 @@ from types import CodeType
 from . import abi, iec, natives, stdlib, sysmac_fns
 from .faults import GEN_FILE, RuntimeFaultError, WatchdogError
 
-__all__ = ["GEN_FILE", "HELPERS", "Image", "PouClass", "Program"]
+__all__ = ["GEN_FILE", "HELPERS", "Image", "InstanceSpec", "PouClass", "Program", "TaskSpec", "program_key"]
 
 
 def make_watchdog(deadline: list, probation: list, limit_s: list):
@@ -60,6 +60,28 @@ class PouClass:
     native: bool = False
 
 
+@dataclass(frozen=True)
+class TaskSpec:
+    """A TASK of the CONFIGURATION: what the scan loop needs of it."""
+    name: str
+    period_ns: int
+    priority: int
+
+
+@dataclass(frozen=True)
+class InstanceSpec:
+    """``PROGRAM name WITH task : type;`` of the CONFIGURATION, its type resolved when compiling."""
+    name: str                 # the instance name as declared
+    type_text: str            # the PROGRAM type as written (messages, --program matching)
+    key: str | None           # upper POU qualified name of the PROGRAM type; None when it names no PROGRAM
+    task: str                 # upper task name ("" without WITH)
+
+
+def program_key(text: str) -> str:
+    """The form of a POU name ``Lib\\Name`` / ``Name`` under which :attr:`Program.program_names` holds it."""
+    return "\\".join(p for p in text.replace("\\\\", "\\").split("\\") if p).upper()
+
+
 @dataclass
 class Program:
     project: object                                     # the checked project it was compiled from
@@ -70,6 +92,11 @@ class Program:
     pous: dict = field(default_factory=dict)            # upper POU qualified name -> PouClass
     structs: list = field(default_factory=list)         # (class name, vars, StructType)
     globals_vars: dict = field(default_factory=dict)
+    # what a PLC instance needs to set up its tasks, without the project's syntax tree:
+    configured: bool = False                            # the sources have a CONFIGURATION
+    resources: tuple = ()                               # per RESOURCE: (tuple of TaskSpec, tuple of InstanceSpec)
+    programs: tuple = ()                                # POU keys of the user's PROGRAMs in source order
+    program_names: dict = field(default_factory=dict)   # program_key(name as a user may write it) -> POU key
 
     def load(self) -> "Image":
         """Run the compiled code in a fresh namespace: the classes and state of one PLC instance."""
