@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from .frontend import types as T
 from .compiler.codegen import CodeGen
-from .runtime import abi
+from .runtime import abi, sysmac_system
 from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
 from .runtime.program import program_key
@@ -153,7 +153,7 @@ class Plc:
         try:
             self.globals = module.globals_cls()
             ns[abi.GLOBALS] = self.globals
-            self.engine.bind_system_vars(self.globals)
+            self.engine.before_task = sysmac_system.task_hook(self.engine, self.globals)
             self.instances: dict[str, object] = ns[abi.PROGRAMS]
             self.type_named_instances: dict[str, list[str]] = {}   # see _setup_tasks
             self._setup_tasks(task, programs)

@@ -74,9 +74,9 @@ class Engine:
         _ENGINES.add(self)
         self.stmt_counter = module.namespace[abi.STATEMENTS]
         self.now_cell = module.namespace[abi.SCAN_TIME]          # what VPLC_ScanTime() returns in generated code
-        self.system_vars = None           # (globals dict, first-run attrs, [(attr, period ns)]): see bind_system_vars
-        self.system_vars_next = 0         # scan time at which a clock pulse changes next
-        self.current_time = None          # (globals dict, attr) of _CurrentTime, set before every task execution
+        self.before_task = None           # hook(task, now_ns) run before every task execution (a dialect's
+                                          # system variables: runtime/sysmac_system.py), or None
+        self.current_task: Task | None = None     # the task whose programs are running
         self.instruction_errors: collections.deque[str] = collections.deque(maxlen=100)   # the latest, located
         self.instruction_error_count = 0
 
@@ -102,32 +102,6 @@ class Engine:
                 s = frame.f_locals.get("s")
                 inst = getattr(s, "i__path", inst) if s is not None else inst
         return loc, inst
-
-    def bind_system_vars(self, globals_obj) -> None:
-        """Let the scan update the Sysmac system-defined variables of prelude/sysmac_sysvars.st that the
-        program can see (first-scan flags, clock pulses)."""
-        info = getattr(type(globals_obj), "i__vars", {})
-        first = [info[n][0] for n in ("P_FIRST_RUN", "P_FIRST_RUNMODE") if n in info]
-        clocks = [(info[n][0], period) for n, period in (("P_0_02S", 20_000_000), ("P_0_1S", 100_000_000),
-                                                         ("P_0_2S", 200_000_000), ("P_1S", 1_000_000_000),
-                                                         ("P_1MIN", 60_000_000_000)) if n in info]
-        if first or clocks:
-            self.system_vars = (globals_obj.__dict__, first, clocks)
-        if "_CURRENTTIME" in info:
-            self.current_time = (globals_obj.__dict__, info["_CURRENTTIME"][0])
-
-    def update_system_vars(self, task: Task, now_ns: int) -> None:
-        """First-run flags for the task's first cycle; clock pulses (half period on, half off). The next call is
-        due when the next pulse changes (the scan skips the work until then)."""
-        values, first, clocks = self.system_vars
-        for attr in first:
-            values[attr] = task.cycles == 0
-        nxt = math.inf
-        for attr, period in clocks:
-            half = period // 2
-            values[attr] = now_ns % period < half
-            nxt = min(nxt, now_ns - now_ns % half + half)
-        self.system_vars_next = nxt
 
     # ---- services used by native POUs -----------------------------------------------------------
     def new_struct(self, name: str):
@@ -163,6 +137,7 @@ class Engine:
         self.started = True
         self.now_ns = self.now_cell[0] = now_ns
         deadline = self.deadline
+        before_task = self.before_task
         deadline[0] = _perf_counter() + self.watchdog_s
         try:
             for task in self.tasks:
@@ -171,11 +146,9 @@ class Engine:
                     due = now_ns
                 elif now_ns < due:
                     continue
-                if self.system_vars is not None and (task.cycles < 2 or now_ns >= self.system_vars_next):
-                    self.update_system_vars(task, now_ns)
+                if before_task is not None:
+                    before_task(task, now_ns)
                 self.current_task = task          # GetMyTaskInterval (W502) reads the period of the running task
-                if self.current_time is not None:  # _CurrentTime (W501 system-defined variables): the clock
-                    self.current_time[0][self.current_time[1]] = self.clock_dt_ns()
                 for inst, body in task.programs:
                     body(inst)
                 task.cycles += 1
