@@ -31,28 +31,34 @@ class Task:
     cycles: int = 0                                   # completed executions of the task's programs
 
 
-_ENGINES: "weakref.WeakSet[Engine]" = weakref.WeakSet()    # every engine; scanning when its deadline is set
-_GC_START = [0.0]
 _perf_counter = time.perf_counter
 
 
-def _gc_pause(phase: str, _info) -> None:
-    """Python's garbage collector is the host's time, not the program's: a collection during a scan moves
-    the watchdog deadline of every scan in progress by its duration (it must not look like an endless loop)."""
-    if phase == "start":
-        _GC_START[0] = time.perf_counter()
-    elif _GC_START[0]:
-        pause = time.perf_counter() - _GC_START[0]
-        _GC_START[0] = 0.0
-        for engine in list(_ENGINES):
-            deadline = engine.deadline
+def gc_pause_callback(deadline: list, probation: list):
+    """A ``gc.callbacks`` entry for one engine. Python's garbage collector is the host's time, not the program's:
+    a collection during a scan moves the engine's watchdog deadline (and a probation it started) by its duration,
+    so it does not look like an endless loop. The callback holds the engine's two cells, not the engine, so an
+    engine nobody uses any more can still be collected; :func:`_forget` then removes the callback."""
+    started = [0.0]
+
+    def callback(phase: str, _info) -> None:
+        if phase == "start":
+            started[0] = _perf_counter()
+        elif started[0]:
+            pause = _perf_counter() - started[0]
+            started[0] = 0.0
             if deadline[0] != math.inf:
-                if engine.probation[0] == deadline[0]:
-                    engine.probation[0] += pause
+                if probation[0] == deadline[0]:
+                    probation[0] += pause
                 deadline[0] += pause
+    return callback
 
 
-gc.callbacks.append(_gc_pause)
+def _forget(callback) -> None:
+    try:
+        gc.callbacks.remove(callback)
+    except ValueError:
+        pass
 
 
 class Engine:
@@ -71,7 +77,9 @@ class Engine:
         self.deadline = module.namespace[abi.DEADLINE]
         self.probation = module.namespace[abi.PROBATION]       # watchdog probation: [deadline it set, CPU time]
         module.namespace[abi.WATCHDOG_LIMIT][0] = self.watchdog_s
-        _ENGINES.add(self)
+        pause = gc_pause_callback(self.deadline, self.probation)       # owned by this engine: gone with it
+        gc.callbacks.append(pause)
+        weakref.finalize(self, _forget, pause)
         self.stmt_counter = module.namespace[abi.STATEMENTS]
         self.now_cell = module.namespace[abi.SCAN_TIME]          # what VPLC_ScanTime() returns in generated code
         self.before_task = None           # hook(task, now_ns) run before every task execution (a dialect's
