@@ -55,6 +55,7 @@ def arrivals(sim):
     return [tuple(round(v) for v in e["pose"][:3]) for e in sim.robots[0].events if e["kind"] == "motion_end"]
 
 
+@pytest.mark.slow
 def test_commissioning_passes_with_a_cut_link_and_an_estop_and_every_move_once(robot):
     r = vplc_run(robot)
     assert r.returncode == 0, r.stdout + r.stderr

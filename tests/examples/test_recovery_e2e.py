@@ -74,6 +74,7 @@ def free_port():
         return s.getsockname()[1]
 
 
+@pytest.mark.slow
 def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp_path):
     """SIGKILL: no FIN, no RST from a process that is gone — the kernel answers for it. CBT_Connect (Execute held)
     reports the loss and reconnects by itself once the simulator is back; the cycle resumes with an operator

@@ -109,6 +109,7 @@ def test_leaving_the_listen_node_is_an_alarm_and_back_to_listen_node_brings_the_
     browser.wait_for(lambda d: browser.alarm_rows() == [], "normal")
 
 
+@pytest.mark.slow
 def test_a_link_outage_is_one_alarm_through_every_reconnect_attempt_until_connected(system):
     """CBT_Connect shows Error only during its back-off waits (docs/library/CBT_Connect.md, "Reconnect"): one
     alarm for the outage. Black hole: the loss (16#2006) raises it; acknowledged, it stays active while attempt 1

@@ -146,6 +146,7 @@ def test_pnp_segment_edit_writes_only_that_segment(page):
 
 
 
+@pytest.mark.slow
 def test_alarm_list_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
     """Six alarms raised one after the other (a command FB's Error with a new ErrorID each time, each an alarm of the
     server's list): the list on the main page shows at least five of them whole, one line each, scrolls only

@@ -79,6 +79,7 @@ def test_the_browser_forward_model_is_the_simulators(page):
         assert [v for row in flange for v in row] == pytest.approx([v for row in expected for v in row], abs=1e-6)
 
 
+@pytest.mark.slow
 def test_the_browser_reach_check_agrees_with_the_simulator(page):
     """Poses the simulator's inverse kinematics solves are accepted, the ones it refuses are refused (tool: none)."""
     plc, _, open_page = page
@@ -222,6 +223,7 @@ def pnp_example_cycle(plc):
 PAGES_WITH_VIEWS = ["index", "connect", "changebase", "moverel", "moveabs", "movecircle", "setoutput", "stop", "pnp"]
 
 
+@pytest.mark.slow
 def test_every_page_shows_the_same_axes_and_a_switch_holds_for_every_page(page):
     """Top X-Y and side Y-Z everywhere, the PnP drawing included; X-Z chosen on one page is X-Z on all of them."""
     plc, _, open_page = page

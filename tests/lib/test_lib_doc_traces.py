@@ -6,6 +6,8 @@ import filecmp
 import importlib.util
 import re
 
+import pytest
+
 from doc_steps import STEPS
 from rig import ROOT
 
@@ -38,6 +40,7 @@ def test_non_blended_pages_do_not_say_done_on_acceptance():
             in timing
 
 
+@pytest.mark.slow
 def test_every_diagram_is_referenced_and_regenerates_identically(tmp_path):
     committed = {p.name for p in (DOCS / "traces").glob("*.svg")}
     pages = "".join(p.read_text(encoding="utf-8") for p in DOCS.glob("*.md"))

@@ -1,7 +1,10 @@
 """A pick-and-place run of 1,000 motions loses nothing and executes nothing twice."""
+import pytest
+
 from rig import Rig
 
 
+@pytest.mark.slow
 def test_thousand_motion_pick_and_place_run_loses_nothing():
     r = Rig(program="Main_PnP.st", speedup=20.0)
     try:

@@ -230,6 +230,7 @@ def test_bad_input_gets_cperr_or_status_and_both_ports_keep_serving(h):
     assert not any(e["kind"] == "internal_error" for e in h.robot.events)
 
 
+@pytest.mark.slow
 def test_a_client_that_never_reads_the_stream_is_dropped_not_the_others():
     h = Harness(svr_port=0, svr_options={"period": 0.001, "mode": 2, "items": list(ITEMS)})
     try:

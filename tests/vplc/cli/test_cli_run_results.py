@@ -75,6 +75,7 @@ def test_watch_of_a_long_array_writes_the_first_elements_and_counts_the_rest(pro
     assert "  Main.Many = [" + "16#00, " * 32 + "… 68 more]" in r.stdout.splitlines()
 
 
+@pytest.mark.slow
 def test_the_svg_timing_diagram_writes_bit_strings_in_16_notation(program, tmp_path):
     svg = tmp_path / "t.svg"
     r = vplc("run", program, "--virtual-time", "--cycles", "4", "--trace", "Main.Status,Main.Count,Main.Mode",
@@ -108,6 +109,7 @@ def test_a_real_time_run_reports_its_overruns_and_fails_above_max_overruns(tmp_p
         in last
 
 
+@pytest.mark.slow
 def test_max_overruns_is_a_real_time_option(tmp_path):
     path = tmp_path / "busy.st"
     path.write_text(BUSY, encoding="utf-8")

@@ -43,6 +43,7 @@ def test_temporal_literals_with_thousands_of_digits_are_diagnostics(tmp_path):
     assert "…" in out and max(len(line) for line in out.splitlines() if "error[" in line) < 300
 
 
+@pytest.mark.slow
 def test_a_case_with_8000_labels_checks_and_runs(tmp_path):
     labels = "\n".join(f"{i}: y := {i * 3};" for i in range(8000))
     src = write(tmp_path, "case.st", f"PROGRAM P\nVAR x : DINT; y : DINT; z : DINT; END_VAR\n"

@@ -66,6 +66,7 @@ def test_folder_without_sources_exports_nothing(tmp_path, capsys):
     assert code == 2 and "nothing to export" in err and not (tmp_path / "x.xml").exists()
 
 
+@pytest.mark.slow
 def test_command_is_registered_with_python_m_vplc(tmp_path):
     env_path = f"{ROOT / 'src'}"
     r = subprocess.run([sys.executable, "-m", "vplc", "export", "--help"], capture_output=True, text=True,
@@ -115,6 +116,7 @@ def test_negated_data_source_and_in_out_variable_in_a_rung_are_refused(tmp_path,
         assert code == 1 and message in err, (name, err)
 
 
+@pytest.mark.slow
 def test_only_writes_the_named_objects_and_names_a_missing_one(tmp_path, capsys):
     out = tmp_path / "one.xml"
     code, stdout, err = run(capsys, "export", str(LIB), str(ROOT / "examples"), "--only", "Commands_Example",

@@ -45,6 +45,7 @@ def export(capsys, out: pathlib.Path, *paths) -> pathlib.Path:
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("paths", [[LIB], [LIB, ROOT / "examples"], [LIB, ROOT / "examples" / "palletizer"]],
                          ids=["library", "library+examples", "library+palletizer"])
 def test_library_and_examples_validate(schema, tmp_path, capsys, paths):

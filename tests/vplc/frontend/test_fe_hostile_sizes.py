@@ -8,6 +8,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from fe_helpers import check_text, codes, program
 
 from vplc.frontend import lexer
@@ -120,6 +122,7 @@ def test_the_linear_comment_scan_ends_every_comment_where_the_nesting_rules_end_
             assert lexer._skip_comment(text, 0) == _reference_skip(text, 0), text
 
 
+@pytest.mark.slow
 def test_a_deeply_nested_comment_closes_and_an_unclosed_one_is_reported(tmp_path):
     depth = 5_000
     proj = check_text(tmp_path, program("(*" * depth + " note " + "*)" * depth + "\nx := 1;", "x : INT;"))

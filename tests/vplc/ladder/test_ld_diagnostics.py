@@ -198,6 +198,7 @@ def test_wire_from_an_element_without_output(tmp_path):
     assert d.code == "ST2103" and "is wired to jump L, which has no output to read" in d.message
 
 
+@pytest.mark.slow
 def test_damaged_files_give_diagnostics_never_a_traceback(tmp_path):
     """300 seeded mutations of a ladder using every element kind: wires moved, elements deleted, pins,
     modifiers and operands changed. Each load ends in diagnostics (or none), never in an exception."""

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import shutil
 
+import pytest
+
 from ld_trace import ROOT, first_difference, trace
 
 LIB = ROOT / "lib" / "CBT_Commands_Lib"
 
 
+@pytest.mark.slow
 def test_ladder_example_and_its_st_twin_give_the_same_trace(tmp_path):
     st = tmp_path / "st"
     shutil.copytree(ROOT / "examples", st, ignore=shutil.ignore_patterns("*.py", "Commands_Example.xml"))

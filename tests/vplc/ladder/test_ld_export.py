@@ -26,6 +26,7 @@ def export(tmp_path, fmt, *paths) -> str:
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_exported_example_project_runs_the_same_1000_scans(tmp_path, fmt):
     out = export(tmp_path, fmt, LIB, ROOT / "examples")

@@ -3,6 +3,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 
 PROG = """PROGRAM Main
@@ -87,6 +89,7 @@ def test_a_fault_is_a_one_line_reason_after_the_details(tmp_path):
     assert r.stderr.strip().splitlines()[-1].startswith("vplc run: FAILED: major fault at 0.000 s: ")
 
 
+@pytest.mark.slow
 def test_scenario_mistakes_are_usage_errors_naming_file_and_line(tmp_path):
     cases = {"at 2 set Main.Start TRUE\n": ":1: time `2` is not a time like 2s",
              "\nat 1s set Main.Nope TRUE\n": ":2: `Nope` is not a variable of Main",

@@ -101,6 +101,7 @@ def test_robot_words_become_the_documented_requests():
 
 
 # ---- usage errors before the run -------------------------------------------------------------------------
+@pytest.mark.slow
 def test_scenario_mistakes_about_the_simulator_are_usage_errors_with_file_and_line(tmp_path, sim):
     cases = {"at 1s robot 3 cut_link\n": ":1: robot 3 does not exist: the simulator at 127.0.0.1:",
              "\nat 1s robot 0 estop\n": ":2: `robot 0`: robots are numbered from 1",

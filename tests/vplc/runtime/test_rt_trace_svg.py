@@ -58,6 +58,7 @@ def test_trace_window_draws_only_that_part_with_the_value_in_effect_at_its_start
     assert float(re.split("[ ,]", first_shape)[-2]) == pytest.approx(LABEL_W)
 
 
+@pytest.mark.slow
 def test_dense_bus_changes_become_one_hatched_band():
     rec = Rec([("Main.N", ("int", 16), [(t * MS, t) for t in range(5000)])], 5000 * MS)
     svg = render_svg(rec)
