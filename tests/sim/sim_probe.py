@@ -1,9 +1,6 @@
-"""Helpers of the simulator security tests: the tests/sim harness (virtual clock, loopback) and a raw
-JSON-lines client of the control channel."""
+"""A raw JSON-lines client of the simulator's control channel, for the probes that send it hostile lines."""
 import json
 import socket
-
-from sim_harness import Harness, Peer, sct, sta  # noqa: F401
 
 
 class ControlClient:

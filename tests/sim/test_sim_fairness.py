@@ -14,7 +14,7 @@ from tmsim.limits import (CONTROL_TURN_PIECES, CONTROL_TURN_REQUESTS, PARSE_SLIC
 from tmsim.robot.model import RobotModel
 from tmsim.protocol.listen_session import ListenSession
 
-from sim_probe import Harness, sct, sta
+from sim_harness import Harness, sct, sta
 
 TCP_HOME = (417.5, -122.3, 359.7)
 

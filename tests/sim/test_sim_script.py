@@ -9,7 +9,7 @@ from tmsim.tmscript import parser as script
 from tmsim.limits import (ARRAY_MAX, STATEMENTS_MAX, STEPS_MAX, STRING_MAX, TOKENS_MAX, VARIABLE_BYTES_MAX,
                         VARIABLES_MAX)
 
-from sim_probe import Harness, sct, sta
+from sim_harness import Harness, sct, sta
 
 PTP_LONG = 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)'
 
@@ -52,7 +52,8 @@ def test_squaring_an_int_wraps_at_32_bits(robot):
 
 def test_state_answer_after_a_large_integer_computation_is_valid_json():
     from tmsim.net.server import SimServer
-    from sim_probe import ControlClient, Peer
+    from sim_harness import Peer
+    from sim_probe import ControlClient
     srv = SimServer(port=0, control_port=0).start_background()
     try:
         peer = Peer(srv.ports[0])
