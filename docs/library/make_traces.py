@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from rig import LIB, SEC, Rig, move_abs
-from test_lib_doc_examples import STEPS, example_of, on_simulator, simulator
+from doc_steps import STEPS, example_of, on_simulator, simulator
 from vplc.api import PathError, load_plc
 from vplc.trace.recorder import Recorder, write_trace
 

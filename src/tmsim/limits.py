@@ -1,7 +1,7 @@
 """Every bound of the simulated controller and of its servers, in one place.
 
 docs/simulator.md ("Limits") shows each of them with the error a client sees;
-tests/security/test_sim_limits_doc.py checks that the table and this file agree.
+tests/sim/test_sim_limits_doc.py checks that the table and this file agree.
 Values marked [MAN 2.24 §x] follow Techman's *Programming Language TMscript* 2.24 manual;
 the others are the simulator's choice (a robot controller has such bounds, the manual does not
 give their values).

@@ -6,7 +6,7 @@ connected again, however many reconnect attempts it takes; a robot that left its
 header says so, and Back to Listen Node on Main brings it back through CBT_ProjectControl."""
 import pytest
 from selenium.webdriver.common.by import By
-from test_hmi_end_to_end import System
+from hmi_system import System
 
 
 @pytest.fixture(scope="module")

@@ -5,96 +5,14 @@ Each test drives the pages like an operator and checks the robot side in the sim
 """
 from __future__ import annotations
 
-import pathlib
-import threading
 import time
 
 import pytest
 from selenium.webdriver.common.by import By
 
 from browser import Browser
-from tmsim.net.server import SimServer
-from vplc.api import load_plc
-from cbt_hmi.web.mapping import Mapping
-from cbt_hmi.web.server import HmiServer
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
-MOVE_WAIT_S = 30
-SIM_SPEEDUP = 4.0     # the robot model runs 4x faster than the wall clock; PLC timers stay real time
-DWELL_NS = 250_000_000  # PnP_DwellTime for the cycle tests (T#250ms)
-
-
-class System:
-    def __init__(self, browser: Browser):
-        self.mapping = Mapping.load()
-        self.sim = SimServer(port=0, robots=1, speedup=SIM_SPEEDUP, svr_port=0)
-        self.sim.start_background()
-        self.robot = self.sim.robots[0]
-        self.plc = load_plc(SOURCES)
-        self.mapping.check_against_plc(self.plc)
-        with self.plc.lock:
-            self.plc.write("Connect_AddressIP", "127.0.0.1")
-            self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
-            self.plc.write("Connect_SvrPort", self.robot.svr_port)
-        self.stop_event = threading.Event()
-        self.plc_thread = threading.Thread(target=self.plc.run_realtime, args=(self.stop_event,),
-                                           kwargs={"spin_ns": 0}, daemon=True)
-        self.plc_thread.start()
-        self.hmi = HmiServer(self.plc, self.mapping, port=0)
-        self.hmi.start()
-        self.browser = browser
-
-    def close(self):
-        self.hmi.stop()
-        self.stop_event.set()
-        self.plc_thread.join(timeout=5)
-        self.plc.close()
-        self.sim.close()
-
-    def read(self, name):
-        with self.plc.lock:
-            return self.plc.read(name)
-
-    def events(self, kind: str, since: float = -1.0) -> list[dict]:
-        """Events of one kind logged after the robot-clock time ``since`` (the in-memory log is capped, so
-        positions in it shift; times do not)."""
-        with self.sim.lock:
-            return [e for e in self.robot.events if e["kind"] == kind and e["t"] > since]
-
-    def event_count(self) -> float:
-        """A mark for events(): the robot clock of the newest event."""
-        with self.sim.lock:
-            return self.robot.events[-1]["t"] if self.robot.events else -1.0
-
-    def wait(self, predicate, what: str, timeout: float = MOVE_WAIT_S):
-        done = threading.Event()
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}\n{self.snapshot()}")
-            done.wait(0.02)
-
-    def snapshot(self) -> str:
-        """What the robot and the PLC were doing, for the message of a failed wait."""
-        with self.sim.lock:
-            tail = [{k: v for k, v in e.items() if k != "pose"} for e in self.robot.events[-25:]]
-            state = self.robot.state()
-        names = ("PnP_Segment", "PnP_MoveBusy", "ProgramControl_Execute", "ProgramControl_Busy",
-                 "ProgramControl_Done", "ProgramControl_Error", "ProgramControl_ErrorDescrip",
-                 "ProgramControl_Param.Command", "Cobot.QueueDepth", "Cobot.Connected")
-        with self.plc.lock:
-            plc = {n: self.plc.read(n) for n in names}
-        lines = [f"robot state: {state}", f"PLC: {plc}", "last robot events:"] + [f"  {e}" for e in tail]
-        return "\n".join(lines)
-
-    def open(self, page: str) -> Browser:
-        self.browser.open(self.hmi.page_url(page, "engineer"))
-        return self.browser
-
-    def robot_state(self) -> dict:
-        with self.sim.lock:
-            return self.robot.state()
+from hmi_system import DWELL_NS, MOVE_WAIT_S, System
 
 
 @pytest.fixture(scope="module")
@@ -276,6 +194,7 @@ def edit_place_speed(system, browser, speed: int) -> None:
     system.wait(lambda: system.read("PnP_MoveParameters")[4]["Speed"] == speed, "the new place speed in the PLC")
 
 
+@pytest.mark.slow
 def test_two_pnp_cycles_with_pause_and_resume(connected):
     browser = connected.open("pnp")
     browser.click("btn-preset")
@@ -334,6 +253,7 @@ def pnp_page_offers(browser) -> dict:
             for name in ("execute", "stop", "reset")}
 
 
+@pytest.mark.slow
 def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(connected):
     """Issue 25 item 1: Stop on the Stop Motion page while the cycle dwells at the pick point, and again while a
     move runs. The page releases Stop 1.5 s later; the robot must not move again by itself, and the PnP page

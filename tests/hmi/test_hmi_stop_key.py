@@ -7,7 +7,7 @@ from __future__ import annotations
 import time
 
 import pytest
-from test_hmi_end_to_end import DWELL_NS, MOVE_WAIT_S, System
+from hmi_system import DWELL_NS, MOVE_WAIT_S, System
 
 PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "setoutput", "stop",
          "pnp", "jog", "program"]

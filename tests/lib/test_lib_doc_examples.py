@@ -4,53 +4,16 @@ page says it sends."""
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import pytest
 
-from doc_steps import STEPS
-from rig import LIB, ROOT, SEC
-from tmsim.robot.camera import camera_of
-from tmsim.net.server import SimServer
-from tmsim.protocol.svr_table import parse_variable
+from doc_steps import DOCS, STEPS, example_of, on_simulator, simulator
+from rig import LIB, SEC
 from vplc.api import load_plc
-
-DOCS = ROOT / "docs" / "library"
-EXAMPLE = re.compile(r"^## Example\n```\n(.*?)```\n(.*?)(?=^## |\Z)", re.S | re.M)
-SCRIPT = re.compile(r"^- `(.*)`$", re.M)
-
-# the global variables of the robot's project that the pages' examples read and write (simulator: --svr-var)
-SVR_VARIABLES = ("g_PartCount:int=17", "g_Recipe:string=\"Flange\"", "g_Offset:float[3]={0.5,-1.25,0}")
-
-
-# the vision job of the robot's project (simulator: --vision-job) and the one part its camera finds
-VISION_JOB, VISION_OBJECT = "job1", [417.5, -122.3, 300, 0, 0, 0]
-
-
-def simulator() -> SimServer:
-    """The robot the examples run against: Listen node, Ethernet Slave, the variables and the vision job above."""
-    srv = SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0,
-                    svr_options={"variables": [parse_variable(spec) for spec in SVR_VARIABLES]})
-    camera_of(srv.robots[0].session.robot).define(VISION_JOB, objects=[VISION_OBJECT])
-    return srv
-
-
-def example_of(page: str) -> tuple[str, list[str]]:
-    text = (DOCS / f"{page}.md").read_text(encoding="utf-8")
-    m = EXAMPLE.search(text)
-    assert m, f"{page}.md has no '## Example' section with a code block"
-    return m.group(1), SCRIPT.findall(m.group(2))
-
 
 def test_every_fb_page_has_a_runnable_example():
     pages = {p.stem for p in DOCS.glob("CBT_*.md")}
     assert pages == set(STEPS), "a page was added or removed: give its example steps in STEPS"
-
-
-def on_simulator(code: str, srv) -> str:
-    """The example as the page shows it, pointed at the simulator's robot and Ethernet Slave on loopback."""
-    return (code.replace("'192.168.1.10'", "'127.0.0.1'").replace("IPPort := 5890", f"IPPort := {srv.ports[0]}")
-            .replace("SvrPort := 5891", f"SvrPort := {srv.robots[0].svr_port}"))
 
 
 @pytest.mark.parametrize("page", sorted(STEPS))

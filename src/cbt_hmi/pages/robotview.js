@@ -20,7 +20,7 @@ const ZOOMS = [0.5, 1, 2, 4];                                   // 1: ±1000 mm 
 const RED = "#c0241a", VIOLET = "#6a2fa8";
 
 /* ---- the TM5-700's kinematics, from the one data file src/cbt_hmi/pages/tm5_700.json (checked against the simulator's
-   src/tmsim/kinematics.py by tests/hmi/test_hmi_robot_model.py). Matrices are 4x4 row lists. ---- */
+   src/tmsim/robot/kinematics.py by tests/hmi/test_hmi_robot_view.py). Matrices are 4x4 row lists. ---- */
 const ARM = { data: null };
 const armReady = fetch("tm5_700.json").then((r) => r.json()).then((d) => { ARM.data = d; })
   .catch(() => { /* no arm data: the view draws no arm and the page leaves the reach check to the robot */ });
