@@ -294,7 +294,8 @@ class Demo:
             f"  control channel   {CONTROL_HOST}:{self.sim.control.port}, the simulator's JSON-line requests "
             f"({robot_numbering(1)}):",
             "                    E-stop, project stop/start, cut the link (docs/simulator.md \"Control channel\")",
-            f"  virtual PLC       PnP_Example + Commands_Example (ladder) in a {period_ms:g} ms task (real time)",
+            f"  virtual PLC       PnP_Example, JogTeach_Example, Commands_Example (ladder) in a {period_ms:g} ms task "
+            "(real time)",
             f"  web HMI           {self.hmi.url} (without a key: monitor only)",
             "",
             "Open the operator address in a browser, press Connect, then try the Motion pages:",
