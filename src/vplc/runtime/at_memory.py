@@ -7,7 +7,7 @@ memory belongs to one PLC (its Globals object), like every other variable.
 """
 from __future__ import annotations
 
-from .unions import _decode, _encode
+from .unions import ElementView, _decode, _encode
 
 
 class AreaMemory:
@@ -39,41 +39,18 @@ def _write(mem: bytearray, offset: int, size: int, kind: str, value) -> None:
     mem[first:last] = raw.to_bytes(last - first, "little")
 
 
-class AreaArray:
+class AreaArray(ElementView):
     """An array variable in a memory area: a live view of its elements."""
-    __slots__ = ("mem", "offset", "kind", "size", "n")
+    __slots__ = ("mem", "offset", "kind", "size")
 
     def __init__(self, mem: bytearray, offset: int, kind: str, size: int, n: int) -> None:
         self.mem, self.offset, self.kind, self.size, self.n = mem, offset, kind, size, n
 
-    def __len__(self) -> int:
-        return self.n
+    def _get(self, i: int):
+        return _read(self.mem, self.offset + i * self.size, self.size, self.kind)
 
-    def _at(self, i: int) -> int:
-        if not 0 <= i < self.n:
-            raise IndexError(i)
-        return self.offset + i * self.size
-
-    def __getitem__(self, i):
-        if isinstance(i, slice):
-            return [self[k] for k in range(*i.indices(self.n))]
-        return _read(self.mem, self._at(i), self.size, self.kind)
-
-    def __setitem__(self, i, v) -> None:
-        if isinstance(i, slice):
-            for k, x in zip(range(*i.indices(self.n)), v):
-                self[k] = x
-            return
-        _write(self.mem, self._at(i), self.size, self.kind, v)
-
-    def __iter__(self):
-        return (self[i] for i in range(self.n))
-
-    def __eq__(self, other) -> bool:
-        return list(self) == list(other)
-
-    def __repr__(self) -> str:
-        return repr(list(self))
+    def _set(self, i: int, v) -> None:
+        _write(self.mem, self.offset + i * self.size, self.size, self.kind, v)
 
 
 def area_property(area: str, bank: int, words: int, word: int, bit: int, kind: str, size: int,

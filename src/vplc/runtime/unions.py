@@ -39,33 +39,36 @@ def write(cell: list, kind: str, size: int, value, offset: int = 0) -> None:
     cell[0] = (cell[0] & ~mask) | (_encode(value, kind, size) << offset)
 
 
-class MemberArray:
-    """An array member of a union: a live view of its elements in the union's image (writing an element writes
-    the image, so the other members see it)."""
-    __slots__ = ("cell", "kind", "size", "n")
+class ElementView:
+    """A live view of the elements of an array stored in a memory image (a union's image, a memory area): the
+    list behaviour both share; a subclass reads and writes one element at a checked index."""
+    __slots__ = ("n",)
 
-    def __init__(self, cell: list, kind: str, size: int, n: int) -> None:
-        self.cell, self.kind, self.size, self.n = cell, kind, size, n
+    def _get(self, i: int):
+        raise NotImplementedError
+
+    def _set(self, i: int, v) -> None:
+        raise NotImplementedError
+
+    def _checked(self, i: int) -> int:
+        if not 0 <= i < self.n:
+            raise IndexError(i)
+        return i
 
     def __len__(self) -> int:
         return self.n
 
-    def _index(self, i: int) -> int:
-        if not 0 <= i < self.n:
-            raise IndexError(i)
-        return i * self.size
-
     def __getitem__(self, i):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(self.n))]
-        return read(self.cell, self.kind, self.size, self._index(i))
+        return self._get(self._checked(i))
 
     def __setitem__(self, i, v) -> None:
         if isinstance(i, slice):
             for k, x in zip(range(*i.indices(self.n)), v):
                 self[k] = x
             return
-        write(self.cell, self.kind, self.size, v, self._index(i))
+        self._set(self._checked(i), v)
 
     def __iter__(self):
         return (self[i] for i in range(self.n))
@@ -75,6 +78,21 @@ class MemberArray:
 
     def __repr__(self) -> str:
         return repr(list(self))
+
+
+class MemberArray(ElementView):
+    """An array member of a union: a live view of its elements in the union's image (writing an element writes
+    the image, so the other members see it)."""
+    __slots__ = ("cell", "kind", "size")
+
+    def __init__(self, cell: list, kind: str, size: int, n: int) -> None:
+        self.cell, self.kind, self.size, self.n = cell, kind, size, n
+
+    def _get(self, i: int):
+        return read(self.cell, self.kind, self.size, i * self.size)
+
+    def _set(self, i: int, v) -> None:
+        write(self.cell, self.kind, self.size, v, i * self.size)
 
 
 def member_property(kind: str, size: int, count: int | None) -> property:
