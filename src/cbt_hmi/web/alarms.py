@@ -82,6 +82,19 @@ def stamp(seconds: float) -> str:
     return time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(seconds)) + f".{int(seconds * 1000) % 1000:03d}"
 
 
+def plc_fault(plc) -> dict | None:
+    """The PLC's major fault, None while it can scan: {"message": the controller's whole text, "what": the
+    cause alone (after "major fault in <instance>: ")}. vplc's Plc.fault holds it from the scan that faulted on;
+    the PLC no longer scans, its variables keep the values of that moment and its sockets are closed. A PLC
+    stand-in without a fault property never faults."""
+    fault = getattr(plc, "fault", None)
+    if fault is None:
+        return None
+    message = str(fault)
+    what = message.partition(": major fault in ")[2].partition(": ")[2]
+    return {"message": message, "what": what or message}
+
+
 @dataclass
 class Alarm:
     number: int
@@ -238,7 +251,6 @@ class AlarmSystem:
                 log.exception("HMI alarm sample failed")
 
     def _read(self) -> tuple[dict | None, dict | None, tuple | None]:
-        from .server import plc_fault
         if not self.plc.lock.acquire(timeout=LOCK_WAIT_S):
             return None, None, None
         try:

@@ -40,7 +40,7 @@ from http.server import BaseHTTPRequestHandler
 from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
-from .alarms import HISTORY, AlarmSystem, stamp
+from .alarms import HISTORY, AlarmSystem, plc_fault, stamp
 from .front import MAX_BODY, HttpFront, HttpLimits
 from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, validate
 from .trail import Trail
@@ -62,19 +62,6 @@ def _number_digits(text: str) -> str:
     if sum(c.isdigit() for c in mantissa) > MAX_DIGITS:
         raise RequestError(f"a number in the request has more than {MAX_DIGITS} digits")
     return text
-
-
-def plc_fault(plc) -> dict | None:
-    """The PLC's major fault, None while it can scan: {"message": the controller's whole text, "what": the
-    cause alone (after "major fault in <instance>: ")}. vplc's Plc.fault holds it from the scan that faulted on;
-    the PLC no longer scans, its variables keep the values of that moment and its sockets are closed. A PLC
-    stand-in without a fault property never faults."""
-    fault = getattr(plc, "fault", None)
-    if fault is None:
-        return None
-    message = str(fault)
-    what = message.partition(": major fault in ")[2].partition(": ")[2]
-    return {"message": message, "what": what or message}
 
 
 def _json_body(raw: bytes):

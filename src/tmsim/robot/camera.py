@@ -26,6 +26,7 @@ import math
 import re
 
 from tmsim.limits import VISION_JOBS_MAX, VISION_OBJECTS_MAX, VISION_POSE_MAX, VISION_SECONDS_MAX
+from tmsim.tmscript.floats import float_text      # the texts GetString prints
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,47}\Z")
 
@@ -79,7 +80,6 @@ class Camera:
 
     def finish(self, job: VisionJob) -> bool:
         """The job has run: its output variable now holds its objects (none when it failed)."""
-        from tmsim.tmscript.interp import float_text         # the texts GetString prints (interp imports this module)
         self.runs += 1
         rows = [[float_text(v) for v in pose] for pose in job.objects] if job.passed else []
         self.outputs[job.variable] = rows

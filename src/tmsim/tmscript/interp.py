@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import math
 import struct
-from decimal import Decimal
 
 from tmsim.tmscript import parser as ast
 from tmsim.tmscript import functions as table
@@ -35,6 +34,7 @@ from tmsim.protocol.codec import encode as encode_frame
 from tmsim.limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
                      VARIABLES_MAX, WORK_STEP)
 from tmsim.robot.motion import MotionRequest
+from tmsim.tmscript.floats import float_text
 from tmsim.tmscript.work import WorkMeter
 
 MOTIONS = ("PTP", "Line", "Circle", "PLine", "Move_PTP", "Move_Line", "Move_PLine")
@@ -628,31 +628,6 @@ def to_text(value) -> str:
     if isinstance(value, list):
         return "{" + ",".join(to_text(v) for v in value) + "}"
     return str(value)
-
-
-def float_text(value: float) -> str:
-    """A TM ``float`` is 32 bits: printed with the fewest digits that read back as the same 32-bit value
-    (0.1 -> "0.1", 417.5 -> "417.5", 1/3 -> "0.33333334"), fixed point for exponents -5..14, else
-    "1E+15" / "1.5E-07" (our reading of the robot's .NET-style output; docs/simulator.md)."""
-    if not math.isfinite(value):
-        return "NaN" if math.isnan(value) else ("Infinity" if value > 0 else "-Infinity")
-    try:
-        single = struct.unpack("<f", struct.pack("<f", value))[0]
-    except OverflowError:
-        return "Infinity" if value > 0 else "-Infinity"
-    if single == 0:
-        return "0"
-    for digits in range(1, 10):
-        text = f"{single:.{digits}g}"
-        if struct.unpack("<f", struct.pack("<f", float(text)))[0] == single:
-            break
-    number = Decimal(text)
-    exponent = number.adjusted()
-    if -5 <= exponent < 15:
-        fixed = format(number, "f")
-        return fixed.rstrip("0").rstrip(".") if "." in fixed else fixed
-    mantissa, _, power = f"{number:E}".partition("E")
-    return f"{mantissa}E{power[0]}{int(power[1:]):02d}"
 
 
 def encode_value(value, type_name=None) -> bytes:
