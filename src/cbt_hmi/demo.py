@@ -156,7 +156,7 @@ def tcp_port(text: str) -> int:
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="make demo", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="cbt-demo", description=__doc__.splitlines()[0])
     parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     parser.add_argument("--robot-port", type=tcp_port, default=5890, help="robot Listen Node port (default 5890)")
     parser.add_argument("--svr-port", type=tcp_port, default=None,
