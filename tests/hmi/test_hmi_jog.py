@@ -137,3 +137,32 @@ def test_teach_stores_the_position_in_the_chosen_entry(cell):
     browser.wait_for(lambda d: "Teach: Done" in browser.message(), "Done on the message line")
     cell.wait(lambda: cell.read("Teach_Execute") is False, "the page to release Teach")
     browser.screenshot("jog_page_taught")
+
+
+def test_a_taught_point_becomes_the_target_of_move_absolute_and_of_a_pnp_segment(cell):
+    """Issue 26: the position table the Teach button fills is usable by the motion pages and the PnP segments —
+    'Use as target' writes the point's TCP pose (or its joint angles where the target is in JPP_Abs)."""
+    browser = cell.open()
+    browser.driver.find_element(By.CSS_SELECTOR, "#teach-index option[value='6']").click()
+    name = browser.driver.find_element(By.ID, "teach-name")
+    name.clear()
+    name.send_keys("Place")
+    browser.click("btn-teach")
+    cell.wait(lambda: cell.read("TeachTable[6]")["Taught"], "the point to be taught")
+    cell.wait(lambda: cell.read("Teach_Execute") is False, "the page to release Teach")
+    point = cell.read("TeachTable[6]")
+    axes = ("X", "Y", "Z", "RX", "RY", "RZ")
+    with cell.plc.lock:
+        cell.plc.write("MoveAbs_Param.DataFormat", "CPP_Abs")
+        cell.plc.write("PnP_MoveParameters[2].DataFormat", "JPP_Abs")
+    for target, expected in (("MoveAbs_Param", point["Pose"]), ("PnP_MoveParameters[2]", point["Joints"])):
+        browser.driver.find_element(By.CSS_SELECTOR, f"#teach-use-target option[value='{target}']").click()
+        browser.click("btn-teach-use")
+        browser.wait_for(lambda d: "Use point 6" in browser.message(), "the answer: " + browser.message())
+        cell.wait(lambda: [cell.read(f"{target}.TargetPosition")[k] for k in axes]
+                  == pytest.approx([expected[k] for k in axes], abs=1e-3), f"{target} to take the point: " + browser.message())
+        browser.wait_for(lambda d: "Use point 6 'Place': now the target of" in browser.message(), "the message")
+    browser.driver.find_element(By.CSS_SELECTOR, "#teach-index option[value='16']").click()
+    browser.click("btn-teach-use")
+    browser.wait_for(lambda d: "the point is not taught yet" in browser.message(), "the refusal of an empty point")
+    browser.screenshot("jog_page_point_used")

@@ -24,6 +24,7 @@ const JOG_STYLE = `
 .jog .indicators { grid-template-columns: repeat(4, minmax(0, 1fr)); }
 .jog .teach-row { display: flex; gap: 6px; align-items: center; margin-bottom: 4px; }
 .jog .teach-row input, .jog .teach-row select { height: 34px; font-size: 14px; }
+.jog .points-box { max-height: 276px; overflow-y: auto; }
 .jog table.points { border-collapse: collapse; font-size: 14px; width: 100%; }
 .jog table.points td { border-bottom: 1px solid #d5dbe1; padding: 1px 4px; }
 .jog table.points tr.sel { outline: 2px solid #2368a8; }`;
@@ -138,6 +139,35 @@ async function teachPress() {
     releaseWhenFinished("Teach", "Teach", `point ${index} '${name}' holds the robot's position`);
 }
 
+/* A taught point becomes the target of Move Absolute or of a PnP segment: its TCP pose, or its joint angles when
+   that target is in the joint format (JPP_Abs = 0); the move itself is started on its own page. */
+const TEACH_TARGETS = [["MoveAbs_Param", "Move Absolute"],
+  ...Array.from({ length: 6 }, (_, k) => [`PnP_MoveParameters[${k}]`, `PnP segment ${k + 1}`])];
+
+async function teachUse() {
+  const index = Number(document.getElementById("teach-index").value);
+  const select = document.getElementById("teach-use-target");
+  const root = select.value, label = select.selectedOptions[0].textContent;
+  const point = (live.values.TeachTable || [])[index - 1];
+  if (!point || point.Taught !== true) {
+    message(`Use point ${index}: the point is not taught yet; teach it first.`, "error");
+    return;
+  }
+  const name = root.split("[")[0];
+  try {
+    const now = (await readVars([name])).values[name];
+    const param = root.includes("[") ? now[Number(root.match(/\[(\d+)\]/)[1])] : now;
+    const joints = param.DataFormat === 0 || param.DataFormat === "JPP_Abs";     // read as a number or a name
+    const values = {};
+    ["X", "Y", "Z", "RX", "RY", "RZ"].forEach((k) => {
+      values[`${root}.TargetPosition.${k}`] = joints ? point.Joints[k] : point.Pose[k];
+    });
+    await api("/api/write", { values });
+    message(`Use point ${index} '${point.Name}': now the target of ${label} (${joints ? "joint angles" : "TCP pose"}); ` +
+            "start the move on its page.", "ok");
+  } catch (e) { message(`Use point ${index}: ${e.message}`, "error"); }
+}
+
 function jogPage() {
   const main = frame("Jog / Teach", false);
   const style = document.createElement("style");
@@ -160,12 +190,18 @@ function jogPage() {
       Point <select id="teach-index">${options}</select>
       <input id="teach-name" maxlength="24" placeholder="Name" value="P1" style="width:120px">
       <button type="button" id="btn-teach">Teach</button></div>
-      <table class="points"><tbody id="teach-points">${rows}</tbody></table></fieldset></div></div>`;
+      <div class="teach-row">Use it in <select id="teach-use-target">${TEACH_TARGETS.map(([v, t]) =>
+        `<option value="${v}">${t}</option>`).join("")}</select>
+      <button type="button" id="btn-teach-use">Use as target</button></div>
+      <div class="points-box"><table class="points"><tbody id="teach-points">${rows}</tbody></table></div>
+      </fieldset></div></div>`;
   for (const b of document.querySelectorAll(".frames button"))
     b.addEventListener("click", () => { if (!jog.held) { jog.frame = b.dataset.frame; jogAxes(); jogShow(); } });
   document.getElementById("btn-teach").addEventListener("click", teachPress);
   document.getElementById("btn-teach").disabled = !mayWrite("Teach_Execute");
   document.getElementById("teach-index").addEventListener("change", jogShow);
+  document.getElementById("btn-teach-use").addEventListener("click", teachUse);
+  document.getElementById("btn-teach-use").disabled = !mayWrite("MoveAbs_Param.TargetPosition.X");
   window.addEventListener("blur", jogRelease);
   document.addEventListener("visibilitychange", () => { if (document.hidden) jogRelease(); });
   jogAxes();
