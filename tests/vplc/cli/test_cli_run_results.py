@@ -121,13 +121,19 @@ def test_max_overruns_is_a_real_time_option(tmp_path):
     assert r.returncode == 0 and "overrun" not in r.stdout          # virtual time has none to report
 
 
+def _default_sigint():
+    """Ctrl-C as at a terminal: a test run started in the background (a non-interactive shell's `&`) hands its
+    children SIGINT ignored, and Python keeps an ignored SIGINT, so the child would never see the operator's key."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("sig, who", [(signal.SIGTERM, "SIGTERM"), (signal.SIGINT, "the operator")])
 def test_a_run_stopped_by_a_signal_still_writes_its_trace(program, tmp_path, sig, who):
     svg = tmp_path / "stop.svg"
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
     proc = subprocess.Popen([sys.executable, "-m", "vplc", "run", str(program), "--trace", "Main.Status,Main.Count",
                              "--trace-out", str(svg), "--watch", "Main.Mode"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
+                            stderr=subprocess.PIPE, text=True, env=env, preexec_fn=_default_sigint)
     try:
         assert proc.stdout.readline().startswith("vplc run: task Main")
         assert "Main.Mode = Running" in proc.stdout.readline()      # scanning
