@@ -29,9 +29,9 @@ import threading
 import time
 import urllib.request
 
-from tmsim.net.server import SimServer
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer
+from tmsim.net.server import SimServer
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
@@ -342,7 +342,7 @@ def compare_with(directory: str, blocks: int = 16, reads: int = 150, count: int 
     servers = {"before": older_server(directory), "now": HmiServer}
 
     def ratio_line(what, figures):
-        ratios = sorted(n / b for n, b in zip(figures["now"], figures["before"]))
+        ratios = sorted(n / b for n, b in zip(figures["now"], figures["before"], strict=False))
         print(f"{what}: before {statistics.median(figures['before']):.3f} ms, now {statistics.median(figures['now']):.3f}"
               f" ms (medians of {blocks} blocks); now/before per block median {statistics.median(ratios):.3f}, "
               f"{ratios[0]:.3f} .. {ratios[-1]:.3f}")

@@ -12,8 +12,8 @@ import sys
 import tempfile
 import time
 
-from vplc.api import load_plc          
-from vplc.project import load_project  
+from vplc.api import load_plc
+from vplc.project import load_project
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -46,7 +46,7 @@ def per_scan_us(sources) -> float:
 
 def rung_xml(i: int, y: int) -> str:
     base = 10 + i * 10
-    cp = f'<connectionPointIn><connection refLocalId="{{}}"/></connectionPointIn>'
+    cp = '<connectionPointIn><connection refLocalId="{}"/></connectionPointIn>'
     return (f'<contact localId="{base + 1}"><position x="40" y="{y}"/>{cp.format(1)}<connectionPointOut/>'
             f'<variable>In{i % 50}</variable></contact>'
             f'<contact localId="{base + 2}" negated="true"><position x="140" y="{y}"/>{cp.format(base + 1)}'

@@ -18,8 +18,8 @@ import statistics
 import time
 from pathlib import Path
 
-from rig import ST, Rig, move_abs
 from latency import ORDERS, execute_to_socket, reply_to_done, scan, sustained
+from rig import ST, Rig, move_abs
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -11,9 +11,10 @@ import tempfile
 import threading
 import time
 
-from vplc.api import load_plc          
-import engine_compare                  
-from vplc.runtime.stats import ScanStats, percentile 
+import engine_compare
+
+from vplc.api import load_plc
+from vplc.runtime.stats import ScanStats, percentile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

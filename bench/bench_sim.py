@@ -24,8 +24,8 @@ import subprocess
 import sys
 import time
 
-from tmsim.protocol import codec
 from tmsim.net.server import SimServer
+from tmsim.protocol import codec
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 

@@ -18,8 +18,8 @@ import subprocess
 import sys
 import time
 
-from tmsim.protocol import codec
 from tmsim.net.server import SimServer
+from tmsim.protocol import codec
 from tmsim.protocol.svr_session import DEFAULT_STREAM
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

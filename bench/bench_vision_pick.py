@@ -10,7 +10,7 @@ the cell's figures are the mean and the largest scan from Start to Done.
 """
 import statistics
 
-from test_vision_pick import PARTS, SEC, Cell   # the test's cell: simulator, camera, table (make bench finds it)
+from test_vision_pick import PARTS, SEC, Cell  # the test's cell: simulator, camera, table (make bench finds it)
 
 
 def per_scan(cell, pred, seconds):

@@ -7,13 +7,13 @@ digest of every variable it can read after every scan: the results must be ident
 """
 from __future__ import annotations
 
+import io
 import json
 import os
 import subprocess
 import sys
 import tarfile
 import tempfile
-import io
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

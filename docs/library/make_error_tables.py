@@ -58,7 +58,7 @@ def load(path: Path = TABLE) -> dict[str, dict[str, str]]:
         where = f"{path.name}:{number}"
         if len(fields) != len(COLUMNS):
             raise TableError(f"{where}: {len(fields)} fields, expected {len(COLUMNS)} separated by tabs")
-        row = dict(zip(COLUMNS, (f.strip() for f in fields)))
+        row = dict(zip(COLUMNS, (f.strip() for f in fields), strict=False))
         code = row["id"]
         if not ID.fullmatch(code) or code[3] not in LAYERS:
             raise TableError(f"{where}: id {code!r} is not 16#1xxx..16#4xxx with four upper-case hex digits")

@@ -6,8 +6,9 @@ FB page, drawn from that page's own "## Example" program, plus the blended and e
 import re
 from pathlib import Path
 
-from rig import LIB, SEC, Rig, move_abs
 from doc_steps import STEPS, example_of, on_simulator, simulator
+from rig import LIB, SEC, Rig, move_abs
+
 from vplc.api import PathError, load_plc
 from vplc.trace.recorder import Recorder, write_trace
 

@@ -47,7 +47,7 @@ def load(path: Path = TABLE) -> dict[str, dict[str, str]]:
         fields = line.split("\t")
         if len(fields) != len(COLUMNS):
             raise TableError(f"{where}: {len(fields)} fields, expected {len(COLUMNS)} separated by tabs")
-        row = dict(zip(COLUMNS, (f.strip() for f in fields)))
+        row = dict(zip(COLUMNS, (f.strip() for f in fields), strict=False))
         code, name = row["code"], row["name"]
         if not CODE.fullmatch(code):
             raise TableError(f"{where}: code {code!r} is not ST followed by four digits")

@@ -18,11 +18,11 @@ import socket
 import sys
 import threading
 
-from tmsim.net.control import robot_numbering
-from tmsim.net.server import SimServer
 from cbt_hmi.web.mapping import Mapping, MappingError
 from cbt_hmi.web.pagedesc import load_pages, program_table
 from cbt_hmi.web.server import HmiServer
+from tmsim.net.control import robot_numbering
+from tmsim.net.server import SimServer
 
 LIBRARY, EXAMPLES = pathlib.Path("lib", "CBT_Commands_Lib"), pathlib.Path("examples")
 CONTROL_HOST = "127.0.0.1"     # the simulator's control channel stays on loopback whatever --host says

@@ -25,12 +25,12 @@ import sys
 import threading
 
 from tmsim.limits import NODE_TIMEOUT_MAX_S, SPEEDUP_MAX
-from tmsim.robot.camera import Camera, camera_of, parse_option
 from tmsim.net.control import robot_numbering
-from tmsim.tmscript.profiles import STOP_TAGS, VERSIONS, Profile
 from tmsim.net.server import SimServer
 from tmsim.protocol.svr_session import DEFAULT_STREAM
 from tmsim.protocol.svr_table import ITEMS, SvrValueError, parse_variable
+from tmsim.robot.camera import Camera, camera_of, parse_option
+from tmsim.tmscript.profiles import STOP_TAGS, VERSIONS, Profile
 
 SVR_FORMATS = {"binary": 1, "string": 2, "json": 3}
 
@@ -145,7 +145,7 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
             problems.append(f"{flag} must be 0 (none) to {NODE_TIMEOUT_MAX_S:g} seconds (got {value:g})")
     svr_port = None if args.no_svr else args.port + args.robots if args.svr_port is None and args.port else \
         (args.svr_port or 0)
-    if svr_port is not None and not (0 <= svr_port and (not svr_port or svr_port + args.robots - 1 <= 65535)):
+    if svr_port is not None and not (svr_port >= 0 and (not svr_port or svr_port + args.robots - 1 <= 65535)):
         if args.svr_port is not None:
             problems.append(f"--svr-port {svr_port} with {args.robots} robot(s) leaves the port range 1..65535")
         else:

@@ -14,8 +14,8 @@ import time
 from collections import OrderedDict
 from dataclasses import dataclass
 
-from .frontend import types as T
 from .compiler.codegen import CodeGen
+from .frontend import types as T
 from .runtime import abi, sysmac_system
 from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
@@ -66,7 +66,7 @@ def parse_task(task: str) -> tuple[str, int]:
 
 def load_plc(paths, task: str = "Main@1ms", programs=None, *, dialect: str = "sysmac",
              watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
-             count_statements: bool = False, clock_base_ns: int | None = None, axes=None) -> "Plc":
+             count_statements: bool = False, clock_base_ns: int | None = None, axes=None) -> Plc:
     """A new PLC instance (its own variables, tasks and sockets) running the compiled ``paths``; ``axes``: the
     axis configuration file of its virtual servo axes (docs/toolchain/runtime_sysmac.md section 5)."""
     program = compile_program(paths, dialect=dialect, count_statements=count_statements)

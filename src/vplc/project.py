@@ -5,14 +5,15 @@ import gc
 import os
 from dataclasses import dataclass, field
 
-from .frontend import ast as A
-from .frontend import codes
-from .frontend import types as T
-from .checker import calls, portable as portable_rule, recursion
+from .checker import calls, recursion
+from .checker import portable as portable_rule
 from .checker.body import BodyChecker
 from .checker.declare import Declarer
 from .checker.scope import Ambiguous, Tables
-from .frontend.diagnostics import DiagnosticBag, Diagnostic, render_all, sort_key
+from .frontend import ast as A
+from .frontend import codes
+from .frontend import types as T
+from .frontend.diagnostics import Diagnostic, DiagnosticBag, render_all, sort_key
 from .frontend.parser import parse
 from .frontend.source import SourceFile, Span
 from .ladder.load import attach_ladders, check_operands, is_project_xml, is_xml, read_xml

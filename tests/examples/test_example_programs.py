@@ -4,8 +4,8 @@ Pause/Resume and clean end (stop, fault and recovery of the PnP cycle: test_pnp_
 from __future__ import annotations
 
 import pytest
-
 from pnp_plant import SECOND, SOURCES, Plant
+
 from cbt_hmi.web.mapping import Mapping
 from vplc.project import load_project
 

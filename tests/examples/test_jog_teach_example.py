@@ -5,7 +5,6 @@ position into the examples' TeachTable."""
 from __future__ import annotations
 
 import pytest
-
 from pnp_plant import Plant
 
 SEC = 1_000_000_000

@@ -187,8 +187,8 @@ def test_taken_port_names_the_process_that_holds_it(busy_port):
 def test_robot_side_events_print_one_console_line_each():
     """The demo prints one line per robot-side event: a robot error, the project stopped and started, the flow
     leaving and entering the Listen node, a stick button pressed through the Ethernet Slave."""
-    from tmsim.net.server import SimServer
     from cbt_hmi.demo import robot_event_line
+    from tmsim.net.server import SimServer
 
     sim = SimServer(port=0, robots=1, svr_port=0)
     sim.start()

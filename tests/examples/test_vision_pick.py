@@ -16,9 +16,9 @@ import pathlib
 
 import pytest
 
+from tmsim.net.server import SimServer
 from tmsim.robot import kinematics as kin
 from tmsim.robot.camera import camera_of
-from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -62,8 +62,8 @@ class Cell:
             tcp = kin.pose_to_matrix(self.model.tcp_pose_robot())
             for part in self.table:
                 at_part = kin.matmul(kin.pose_to_matrix(part), kin.pose_to_matrix(GRIP))
-                if all(math.isclose(a, b, abs_tol=0.5) for row_a, row_b in zip(tcp, at_part)
-                       for a, b in zip(row_a, row_b)):
+                if all(math.isclose(a, b, abs_tol=0.5) for row_a, row_b in zip(tcp, at_part, strict=False)
+                       for a, b in zip(row_a, row_b, strict=False)):
                     self.holding = part
                     self.table.remove(part)
                     self.gripped.append(part)
@@ -172,7 +172,7 @@ def run_at(override):
 def test_override_50_doubles_the_time_of_every_motion_in_the_simulators_log():
     full, half = run_at(100), run_at(50)
     assert len(full) == len(half) == 3 * 4                          # approach, down, up, drop per part
-    for (target, seconds), (target_half, seconds_half) in zip(full, half):
+    for (target, seconds), (target_half, seconds_half) in zip(full, half, strict=False):
         assert list(target) == pytest.approx(list(target_half), abs=1e-6)       # the same path
         assert seconds_half == pytest.approx(2 * seconds, abs=2 * SCAN_S), (target, seconds, seconds_half)
 

@@ -46,7 +46,7 @@ class Browser:
             "return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
         self.driver.set_window_size(800 + dw, 480 + dh)
 
-    def fresh(self) -> "Browser":
+    def fresh(self) -> Browser:
         """The same Chromium with a new tab in place of the old one: no page, no sessionStorage (access key, alarm
         list) left by the tests that used it before."""
         old = self.driver.current_window_handle

@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 import pytest
-from selenium.common.exceptions import WebDriverException
-
 from browser import Browser
 from fake_plc import FakePlc, command_program, scanning, serving
 from hmi_http import Client
+from selenium.common.exceptions import WebDriverException
+
 from cbt_hmi.web.mapping import Mapping
 
 

@@ -2,7 +2,6 @@
 at least 4.5:1 between a control's text and the background it stands on."""
 from __future__ import annotations
 
-
 CONTROL_METRICS = """
     const lum = (c) => { const v = c.match(/[\\d.]+/g).slice(0, 3).map(Number).map((x) => x / 255)
       .map((x) => (x <= 0.03928 ? x / 12.92 : ((x + 0.055) / 1.055) ** 2.4)); return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; };

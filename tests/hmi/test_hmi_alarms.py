@@ -5,8 +5,8 @@ details; it returns to normal when Play has restarted the project; a link outage
 connected again, however many reconnect attempts it takes; a robot that left its Listen node is an alarm, the
 header says so, and Back to Listen Node on Main brings it back through CBT_ProjectControl."""
 import pytest
-from selenium.webdriver.common.by import By
 from hmi_system import System
+from selenium.webdriver.common.by import By
 
 
 @pytest.fixture(scope="module")

@@ -12,13 +12,13 @@ import urllib.error
 import urllib.request
 
 import pytest
-
 from browser import chromium_paths
 from panel_metrics import page_metrics
-from vplc.api import load_plc
+
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.pagedesc import load_pages, program_table
 from cbt_hmi.web.server import HmiServer
+from vplc.api import load_plc
 
 CELL = pathlib.Path(__file__).resolve().parent / "user_cell"
 

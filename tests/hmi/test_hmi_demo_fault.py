@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import socket
 
-from cbt_hmi.demo import Demo
 from hmi_http import Client
+
+from cbt_hmi.demo import Demo
 from vplc.api import PlcFault
 
 

@@ -8,11 +8,9 @@ from __future__ import annotations
 import time
 
 import pytest
-from selenium.webdriver.common.by import By
-
 from browser import Browser
-
 from hmi_system import DWELL_NS, MOVE_WAIT_S, System
+from selenium.webdriver.common.by import By
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +71,7 @@ def test_main_page_shows_the_live_tcp_position(connected):
 def test_move_absolute_page_moves_the_robot_to_the_entered_target(connected):
     browser = connected.open("moveabs")
     browser.click("btn-preset")
-    for axis, value in zip(("X", "Y", "Z"), ("380", "-50", "420")):
+    for axis, value in zip(("X", "Y", "Z"), ("380", "-50", "420"), strict=False):
         browser.type_into(f"MoveAbs_Param.TargetPosition.{axis}", value)
     since = connected.event_count()
     execute_and_wait_done(connected, browser, "MoveAbs")
@@ -143,7 +141,7 @@ def test_digital_output_page_switches_the_gripper_output(connected):
 def test_stop_page_stops_a_running_move_and_aborts_it(connected):
     browser = connected.open("moveabs")
     browser.click("btn-preset")       # 1 %: the move still runs when the stop arrives, even on a loaded machine
-    for axis, value in zip(("X", "Y", "Z", "Speed"), ("300", "250", "300", "1")):
+    for axis, value in zip(("X", "Y", "Z", "Speed"), ("300", "250", "300", "1"), strict=False):
         browser.type_into(f"MoveAbs_Param.{'' if axis == 'Speed' else 'TargetPosition.'}{axis}", value)
     browser.click("btn-execute")
     connected.wait(lambda: connected.robot_state()["moving"], "the slow move to start")

@@ -12,10 +12,10 @@ import pytest
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 
-from tmsim.net.server import SimServer
-from vplc.api import load_plc
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer
+from tmsim.net.server import SimServer
+from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]

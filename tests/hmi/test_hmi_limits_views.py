@@ -7,11 +7,11 @@ import json
 import math
 
 import pytest
+from browser import ROOT, Browser
+from fake_plc import FakePlc, command_program, scanning, serving
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
-from browser import ROOT, Browser
-from fake_plc import FakePlc, command_program, scanning, serving
 from cbt_hmi.web.mapping import Mapping
 
 TCP = {"X": 400.0, "Y": 0.0, "Z": 400.0, "RX": 180.0, "RY": 0.0, "RZ": 90.0}
@@ -74,7 +74,7 @@ def test_a_value_refused_for_one_format_is_sent_for_another(page):
     assert "Speed: 150 is out of range 1..100 % (the FB would refuse it with 16#1013)" in b.message()
     assert plc.writes == []
     select(b, "MoveAbs_Param.DataFormat", "CAP_Abs")
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 180, 0, 90)):   # a target it can reach
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 180, 0, 90), strict=False):   # a target it can reach
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     b.click("btn-execute")
     b.wait_for(lambda d: ("MoveAbs_Execute", True) in plc.writes, "the command to be sent")
@@ -143,7 +143,7 @@ def test_move_absolute_previews_the_entered_target_before_execute(page):
     b = open_page("moveabs")
     select(b, "MoveAbs_Param.MovementCommand", "PTP")
     select(b, "MoveAbs_Param.DataFormat", "CPP_Abs")
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, -150, 250, 180, 0, 90)):
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, -150, 250, 180, 0, 90), strict=False):
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     path = preview_path(b)
     assert path[0] == [400, 0, 400] and path[-1] == [350, -150, 250]
@@ -171,7 +171,7 @@ def test_move_circle_preview_is_the_arc_through_the_arc_point(page):
     _, _, open_page = page
     b = open_page("movecircle")
     for prefix, (x, y) in (("ArcPoint", (450, 50)), ("EndPoint", (400, 100))):
-        for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (x, y, 400, 180, 0, 90)):
+        for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (x, y, 400, 180, 0, 90), strict=False):
             b.type_into(f"MoveCircle_Param.{prefix}.{axis}", str(value))
     path = preview_path(b)
     assert path[0] == pytest.approx([400, 0, 400]) and path[-1] == pytest.approx([400, 100, 400])

@@ -4,10 +4,10 @@ from __future__ import annotations
 import threading
 
 import pytest
+from fake_plc import FakePlc, command_program
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
-from fake_plc import FakePlc, command_program
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer
 
@@ -157,7 +157,7 @@ def test_alarm_list_shows_five_whole_rows_without_a_horizontal_scrollbar(page):
     texts = ["No reply from the robot within ReplyTimeout: check the robot before repeating the command",
              "Malformed frame received from the robot (skipped): check the network between PLC and robot"] * 3
     try:
-        for n, (error_id, text) in enumerate(zip(ids, texts), 1):
+        for n, (error_id, text) in enumerate(zip(ids, texts, strict=False), 1):
             with plc.lock:
                 plc.vars.update(MoveAbs_Error=True, MoveAbs_ErrorID=error_id, MoveAbs_ErrorDescrip=text)
             browser.wait_for(lambda d, n=n: len(browser.alarm_rows()) == n, f"alarm {n} in the list")

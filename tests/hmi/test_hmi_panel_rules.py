@@ -5,9 +5,9 @@ The screenshots go to artifacts/screenshots/panel_<page>_<role>_<size>.png."""
 from __future__ import annotations
 
 import pytest
-
 from fake_plc import FakePlc, command_program, scanning, serving
 from panel_metrics import page_metrics
+
 from cbt_hmi.web.mapping import Mapping
 
 PAGES = ["index", "connect", "changebase", "changetcp", "moverel", "moveabs", "movecircle", "setoutput", "stop",
@@ -102,8 +102,9 @@ def ladder_stack(chromium):
     """The Program page needs the real ladder example: the examples on the virtual PLC (no robot needed)."""
     import pathlib
     import threading
-    from vplc.api import load_plc
+
     from cbt_hmi.web.server import HmiServer
+    from vplc.api import load_plc
     root = pathlib.Path(__file__).resolve().parents[2]
     plc = load_plc([str(root / "lib" / "CBT_Commands_Lib"), str(root / "examples")])
     stop = threading.Event()

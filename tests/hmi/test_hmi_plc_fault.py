@@ -9,12 +9,12 @@ from __future__ import annotations
 import types
 
 import pytest
-
 from fake_plc import FakePlc, command_program, scanning, serving
 from hmi_http import Client
-from vplc.api import PlcFault, load_plc
+
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer
+from vplc.api import PlcFault, load_plc
 
 FAULT = "examples/PnP_Example.st:57: major fault in PnP_Example: integer division by zero (100 / 0)"
 

@@ -7,16 +7,16 @@ import pathlib
 import threading
 
 import pytest
-from selenium.webdriver.common.by import By
-from selenium.webdriver.support.ui import Select
-
 from browser import chromium_paths
 from hmi_http import Client
 from panel_metrics import check_controls
-from tmsim.net.server import SimServer
-from vplc.api import load_plc
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import Select
+
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer
+from tmsim.net.server import SimServer
+from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]

@@ -5,18 +5,17 @@ joints have their own limits, the scale is fixed (zoom buttons, labelled grid) a
 from __future__ import annotations
 
 import json
-import math
 import random
 
 import pytest
-from selenium.webdriver.common.by import By
-from selenium.webdriver.support.ui import Select
-
 from browser import ROOT
 from fake_plc import FakePlc, command_program, scanning, serving
 from panel_metrics import check_controls
-from tmsim.robot import kinematics
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import Select
+
 from cbt_hmi.web.mapping import Mapping
+from tmsim.robot import kinematics
 
 ARM = json.loads((ROOT / "src" / "cbt_hmi" / "pages" / "tm5_700.json").read_text(encoding="utf-8"))
 TCP = [400.0, 0.0, 400.0, 180.0, 0.0, 90.0]
@@ -50,7 +49,7 @@ def page(stack):
     with plc.lock:
         plc.writes.clear()
         plc.vars["ReadPos_Valid"] = True
-        plc.vars["ReadPos_Position"]["TCP"].update(dict(zip(("X", "Y", "Z", "RX", "RY", "RZ"), TCP)))
+        plc.vars["ReadPos_Position"]["TCP"].update(dict(zip(("X", "Y", "Z", "RX", "RY", "RZ"), TCP, strict=False)))
         plc.vars["ReadPos_Position"]["Joints"] = list(JOINTS)
 
     def open_page(name: str, size=(800, 480)):
@@ -120,7 +119,7 @@ def test_an_unreachable_target_is_previewed_in_red_and_refused_with_its_reason(p
     Select(b.field("MoveAbs_Param.MovementCommand")).select_by_visible_text("PTP")
     Select(b.field("MoveAbs_Param.DataFormat")).select_by_visible_text("CPP_Abs")
     b.type_into("MoveAbs_Param.Speed", "10")
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (2000, 0, 300, 180, 0, 90)):
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (2000, 0, 300, 180, 0, 90), strict=False):
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     b.wait_for(lambda _d: js(b, "return !!(VIEW.preview && VIEW.preview.refused)"), "the refused preview")
     refused_red = red_pixels(b, "view-top")
@@ -152,13 +151,13 @@ def test_joints_and_angles_have_their_own_limits(page):
     assert labels == ["J1", "J2", "J3", "J4", "J5", "J6"]
     legend = b.driver.find_element(By.CSS_SELECTOR, 'fieldset.pose[data-member="TargetPosition"] legend').text
     assert "±270 ±180 ±155 ±180 ±180 ±270" in legend
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (0, 0, 170, 0, 90, 0)):
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (0, 0, 170, 0, 90, 0), strict=False):
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     b.click("btn-execute")
     b.wait_for(lambda _d: "nothing was sent" in b.message(), "the refusal")
     assert b.message() == "Target Position J3: 170° is out of range -155..155° for the TM5-700 — nothing was sent."
     Select(b.field("MoveAbs_Param.DataFormat")).select_by_visible_text("CPP_Abs")
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 400, 0, 90)):
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 400, 0, 90), strict=False):
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     assert "RX RY RZ ±360°" in b.driver.find_element(By.CSS_SELECTOR, 'fieldset.pose[data-member="TargetPosition"] legend').text
     b.click("btn-execute")
@@ -176,7 +175,7 @@ def test_fixed_scale_zoom_buttons_labelled_grid_and_the_arm(page, size):
     assert span() == pytest.approx(1800)                        # mm across the narrower side at 1x
     Select(b.field("MoveAbs_Param.MovementCommand")).select_by_visible_text("PTP")
     Select(b.field("MoveAbs_Param.DataFormat")).select_by_visible_text("CPP_Abs")
-    for axis, value in zip(("Y", "Z", "RX", "RY", "RZ"), (0, 300, 180, 0, 90)):
+    for axis, value in zip(("Y", "Z", "RX", "RY", "RZ"), (0, 300, 180, 0, 90), strict=False):
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     b.type_into("MoveAbs_Param.TargetPosition.X", "650")        # typing does not re-zoom the view
     b.wait_for(lambda _d: js(b, "return !!VIEW.preview && !!VIEW.preview.path"), "the preview")
@@ -197,7 +196,7 @@ def test_fixed_scale_zoom_buttons_labelled_grid_and_the_arm(page, size):
     frames = kinematics._frames(JOINTS)
     side = b.driver.find_element(By.ID, "view-side")
     s, w, h = scale(), side.get_attribute("width"), side.get_attribute("height")
-    for (px, py), f in zip(arm[1:7], frames[1:]):                 # drawn where the simulator puts the joints (Y-Z)
+    for (px, py), f in zip(arm[1:7], frames[1:], strict=False):                 # drawn where the simulator puts the joints (Y-Z)
         assert px == pytest.approx(int(w) / 2 + f[1][3] * s, abs=1) and py == pytest.approx(int(h) / 2 - (f[2][3] - 350) * s, abs=1)
     font = js(b, "return parseFloat(getComputedStyle(document.querySelector('.viewfoot')).fontSize)")
     assert font >= 14
@@ -254,7 +253,7 @@ def test_move_relative_and_a_pnp_segment_are_refused_out_of_reach(page):
     Select(b.field("MoveRel_Param.MovementCommand")).select_by_visible_text("Line")
     Select(b.field("MoveRel_Param.DataFormat")).select_by_visible_text("CPP_Rel")
     b.type_into("MoveRel_Param.Speed", "10")
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (900, 0, 0, 0, 0, 0)):   # 400 + 900 mm along X
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (900, 0, 0, 0, 0, 0), strict=False):   # 400 + 900 mm along X
         b.type_into(f"MoveRel_Param.TargetPosition.{axis}", str(value))
     b.wait_for(lambda _d: js(b, "return !!(VIEW.preview && VIEW.preview.refused)"), "the refused preview")
     b.click("btn-execute")

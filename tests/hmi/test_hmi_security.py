@@ -14,9 +14,9 @@ import socket
 import threading
 
 import pytest
-
 from fake_plc import FakePlc, command_program, serving
 from hmi_http import Client
+
 from cbt_hmi.web import front
 from cbt_hmi.web import server as hmi_server
 from cbt_hmi.web.server import HmiServer  # noqa: E402

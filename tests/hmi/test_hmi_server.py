@@ -4,9 +4,9 @@ from __future__ import annotations
 import json
 
 import pytest
-
 from fake_plc import FakePlc
 from hmi_http import Client
+
 from cbt_hmi.web.mapping import Mapping, MappingError
 from cbt_hmi.web.server import MAX_BODY, HmiServer
 
@@ -147,7 +147,7 @@ def test_execute_edge_is_seen_by_the_task_even_when_scans_skip_it(client, fake_p
         status, answer = client.json("/api/execute", {"execute": "ProgramControl_Execute"})
         assert status == 200 and answer["ok"] is True
     seen.append(fake_plc.vars["ProgramControl_Execute"])
-    edges = sum(1 for before, after in zip(seen, seen[1:]) if after and not before)
+    edges = sum(1 for before, after in zip(seen, seen[1:], strict=False) if after and not before)
     assert edges == 20, "every Execute request must reach the program as its own rising edge"
 
 

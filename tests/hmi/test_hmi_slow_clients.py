@@ -14,9 +14,9 @@ import socket
 import threading
 
 import pytest
-
 from fake_plc import FakePlc, command_program, scanning
 from hmi_http import Client
+
 from cbt_hmi.web.front import MAX_HEAD, HttpLimits
 from cbt_hmi.web.mapping import Mapping
 from cbt_hmi.web.server import HmiServer

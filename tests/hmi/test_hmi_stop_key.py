@@ -62,7 +62,7 @@ def start_slow_move(system):
     """A 1 % move as the engineer sets it up, so it still runs when the stop arrives."""
     browser = system.open("moveabs")
     browser.click("btn-preset")
-    for axis, value in zip(("X", "Y", "Z", "Speed"), ("300", "250", "300", "1")):
+    for axis, value in zip(("X", "Y", "Z", "Speed"), ("300", "250", "300", "1"), strict=False):
         browser.type_into(f"MoveAbs_Param.{'' if axis == 'Speed' else 'TargetPosition.'}{axis}", value)
     browser.click("btn-execute")
     system.wait(lambda: system.robot_state()["moving"], "the slow move to start")

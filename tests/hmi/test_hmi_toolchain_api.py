@@ -20,7 +20,7 @@ def test_the_integer_ranges_are_the_iec_ones_and_the_hmi_has_no_copy():
     expected = {name: (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if name in ("SINT", "INT", "DINT", "LINT")
                 else (0, (1 << bits) - 1) for name, bits in WIDTHS.items()}
     assert integer_ranges() == expected
-    assert INT_RANGES == expected
+    assert expected == INT_RANGES
 
 
 @pytest.mark.parametrize("type_name,value,accepted", [("INT", 32767, True), ("INT", 32768, False),

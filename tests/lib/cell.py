@@ -1,7 +1,6 @@
 """Shared fixture of the issue 26 tests (CBT_ReadIO, CBT_SetOverride, CBT_WaitQueue, motion status): one robot with
 its Ethernet Slave, tests/lib/st/Main_Cell.st connected, CBT_RobotStatus and CBT_ReadIO enabled and Valid."""
 import pytest
-
 from rig import Rig
 
 

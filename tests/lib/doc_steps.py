@@ -5,6 +5,7 @@ taken from a page."""
 import re
 
 from rig import ROOT
+
 from tmsim.net.server import SimServer
 from tmsim.protocol.svr_table import parse_variable
 from tmsim.robot.camera import camera_of

@@ -6,7 +6,6 @@ Busy -> Active -> Done. Buffered (the default) sends what it always sent."""
 import itertools
 
 import pytest
-
 from rig import Rig, circ, move_abs, rel
 
 FAR = dict(X=90, Y=0, Z=90, RX=0, RY=90, RZ=0)

@@ -5,7 +5,6 @@ Studio take only literals as bounds, and a Sysmac library has no global constant
 import re
 
 import pytest
-
 from rig import LIB, ROOT
 
 COMMENT = re.compile(r"\(\*.*?\*\)|//[^\n]*|'(?:\$.|[^'$])*'", re.S)     # comments and texts

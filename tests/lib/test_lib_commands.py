@@ -1,7 +1,6 @@
 """CBT_MoveRelative, CBT_MoveCircle, CBT_ChangeBase, CBT_ChangeTCP, CBT_ProgramControl, CBT_Stop,
 CBT_ReadActualPosition: normal end, script sent, parameter errors."""
 import pytest
-
 from rig import circ, move_abs, rel, run
 
 

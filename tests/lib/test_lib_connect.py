@@ -1,6 +1,5 @@
 """CBT_Connect: connection, identification, retries, supervision and loss."""
 import pytest
-
 from rig import Rig
 
 

@@ -6,10 +6,11 @@ from __future__ import annotations
 import re
 
 import pytest
-
 from doc_steps import DOCS, STEPS, example_of, on_simulator, simulator
 from rig import LIB, SEC
+
 from vplc.api import load_plc
+
 
 def test_every_fb_page_has_a_runnable_example():
     pages = {p.stem for p in DOCS.glob("CBT_*.md")}

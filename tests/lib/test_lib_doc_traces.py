@@ -7,7 +7,6 @@ import importlib.util
 import re
 
 import pytest
-
 from doc_steps import STEPS
 from rig import ROOT
 

@@ -4,7 +4,6 @@ there with a raw write, as an HMI or a memory copy can on the controller). A pos
 read (the simulator's corrupt_checksum fault makes the library drop one of the two ListenSend frames) is not an
 error: it is dropped and counted."""
 import pytest
-
 from rig import move_abs
 
 TEXT = {

@@ -7,11 +7,10 @@ import subprocess
 import sys
 
 import pytest
-
 from rig import LIB, ROOT
-from vplc.api import load_plc
 
 from docs.library import make_error_tables as tables
+from vplc.api import load_plc
 
 LITERAL = re.compile(r"WORD#16#([0-9A-Fa-f]{1,4})\b")
 NAMED = re.compile(r"\bErr[A-Z][A-Za-z0-9]*")

@@ -1,7 +1,6 @@
 """The robot's Ethernet Slave as the library's second channel (issue 14): status, project control and the actual
 position from the streamed data table, on the virtual PLC against the simulator's Ethernet Slave over loopback."""
 import pytest
-
 from rig import Rig, move_abs
 
 UNREACHABLE = dict(X=1900.0, Y=0.0, Z=300.0, RX=180.0, RY=0.0, RZ=90.0)

@@ -1,7 +1,6 @@
 """Fault matrix from the simulator's injection list: each ends in the documented state within its timeout,
 no FB stays Busy, and the event log shows no script executed twice or lost."""
 import pytest
-
 from rig import move_abs
 
 
@@ -208,6 +207,7 @@ def test_queue_tag_unknown_to_robot_ends_waiting_motion(rig):
 
 def test_peer_that_is_not_a_tm_robot_is_refused_after_time_out():
     import socket
+
     from rig import Rig
     r = Rig(connect=False)
     silent = socket.socket()

@@ -11,7 +11,6 @@ import math
 import sys
 
 import pytest
-
 from rig import ROOT, SEC, Rig, move_abs
 
 DOCS = ROOT / "docs" / "library"
@@ -248,7 +247,7 @@ def test_teach_stores_the_actual_position_and_a_move_goes_back_to_it(svr):
         rig.until(lambda: False, 0.2)
         release_and_wait(rig)
         assert tcp(rig)[1] != pytest.approx(pose[1], abs=1.0)
-        target = dict(zip(("X", "Y", "Z", "RX", "RY", "RZ"), pose))
+        target = dict(zip(("X", "Y", "Z", "RX", "RY", "RZ"), pose, strict=False))
         rig.set_struct("MoveParam", move_abs(MovementCommand=0, DataFormat=1, TargetPosition=target))
         rig.write("MoveExec", True)
         assert rig.until(lambda: rig.read("mover.Done") or rig.read("mover.Error"), 5)

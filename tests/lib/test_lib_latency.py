@@ -1,8 +1,7 @@
 """Latency in scans (issue 6) in both call orders, and the fast order (CBT_Connect before and after the
 command FBs) working like the documented one. Figures and their proof: docs/library/design.md, "Latency"."""
-import pytest
-
 import latency as L
+import pytest
 from rig import Rig, move_abs
 
 

@@ -1,6 +1,5 @@
 """CBT_MoveAbsolute: normal ends, completion semantics, timing-chart rules, every parameter ErrorID."""
 import pytest
-
 from rig import move_abs
 
 

@@ -1,8 +1,8 @@
 """32 robots from one program, each with its own stCBT_Connection, independent of each other."""
+from rig import LIB, SEC, ST
+
 from tmsim.net.server import SimServer
 from vplc.api import load_plc
-
-from rig import LIB, SEC, ST
 
 
 def test_thirty_two_robots_move_independently():

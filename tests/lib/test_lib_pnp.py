@@ -1,6 +1,5 @@
 """A pick-and-place run of 1,000 motions loses nothing and executes nothing twice."""
 import pytest
-
 from rig import Rig
 
 

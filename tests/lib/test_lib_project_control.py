@@ -4,7 +4,6 @@ virtual time over loopback — the robot's status codes of TMscript 2.24 §17.4.
 the FB's ErrorID and ErrorDescrip (the text of docs/library/errors.tsv) and nothing done to the project."""
 
 import pytest
-
 from rig import SEC, Rig
 
 from docs.library import make_error_tables as tables

@@ -2,8 +2,8 @@
 of the last four queue tags only): 16 motions in flight per robot, up to 4 robots, pushes lost to bad
 checksums, and a stop in the middle. Every mover ends exactly once; Done never before its motion ended."""
 import pytest
-
 from rig import LIB, SEC, ST
+
 from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
@@ -135,8 +135,9 @@ def test_a_stop_in_the_middle_aborts_exactly_the_motions_it_cleared(rig):
 def test_a_stop_the_library_did_not_send_ends_waiting_motions_with_4004_never_done(rig):
     """Another client clears the queue: the last four tags answer 'none' (not existed), and the older ones
     were reached or cleared - the library cannot tell which, so none of them reports Done."""
-    from tmsim.protocol import codec
     import socket
+
+    from tmsim.protocol import codec
     rig.plc.write("Main.Speed", 20)
     rig.start_all()
     assert rig.until(lambda: len(rig.motion_ends(1)) == 2, 30)

@@ -9,7 +9,6 @@ import struct
 import sys
 
 import pytest
-
 from rig import ROOT, Rig
 
 DOCS = ROOT / "docs" / "library"

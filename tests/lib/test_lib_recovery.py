@@ -2,9 +2,8 @@
 Error with its own ErrorID for at least one scan and then repaired by automatic reconnect attempts with the
 documented back-off (100 ms, 1 s, 2 s, then every 5 s); a command sent but not confirmed before the loss ends
 with 16#200B (outcome unknown), never as "failed". The simulator's event log is the witness."""
-from rig import SEC, Rig, move_abs
-
 import pytest
+from rig import SEC, Rig, move_abs
 
 
 def go(rig, k, rz, speed=50):
@@ -97,7 +96,7 @@ def test_back_off_between_refused_attempts_is_100ms_1s_2s_then_5s():
             if r.read("conn.RetryCount") > len(times):
                 times.append((now - lost) / SEC)
         assert r.until(lambda: len(times) >= 5, 20, on_scan=hook)
-        gaps = [round(b - a, 1) for a, b in zip(times, times[1:])]
+        gaps = [round(b - a, 1) for a, b in zip(times, times[1:], strict=False)]
         assert round(times[0], 1) == 0.1 and gaps == [1.0, 2.0, 5.0, 5.0], (times, gaps)
         assert r.read("conn.Error") or r.read("conn.Busy")
         assert r.read("conn.ErrorID") in (0, 0x2004)

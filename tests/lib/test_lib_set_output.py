@@ -1,9 +1,7 @@
 """CBT_SetOutput: queued and immediate digital outputs, completion on acceptance or when set, ordering with
 motions, parameter errors, abort by CBT_Stop."""
 import pytest
-
 from rig import move_abs, run
-
 
 LONG_MOVE = move_abs(BlendingEnable=True, BlendingValue=0, Speed=20,
                      TargetPosition=dict(X=90, Y=0, Z=90, RX=0, RY=90, RZ=0))      # J1 turns 90 deg: > 1 s

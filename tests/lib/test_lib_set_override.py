@@ -8,7 +8,6 @@ import importlib.util
 import sys
 
 import pytest
-
 from cell import svr  # noqa: F401 - the fixture
 from rig import ROOT, SEC, Rig, move_abs
 

@@ -3,8 +3,8 @@
 the A formats, sent as written, run by a TMflow 2.x robot; refused with 16#1027 (nothing sent) when the
 connection's RobotSoftware is TMflow1x, and a TMflow 1.8 robot would reject them (ERROR;1)."""
 import pytest
-
 from rig import Rig, circ, move_abs, rel, run
+
 from tmsim.tmscript.profiles import Profile
 
 LINE = dict(MovementCommand=0, TargetPosition=dict(X=417.5, Y=-122.3, Z=300, RX=180, RY=0, RZ=90))

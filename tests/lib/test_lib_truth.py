@@ -4,8 +4,8 @@ cause shows one ErrorID in every run, whatever the phase of the two channels."""
 import socket
 
 import pytest
-
 from rig import SEC, Rig, move_abs
+
 from tmsim.protocol import codec
 
 UNREACHABLE = dict(X=1900.0, Y=0.0, Z=300.0, RX=180.0, RY=0.0, RZ=90.0)

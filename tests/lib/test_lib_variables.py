@@ -6,8 +6,8 @@ and no Listen-node traffic."""
 import math
 
 import pytest
-
 from rig import Rig
+
 from tmsim.protocol import svr_table as table
 
 SPECS = ['g_count:int=5', 'g_ratio:float=0.5', 'g_ok:bool=true', 'g_name:string="Cell 1"',
@@ -251,6 +251,7 @@ def test_reader_writer_and_override_share_the_channel(var):
 def range_rows():
     import importlib.util
     import sys
+
     from rig import ROOT
     spec = importlib.util.spec_from_file_location("make_types", ROOT / "docs" / "library" / "make_types.py")
     module = importlib.util.module_from_spec(spec)

@@ -1,6 +1,5 @@
 """Fixtures of the simulator tests."""
 import pytest
-
 from session_rig import S
 from sim_harness import Harness
 

@@ -1,8 +1,9 @@
 """A Listen-node session of the simulator without sockets (sans-I/O), for the session-level tests of tests/sim:
 ``S`` connects clients, feeds them frames and returns what each received; time advances on a virtual clock."""
+from sim_harness import sct, sta  # noqa: F401  (the frames the session tests send)
+
 from tmsim.protocol import codec
 from tmsim.protocol.listen_session import ListenSession
-from sim_harness import sct, sta  # noqa: F401  (the frames the session tests send)
 
 PTP_LONG = 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)'   # 90 deg at 18 deg/s: 5.35 s
 

@@ -2,8 +2,8 @@
 import select
 import socket
 
-from tmsim.protocol import codec
 from tmsim.net.server import SimServer
+from tmsim.protocol import codec
 
 
 class Peer:

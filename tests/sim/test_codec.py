@@ -28,7 +28,7 @@ VECTORS = [
     b'$TMSCT,74,M2,Line("CAR",417.5,-122.3,343.9,180,0,90,100,200,50,false)\r\nQueueTag(2,1),*04\r\n',
     b"$TMSCT,10,M2,ERROR;1,*71\r\n", b"$TMSCT,24,P1,StopAndClearBuffer(0),*01\r\n",
     b"$TMSCT,15,X1,ScriptExit(),*3E\r\n", b"$TMSTA,3,00,,*6c\r\n",
-    '$TMSCT,20,7,string s = "Über",*39\r\n'.encode("utf-8"),
+    '$TMSCT,20,7,string s = "Über",*39\r\n'.encode(),
     b"$TMSCT,52,SCTpy0,PTP(\"JPP\",10,-10,10,-10,10,-10,10,200,0,true),*00\r\n",
     b"$TMSTA,5,01,03,*68\r\n",
 ]
@@ -138,7 +138,7 @@ def test_data_may_contain_dollar_star_comma_and_crlf():
 
 def test_length_counts_utf8_bytes():
     raw = codec.encode("TMSCT", '7,string s = "Über"')
-    assert raw == '$TMSCT,20,7,string s = "Über",*39\r\n'.encode("utf-8")
+    assert raw == '$TMSCT,20,7,string s = "Über",*39\r\n'.encode()
 
 
 def test_manual_13_3_queue_tag_example_is_172_bytes_with_checksum_49():

@@ -4,13 +4,13 @@ stick buttons acting on the project and the Listen node."""
 import json
 
 import pytest
+from sim_harness import Harness, sct, sta
+from svr_client import ask, svr, values
 
+from tmsim.net.server import SimServer
 from tmsim.protocol import codec
 from tmsim.protocol import svr_table as table
 from tmsim.protocol.svr_table import ITEMS
-from tmsim.net.server import SimServer
-from sim_harness import Harness, sct, sta
-from svr_client import ask, svr, values
 
 
 @pytest.fixture

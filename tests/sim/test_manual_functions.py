@@ -3,11 +3,11 @@
 priority commands take a literal argument only - a packet with StopAndClearBuffer(var) is invalid
 (ERROR;line) and nothing of it runs."""
 import pytest
+from session_rig import PTP_LONG, S, sct
 
 from tmsim.protocol import codec
 from tmsim.tmscript import functions as tmscript
 from tmsim.tmscript.profiles import Profile
-from session_rig import PTP_LONG, S, sct
 
 
 def reply(ident, status):

@@ -6,8 +6,8 @@ input."""
 import json
 
 import pytest
-
 from sim_harness import Harness
+
 from tmsim.protocol import codec
 from tmsim.protocol.control import RequestError, decode_request, next_line
 

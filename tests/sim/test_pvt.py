@@ -1,9 +1,9 @@
 """PVT mode (PVTEnter / PVTPoint / PVTExit) as the official TM ROS drivers send it: one packet per trajectory,
 Hermite curves between the points, speed and reach checked, PVT mode ending on PVTExit or a stop."""
 import pytest
+from session_rig import S, sct
 
 from tmsim.robot.motion import hermite
-from session_rig import S, sct
 
 ROS_TRAJECTORY = ("PVTEnter(0)\r\n"
                   "PVTPoint(10,0,90,0,90,0,20,0,0,0,0,0,1)\r\n"

@@ -11,8 +11,8 @@ from pytmrobot import TMRobot  # noqa: E402
 from pytmrobot.exceptions import TMScriptError  # noqa: E402
 from pytmrobot.types import CartPoint, JointPoint  # noqa: E402
 
-from tmsim.tmscript.profiles import Profile  # noqa: E402
 from tmsim.net.server import SimServer  # noqa: E402
+from tmsim.tmscript.profiles import Profile  # noqa: E402
 
 
 def start(profile=None):

@@ -1,10 +1,10 @@
 """Queue tags as the TMscript 2.24 manual describes them (§13.1 QueueTag, §13.2 WaitQueueTag, §13.3
 CheckQueueTag): the last four tags only, 1 / 0 / -1 results, the no-argument wait, and what a stop does."""
 import pytest
+from session_rig import PTP_LONG, S, sct, sta
 
 from tmsim.protocol import codec
 from tmsim.tmscript.profiles import Profile
-from session_rig import PTP_LONG, S, sct, sta
 
 PTP_SHORT = 'PTP("JPP",0,0,90,0,90,10,100,200,0,false)'
 
@@ -30,7 +30,7 @@ def result_of(node, expr, wait=0.0):
 def status(node, tag):
     """TMSTA 01 answer for ``tag`` (true / false / none)."""
     reply = node.send(1, sta(f"01,{tag:02d}"))
-    assert len(reply) == 1 and reply[0].startswith(f"$TMSTA,") and f",01,{tag:02d}," in reply[0]
+    assert len(reply) == 1 and reply[0].startswith("$TMSTA,") and f",01,{tag:02d}," in reply[0]
     return reply[0].split(",")[4]
 
 

@@ -5,8 +5,8 @@ import random
 import pytest
 
 from tmsim.robot import kinematics as kin
-from tmsim.robot.motion import SETTLE_S, MotionRequest, rotation_angle, trapezoid_fraction, trapezoid_time
 from tmsim.robot.model import RobotModel
+from tmsim.robot.motion import SETTLE_S, MotionRequest, rotation_angle, trapezoid_fraction, trapezoid_time
 
 
 def req(function, fmt, target, speed=100, accel=200, blend=0, precise=False, **kw):
@@ -41,7 +41,7 @@ def test_short_move_uses_a_triangular_profile():
 def test_profile_fraction_is_monotonic_and_ends_at_one():
     values = [trapezoid_fraction(t / 100, 1.2, 0.2) for t in range(0, 121)]
     assert values[0] == 0 and values[-1] == pytest.approx(1.0)
-    assert all(b >= a for a, b in zip(values, values[1:]))
+    assert all(b >= a for a, b in zip(values, values[1:], strict=False))
 
 
 def test_line_in_mm_per_second_takes_distance_over_speed():

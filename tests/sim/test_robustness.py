@@ -3,11 +3,13 @@ import random
 import socket
 import time
 
+from sim_harness import Harness, sct, sta
+
+from tmsim.limits import FRAME_DATA_MAX
+from tmsim.limits import PENDING_SCRIPTS_MAX as MAX_PENDING
 from tmsim.protocol import codec
 from tmsim.tmscript.parser import split_lines
 from tmsim.tmscript.static_check import check_script
-from tmsim.limits import FRAME_DATA_MAX, PENDING_SCRIPTS_MAX as MAX_PENDING
-from sim_harness import Harness, sct, sta
 
 
 def alive(h):

@@ -1,8 +1,8 @@
 """Script parser and checker: ERROR;lines for exactly the offending lines, OK;lines for warnings."""
 import pytest
 
-from tmsim.tmscript.static_check import check_script
 from tmsim.tmscript.parser import Call, Decl, split_lines
+from tmsim.tmscript.static_check import check_script
 
 
 def check(script, variables=None):

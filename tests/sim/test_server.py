@@ -1,17 +1,16 @@
 """SimServer over real loopback sockets, driven by poll() on a virtual clock (no sleeps)."""
 import json
+import pathlib
 import socket
 import subprocess
 import sys
-import pathlib
 
 import pytest
+from sim_harness import Harness, sct, sta
 
-from tmsim.protocol import codec
 from tmsim.net.control import request as control_request
 from tmsim.net.server import SimServer
-
-from sim_harness import Harness, sct, sta
+from tmsim.protocol import codec
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PTP_LONG = 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)'

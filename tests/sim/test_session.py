@@ -2,12 +2,21 @@
 import struct
 
 import pytest
-
-from tmsim.protocol import codec
-from tmsim.limits import CPERR_BURST, CPERR_PER_S
-from tmsim.protocol.listen_session import (EXITING, FRAME_LIMIT, IDLE, IN_NODE, INPUT_DONE, INPUT_LEFT, STOPPED, TRANSITIONS,
-                         TransitionError)
 from session_rig import PTP_LONG, S, sct, sta
+
+from tmsim.limits import CPERR_BURST, CPERR_PER_S
+from tmsim.protocol import codec
+from tmsim.protocol.listen_session import (
+    EXITING,
+    FRAME_LIMIT,
+    IDLE,
+    IN_NODE,
+    INPUT_DONE,
+    INPUT_LEFT,
+    STOPPED,
+    TRANSITIONS,
+    TransitionError,
+)
 
 
 def test_nothing_is_sent_on_connect_and_enter_message_only_when_entering():

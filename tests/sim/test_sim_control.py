@@ -4,11 +4,10 @@ Each probe is answered with {"ok": false, "error": ...} and the simulator keeps 
 import socket
 
 import pytest
+from sim_probe import ControlClient
 
 from tmsim.limits import CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX
 from tmsim.net.server import SimServer
-
-from sim_probe import ControlClient
 
 
 @pytest.fixture

@@ -8,13 +8,23 @@ import json
 import math
 import socket
 
-from tmsim.robot import eventlog
-from tmsim.limits import (CONTROL_TURN_PIECES, CONTROL_TURN_REQUESTS, PARSE_SLICE, STEPS_MAX, TURN_WORK, WORK_CHAR,
-                          WORK_LINE, WORK_LOG_BYTES, WORK_PVT_CARTESIAN, WORK_TOKEN)
-from tmsim.robot.model import RobotModel
-from tmsim.protocol.listen_session import ListenSession
-
 from sim_harness import Harness, sct, sta
+
+from tmsim.limits import (
+    CONTROL_TURN_PIECES,
+    CONTROL_TURN_REQUESTS,
+    PARSE_SLICE,
+    STEPS_MAX,
+    TURN_WORK,
+    WORK_CHAR,
+    WORK_LINE,
+    WORK_LOG_BYTES,
+    WORK_PVT_CARTESIAN,
+    WORK_TOKEN,
+)
+from tmsim.protocol.listen_session import ListenSession
+from tmsim.robot import eventlog
+from tmsim.robot.model import RobotModel
 
 TCP_HOME = (417.5, -122.3, 359.7)
 
@@ -187,7 +197,7 @@ def test_a_control_channel_flood_is_answered_in_bounded_turns_between_the_robots
         received = [bytearray() for _ in flooders]
 
         def read_all():
-            for sock, buf in zip(flooders, received):
+            for sock, buf in zip(flooders, received, strict=False):
                 try:
                     while True:
                         chunk = sock.recv(1 << 20)

@@ -4,12 +4,10 @@ its memory is never freed", "A 5,000-digit number or a very long sum ..."). TMsc
 Error), §2.3 (at most 2048 array elements), §2.5 (a value beyond the float range is an Error).
 Every probe gets a reply (OK or ERROR;line), nothing is dropped and the project keeps running."""
 import pytest
-
-from tmsim.tmscript import parser as script
-from tmsim.limits import (ARRAY_MAX, STATEMENTS_MAX, STEPS_MAX, STRING_MAX, TOKENS_MAX, VARIABLE_BYTES_MAX,
-                        VARIABLES_MAX)
-
 from sim_harness import Harness, sct, sta
+
+from tmsim.limits import ARRAY_MAX, STATEMENTS_MAX, STEPS_MAX, STRING_MAX, TOKENS_MAX, VARIABLE_BYTES_MAX, VARIABLES_MAX
+from tmsim.tmscript import parser as script
 
 PTP_LONG = 'PTP("JPP",90,0,90,0,90,0,10,200,0,false)'
 
@@ -51,9 +49,10 @@ def test_squaring_an_int_wraps_at_32_bits(robot):
 
 
 def test_state_answer_after_a_large_integer_computation_is_valid_json():
-    from tmsim.net.server import SimServer
     from sim_harness import Peer
     from sim_probe import ControlClient
+
+    from tmsim.net.server import SimServer
     srv = SimServer(port=0, control_port=0).start_background()
     try:
         peer = Peer(srv.ports[0])

@@ -4,9 +4,9 @@ import os
 import resource
 import socket
 
-from tmsim.limits import ACCEPT_BACKOFF_S, CPERR_BURST, CPERR_PER_S, EVENT_BYTES_MAX
-
 from sim_harness import Harness, sct, sta
+
+from tmsim.limits import ACCEPT_BACKOFF_S, CPERR_BURST, CPERR_PER_S, EVENT_BYTES_MAX
 
 
 def test_clearing_faults_while_split_replies_are_held_delivers_every_byte_and_leaves_no_fault():

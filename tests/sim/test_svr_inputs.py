@@ -4,10 +4,10 @@ control-box or end-module input as a wired sensor would, the Ethernet Slave's re
 value the input cannot hold, is refused with a message naming it and changes nothing. Project_Speed as the PLC's
 override writes it (mode 2, multiples of 5 in 5..100) is in test_ethernet_slave.py."""
 import pytest
-
 from sim_harness import Harness
-from tmsim.net.server import SimServer
 from svr_client import ask, values
+
+from tmsim.net.server import SimServer
 
 
 @pytest.fixture

@@ -9,10 +9,10 @@ import math
 import struct
 
 import pytest
-
-from tmsim.protocol import codec
-from tmsim.net.server import SimServer
 from sim_harness import Harness, sct
+
+from tmsim.net.server import SimServer
+from tmsim.protocol import codec
 
 # tm_robot_state.h TmRobotStateData: the C field each item is copied into, its size in bytes, and whether the
 # driver requires the item (TmDataTable: Item::NOT_REQUIRE marks the optional ones).

@@ -4,12 +4,12 @@ the simulator knows only the variables declared to it). Reads in modes 11/12/13,
 §17.4.1 status codes for a variable that does not exist, a read-only one, an auto-only one in manual mode and a
 value of the wrong type or size; the manual's byte dump of the string array g_ss; the --svr-var option."""
 import pytest
+from sim_harness import Harness
 
+from tmsim.cli import build_parser, check_args, check_variables
 from tmsim.protocol import codec
 from tmsim.protocol import svr_table as table
-from tmsim.cli import build_parser, check_args, check_variables
 from tmsim.protocol.svr_session import SvrConfigError, SvrSession
-from sim_harness import Harness
 
 SPECS = ['g_count:int=5', 'g_ratio:float=0.5', 'g_ok:bool=true', 'g_name:string="Cell 1"',
          'g_pos:float[6]={1,2,3,0.1,0.2,0.3}', 'g_ss:string[3]={"Hi","TM","Robot"}', 'g_limit:int:ro=100',

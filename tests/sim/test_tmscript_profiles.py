@@ -2,13 +2,13 @@
 format and Robot[0] attribute passes where its version has it and is refused (ERROR;line, as an unknown
 name) where it does not; values print as a 32-bit TM float does."""
 import pytest
+from session_rig import S, sct
 
 from tmsim.protocol import codec
-from tmsim.tmscript import functions as tmscript
 from tmsim.robot.camera import camera_of
+from tmsim.tmscript import functions as tmscript
 from tmsim.tmscript.interp import float_text
 from tmsim.tmscript.profiles import Profile
-from session_rig import S, sct
 
 # one call per overload that the checker accepts, and one it refuses (wrong type or arity)
 EXAMPLES = {

@@ -6,12 +6,12 @@ the control channel and --vision-job."""
 import threading
 
 import pytest
+from session_rig import PTP_LONG, sct
 
-from tmsim.protocol import codec
-from tmsim.robot.camera import Camera, camera_of, parse_option
 from tmsim.cli import build_parser, check_vision_jobs
 from tmsim.net.control import ControlChannel
-from session_rig import PTP_LONG, sct
+from tmsim.protocol import codec
+from tmsim.robot.camera import Camera, camera_of, parse_option
 
 PARTS = [[300, 0, 5, 0, 0, 0], [300, 60, 5, 0, 0, 90], [240, -60, 5, 0, 0, -45.5]]
 

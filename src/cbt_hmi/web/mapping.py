@@ -92,7 +92,7 @@ class Mapping:
             raise MappingError(f"{source}: malformed variable table ({type(exc).__name__}: {exc})") from None
 
     @classmethod
-    def load(cls, path: pathlib.Path | str = DEFAULT_MAPPING) -> "Mapping":
+    def load(cls, path: pathlib.Path | str = DEFAULT_MAPPING) -> Mapping:
         path = pathlib.Path(path)
         document = read_json(path, "HMI variable table", MappingError)
         ranges_file = path.with_name(DEFAULT_RANGES.name)
@@ -238,6 +238,6 @@ def jsonable(value):
         return value
     if isinstance(value, float):
         return value if math.isfinite(value) else None
-    if hasattr(value, "value") and isinstance(getattr(value, "value"), int):
+    if hasattr(value, "value") and isinstance(value.value, int):
         return value.value
     return str(value)

@@ -44,10 +44,7 @@ def apply_ranges(document: dict, table: dict, source: str = "ranges") -> dict:
         if owner not in types and owner not in fed and not owner.startswith("st"):
             continue                                    # an FB the HMI does not drive
         for member, entries in members.items():
-            if owner in types:
-                spec = types[owner].get("fields", {}).get(member)
-            else:
-                spec = inputs.get(f"{owner}.{member}")
+            spec = types[owner].get("fields", {}).get(member) if owner in types else inputs.get(f"{owner}.{member}")
             if spec is None:
                 raise RangeTableError(f"{source}: {owner}.{member} is not in the HMI variable table")
             numeric = [e for e in entries if "min" in e]

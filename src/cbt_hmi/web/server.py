@@ -269,7 +269,7 @@ class HmiServer:
         with self.plc.lock:
             cycles_at = self.plc.task_cycles
         deadline = time.monotonic() + SCAN_WAIT_S
-        while not all(now > then for now, then in zip(self.plc.task_cycles, cycles_at)):
+        while not all(now > then for now, then in zip(self.plc.task_cycles, cycles_at, strict=False)):
             if time.monotonic() > deadline:
                 self._refuse_when_faulted()          # a fault since the request came: say so, not "not scanning"
                 raise RequestError(f"the PLC is not scanning: {what}", HTTPStatus.SERVICE_UNAVAILABLE)

@@ -37,14 +37,33 @@ import math
 import selectors
 import socket
 
-from tmsim.limits import (CONTROL_ANSWER_BYTES, CONTROL_CLIENTS_MAX, CONTROL_EVENTS_MAX,
-                     CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_BYTES, CONTROL_TURN_PIECES,
-                     CONTROL_TURN_REQUESTS)
-from tmsim.robot.camera import camera_of
+from tmsim.limits import (
+    CONTROL_ANSWER_BYTES,
+    CONTROL_CLIENTS_MAX,
+    CONTROL_EVENTS_MAX,
+    CONTROL_LINE_MAX,
+    CONTROL_OUTBOX_MAX,
+    CONTROL_TURN_BYTES,
+    CONTROL_TURN_PIECES,
+    CONTROL_TURN_REQUESTS,
+)
 from tmsim.net.tcp_listener import Listener, receive
-from tmsim.protocol.control import (RequestError, bool_field, decode_request, encode_answer, error_answer, fault_params,
-                                    int_field, next_line, operation_mode, plc_time, show, text_field)
+from tmsim.protocol.control import (
+    RequestError,
+    bool_field,
+    decode_request,
+    encode_answer,
+    error_answer,
+    fault_params,
+    int_field,
+    next_line,
+    operation_mode,
+    plc_time,
+    show,
+    text_field,
+)
 from tmsim.protocol.listen_session import TransitionError
+from tmsim.robot.camera import camera_of
 
 
 class _Client:

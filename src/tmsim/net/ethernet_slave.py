@@ -20,7 +20,6 @@ from tmsim.protocol.svr_session import DEFAULT_STREAM, SvrSession
 from tmsim.robot.svr_source import RobotDataSource
 
 
-
 class _Conn:
     __slots__ = ("sock", "id", "wbuf", "robot")
 

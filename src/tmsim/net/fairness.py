@@ -14,9 +14,16 @@ from __future__ import annotations
 
 import time
 
-from tmsim.limits import FRAME_DATA_MAX, IO_SLICE_S, PENDING_SCRIPTS_MAX, POLL_BUDGET_S, SERVE_ITEMS, SERVE_SCAN, TURN_WORK
+from tmsim.limits import (
+    FRAME_DATA_MAX,
+    IO_SLICE_S,
+    PENDING_SCRIPTS_MAX,
+    POLL_BUDGET_S,
+    SERVE_ITEMS,
+    SERVE_SCAN,
+    TURN_WORK,
+)
 from tmsim.protocol.listen_session import FRAME_LIMIT, INPUT_DONE
-
 
 
 class FairInput:

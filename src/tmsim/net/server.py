@@ -25,18 +25,31 @@ import socket
 import threading
 import time
 
+from tmsim.limits import (
+    EVENT_BYTES_MAX,
+    EVENTS_KEPT_MAX,
+    FRAME_DATA_MAX,
+    IO_SLICE_S,
+    LISTEN_CLIENTS_MAX,
+    LISTEN_OUTBOX_MAX,
+    OUTBOX_TOTAL_MAX,
+    PENDING_BYTES_MAX,
+    POLL_BUDGET_S,
+    RECV_BYTES,
+    TURN_WORK,
+)
 from tmsim.net.control import ControlChannel
 from tmsim.net.ethernet_slave import EthernetSlave
+from tmsim.net.fairness import FairInput
+from tmsim.net.fairness import is_greedy as _is_greedy
 from tmsim.net.tcp_listener import Listener, receive
-from tmsim.robot.eventlog import EventLog, LogFile, text as _text
-from tmsim.net.fairness import FairInput, is_greedy as _is_greedy
-from tmsim.robot.faults import FaultState, check_params as check_fault_params
-from tmsim.limits import (EVENT_BYTES_MAX, EVENTS_KEPT_MAX, FRAME_DATA_MAX, IO_SLICE_S, LISTEN_CLIENTS_MAX,
-                          LISTEN_OUTBOX_MAX, OUTBOX_TOTAL_MAX, PENDING_BYTES_MAX, POLL_BUDGET_S,
-                          RECV_BYTES, TURN_WORK)
-from tmsim.tmscript.profiles import Profile
-from tmsim.robot.model import RobotModel
 from tmsim.protocol.listen_session import STOPPED, ListenSession
+from tmsim.robot.eventlog import EventLog, LogFile
+from tmsim.robot.eventlog import text as _text
+from tmsim.robot.faults import FaultState
+from tmsim.robot.faults import check_params as check_fault_params
+from tmsim.robot.model import RobotModel
+from tmsim.tmscript.profiles import Profile
 
 RBUF_READ_BELOW = FRAME_DATA_MAX + 64     # a receive buffer this full holds a complete item: process it first
 GC_IDLE = 700               # manage_gc: collect young objects in an idle poll once this many are waiting...

@@ -14,14 +14,14 @@ import re
 from collections import deque
 from dataclasses import dataclass, field
 
-from tmsim.protocol import codec
-from tmsim.tmscript.static_check import ScriptChecker
-from tmsim.robot.eventlog import text as _text
-from tmsim.tmscript.interp import Context, ScriptRuntimeError, run_script, variable_memory
 from tmsim.limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN
-from tmsim.tmscript.profiles import Profile
+from tmsim.protocol import codec
+from tmsim.robot.eventlog import text as _text
 from tmsim.robot.model import RobotModel
+from tmsim.tmscript.interp import Context, ScriptRuntimeError, run_script, variable_memory
 from tmsim.tmscript.parser import iter_lines
+from tmsim.tmscript.profiles import Profile
+from tmsim.tmscript.static_check import ScriptChecker
 
 STOPPED, IDLE, IN_NODE, EXITING = "project_stopped", "not_in_node", "in_node", "exiting"
 

@@ -26,7 +26,7 @@ import math
 import re
 
 from tmsim.limits import VISION_JOBS_MAX, VISION_OBJECTS_MAX, VISION_POSE_MAX, VISION_SECONDS_MAX
-from tmsim.tmscript.floats import float_text      # the texts GetString prints
+from tmsim.tmscript.floats import float_text  # the texts GetString prints
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,47}\Z")
 

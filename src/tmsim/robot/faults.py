@@ -143,7 +143,7 @@ class FaultState:
         if self.black_hole:
             out.clear()
 
-    def adopt(self, other: "FaultState"):
+    def adopt(self, other: FaultState):
         """Take over the frames another (cleared) fault state still holds back."""
         self._queues, self._partial = other._queues, other._partial
 

@@ -159,7 +159,7 @@ def _gauss(m, n):
 
 def _solve(jac, err, damping):
     """Newton step J dq = e; near a singularity damped least squares dq = J^T (J J^T + l^2 I)^-1 e."""
-    step = _gauss([row[:] + [e] for row, e in zip(jac, err)], 6)
+    step = _gauss([row[:] + [e] for row, e in zip(jac, err, strict=False)], 6)
     if step is not None and max(abs(v) for v in step) < 1.0:
         return step
     m = [[sum(map(operator.mul, jac[i], jac[j])) + (damping if i == j else 0.0) for j in range(6)] + [err[i]]
@@ -238,7 +238,7 @@ def _analytic(target):
 def _chain(first, angles):
     """Product of the DH transforms of joints first+1 .. first+len(angles) (0-based ``first``)."""
     m = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
-    for i, q in zip(range(first, first + len(angles)), angles):
+    for i, q in zip(range(first, first + len(angles)), angles, strict=False):
         th = math.radians(q + OFFSET[i])
         ct, st, ca, sa = math.cos(th), math.sin(th), _COS_ALPHA[i], _SIN_ALPHA[i]
         m = matmul(m, [[ct, -st * ca, st * sa, A[i] * ct], [st, ct * ca, -ct * sa, A[i] * st],
@@ -248,7 +248,7 @@ def _chain(first, angles):
 
 def _wrap(q, reference):
     """Bring each angle to the 360-degree equivalent closest to the reference."""
-    return [a - 360.0 * round((a - r) / 360.0) for a, r in zip(q, reference)]
+    return [a - 360.0 * round((a - r) / 360.0) for a, r in zip(q, reference, strict=False)]
 
 
 def configuration(joints):
@@ -268,7 +268,7 @@ def configuration(joints):
 def _best_turn(q, reference):
     """The 360-degree variant of each joint nearest to the reference that respects the limits."""
     out = []
-    for a, ref, lim in zip(q, reference, LIMITS):
+    for a, ref, lim in zip(q, reference, LIMITS, strict=False):
         v = a + 360.0 * round((ref - a) / 360.0)
         if v > lim + 1e-6:
             v -= 360.0
@@ -286,7 +286,7 @@ def _matches(q, target):
 
 
 def within_limits(joints):
-    return all(abs(q) <= lim + 1e-6 for q, lim in zip(joints, LIMITS))
+    return all(abs(q) <= lim + 1e-6 for q, lim in zip(joints, LIMITS, strict=False))
 
 
 def inverse_kinematics(target, tool=None, reference=(0.0, 0.0, 90.0, 0.0, 90.0, 0.0), config=None):
@@ -304,7 +304,7 @@ def inverse_kinematics(target, tool=None, reference=(0.0, 0.0, 90.0, 0.0, 90.0, 
         raise KinematicsError("target pose is out of reach")
     heading = math.degrees(math.atan2(py, px)) if abs(px) + abs(py) > 1e-6 else reference[0]
     candidates = [q for q in (_best_turn(q, reference) for q in _analytic(target)) if q is not None]
-    candidates.sort(key=lambda q: sum((a - b) ** 2 for a, b in zip(q, reference)))
+    candidates.sort(key=lambda q: sum((a - b) ** 2 for a, b in zip(q, reference, strict=False)))
     for q in candidates:
         if (config is None or configuration(q) == tuple(config)) and _matches(q, target):
             return q
@@ -332,4 +332,4 @@ def inverse_kinematics(target, tool=None, reference=(0.0, 0.0, 90.0, 0.0, 90.0, 
             raise KinematicsError("target pose cannot be reached in the requested arm configuration "
                                   "or within the joint limits")
         raise KinematicsError("target pose is out of reach or beyond the joint limits")
-    return min(found, key=lambda q: sum((a - b) ** 2 for a, b in zip(q, reference)))
+    return min(found, key=lambda q: sum((a - b) ** 2 for a, b in zip(q, reference, strict=False)))

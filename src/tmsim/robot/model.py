@@ -9,10 +9,10 @@ from __future__ import annotations
 import math
 from collections import deque
 
-from tmsim.robot import kinematics as kin
-from tmsim.robot.motion import MotionError, MotionRequest, Planner
 from tmsim.limits import FIFO_ITEMS_MAX, WORK_PLAN, WORK_PVT_CARTESIAN
+from tmsim.robot import kinematics as kin
 from tmsim.robot.errors import classify
+from tmsim.robot.motion import MotionError, MotionRequest, Planner
 from tmsim.tmscript.work import WorkMeter
 
 HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)

@@ -103,11 +103,11 @@ class Plan:
         if s >= 1.0:
             return list(self.end_joints)
         if self.cartesian is None:
-            return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints)]
+            return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints, strict=False)]
         try:
             return kin.inverse_kinematics(self.cartesian(s), self.tool, reference=reference or self.start_joints)
         except kin.KinematicsError:
-            return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints)]
+            return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints, strict=False)]
 
 
 def hermite(p0, v0, p1, v1, T, t):
@@ -116,8 +116,8 @@ def hermite(p0, v0, p1, v1, T, t):
     s2, s3 = s * s, s * s * s
     h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2
     d00, d10, d01, d11 = 6 * s2 - 6 * s, 3 * s2 - 4 * s + 1, -6 * s2 + 6 * s, 3 * s2 - 2 * s
-    pos = [h00 * a + h10 * T * va + h01 * b + h11 * T * vb for a, va, b, vb in zip(p0, v0, p1, v1)]
-    vel = [(d00 * a + d01 * b) / T + d10 * va + d11 * vb for a, va, b, vb in zip(p0, v0, p1, v1)]
+    pos = [h00 * a + h10 * T * va + h01 * b + h11 * T * vb for a, va, b, vb in zip(p0, v0, p1, v1, strict=False)]
+    vel = [(d00 * a + d01 * b) / T + d10 * va + d11 * vb for a, va, b, vb in zip(p0, v0, p1, v1, strict=False)]
     return pos, vel
 
 
@@ -221,7 +221,7 @@ class Planner:
         if req.function == "Circle":
             return self._plan_circle(req, joints, start_tcp)
         if frame == "J":
-            end_joints = [a + b for a, b in zip(joints, req.target)] if relative else list(req.target)
+            end_joints = [a + b for a, b in zip(joints, req.target, strict=False)] if relative else list(req.target)
             if not kin.within_limits(end_joints):
                 raise MotionError(f"{req.function} target joints exceed the joint limits")
             end_tcp = kin.forward(end_joints, self.tool)
@@ -245,7 +245,7 @@ class Planner:
         joint_move = req.function in ("PTP", "Move_PTP")
         if joint_move:
             duration = max(trapezoid_time(abs(b - a), JOINT_SPEED[i] * req.speed / 100.0, ta)
-                           for i, (a, b) in enumerate(zip(joints, end_joints)))
+                           for i, (a, b) in enumerate(zip(joints, end_joints, strict=False)))
             distance = math.dist([start_tcp[i][3] for i in range(3)], [end_tcp[i][3] for i in range(3)])
             path = None
         else:
@@ -271,7 +271,7 @@ class Planner:
                 raise MotionError("PVTPoint target joints exceed the joint limits")
         else:
             p0 = tuple(start_pose)
-            p1 = tuple(a + _unwrap(b - a) if i >= 3 else b for i, (a, b) in enumerate(zip(p0, p1)))
+            p1 = tuple(a + _unwrap(b - a) if i >= 3 else b for i, (a, b) in enumerate(zip(p0, p1, strict=False)))
 
             def to_joints(pose, reference, planner=self):
                 return kin.inverse_kinematics(planner.flange_target(pose), planner.tool, reference=reference)
@@ -289,7 +289,7 @@ class Planner:
             peaks, previous, dt = [0.0] * 6, list(joints), T / 12
             for k in range(1, 13):
                 current = plan.joints_at(dt * k, previous)
-                peaks = [max(peak, abs(b - a) / dt) for peak, a, b in zip(peaks, previous, current)]
+                peaks = [max(peak, abs(b - a) / dt) for peak, a, b in zip(peaks, previous, current, strict=False)]
                 previous = current
         for i, peak in enumerate(peaks):
             if peak > JOINT_SPEED[i] * 1.001:

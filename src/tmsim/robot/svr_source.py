@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import datetime
 
-from tmsim.robot import kinematics as kin
 from tmsim.protocol.svr_table import ITEMS
+from tmsim.robot import kinematics as kin
 
 _SPEED_STEP_S = 0.01          # Joint_Speed / TCP_Speed: difference quotient over this much motion time
 
@@ -229,8 +229,8 @@ class _Moment:
                 later = plan.joints_at(min(plan.total, model.active_t + _SPEED_STEP_S), self.joints)
                 scale = model.motion_rate(plan.request) / _SPEED_STEP_S
                 then = kin.matrix_to_pose(kin.forward(later, model._matrix(model.tool_pose)))
-                tcp = [(b - a) * scale for a, b in zip(self.pose("Coord_Robot_Tool"), then)]
-                self._speeds = {"Joint_Speed": [(b - a) * scale for a, b in zip(self.joints, later)],
+                tcp = [(b - a) * scale for a, b in zip(self.pose("Coord_Robot_Tool"), then, strict=False)]
+                self._speeds = {"Joint_Speed": [(b - a) * scale for a, b in zip(self.joints, later, strict=False)],
                                 "TCP_Speed": tcp, "TCP_Speed3D": sum(v * v for v in tcp[:3]) ** 0.5}
         return self._speeds
 

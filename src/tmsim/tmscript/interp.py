@@ -27,13 +27,24 @@ from __future__ import annotations
 import math
 import struct
 
-from tmsim.tmscript import parser as ast
-from tmsim.tmscript import functions as table
-from tmsim.robot.camera import camera_of
+from tmsim.limits import (
+    ARRAY_MAX,
+    BYTE_MAX,
+    FLOAT_MAX,
+    INT_MAX,
+    INT_MIN,
+    IO_INDEX_MAX,
+    STEPS_MAX,
+    STRING_MAX,
+    VARIABLE_BYTES_MAX,
+    VARIABLES_MAX,
+    WORK_STEP,
+)
 from tmsim.protocol.codec import encode as encode_frame
-from tmsim.limits import (ARRAY_MAX, BYTE_MAX, FLOAT_MAX, INT_MAX, INT_MIN, IO_INDEX_MAX, STEPS_MAX, STRING_MAX, VARIABLE_BYTES_MAX,
-                     VARIABLES_MAX, WORK_STEP)
+from tmsim.robot.camera import camera_of
 from tmsim.robot.motion import MotionRequest
+from tmsim.tmscript import functions as table
+from tmsim.tmscript import parser as ast
 from tmsim.tmscript.floats import float_text
 from tmsim.tmscript.work import WorkMeter
 

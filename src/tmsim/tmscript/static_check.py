@@ -9,8 +9,8 @@ the robot they fail at run time.
 """
 from __future__ import annotations
 
-from tmsim.tmscript import parser as ast
 from tmsim.tmscript import functions as table
+from tmsim.tmscript import parser as ast
 
 F, I, S, B, FA, IA, ANY, VOID = "float", "int", "string", "bool", "float[]", "int[]", "any", "void"
 
@@ -58,7 +58,7 @@ class ScriptChecker:
 
 def _assignable(target: str, value: str) -> str | None:
     """'' when assignable, 'warn' for a lossy conversion, None when not assignable."""
-    if target == ANY or value == ANY or target == value:
+    if target in (ANY, value) or value == ANY:
         return ""
     numeric = ("int", "float", "byte")
     if target in numeric and value in numeric:
@@ -275,7 +275,7 @@ class _LineChecker:
         problem = None
         for params, ret in candidates:
             lossy = []
-            for position, (param, arg) in enumerate(zip(params, arg_types), start=1):
+            for position, (param, arg) in enumerate(zip(params, arg_types, strict=False), start=1):
                 result = _assignable(param, arg)
                 if result is None:
                     problem = f"{node.name} argument {position} must be {param}, got {arg}"

@@ -17,7 +17,7 @@ from .consteval import const_int
 
 
 def check(ck, e, array_type) -> None:
-    for ix, (lo, hi) in zip(e.indices, array_type.dims):
+    for ix, (lo, hi) in zip(e.indices, array_type.dims, strict=False):
         if lo is None:
             continue
         value = const_int(ix, ck.ctx, ck.scope)

@@ -291,7 +291,7 @@ def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
         ctx.diags.error(codes.ARGUMENT_TYPE, f"{b.name}: {err}", span)
         return T.ERROR
     args = []
-    for i, (v, conv) in enumerate(zip(values, convs)):
+    for i, (v, conv) in enumerate(zip(values, convs, strict=False)):
         if conv is not None and v.conv is None and not T.is_error(conv):
             v.conv = conv
         name = b.formal_names[i] if i < len(b.formal_names) else f"IN{i + 1}"

@@ -35,5 +35,5 @@ def compatible(src: T.Type, dst: T.Type) -> bool:
     if isinstance(s, T.ArrayType) and isinstance(d, T.ArrayType):
         if len(s.dims) != len(d.dims) or not compatible(s.element, d.element):
             return False
-        return d.open or all((sh - sl) == (dh - dl) for (sl, sh), (dl, dh) in zip(s.dims, d.dims))
+        return d.open or all((sh - sl) == (dh - dl) for (sl, sh), (dl, dh) in zip(s.dims, d.dims, strict=False))
     return False

@@ -8,9 +8,8 @@ from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from ..frontend.builtins import default_string
-from . import data_size, duplicates, undeclared
+from . import at_address, data_size, duplicates, undeclared, union_member
 from .consteval import const_int
-from . import at_address, union_member
 from .scope import GENERIC_TYPES, Ambiguous
 from .symbols import VarSymbol
 

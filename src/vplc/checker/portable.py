@@ -24,8 +24,16 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend.source import Span
-from . import (portable_array_types, portable_case_labels, portable_discarded_result, portable_empty_call,
-               portable_enum_order, portable_enum_values, portable_keywords, portable_len_type)
+from . import (
+    portable_array_types,
+    portable_case_labels,
+    portable_discarded_result,
+    portable_empty_call,
+    portable_enum_order,
+    portable_enum_values,
+    portable_keywords,
+    portable_len_type,
+)
 
 RULES = (portable_enum_values, portable_keywords, portable_case_labels, portable_discarded_result,
          portable_enum_order, portable_empty_call, portable_len_type, portable_array_types)

@@ -25,7 +25,7 @@ class VarSymbol:
     constant: bool = False
     retain: bool = False
     global_list: str | None = None
-    target: "VarSymbol | None" = None
+    target: VarSymbol | None = None
     used: bool = False
     at_address: Any = None          # a global in a Sysmac memory area: (area, bank, word, bit, layout, words), at_address.py
 

@@ -17,8 +17,7 @@ from __future__ import annotations
 
 import difflib
 
-from ..frontend import codes
-from ..frontend import sysmac_names
+from ..frontend import codes, sysmac_names
 
 
 def _suggest(name: str, candidates) -> list[str]:

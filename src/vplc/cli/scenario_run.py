@@ -121,7 +121,7 @@ class Runner:
             values = group[1](group[0])
             if values != group[3]:             # nothing watched in this instance changed: the usual scan
                 group[3] = values
-                for s, raw in zip(group[2], values):
+                for s, raw in zip(group[2], values, strict=False):
                     if raw != s.raw:           # the first time too: s.raw is _UNSEEN
                         s.raw = raw
                         changed.append(s)

@@ -12,11 +12,11 @@ import re
 
 from ..frontend import ast as A
 from ..frontend import types as T
-from .codegen_expr import ExprGen, attr, cut, is_scalar
-from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop_range, unguarded
 from ..runtime import abi
 from ..runtime.program import GEN_FILE, InstanceSpec, PouClass, Program, TaskSpec, program_key
 from ..runtime.sysmac_fns import KEEPS_OUT_ON_ERROR
+from .codegen_expr import ExprGen, attr, cut, is_scalar
+from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop_range, unguarded
 
 BULK_CELLS = 1024         # a statement copying a structured value this large checks the watchdog after it
 CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)

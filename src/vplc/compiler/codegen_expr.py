@@ -10,8 +10,8 @@ import re
 
 from ..frontend import ast as A
 from ..frontend import types as T
-from .inline import readonly_inputs
 from ..runtime import abi, iec
+from .inline import readonly_inputs
 
 _PY_RESERVED = set(keyword.kwlist) | {"None", "True", "False", abi.SELF, abi.GLOBALS}
 

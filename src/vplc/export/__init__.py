@@ -53,11 +53,12 @@ def _usage(msg: str) -> int:
 
 def run_export(args) -> int:
     from ..frontend.diagnostics import ERROR, NOTE
+    from ..ladder.model import WriteError
     from ..project import load_project
     from .iec61131_10 import render
-    from ..ladder.model import WriteError
     from .model import ExportError, collect
-    from .paste import PasteTargetError, write as write_paste
+    from .paste import PasteTargetError
+    from .paste import write as write_paste
 
     device = None
     if getattr(args, "device", None):

@@ -14,6 +14,7 @@ from ..frontend import ast as A
 from ..frontend import printer
 from .order import dependency_order
 
+
 class ExportError(Exception):
     """The sources are valid ST but use something the chosen export format cannot express."""
 
@@ -199,9 +200,7 @@ def _named_refs(ref: A.TypeRef):
         yield ref.name.text()
     elif isinstance(ref, A.ArrayTypeRef):
         yield from _named_refs(ref.element)
-    elif isinstance(ref, A.SubrangeTypeRef):
-        yield from _named_refs(ref.base)
-    elif isinstance(ref, A.EnumTypeRef) and ref.base is not None:
+    elif isinstance(ref, A.SubrangeTypeRef) or isinstance(ref, A.EnumTypeRef) and ref.base is not None:
         yield from _named_refs(ref.base)
     elif isinstance(ref, A.StructTypeRef):
         for f in ref.fields:

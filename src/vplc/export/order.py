@@ -6,7 +6,8 @@ The XML export uses the same order, which keeps the file readable top to bottom.
 """
 from __future__ import annotations
 
-from typing import Callable, Hashable, Iterable, TypeVar
+from collections.abc import Callable, Hashable, Iterable
+from typing import TypeVar
 
 Item = TypeVar("Item")
 

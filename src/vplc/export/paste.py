@@ -20,8 +20,8 @@ from __future__ import annotations
 import os
 import shutil
 
-from ..frontend import ast as A
 from .. import __version__
+from ..frontend import ast as A
 from .model import ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 
 VAR_COLUMNS = ("Name", "Data Type", "Initial Value", "AT", "Retain", "Constant", "Comment")

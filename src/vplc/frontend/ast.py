@@ -60,15 +60,15 @@ class NamedTypeRef(TypeRef):
 class StringTypeRef(TypeRef):
     """``STRING``, ``STRING[n]``, ``STRING(n)``, ``WSTRING[n]``; ``length`` is None when not given."""
     wide: bool
-    length: "Expr | None"
+    length: Expr | None
     span: Span = _ann()
 
 
 @dataclass(eq=True)
 class DimRange(Node):
     """One array dimension ``lo..hi``; both None for an open dimension ``*``."""
-    lo: "Expr | None"
-    hi: "Expr | None"
+    lo: Expr | None
+    hi: Expr | None
     span: Span = _ann()
 
 
@@ -83,15 +83,15 @@ class ArrayTypeRef(TypeRef):
 class SubrangeTypeRef(TypeRef):
     """``INT(0..100)``."""
     base: TypeRef
-    lo: "Expr"
-    hi: "Expr"
+    lo: Expr
+    hi: Expr
     span: Span = _ann()
 
 
 @dataclass(eq=True)
 class EnumValueDecl(Node):
     name: str
-    value: "Expr | None"
+    value: Expr | None
     span: Span = _ann()
 
     @property
@@ -111,7 +111,7 @@ class EnumTypeRef(TypeRef):
 @dataclass(eq=True)
 class StructTypeRef(TypeRef):
     """STRUCT ... END_STRUCT, or UNION ... END_UNION (``union``: the members share one memory image, W501)."""
-    fields: list["VarDecl"]
+    fields: list[VarDecl]
     span: Span = _ann()
     union: bool = False
 
@@ -217,7 +217,7 @@ class Call(Expr):
 @dataclass(eq=True)
 class ArrayInit(Expr):
     """``[1, 2, 3(0)]``: items are :class:`InitItem`."""
-    items: list["InitItem"]
+    items: list[InitItem]
 
 
 @dataclass(eq=True)
@@ -231,7 +231,7 @@ class InitItem(Node):
 @dataclass(eq=True)
 class StructInit(Expr):
     """``(X := 1.0, Y := 2.0)``."""
-    fields: list["FieldInit"]
+    fields: list[FieldInit]
 
 
 @dataclass(eq=True)

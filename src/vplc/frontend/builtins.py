@@ -10,8 +10,8 @@ Sysmac dialect: LEN and FIND return UINT (IEC: INT).
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from . import types as T
 
@@ -172,7 +172,7 @@ def _str_default(dialect: str) -> T.StringType:
 def _string_fn(pattern: str) -> Callable:
     """pattern letters: s = STRING arg, i = integer arg; result STRING."""
     def resolve(args, dialect):
-        for i, (a, p) in enumerate(zip(args, pattern)):
+        for i, (a, p) in enumerate(zip(args, pattern, strict=False)):
             if p == "s":
                 _need(T.is_string, a, i, "a STRING")
             else:
@@ -209,7 +209,7 @@ def _bound(args, dialect):
 def _fixed(params: tuple[T.Type, ...], result: T.Type) -> Callable:
     def resolve(args, dialect):
         convs = []
-        for i, (a, p) in enumerate(zip(args, params)):
+        for i, (a, p) in enumerate(zip(args, params, strict=False)):
             if not (T.widens_to(a, p) or (dialect == "sysmac" and T.sysmac_assignable(a, p))):
                 raise SignatureError(f"argument {i + 1} must be {p.name}, not {a.name}", i)
             convs.append(None if T.same_type(a, p) or T.is_error(a) else p)

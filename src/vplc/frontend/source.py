@@ -58,7 +58,7 @@ class Span:
     start: int
     end: int
 
-    def to(self, other: "Span") -> "Span":
+    def to(self, other: Span) -> Span:
         """The span covering ``self`` up to the end of ``other``."""
         return Span(self.file, self.start, max(self.end, other.end))
 

@@ -14,7 +14,8 @@ from ..frontend.source import SourceFile, Span
 from . import iec10_read, plcopen_read
 from .decls import FormatError
 from .translate import LadderSource, unit_source
-from .xmlsafe import XmlError, read as read_safely
+from .xmlsafe import XmlError
+from .xmlsafe import read as read_safely
 
 XML_SUFFIXES = (".xml",)
 PLCOPEN_NS = "http://www.plcopen.org/xml/tc6"

@@ -66,28 +66,28 @@ class Txt:
         self.marks = list(marks)
         self.prec = prec
 
-    def __add__(self, other: "Txt | str") -> "Txt":
+    def __add__(self, other: Txt | str) -> Txt:
         if isinstance(other, str):
             return Txt(self.text + other, self.marks, min(self.prec, 3))
         n = len(self.text)
         return Txt(self.text + other.text, self.marks + [(s + n, e + n, lab) for s, e, lab in other.marks])
 
-    def __radd__(self, other: str) -> "Txt":
+    def __radd__(self, other: str) -> Txt:
         n = len(other)
         return Txt(other + self.text, [(s + n, e + n, lab) for s, e, lab in self.marks])
 
-    def marked(self, label: str) -> "Txt":
+    def marked(self, label: str) -> Txt:
         return Txt(self.text, self.marks + [(0, len(self.text), label)], self.prec)
 
-    def at_least(self, prec: int) -> "Txt":
+    def at_least(self, prec: int) -> Txt:
         return self if self.prec >= prec else ("(" + self + ")").with_prec(3)
 
-    def with_prec(self, prec: int) -> "Txt":
+    def with_prec(self, prec: int) -> Txt:
         self.prec = prec
         return self
 
 
-def _joined(parts: "list[Txt]", sep: str, prec: int) -> Txt:
+def _joined(parts: list[Txt], sep: str, prec: int) -> Txt:
     """``parts`` joined by ``sep`` in one pass (adding them one by one would copy the text once per part)."""
     texts, marks, n = [], [], 0
     for i, t in enumerate(parts):
@@ -110,7 +110,7 @@ class Writer:
         self.statements: list[tuple[int, int]] = []
         self.checks: list[tuple[int, int, str, str]] = []
 
-    def put(self, text: "Txt | str", label: str | None = None, statement: bool = False) -> None:
+    def put(self, text: Txt | str, label: str | None = None, statement: bool = False) -> None:
         t = text if isinstance(text, Txt) else Txt(text)
         base = self.size
         for s, e, lab in t.marks:
@@ -394,7 +394,7 @@ class RungCompiler:
         self.stmt(name + " := " + value + ";")
         return Txt(name)
 
-    def stmt(self, text: "Txt | str", label: str | None = None) -> None:
+    def stmt(self, text: Txt | str, label: str | None = None) -> None:
         self.emit((text if isinstance(text, Txt) else Txt(text)) + "\n", label or self.where, self.indent)
 
     def shared(self, e: Element, value: Txt, pin: str | None = None) -> Txt:
@@ -502,7 +502,7 @@ class RungCompiler:
             raise _error(lab, f"a {e.type_name.upper()} block needs at least two connected inputs",
                          codes.LADDER_MISSING_CONNECTION)
         op = COMPARE[e.type_name.upper()]
-        terms = [("(" + a + f" {op} " + b + ")") for a, b in zip(values, values[1:])]
+        terms = [("(" + a + f" {op} " + b + ")") for a, b in zip(values, values[1:], strict=False)]
         out = terms[0]
         for t in terms[1:]:
             out = out + " AND " + t

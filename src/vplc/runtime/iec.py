@@ -109,7 +109,7 @@ def ix1(i: int, lo: int, hi: int, what: str = "array") -> int:
 
 def ixn(idx: tuple, dims: tuple, what: str = "array") -> int:
     off = 0
-    for i, (lo, hi) in zip(idx, dims):
+    for i, (lo, hi) in zip(idx, dims, strict=False):
         if not lo <= i <= hi:
             raise RuntimeFaultError(f"index {i} out of range {lo}..{hi} of {what}")
         off = off * (hi - lo + 1) + (i - lo)
@@ -153,7 +153,7 @@ class ArrView:
 
     def __setitem__(self, i, v) -> None:
         if isinstance(i, slice):
-            for k, x in zip(range(*i.indices(self.n)), v):
+            for k, x in zip(range(*i.indices(self.n)), v, strict=False):
                 self.base[self.off + k] = x
             return
         self.base[self.off + i] = v

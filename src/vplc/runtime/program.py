@@ -98,7 +98,7 @@ class Program:
     programs: tuple = ()                                # POU keys of the user's PROGRAMs in source order
     program_names: dict = field(default_factory=dict)   # program_key(name as a user may write it) -> POU key
 
-    def load(self) -> "Image":
+    def load(self) -> Image:
         """Run the compiled code in a fresh namespace: the classes and state of one PLC instance."""
         ns = dict(stdlib.NAMESPACE)
         ns.update(HELPERS)

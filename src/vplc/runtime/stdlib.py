@@ -62,7 +62,7 @@ def _left(s: str, n: int) -> str:
 
 
 def _right(s: str, n: int) -> str:
-    return s[len(s) - n:] if 0 < n else ""
+    return s[len(s) - n:] if n > 0 else ""
 
 
 def _mid(s: str, n: int, p: int) -> str:

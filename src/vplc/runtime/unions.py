@@ -65,7 +65,7 @@ class ElementView:
 
     def __setitem__(self, i, v) -> None:
         if isinstance(i, slice):
-            for k, x in zip(range(*i.indices(self.n)), v):
+            for k, x in zip(range(*i.indices(self.n)), v, strict=False):
                 self[k] = x
             return
         self._set(self._checked(i), v)

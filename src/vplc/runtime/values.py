@@ -95,10 +95,7 @@ class Resolver:
         """-> (container, key, type) of the variable at ``path``."""
         root, steps = self._parse(path)
         plc = self.plc
-        if root is not None:
-            obj = plc.instances[root]
-        else:
-            obj = plc.globals
+        obj = plc.instances[root] if root is not None else plc.globals
         container, key, cur_t = None, None, (obj.i__type if root is not None else None)
         for seg, name, shown, indexes in steps:
             value = obj if container is None else container[key]

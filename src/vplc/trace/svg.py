@@ -60,7 +60,7 @@ def clip(changes, t0: int, t1: int) -> list[tuple[int, object]]:
 
 
 def _bool_row(ch, x, t1, hi, base) -> list[str]:
-    segs = list(zip(ch, ch[1:] + [(t1, None)]))
+    segs = list(zip(ch, ch[1:] + [(t1, None)], strict=False))
     pts, marks = [], []
     cursor = None
     for (t, v), (t2, _) in segs:
@@ -88,7 +88,7 @@ def _analog_row(ch, x, t1, top, bottom) -> list[str]:
     y = lambda v: bottom - (float(v) - lo) * (bottom - top) / (hi - lo)  # noqa: E731
     cols: dict[int, list[float]] = {}           # one pixel column keeps first, min, max, last
     order: list[int] = []
-    for (t, v), (t2, _) in zip(ch, ch[1:] + [(t1, None)]):
+    for (t, v), (t2, _) in zip(ch, ch[1:] + [(t1, None)], strict=False):
         for px in {int(x(t)), int(x(t2))}:
             if px not in cols:
                 cols[px] = []
@@ -106,7 +106,7 @@ def _analog_row(ch, x, t1, top, bottom) -> list[str]:
 def _bus_row(ch, x, t1, hi, base, fmt=_fmt) -> list[str]:
     out = []
     mid = (hi + base) / 2
-    segs = [(x(t), x(t2), v) for (t, v), (t2, _) in zip(ch, ch[1:] + [(t1, None)])]
+    segs = [(x(t), x(t2), v) for (t, v), (t2, _) in zip(ch, ch[1:] + [(t1, None)], strict=False)]
     i = 0
     while i < len(segs):
         x1, x2, v = segs[i]
@@ -144,7 +144,7 @@ def render_svg(rec, window: tuple[int, int] | None = None) -> str:
            f'<rect width="{WIDTH}" height="{h}" fill="white"/>']
     top = 10
     labels = getattr(rec, "labels", None) or rec.paths
-    for i, (p, (kind, bits)) in enumerate(zip(labels, rec.kinds)):
+    for i, (p, (kind, bits)) in enumerate(zip(labels, rec.kinds, strict=False)):
         rh = heights[i]
         base, hi = top + rh - 8, top + rh - 8 - (HIGH if kind != "real" else rh - 14)
         label_y = base - 4 if kind != "real" else (hi + base) / 2 + 4

@@ -26,9 +26,9 @@ def _value(kind: str, bits: int, v, ident: str) -> str:
 
 
 def write_vcd(rec, filename: str) -> None:
-    lines = [f"$date {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M:%S} UTC $end",
+    lines = [f"$date {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M:%S} UTC $end",
              "$version vplc virtual PLC $end", "$timescale 1ns $end", "$scope module plc $end"]
-    for i, (p, (kind, bits)) in enumerate(zip(rec.paths, rec.kinds)):
+    for i, (p, (kind, bits)) in enumerate(zip(rec.paths, rec.kinds, strict=False)):
         vtype = {"bool": "wire", "int": "wire", "bits": "wire", "real": "real", "text": "string"}[kind]
         width = {"bool": 1, "int": bits, "bits": bits, "real": 64, "text": 1}[kind]
         lines.append(f"$var {vtype} {width} {_ident(i)} {p.replace(' ', '_')} $end")

@@ -3,13 +3,12 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from tests.vplc.export.conftest import LIB, NS, XSI_TYPE, local, q
 from vplc.frontend import ast as A
 from vplc.frontend import printer
 from vplc.frontend.diagnostics import DiagnosticBag
 from vplc.frontend.parser import parse
 from vplc.frontend.source import SourceFile
-
-from tests.vplc.export.conftest import LIB, NS, XSI_TYPE, local, q
 
 PARAM_TAG = {"in": "InputVars", "out": "OutputVars", "inout": "InoutVars"}
 POU_TAG = {"FUNCTION": "Function", "FUNCTION_BLOCK": "FunctionBlock", "PROGRAM": "Program"}
@@ -84,7 +83,7 @@ def test_every_library_type_is_exported_with_its_members_in_order(lib_root, lib_
             assert spec.get(XSI_TYPE) == "StructTypeSpec"
             members = spec.findall(q("Member"))
             assert [m.get("name") for m in members] == [f.name for f in decl.spec.fields]
-            for m, f in zip(members, decl.spec.fields):
+            for m, f in zip(members, decl.spec.fields, strict=False):
                 _assert_order(list(m), VARIABLE_ORDER, f"{name}.{f.name}")
                 assert _type_text(m.find(q("Type"))) == printer.type_ref(f.type)
                 init = m.find(f"{q('InitialValue')}/{q('SimpleValue')}")

@@ -1,9 +1,8 @@
 """Paste kit (fallback for CPU units without the IEC 61131-10 import): files, columns, order."""
 from __future__ import annotations
 
-from vplc.frontend import ast as A
-
 from tests.vplc.export.conftest import LIB, run
+from vplc.frontend import ast as A
 
 STOP_VARIABLES = [
     # Name, Data Type, Initial Value, AT, Retain, Constant, Comment

@@ -8,7 +8,6 @@ import pathlib
 import pytest
 
 from tests.vplc.export.conftest import LIB, ROOT, run
-
 from tests.vplc.ladder.ld_xml import program
 
 etree = pytest.importorskip("lxml.etree", reason="lxml is a test dependency: run `make test-deps`")

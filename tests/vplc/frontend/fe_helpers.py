@@ -6,8 +6,8 @@ import textwrap
 
 from vplc.frontend.diagnostics import DiagnosticBag
 from vplc.frontend.parser import parse
-from vplc.project import load_project
 from vplc.frontend.source import SourceFile
+from vplc.project import load_project
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parents[2]

@@ -2,10 +2,10 @@
 from __future__ import annotations
 
 import pytest
+from fe_helpers import check_text, codes, program
 
 from vplc.frontend import builtins as B
 from vplc.frontend import types as T
-from fe_helpers import check_text, codes, program
 
 DECLS = ("i : INT; d : DINT; u : UINT; r : REAL; lr : LREAL; w : WORD; b : BYTE; s : STRING[20]; "
          "t : TIME; dt1 : DT; tod1 : TOD; day : DATE; x : BOOL; arr : ARRAY[1..4] OF INT;")

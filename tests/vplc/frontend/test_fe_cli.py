@@ -3,8 +3,9 @@ from __future__ import annotations
 
 import json
 
-from vplc.cli import main as cli
 from fe_helpers import program
+
+from vplc.cli import main as cli
 
 
 def test_clean_file_exits_0_and_error_file_exits_1_with_rendered_caret(tmp_path, run_cli):

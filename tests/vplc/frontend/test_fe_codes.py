@@ -47,7 +47,7 @@ def test_generated_files_agree_with_the_table():
 
 def test_codes_module_matches_the_table():
     rows = table.load()
-    assert C.BY_NAME == {row["name"]: code for code, row in rows.items()}
+    assert {row["name"]: code for code, row in rows.items()} == C.BY_NAME
     assert all(getattr(C, name) == code for name, code in C.BY_NAME.items())
 
 

@@ -8,13 +8,13 @@ import dataclasses
 import os
 
 import pytest
+from fe_helpers import HERE, ROOT
 
 from vplc.frontend import ast as A
 from vplc.frontend.diagnostics import DiagnosticBag
 from vplc.frontend.lexer import tokenize
-from vplc.project import load_project
 from vplc.frontend.source import SourceFile
-from fe_helpers import HERE, ROOT
+from vplc.project import load_project
 
 UPDATE = os.environ.get("UPDATE_GOLDEN") == "1"
 SKIP = {"span", "ty", "conv", "sysmac_ty", "sym", "binding", "name_span", "namespace", "native", "comments"}

@@ -9,7 +9,6 @@ import subprocess
 import sys
 
 import pytest
-
 from fe_helpers import check_text, codes, program
 
 from vplc.frontend import lexer

@@ -1,8 +1,9 @@
 """Parser: AST shapes for the grammar corners, precedence, recovery and depth limits."""
 from __future__ import annotations
 
-from vplc.frontend import ast as A
 from fe_helpers import parse_text, program
+
+from vplc.frontend import ast as A
 
 
 def body_of(text: str, decls: str = "x : INT;"):

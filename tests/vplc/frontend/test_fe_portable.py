@@ -1,7 +1,6 @@
 """--portable rules ST2004-ST2011: each construct that IEC 61131-3 2nd edition compilers reject is reported
 with its own code (failing example), and the portable rewrite is not (passing example)."""
 import pytest
-
 from fe_helpers import check_text, codes
 
 FN = """
@@ -67,6 +66,7 @@ def test_portable_warning_points_at_file_line_col_with_a_fix(tmp_path):
 def test_st2004_and_st2008_messages_come_out_whole_in_text_and_json(tmp_path):
     """Two quoted names in one message: the prose between them is not a quote and is never shortened."""
     import json
+
     from vplc.frontend.diagnostics import to_json
     proj = check_text(tmp_path, "TYPE eColor : (Red := 0, Green := 1); END_TYPE\n"
                       "PROGRAM P VAR c : eColor; b : BOOL; END_VAR b := c > Red; END_PROGRAM", portable=True)

@@ -2,9 +2,9 @@
 from __future__ import annotations
 
 import pytest
+from fe_helpers import HERE, ROOT, parse_text
 
 from vplc.frontend.printer import print_unit
-from fe_helpers import HERE, ROOT, parse_text
 
 FILES = sorted(
     list((HERE / "cases").glob("*.st"))

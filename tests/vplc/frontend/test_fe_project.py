@@ -1,11 +1,12 @@
 """Project API: resolved types, symbols, call bindings, conversions, namespaces, prelude (frontend_api.md)."""
 from __future__ import annotations
 
+from fe_helpers import check_text, program
+
+from vplc.checker.symbols import EnumValueSymbol, VarSymbol
 from vplc.frontend import ast as A
 from vplc.frontend import types as T
-from vplc.checker.symbols import EnumValueSymbol, VarSymbol
 from vplc.project import load_project
-from fe_helpers import check_text, program
 
 
 def stmts(proj, name="Main"):

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import pytest
-
 from fe_helpers import check_text, codes, program
 from rule_cases import CASES, FB
 

@@ -3,6 +3,7 @@ import pathlib
 import re
 
 from fe_helpers import check_text, codes, program
+
 from vplc.frontend.sysmac_names import SYSMAC_NAMES
 from vplc.project import PRELUDE_DIR
 
@@ -88,6 +89,7 @@ def test_namespaces_nested_10000_deep_are_one_st0203_in_linear_time(tmp_path):
 
 def test_the_printer_keeps_namespaces_and_unions():
     from fe_helpers import parse_text
+
     from vplc.frontend.printer import print_unit
     src = (pathlib.Path(__file__).resolve().parents[1] / "sysmac" / "manual_project" / "Types.st").read_text()
     unit, diags = parse_text(src)

@@ -4,6 +4,7 @@ writes the program of ld_xml first."""
 from __future__ import annotations
 
 from ld_xml import program
+
 from vplc.api import load_plc
 
 MS = 1_000_000

@@ -35,7 +35,7 @@ def trace(sources, scans: int = 1000, stimulus=example_stimulus, watched=WATCHED
 
 
 def first_difference(a, b) -> str | None:
-    for n, (ra, rb) in enumerate(zip(a, b)):
+    for n, (ra, rb) in enumerate(zip(a, b, strict=False)):
         for name in ra:
             if ra[name] != rb[name]:
                 return f"scan {n}: {name} = {ra[name]!r} vs {rb[name]!r}"

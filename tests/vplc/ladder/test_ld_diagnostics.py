@@ -3,8 +3,8 @@ ST checker's rules hold for ladder POUs (docs/toolchain/diagnostics.md, ST21xx).
 from __future__ import annotations
 
 import pytest
+from ld_xml import HEAD, block, coil, contact, invar, jump, label, outvar, program, rail
 
-from ld_xml import HEAD, block, coil, contact, invar, jump, label, outvar, program, rail, right
 from vplc.ladder import xmlsafe
 from vplc.project import load_project
 
@@ -205,8 +205,7 @@ def test_damaged_files_give_diagnostics_never_a_traceback(tmp_path):
     import random
     import re
 
-    from ld_xml import document
-    from ld_xml import ALL_BODY, ALL_KINDS
+    from ld_xml import ALL_BODY, ALL_KINDS, document
     base = document(ALL_KINDS, ALL_BODY)
     rnd = random.Random(16)
 

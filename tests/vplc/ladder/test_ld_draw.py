@@ -5,6 +5,7 @@ import xml.etree.ElementTree as ET
 
 from ld_trace import ROOT
 from ld_xml import block, coil, comment, contact, invar, outvar, program, rail, right
+
 from vplc.cli.main import main
 
 LIB = ROOT / "lib" / "CBT_Commands_Lib"
@@ -131,4 +132,4 @@ def test_long_names_widen_the_rung_instead_of_crossing_the_rails(tmp_path, capsy
     assert {long_in, long_out, "Sum_Of_Everything_Counted_So_Far"} <= {t for *_, t in extents}
     assert [t for x0, x1, left, right, t in extents if x0 < left + 2 or x1 > right - 2] == []
     named = sorted((x0, x1) for x0, x1, _, _, t in extents if t in (long_in, "B", long_out))
-    assert all(a[1] <= b[0] for a, b in zip(named, named[1:])), "names above one row overlap"
+    assert all(a[1] <= b[0] for a, b in zip(named, named[1:], strict=False)), "names above one row overlap"

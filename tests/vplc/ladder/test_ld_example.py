@@ -5,7 +5,6 @@ from __future__ import annotations
 import shutil
 
 import pytest
-
 from ld_trace import ROOT, first_difference, trace
 
 LIB = ROOT / "lib" / "CBT_Commands_Lib"

@@ -6,9 +6,9 @@ from __future__ import annotations
 import re
 
 import pytest
-
 from ld_trace import ROOT, first_difference, trace
 from ld_xml import ALL_BODY, ALL_KINDS, program
+
 from vplc.cli.main import main
 
 LIB = ROOT / "lib" / "CBT_Commands_Lib"

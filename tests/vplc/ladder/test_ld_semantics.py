@@ -3,9 +3,9 @@ order (docs/toolchain/ladder.md), scan by scan on virtual time."""
 from __future__ import annotations
 
 import pytest
-
-from ld_xml import block, coil, comment, contact, invar, jump, label, outvar, program, rail, ret, right
 from ld_run import MS, Run
+from ld_xml import block, coil, comment, contact, invar, jump, label, outvar, program, rail, ret, right
+
 from vplc.api import load_plc
 
 

@@ -5,9 +5,9 @@ per attribute; files of earlier vplc exports keep loading with warning ST2108.""
 from __future__ import annotations
 
 import pytest
-
-from ld_xml import IEC10_HEAD, iec10_program
 from ld_run import Run
+from ld_xml import IEC10_HEAD, iec10_program
+
 from vplc.api import load_plc
 from vplc.project import load_project
 

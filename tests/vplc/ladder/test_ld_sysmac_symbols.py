@@ -1,6 +1,6 @@
 """Ladder blocks Sysmac names by their symbols (W502 2-87, 2-89): `<`, `=`, `+` ... run as LT, EQ, ADD ..."""
-from ld_xml import block, coil, invar, outvar, rail, right
 from ld_run import Run
+from ld_xml import block, coil, invar, outvar, rail, right
 
 
 def test_symbol_blocks_compare_and_add_like_their_iec_names(tmp_path):

@@ -107,7 +107,7 @@ class Rig:
         assert len(on) == 1, on
         return on[0]
 
-    def powered(self) -> "Rig":
+    def powered(self) -> Rig:
         self.scan(2)
         assert self.r("pwr.Status") and self.state() == "Standstill"
         return self

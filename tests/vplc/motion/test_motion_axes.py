@@ -3,8 +3,8 @@ its errors, axes that are not configured, axis names, and tracing _MC_AX members
 each test (the English pages were not readable in our manual corpus; W508's Chinese edition pages are linked in
 docs/toolchain/runtime_sysmac.md section 5)."""
 import pytest
-
 from motion_rig import Rig, files
+
 from vplc.api import LoadError, load_plc
 from vplc.runtime import motion as M
 from vplc.trace.recorder import Recorder, write_trace

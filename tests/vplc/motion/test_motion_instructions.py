@@ -4,8 +4,8 @@ Instructions Reference Manual) or the W507 axis-state chart it pins. The English
 manual corpus; the instruction pages of W508's Chinese edition were (links in docs/toolchain/runtime_sysmac.md
 section 5, "W508 (zh)"), so the citations name the instruction and its table (input ranges, output timing)."""
 import pytest
-
 from motion_rig import Rig, duration, files, s_curve, s_curve_duration, trapezoid
+
 from vplc.api import PlcFault
 from vplc.runtime import motion as M
 

@@ -4,7 +4,6 @@ and a positioning given at the end lands exactly on its target. MOTION_SEEDS=800
 import random
 
 import pytest
-
 from motion_rig import Rig, files
 
 VMAX, AMAX, DT = 200.0, 2000.0, 0.001

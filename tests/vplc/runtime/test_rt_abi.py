@@ -88,7 +88,7 @@ def test_every_name_the_runtime_puts_into_a_program_namespace_is_declared(extra_
         assert sorted(n for n in provided if not abi.is_declared(n)) == []
         assert set(HELPERS) == abi.HELPER_NAMES
         assert {n for n in stdlib.NAMESPACE if not n.startswith(abi.STDLIB_MATH_PREFIX)} <= abi.STDLIB_NAMES
-        assert abi.NAMESPACE_CELLS | abi.BOUND_NAMES <= set(plc.module.namespace)
+        assert set(plc.module.namespace) >= abi.NAMESPACE_CELLS | abi.BOUND_NAMES
         assert all(abi.NATIVE_FB + name in plc.module.namespace for name in natives.NATIVE_FBS)
         assert all(abi.NATIVE_FUNCTION + name in plc.module.namespace for name in natives.NATIVE_FUNCTIONS)
         plc.scan(0)

@@ -2,9 +2,9 @@
 import threading
 
 import pytest
+from rt_helpers import plc_from
 
 from vplc.api import LoadError, load_plc
-from rt_helpers import plc_from
 
 TYPES = """
 TYPE eMode : (Off, Auto); stP : STRUCT X : REAL; Name : STRING[8]; END_STRUCT; END_TYPE

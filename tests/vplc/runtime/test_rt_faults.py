@@ -1,8 +1,8 @@
 """Runtime faults stop the controller with the ST location, instance path and values; never a traceback."""
 import pytest
+from rt_helpers import plc_from
 
 from vplc.api import PlcFault
-from rt_helpers import plc_from
 
 FB = """
 FUNCTION_BLOCK Divider

@@ -11,7 +11,6 @@ import subprocess
 import sys
 
 import pytest
-
 from rt_helpers import plc_from
 
 from vplc.api import PlcFault, compile_program

@@ -36,7 +36,7 @@ def test_optimised_and_plain_code_give_the_same_variables_after_every_scan():
     assert "B1_R_TRIG(_i" not in fast.program.source and "B1_R_TRIG(_i" in plain.program.source
     expected, got = trace(plain, 400), trace(fast, 400)
     assert len(got) == 400
-    for scan, (want, have) in enumerate(zip(expected, got)):
+    for scan, (want, have) in enumerate(zip(expected, got, strict=False)):
         assert have == want, f"scan {scan}: " + ", ".join(k for k in want if have.get(k) != want[k])
     assert got[-1]["Main.HITS"] > 0 and got[-1]["Main.SINGLE.COUNT"] > 0
 

@@ -3,8 +3,8 @@ import math
 import struct
 
 import pytest
-
 from rt_helpers import plc_from, run1
+
 from vplc.api import PlcFault
 
 

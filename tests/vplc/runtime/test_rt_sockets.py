@@ -2,7 +2,6 @@
 import socket
 
 import pytest
-
 from rt_helpers import plc_from
 
 DECLS = """

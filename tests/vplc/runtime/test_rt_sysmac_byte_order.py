@@ -3,7 +3,6 @@ Reference Manual (W502): ToAryByte 2-453 .. 2-455, AryByteTo 2-459 .. 2-461 (iss
 from __future__ import annotations
 
 import pytest
-
 from rt_helpers import run1
 
 

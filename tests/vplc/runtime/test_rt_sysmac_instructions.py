@@ -2,6 +2,7 @@
 import struct
 
 from rt_helpers import plc_from, run1
+
 from vplc.api import load_plc
 
 
