@@ -11,6 +11,8 @@ The servo is ideal (``Act`` = ``Cmd``).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
+from typing import Any
 
 from .motion_config import UNITS, AxisConfig
 from .motion_profile import Profile, plan_position, plan_velocity
@@ -48,7 +50,8 @@ class Command:
 
     __slots__ = ("kind", "fb", "status", "in_velocity", "target", "velocity", "acc", "dec", "jerk", "direction")
 
-    def __init__(self, kind: str, fb, target=0.0, velocity=0.0, acc=0.0, dec=0.0, jerk=0.0, direction=1.0) -> None:
+    def __init__(self, kind: str, fb: Any, target: float = 0.0, velocity: float = 0.0, acc: float = 0.0,
+                 dec: float = 0.0, jerk: float = 0.0, direction: float = 1.0) -> None:
         self.kind, self.fb, self.status, self.in_velocity = kind, fb, WAITING, False
         self.target, self.velocity, self.acc, self.dec, self.direction = target, velocity, acc, dec, direction
         self.jerk = jerk
@@ -57,7 +60,7 @@ class Command:
 class Axis:
     """One virtual servo axis and the _sAXIS_REF value the program sees."""
 
-    def __init__(self, cfg: AxisConfig, ref) -> None:
+    def __init__(self, cfg: AxisConfig, ref: Any) -> None:
         self.cfg, self.ref = cfg, ref
         self.state = DISABLED
         self.pos = self.vel = self.acc = 0.0
@@ -110,7 +113,8 @@ class Axis:
         return self.homed and self.cfg.limit_positive is not None
 
     def in_limits(self, x: float) -> bool:
-        return not self.limits_active() or self.cfg.limit_negative <= x <= self.cfg.limit_positive
+        lo, hi = self.cfg.limit_negative, self.cfg.limit_positive
+        return not self.homed or lo is None or hi is None or lo <= x <= hi
 
     def vmax_of(self, velocity: float) -> tuple[float, bool]:
         """Target velocity × override, at most the axis maximum (W508 MC_SetOverride); True when the maximum
@@ -195,12 +199,11 @@ class Axis:
     def advance(self, t: float) -> None:
         """Evaluate the motion at time t; a buffered command starts exactly when the one before it ends
         (Done, or InVelocity after a velocity command), so the command position stays continuous."""
-        while True:
-            prof = self.profile
+        prof = self.profile
+        while prof is not None:
             x, v, a, finished = prof.at(t)
             if self.limits_active():
-                x, v, a, finished = self._guard_limits(x, v, a, finished, t)
-                prof = self.profile
+                prof, x, v, a, finished = self._guard_limits(prof, x, v, a, finished, t)
             self.pos, self.vel, self.acc = x, v, a
             cmd = self.active
             if not finished or prof.hold:
@@ -214,6 +217,7 @@ class Axis:
                 self._finish(cmd, DONE)
                 nxt, self.queued, self.active = self.queued, None, None
                 self.start(nxt, prof.t_end, at_end=True)
+                prof = self.profile
                 continue
             self.profile = None
             self.vel = self.acc = 0.0
@@ -257,18 +261,20 @@ class Axis:
                 self._set_state(STANDSTILL)
         self.instant.clear()
 
-    def _guard_limits(self, x, v, a, finished, t):
+    def _guard_limits(self, prof: Profile, x: float, v: float, a: float, finished: bool,
+                      t: float) -> tuple[Profile, float, float, float, bool]:
         """Software limits on the command position (W507): a motion that would pass a limit decelerates with
         the axis' maximum deceleration so that it stops on the limit, and the axis goes to ErrorStop with a
-        minor fault; a position already past a limit is held on it."""
+        minor fault; a position already past a limit is held on it. Returns the profile the axis now follows
+        with (position, velocity, acceleration, finished) at t."""
         lo, hi = self.cfg.limit_negative, self.cfg.limit_positive
-        if self.limit_stop:
-            return x, v, a, finished
+        if self.limit_stop or lo is None or hi is None:
+            return prof, x, v, a, finished
         if x > hi or x < lo:
             x = hi if x > hi else lo
             self._limit_fault(x, t)
-            self.profile = Profile(t, x, 0.0, [])
-            return x, 0.0, 0.0, True
+            prof = self.profile = Profile(t, x, 0.0, [])
+            return prof, x, 0.0, 0.0, True
         if v != 0.0:
             edge = hi if v > 0 else lo
             room = abs(edge - x)
@@ -277,10 +283,12 @@ class Axis:
                 self._limit_fault(edge, t)
                 dec = v * v / (2 * room) if room > 0 else 0.0
                 segs = [(abs(v) / dec, math.copysign(dec, -v), 0.0)] if dec > 0 else []
-                self.profile = Profile(t, x, v if dec > 0 else 0.0, segs, edge)
+                prof = self.profile = Profile(t, x, v if dec > 0 else 0.0, segs, edge)
                 self.limit_stop = True
-                return (x, v, -math.copysign(dec, v), False) if dec > 0 else (edge, 0.0, 0.0, True)
-        return x, v, a, finished
+                if dec > 0:
+                    return prof, x, v, -math.copysign(dec, v), False
+                return prof, edge, 0.0, 0.0, True
+        return prof, x, v, a, finished
 
     def _limit_fault(self, edge: float, t: float) -> None:
         self.error(AXIS_SW_LIMIT_POS if edge == self.cfg.limit_positive else AXIS_SW_LIMIT_NEG)
@@ -351,7 +359,7 @@ class Axis:
 class MotionController:
     """The axes of one PLC and the motion processing that runs in its primary task."""
 
-    def __init__(self, rt, configs, globals_obj) -> None:
+    def __init__(self, rt: Any, configs: Iterable[AxisConfig], globals_obj: Any) -> None:
         self.rt = rt
         table = getattr(globals_obj, "_MC_AX", None)
         if table is None:
@@ -373,14 +381,14 @@ class MotionController:
         self.i__path = f"motion control of {n} ax{'is' if n == 1 else 'es'}"     # how `vplc run` lists it
 
     @staticmethod
-    def _global(globals_obj, name: str):
+    def _global(globals_obj: Any, name: str) -> str | None:
         info = getattr(type(globals_obj), "i__vars", {})
         entry = info.get(name.upper())
         if entry is None or getattr(entry[1], "name", "").upper() != "_SAXIS_REF":
             return None
         return entry[0]
 
-    def axis_of(self, ref) -> Axis | None:
+    def axis_of(self, ref: Any) -> Axis | None:
         return self.by_ref.get(id(ref))
 
     def cycle(self) -> None:

@@ -23,6 +23,7 @@ import math
 import os
 import tomllib
 from dataclasses import dataclass
+from typing import Any
 
 MAX_AXES = 64            # _MC_AX[0..63] (prelude/sysmac_motion.st)
 UNITS = {"pulse": 0, "mm": 1, "um": 2, "nm": 3, "deg": 4, "inch": 5}     # _eMC_UNITS values
@@ -52,7 +53,7 @@ _KEYS = {"number", "name", "units", "max_velocity", "max_acceleration", "max_dec
          "software_limit_negative", "software_limit_positive", "home_position", "homed"}
 
 
-def load_axes(path) -> tuple[AxisConfig, ...]:
+def load_axes(path: str | os.PathLike[str]) -> tuple[AxisConfig, ...]:
     """Read and check the axis configuration file ``path``."""
     path = os.fspath(path)
     try:
@@ -73,7 +74,7 @@ def load_axes(path) -> tuple[AxisConfig, ...]:
     return parse_axes(doc, path)
 
 
-def parse_axes(doc: dict, path: str = "<axes>") -> tuple[AxisConfig, ...]:
+def parse_axes(doc: dict[str, Any], path: str = "<axes>") -> tuple[AxisConfig, ...]:
     """Check the parsed document ``doc`` (as tomllib returns it)."""
     extra = sorted(set(doc) - {"axis"})
     if extra:
@@ -96,11 +97,11 @@ def parse_axes(doc: dict, path: str = "<axes>") -> tuple[AxisConfig, ...]:
     return tuple(axes[n] for n in sorted(axes))
 
 
-def _table_of(tables, number) -> str:
+def _table_of(tables: list[dict[str, Any]], number: int) -> str:
     return " and ".join(str(i) for i, t in enumerate(tables, 1) if t.get("number") == number)
 
 
-def _axis(t: dict, path: str, index: int) -> AxisConfig:
+def _axis(t: dict[str, Any], path: str, index: int) -> AxisConfig:
     where = f"{path}: [[axis]] table {index}"
     number = t.get("number")
     if isinstance(number, bool) or not isinstance(number, int):

@@ -19,6 +19,7 @@ modes), never run with another meaning.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from . import motion as M
 from .faults import RuntimeFaultError
@@ -26,7 +27,7 @@ from .faults import RuntimeFaultError
 _BLENDING = {2: "_mcBlendingLow", 3: "_mcBlendingPrevious", 4: "_mcBlendingNext", 5: "_mcBlendingHigh"}
 
 
-def _axis(fb):
+def _axis(fb: Any) -> M.Axis | None:
     """The virtual axis behind fb.Axis, or None after recording why (Error 16#5401 follows)."""
     ctl = getattr(fb.i__rt, "motion", None)
     axis = ctl.axis_of(fb.Axis) if ctl is not None else None
@@ -41,7 +42,7 @@ def _axis(fb):
 REFUSED = -1        # begin(): the instruction ends in CommandAborted (not an ErrorID)
 
 
-def _state_error(axis, stop: bool = False) -> int:
+def _state_error(axis: M.Axis, stop: bool = False) -> int:
     """The PLCopen state diagram as W508 applies it (output timing of MC_Home, MC_SetPosition, MC_Stop: an
     instruction started while the axis has an error, or while MC_Stop runs, ends in CommandAborted; MC_Power: a
     motion instruction on a disabled axis is an error). Another MC_Stop (``stop``) may start while one runs."""
@@ -52,7 +53,7 @@ def _state_error(axis, stop: bool = False) -> int:
     return 0
 
 
-def _now(fb) -> float:
+def _now(fb: Any) -> float:
     return fb.i__rt.now_ns / 1e9
 
 
@@ -61,17 +62,17 @@ class _ExecuteFB:
 
     DONE_OUT = "Done"
 
-    def __init__(self, rt, path: str) -> None:
+    def __init__(self, rt: Any, path: str) -> None:
         self.i__rt, self.i__path = rt, path
-        self.Axis = None
+        self.Axis: Any = None
         self.Execute = False
         self.Busy = self.CommandAborted = self.Error = False
         setattr(self, self.DONE_OUT, False)
         self.ErrorID = 0
         self.i__prev = False
-        self.i__cmd = None
+        self.i__cmd: M.Command | None = None
         self.i__final = False
-        self.i__eaxis = None            # the axis whose error this instance's Error reports
+        self.i__eaxis: M.Axis | None = None     # the axis whose error this instance's Error reports
         self.i__eserial = 0
 
     def i__run(self) -> None:
@@ -119,7 +120,7 @@ class _ExecuteFB:
     def _set_active(self, value: bool) -> None:
         pass
 
-    def _poll(self, cmd) -> None:
+    def _poll(self, cmd: M.Command) -> None:
         st = cmd.status
         if st == M.DONE:
             setattr(self, self.DONE_OUT, True)
@@ -135,18 +136,18 @@ class _ExecuteFB:
         self._set_active(False)
         self.i__cmd, self.i__final = None, True
 
-    def _issue(self, cmd) -> None:
+    def _issue(self, cmd: M.Command) -> None:
         self.i__cmd = cmd
         self.Busy = True
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         raise NotImplementedError
 
 
 class _MoveFB(_ExecuteFB):
     """Instructions with Active and BufferMode: MoveAbsolute, MoveRelative, MoveVelocity, Halt, Stop."""
 
-    def __init__(self, rt, path: str) -> None:
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Active = False
         self.Velocity = self.Acceleration = self.Deceleration = self.Jerk = 0.0
@@ -176,7 +177,7 @@ class _MoveFB(_ExecuteFB):
                                     "(only _mcAborting and _mcBuffered)")
         return 0 if bm in (0, 1) else M.ERR_BUFFER_MODE
 
-    def _give(self, axis, cmd) -> int:
+    def _give(self, axis: M.Axis, cmd: M.Command) -> int:
         """Hand cmd to the axis: at once (Aborting, or Buffered on an axis at rest) or after the running one."""
         act = axis.active
         if self.BufferMode == 1 and act is not None and act.status == M.ACTIVE and act.fb is not self \
@@ -197,15 +198,15 @@ class _MoveFB(_ExecuteFB):
 class MC_MoveAbsolute(_MoveFB):
     """W508 MC_MoveAbsolute. Linear count mode: Direction is checked (0..4) and otherwise not used."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Position = 0.0
         self.Direction = 0
 
-    def target(self, axis) -> float:
+    def target(self, axis: M.Axis) -> float:
         return self.Position
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         code = _state_error(axis) or self._ramps(True)
         if code:
             return code
@@ -224,11 +225,11 @@ class MC_MoveRelative(MC_MoveAbsolute):
     """W508 MC_MoveRelative: the target is Distance from the command position when the motion starts (from the
     target of the command before it when Buffered)."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Distance = 0.0
 
-    def target(self, axis) -> float:
+    def target(self, axis: M.Axis) -> float:
         base = axis.pos
         act = axis.active
         if self.BufferMode == 1 and act is not None and act.kind == "position" and act.status == M.ACTIVE:
@@ -247,12 +248,12 @@ class MC_MoveVelocity(_MoveFB):
 
     DONE_OUT = "InVelocity"
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Direction = 0
         self.Continuous = False
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         code = _state_error(axis) or self._ramps(True, velocity_zero_ok=True)
         if code:
             return code
@@ -270,7 +271,7 @@ class MC_MoveVelocity(_MoveFB):
                         axis.ramp(self.Deceleration, cfg.max_deceleration), axis.jerk(self.Jerk), sign)
         return self._give(axis, cmd)
 
-    def _poll(self, cmd) -> None:
+    def _poll(self, cmd: M.Command) -> None:
         if cmd.status == M.ACTIVE:
             self.Active = True
             self.InVelocity = cmd.in_velocity
@@ -287,7 +288,7 @@ class MC_MoveVelocity(_MoveFB):
 class MC_Halt(_MoveFB):
     """W508 MC_Halt: decelerates to a stop (Discrete); another instruction may abort it."""
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         code = _state_error(axis) or self._ramps(False)
         if code:
             return code
@@ -303,7 +304,7 @@ class MC_Stop(_MoveFB):
     def _buffer_mode(self) -> int:
         return 0                    # reserved for MC_Stop: the stop always aborts
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         code = _state_error(axis, stop=True) or self._ramps(False)
         if code:
             return code
@@ -334,13 +335,13 @@ class MC_Stop(_MoveFB):
             axis.release_stop()
             self.i__stop = None
 
-    i__stop = None          # the stop this instance gave, until the axis leaves Stopping
+    i__stop: M.Command | None = None        # the stop this instance gave, until the axis leaves Stopping
 
 
 class MC_Home(_ExecuteFB):
     """W508 MC_Home with the zero position preset homing method: home = the configured home_position."""
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         code = _state_error(axis)
         if code or axis.state != M.STANDSTILL:
             return code or M.ERR_MOVING
@@ -356,21 +357,21 @@ class MC_SetPosition(_ExecuteFB):
     error, so both ReferenceType values give the same result); home becomes defined. Relative and ExecutionMode
     are reserved."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Position = 0.0
         self.ReferenceType = 0
         self.Relative = False
         self.ExecutionMode = 0
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         if axis.state in (M.ERRORSTOP, M.STOPPING):
             return REFUSED
         if axis.state not in (M.STANDSTILL, M.DISABLED):
             return M.ERR_MOVING
         x = self.Position
-        if not math.isfinite(x) or (axis.cfg.limit_positive is not None
-                                    and not axis.cfg.limit_negative <= x <= axis.cfg.limit_positive):
+        lo, hi = axis.cfg.limit_negative, axis.cfg.limit_positive
+        if not math.isfinite(x) or (lo is not None and hi is not None and not lo <= x <= hi):
             return M.ERR_POSITION
         cmd = M.Command("setpos", self, x)
         axis.instant.append(cmd)
@@ -382,29 +383,31 @@ class MC_Reset(_ExecuteFB):
     """W508 MC_Reset: clears the axis error; Busy until the axis has stopped, then Done. Failure stays FALSE
     (a virtual axis has no error cause that outlasts the reset)."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Failure = False
+        self.i__axis: M.Axis | None = None
 
-    def begin(self, axis) -> int:
+    def begin(self, axis: M.Axis) -> int:
         self._issue(M.Command("reset", self))
         self.i__axis = axis
         self._try()
         return 0
 
-    def _poll(self, cmd) -> None:
+    def _poll(self, cmd: M.Command) -> None:
         self._try()
 
     def _try(self) -> None:
-        if self.i__axis.reset():
+        axis = self.i__axis
+        if axis is not None and axis.reset():
             self.Done = True
             self._end()
 
 
 class _EnableFB:
-    def __init__(self, rt, path: str) -> None:
+    def __init__(self, rt: Any, path: str) -> None:
         self.i__rt, self.i__path = rt, path
-        self.Axis = None
+        self.Axis: Any = None
         self.Enable = False
         self.Busy = self.Error = False
         self.ErrorID = 0
@@ -414,7 +417,7 @@ class MC_Power(_EnableFB):
     """W508 MC_Power: servo ON while Enable is TRUE; Status TRUE once it is ON (after the motion processing of
     the period); Busy follows Enable."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Status = False
 
@@ -438,7 +441,7 @@ class MC_Power(_EnableFB):
 class MC_ReadAxisError(_EnableFB):
     """W508 MC_ReadAxisError: AxisErrorID is the axis' minor fault code while Enable is TRUE."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Valid = False
         self.AxisErrorID = 0
@@ -465,7 +468,7 @@ class MC_SetOverride(_EnableFB):
     as 0.01, and only 0 as 0 — which holds the axis without ending its motion. Enabled goes FALSE one period after
     Enable. AccFactor and JerkFactor are reserved."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.VelFactor = self.AccFactor = self.JerkFactor = 100.0
         self.Enabled = False

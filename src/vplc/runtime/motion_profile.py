@@ -11,6 +11,10 @@ is the cubic of its segment, never an integration over scans. Planners build the
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
+
+Segment = tuple[float, float, float]        # (duration, acceleration at its start, jerk)
+Part = tuple[float, float, float, float, float, float]  # (end time, start time, x, v, a, jerk) of one segment
 
 
 class Profile:
@@ -19,8 +23,9 @@ class Profile:
 
     __slots__ = ("parts", "i", "t_end", "x_end", "v_end", "hold")
 
-    def __init__(self, t0: float, x0: float, v0: float, segments, target: float | None = None) -> None:
-        parts = []
+    def __init__(self, t0: float, x0: float, v0: float, segments: Iterable[Segment],
+                 target: float | None = None) -> None:
+        parts: list[Part] = []
         t, x, v = t0, x0, v0
         for d, a, j in segments:
             if d > 0.0:
@@ -47,7 +52,7 @@ class Profile:
         return x + (v + a * tau / 2) * tau, v + a * tau, a, False
 
 
-def advance(x: float, v: float, segs) -> tuple[float, float]:
+def advance(x: float, v: float, segs: Iterable[Segment]) -> tuple[float, float]:
     """Position and velocity at the end of ``segs`` started at (x, v)."""
     for d, a, j in segs:
         x += (v + (a / 2 + j * d / 6) * d) * d
@@ -55,7 +60,7 @@ def advance(x: float, v: float, segs) -> tuple[float, float]:
     return x, v
 
 
-def ramp(u0: float, u1: float, limit: float, jerk: float) -> list:
+def ramp(u0: float, u1: float, limit: float, jerk: float) -> list[Segment]:
     """Segments changing the velocity from u0 to u1 (acceleration 0 at both ends with a jerk): with jerk 0 a
     constant acceleration of magnitude ``limit``; with jerk J an S-curve whose acceleration reaches at most
     ``limit`` (a triangle of acceleration when the change is too small to reach it)."""
@@ -79,7 +84,7 @@ def ramp_distance(u0: float, u1: float, limit: float, jerk: float) -> float:
     return (u0 + u1) / 2 * sum(d for d, _, _ in ramp(u0, u1, limit, jerk))
 
 
-def settle(a0: float, jerk: float, v0: float = 0.0, vlimit: float = math.inf) -> list:
+def settle(a0: float, jerk: float, v0: float = 0.0, vlimit: float = math.inf) -> list[Segment]:
     """With a jerk, the segment that brings a running acceleration a0 to 0 before a new plan starts. While it
     settles the speed still grows by a0^2 / 2J: a steeper jerk keeps it within ``vlimit`` (the axis maximum; an
     acceleration that cannot settle in time drops to 0 at once)."""
@@ -94,7 +99,7 @@ def settle(a0: float, jerk: float, v0: float = 0.0, vlimit: float = math.inf) ->
 
 
 def plan_velocity(v0: float, vt: float, acc: float, dec: float, jerk: float = 0.0, a0: float = 0.0,
-                  vlimit: float = math.inf) -> list:
+                  vlimit: float = math.inf) -> list[Segment]:
     """Segments from velocity v0 (acceleration a0) to vt: speeding up with acc, slowing down with dec (through 0
     when the direction changes: first dec to 0, then acc)."""
     segs = settle(a0, jerk, v0, vlimit)
@@ -106,7 +111,7 @@ def plan_velocity(v0: float, vt: float, acc: float, dec: float, jerk: float = 0.
 
 
 def plan_position(x0: float, v0: float, xt: float, vmax: float, acc: float, dec: float, jerk: float = 0.0,
-                  a0: float = 0.0, vlimit: float = math.inf) -> list:
+                  a0: float = 0.0, vlimit: float = math.inf) -> list[Segment]:
     """Segments that take the axis from (x0, v0, a0) to rest at xt: speed up with acc to at most vmax, cruise,
     slow down with dec (a lower peak velocity when the distance is short). Moving away from the target, or too
     fast to stop before it, the axis first stops and then comes back."""
