@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import sys
+from dataclasses import dataclass
 
 # ---- script values ------------------------------------------------------------------------------
 INT_MIN, INT_MAX = -2 ** 31, 2 ** 31 - 1    # [MAN 2.24 §2.1] int: 32-bit signed; results wrap (§2.2)
@@ -29,7 +30,7 @@ DEPTH_MAX = 100                             # nesting of one expression (operand
 STEPS_MAX = 20_000                          # work of one script: statements + expression nodes + array
                                             # elements copied / 8 + string characters built or sent / 256
 
-# ---- work of one turn of the scheduler (tmsim/tmscript/work.py): a unit is 1-5 us of the simulator's time (project VM) ---
+# ---- work of one turn of the scheduler (tmsim/tmscript/work.py): a unit is 1-5 us of the simulator's time ---
 TURN_WORK = 500                             # units one turn of one robot may do; then its work goes on later
 WORK_CHAR = 1                               # a character of a script line parsed and checked ...
 WORK_LINE = 4                               # ... plus this per line
@@ -95,3 +96,21 @@ CPERR_PER_S = 100                           # ... then at most this many per sec
 OUTBOX_TOTAL_MAX = 16 << 20                 # unsent bytes of all clients of one robot
 PENDING_BYTES_MAX = 32 << 20                # bytes of buffered scripts, all robots together (each robot at
                                             # least 4 frames of 64 KiB)
+
+
+@dataclass(frozen=True, slots=True)
+class TurnBudget:
+    """The bounds of one turn of one client's input, as the fair scheduler (tmsim/net/fairness.py) hands them to
+    a protocol's ``turn(conn, budget)``: at most ``decoded`` items decoded and ``items`` of them handled, the turn
+    ended once ``waiting`` scripts wait to start (None: no such bound) and its work metered from ``work`` units
+    (None: the meter is left as it is); ``frame_limit`` (the fault ``close_after``) ends it right after the frame
+    that brings the connection's received frames to that count."""
+    items: int = SERVE_ITEMS
+    decoded: int = SERVE_SCAN
+    waiting: int | None = PENDING_SCRIPTS_MAX
+    work: int | None = TURN_WORK
+    frame_limit: int | None = None
+
+
+SERVE_TURN = TurnBudget()                   # one scheduled turn of a Listen-node client's input
+RECEIVE_TURN = TurnBudget(items=SERVE_SCAN, decoded=SERVE_SCAN, waiting=None, work=None)   # receive_data: all at once

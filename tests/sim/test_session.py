@@ -4,7 +4,7 @@ import struct
 import pytest
 from session_rig import PTP_LONG, S, sct, sta
 
-from tmsim.limits import CPERR_BURST, CPERR_PER_S
+from tmsim.limits import CPERR_BURST, CPERR_PER_S, TurnBudget
 from tmsim.protocol import codec
 from tmsim.protocol.listen_session import (
     EXITING,
@@ -17,6 +17,12 @@ from tmsim.protocol.listen_session import (
     TRANSITIONS,
     TransitionError,
 )
+
+
+def budget(items, decoded, **bounds):
+    """A turn of at most ``items`` handled and ``decoded`` decoded, its work not metered."""
+    return TurnBudget(items=items, decoded=decoded, waiting=bounds.get("waiting"), work=None,
+                      frame_limit=bounds.get("frame_limit"))
 
 
 def test_nothing_is_sent_on_connect_and_enter_message_only_when_entering():
@@ -373,25 +379,25 @@ def test_receive_data_takes_bytes_whole_split_and_glued_and_data_to_send_hands_o
     assert n.s.data_to_send(1) == [] and n.s.receive_data(9, raw) == 0          # unknown connection: ignored
 
 
-def test_process_handles_buffered_input_in_bounded_turns_and_says_whether_input_is_left():
+def test_turn_handles_buffered_input_in_bounded_turns_and_says_whether_input_is_left():
     n = S()
     n.connect(1)
     n.out(1)
     n.s.buffer_data(1, sta("00") * 3 + sta("00")[:5])
-    assert n.s.process(1, 2, 256) == (2, INPUT_LEFT) and len(n.out(1)) == 2
-    assert n.s.process(1, 2, 256) == (1, INPUT_DONE) and n.s.input_bytes(1) == 5      # the partial frame waits
+    assert n.s.turn(1, budget(2, 256)) == (2, INPUT_LEFT) and len(n.out(1)) == 2
+    assert n.s.turn(1, budget(2, 256)) == (1, INPUT_DONE) and n.s.input_bytes(1) == 5      # the partial frame waits
     n.s.buffer_data(1, sta("00")[5:] + sct("A", "int a = 1") * 3)
-    assert n.s.process(1, 8, 2) == (2, INPUT_LEFT)                                     # decode bound
-    assert n.s.process(1, 8, 256, frame_limit=6) == (1, FRAME_LIMIT)                 # 5 frames + this one
+    assert n.s.turn(1, budget(8, 2)) == (2, INPUT_LEFT)                                     # decode bound
+    assert n.s.turn(1, budget(8, 256, frame_limit=6)) == (1, FRAME_LIMIT)                 # 5 frames + this one
     assert [k for k, _ in n.events].count("frame_in") == 6
-    assert n.s.process(9, 8, 256) == (0, INPUT_DONE) and n.s.input_bytes(9) == 0      # unknown connection
+    assert n.s.turn(9, budget(8, 256)) == (0, INPUT_DONE) and n.s.input_bytes(9) == 0      # unknown connection
 
 
-def test_process_stops_a_turn_once_max_waiting_scripts_wait():
+def test_turn_stops_once_the_budgets_waiting_scripts_wait():
     n = S()
     n.connect(1)
     n.s.buffer_data(1, sct("A", "Sleep(1000)") + sct("B", "int b = 1") * 4)
-    assert n.s.process(1, 8, 256, max_waiting=2) == (3, INPUT_LEFT) and n.s.waiting_scripts == 2
+    assert n.s.turn(1, budget(8, 256, waiting=2)) == (3, INPUT_LEFT) and n.s.waiting_scripts == 2
 
 
 def test_bad_packets_get_cperr_burst_answers_then_cperr_per_s_and_the_rest_are_counted():

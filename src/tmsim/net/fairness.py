@@ -1,51 +1,99 @@
-"""Fair processing of the robots' client input (mixed into ``server.SimServer``).
+"""Fair processing of the robots' client input: the scheduler the server owns (``SimServer.fair``).
 
-The server only schedules: which client's input is processed next and how much of it. One turn lets the
-robot's session (``ListenSession.process``) handle at most SERVE_ITEMS items of one client's input and
-decode at most SERVE_SCAN, and do at most TURN_WORK units of work (tmsim/tmscript/work.py: checking and running
-scripts, logging; a script that is not done goes on in the robot's next turn, ``SimServer._advance``);
-what is left waits in that client's receive buffer in the session
-(``_backlog``), which is not read further meanwhile, while the other clients get their turn, round
-robin. A client whose last read filled the receive size or who has input left over is "greedy":
-``SimServer._serve`` serves it after the others. The session limits the CPERR answers to bad packets
-(CPERR_BURST, CPERR_PER_S per client). Bounds: tmsim/limits.py.
+The scheduler only decides which client's input is processed next and how much of it; the bytes and
+their meaning belong to the robot's Listen-node session, which takes one bounded turn at a time through
+``turn(conn, budget)`` (a ``TurnBudget`` of tmsim/limits.py): at most SERVE_ITEMS items of one client's
+input handled and SERVE_SCAN decoded, and at most TURN_WORK units of work (tmsim/tmscript/work.py: checking
+and running scripts, logging; a script that is not done goes on in the robot's next turn). What is left
+waits in that client's receive buffer in the session (the scheduler's backlog), which is not read further
+meanwhile, while the other clients get their turn, round robin. A client whose last read filled the receive
+size or who has input left over is "greedy": the server serves it after the others. The session limits the
+CPERR answers to bad packets (CPERR_BURST, CPERR_PER_S per client). Bounds: tmsim/limits.py.
+
+The scheduler reaches the sockets only through its host's public calls (``TurnHost``): the server flushes
+and drops connections, polls its sockets and pauses reading.
 """
 from __future__ import annotations
 
 import time
+from dataclasses import replace
+from typing import TYPE_CHECKING, Protocol
 
-from tmsim.limits import (
-    FRAME_DATA_MAX,
-    IO_SLICE_S,
-    PENDING_SCRIPTS_MAX,
-    POLL_BUDGET_S,
-    SERVE_ITEMS,
-    SERVE_SCAN,
-    TURN_WORK,
-)
+from tmsim.limits import FRAME_DATA_MAX, IO_SLICE_S, PENDING_SCRIPTS_MAX, POLL_BUDGET_S, SERVE_TURN
 from tmsim.protocol.listen_session import FRAME_LIMIT, INPUT_DONE
 
+if TYPE_CHECKING:
+    from tmsim.net.server import Conn, Robot
 
-class FairInput:
-    def _process(self, robot, conn):
-        """One turn of ``conn``'s input: at most SERVE_ITEMS items handled, SERVE_SCAN decoded. What is left
-        waits for the next turn (``_backlog``), after the other clients' turns. The fault ``close_after``
-        closes the connection right after the frame that reaches its count (its replies are sent first)."""
+
+class TurnHost(Protocol):
+    """What the scheduler needs of the server that owns it."""
+
+    def serve_ready(self, quick_only: bool = False) -> int:
+        """Serve the sockets that are ready now (``quick_only``: only clients that are not greedy)."""
+        ...
+
+    def flush(self, robot: Robot, only: Conn | None = None) -> None:
+        """Write what the robot's session produced (``only``: that client's output)."""
+        ...
+
+    def drop(self, robot: Robot, conn: Conn, reason: str) -> None:
+        """Close a client connection of the robot."""
+        ...
+
+    def touch(self, robot: Robot) -> None:
+        """The robot received input: it advances with dt = 0 before the poll ends."""
+        ...
+
+    def pause_reading(self, robot: Robot) -> None:
+        """Back-pressure: stop reading the robot's clients until its script buffer is half empty."""
+        ...
+
+
+class FairScheduler:
+    """Bounded, round-robin turns of the robots' client input (see the module docstring)."""
+
+    def __init__(self, host: TurnHost, pending_bytes_limit: int):
+        self._host = host
+        self.pending_bytes_limit = pending_bytes_limit      # a robot's share of PENDING_BYTES_MAX
+        self._backlog: dict[tuple[int, int], tuple[Robot, Conn]] = {}   # clients with input left over
+
+    @property
+    def has_backlog(self) -> bool:
+        """Some client has input left over from its last turn."""
+        return bool(self._backlog)
+
+    def waits(self, robot: Robot, conn: Conn) -> bool:
+        """``conn`` has input left over and waits for its turn in ``serve_backlog``."""
+        return (robot.index, conn.id) in self._backlog
+
+    def requeue(self, robot: Robot, conn: Conn) -> None:
+        """``conn`` has input buffered (read before a pause): it gets a turn in ``serve_backlog``."""
+        self._backlog[(robot.index, conn.id)] = (robot, conn)
+
+    def forget(self, robot: Robot, conn: Conn) -> None:
+        """``conn`` is gone."""
+        self._backlog.pop((robot.index, conn.id), None)
+
+    def turn(self, robot: Robot, conn: Conn) -> None:
+        """One turn of ``conn``'s input within SERVE_TURN. What is left waits for the next turn (the backlog),
+        after the other clients' turns. The fault ``close_after`` closes the connection right after the frame
+        that reaches its count (its replies are sent first)."""
         key = (robot.index, conn.id)
-        robot.session.meter.begin(TURN_WORK)
-        _, outcome = robot.session.process(conn.id, SERVE_ITEMS, SERVE_SCAN, max_waiting=PENDING_SCRIPTS_MAX,
-                                           frame_limit=robot.faults.close_after)
+        close_after = robot.faults.close_after
+        budget = SERVE_TURN if close_after is None else replace(SERVE_TURN, frame_limit=close_after)
+        _, outcome = robot.session.turn(conn.id, budget)
         if outcome == INPUT_DONE:
             self._backlog.pop(key, None)
         elif outcome == FRAME_LIMIT:
             robot.faults.close_after = None
-            self._flush(robot)
-            self.drop(robot, conn, "fault: close_after")
+            self._host.flush(robot)
+            self._host.drop(robot, conn, "fault: close_after")
         else:
             self._backlog[key] = (robot, conn)
             conn.greedy = True
 
-    def _buffer_full(self, robot, fraction=1.0) -> bool:
+    def buffer_full(self, robot: Robot, fraction: float = 1.0) -> bool:
         """The robot's buffered scripts reach PENDING_SCRIPTS_MAX or its share of PENDING_BYTES_MAX (times
         ``fraction``). Checked once a turn: one turn may add SERVE_ITEMS frames more."""
         waiting = robot.session.waiting_scripts
@@ -54,35 +102,35 @@ class FairInput:
         limit = self.pending_bytes_limit * fraction
         return waiting * FRAME_DATA_MAX >= limit and robot.session.waiting_script_bytes() >= limit
 
-    def _serve_backlog(self):
+    def serve_backlog(self) -> None:
         """Turns for the clients with input left over, round robin, until none is left or POLL_BUDGET_S has
         passed; every IO_SLICE_S the sockets are polled, so fresh requests of other clients go first."""
         served = start = time.perf_counter()
         while self._backlog and time.perf_counter() - start < POLL_BUDGET_S:
-            served = self._backlog_round(served)
+            served = self._round(served)
 
-    def _backlog_round(self, served):
+    def _round(self, served: float) -> float:
+        host = self._host
         for key, (robot, conn) in list(self._backlog.items()):
             if time.perf_counter() - served > IO_SLICE_S:
-                self._serve(0.0, quick_only=True)
+                host.serve_ready(quick_only=True)
                 served = time.perf_counter()
             if conn.id not in robot.conns:
                 self._backlog.pop(key, None)
                 continue
-            if self._buffer_full(robot):
-                self._backlog.pop(key, None)      # the script buffer is full: _set_reading resumes it
+            if self.buffer_full(robot):
+                self._backlog.pop(key, None)      # the script buffer is full: the server resumes reading later
                 if not robot.reading_paused:
-                    self._set_reading(robot, False)
+                    host.pause_reading(robot)
                 continue
-            self._process(robot, conn)
-            if robot not in self._touched:
-                self._touched.append(robot)
+            self.turn(robot, conn)
+            host.touch(robot)
             if not robot.faults.active:
-                self._flush(robot, conn)
+                host.flush(robot, conn)
         return served
 
 
-def is_greedy(ready_item) -> bool:
+def is_greedy(ready_item: tuple) -> bool:
     """Whether a ready selector item is a greedy robot client (see the module docstring)."""
     conn = ready_item[0].data[2]
     return hasattr(conn, "greedy") and conn.greedy

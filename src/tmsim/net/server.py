@@ -40,7 +40,7 @@ from tmsim.limits import (
 )
 from tmsim.net.control import ControlChannel
 from tmsim.net.ethernet_slave import EthernetSlave
-from tmsim.net.fairness import FairInput
+from tmsim.net.fairness import FairScheduler
 from tmsim.net.fairness import is_greedy as _is_greedy
 from tmsim.net.tcp_listener import Listener, receive
 from tmsim.protocol.listen_session import STOPPED, ListenSession
@@ -56,7 +56,7 @@ GC_IDLE = 700               # manage_gc: collect young objects in an idle poll o
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
 
 
-class _Conn:
+class Conn:
     """One client socket of a robot; what it received waits in the robot's session (``buffer_data``)."""
     __slots__ = ("sock", "id", "wbuf", "eof", "peer", "greedy", "_session")
 
@@ -88,7 +88,7 @@ class Robot(EventLog):
                                      profile=profile)
         self.listener = None
         self.port_hold = None                  # the Listen-node port, bound but not listening while it is closed
-        self.conns: dict[int, _Conn] = {}
+        self.conns: dict[int, Conn] = {}
         self.reading_paused = False
         # The robot's Ethernet Slave service (tmsim/net/ethernet_slave.py fills it in when the server runs one;
         # all stay None / empty with --no-svr): the data table's values, the sans-I/O session, its connections,
@@ -158,7 +158,7 @@ class Robot(EventLog):
             return data
 
 
-class SimServer(FairInput):
+class SimServer:
     def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
                  send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
                  control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None,
@@ -172,7 +172,6 @@ class SimServer(FairInput):
         self.lock = threading.RLock()
         self.event_limit = event_limit or EVENTS_KEPT_MAX // robots    # per robot: all robots together keep <= 40,000
         self.event_bytes_limit = EVENT_BYTES_MAX // robots           # per robot: all together keep <= 20 MiB
-        self.pending_bytes_limit = max(4 * FRAME_DATA_MAX, PENDING_BYTES_MAX // robots)
         try:
             self.log_file = LogFile(log_path) if log_path else None
         except OSError as exc:
@@ -187,7 +186,8 @@ class SimServer(FairInput):
         self._now = 0.0
         self._dispatch = {"listen": self._accept, "conn": self._read}     # selector key kind -> handler (see handle)
         self._touched: list[Robot] = []       # robots that received data and still have to advance
-        self._backlog: dict[tuple, tuple] = {}    # (robot index, conn id) -> (robot, conn) with input left over
+        # which client's input goes next and how much; a robot's share of PENDING_BYTES_MAX (at least 4 frames)
+        self.fair = FairScheduler(self, max(4 * FRAME_DATA_MAX, PENDING_BYTES_MAX // robots))
         self._starting = False
         self._slice_start = self._poll_end = 0.0
         self.started = False
@@ -197,6 +197,11 @@ class SimServer(FairInput):
         self.svr = None                       # Ethernet Slave (tmsim/net/ethernet_slave.py) when svr_port is not None
         self._svr = (svr_port, svr_options or {})
         self._control_host = control_host
+
+    @property
+    def pending_bytes_limit(self) -> int:
+        """Bytes of buffered scripts one robot may hold before its clients are no longer read."""
+        return self.fair.pending_bytes_limit
 
     @property
     def ports(self) -> list[int]:
@@ -323,29 +328,29 @@ class SimServer(FairInput):
                     robot.listener.tick(self._now)
                 self._advance(robot)
                 if session.has_output() and not robot.faults.active:
-                    self._flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
+                    self.flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
                 self.breathe()
             if self.svr is not None:
                 self.svr.poll(self._now)
             if self.control is not None:
                 self.control.tick(self._now)
             ready = self._serve(0.0 if self._has_work() else timeout)
-            self._serve_backlog()
+            self.fair.serve_backlog()
             if self.control is not None and self.control.backlog:
                 self.control.serve_backlog()
             self._start_touched()
             for robot in self.robots:
-                self._flush(robot)
+                self.flush(robot)
                 if robot.session.state == STOPPED and (robot.listener is not None or robot.conns):
                     self.close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
-                if robot.reading_paused and not self._buffer_full(robot, 0.5):
+                if robot.reading_paused and not self.fair.buffer_full(robot, 0.5):
                     self._set_reading(robot, True)
             if self.manage_gc:
                 _collect_garbage(idle=not ready)
 
     def _has_work(self) -> bool:
         """Work is left over from earlier turns (client input, control requests): the next poll must not wait."""
-        return bool(self._backlog) or (self.control is not None and self.control.has_backlog) or \
+        return self.fair.has_backlog or (self.control is not None and self.control.has_backlog) or \
             any(robot.session.has_turn_work for robot in self.robots)
 
     def breathe(self, budgeted=False):
@@ -366,7 +371,7 @@ class SimServer(FairInput):
         robot._log("reading_resumed" if reading else "reading_paused", buffered=robot.session.waiting_scripts)
         for conn in robot.conns.values():
             if reading and robot.session.input_bytes(conn.id):
-                self._backlog[(robot.index, conn.id)] = (robot, conn)    # input read before the pause
+                self.fair.requeue(robot, conn)    # input read before the pause
             if conn.eof:
                 continue
             try:
@@ -376,6 +381,20 @@ class SimServer(FairInput):
                     self.selector.unregister(conn.sock)
             except (KeyError, ValueError):
                 pass
+
+    # ---- the fair scheduler's host (tmsim/net/fairness.py TurnHost) ------------------------------
+    def serve_ready(self, quick_only: bool = False) -> int:
+        """Serve the sockets that are ready now, without waiting (``quick_only``: not the greedy clients)."""
+        return self._serve(0.0, quick_only=quick_only)
+
+    def touch(self, robot: Robot) -> None:
+        """``robot`` received input: it advances with dt = 0 before the poll ends (``_start_touched``)."""
+        if robot not in self._touched:
+            self._touched.append(robot)
+
+    def pause_reading(self, robot: Robot) -> None:
+        """Back-pressure: the robot's script buffer is full; its clients are read again once it is half empty."""
+        self._set_reading(robot, False)
 
     def _serve(self, timeout, quick_only=False):
         """Accept and read every ready socket; the replies are written at once. Robots that received
@@ -407,7 +426,7 @@ class SimServer(FairInput):
                 if robot not in self._touched:
                     self._touched.append(robot)
                 if not robot.faults.active:
-                    self._flush(robot, conn)
+                    self.flush(robot, conn)
         return len(ready)
 
     def _advance(self, robot):
@@ -427,7 +446,7 @@ class SimServer(FairInput):
             while self._touched:
                 robot = self._touched.pop(0)
                 self._advance(robot)
-                self._flush(robot)
+                self.flush(robot)
                 self.breathe(budgeted=True)
         finally:
             self._starting = False
@@ -444,7 +463,7 @@ class SimServer(FairInput):
                 robot._log("rejected_connection", peer=addr[0], reason=f"more than {LISTEN_CLIENTS_MAX} clients")
                 sock.close()
                 continue
-            conn = _Conn(sock, self._next_conn, addr[0], robot.session)
+            conn = Conn(sock, self._next_conn, addr[0], robot.session)
             self._next_conn += 1
             robot.conns[conn.id] = conn
             robot.session.connect(conn.id, addr[0])
@@ -455,7 +474,7 @@ class SimServer(FairInput):
         backlog). The server never decodes: the session owns the bytes (h11's model)."""
         if conn.id not in robot.conns or conn.eof:
             return
-        if self._buffer_full(robot):
+        if self.fair.buffer_full(robot):
             self._set_reading(robot, False)
             return
         if robot.session.input_bytes(conn.id) < RBUF_READ_BELOW:    # else: what is buffered goes first (fairness)
@@ -475,10 +494,10 @@ class SimServer(FairInput):
                 robot._log("black_hole", conn=conn.id, bytes=len(data))
                 return
             robot.session.buffer_data(conn.id, data)
-        if (robot.index, conn.id) not in self._backlog:     # else it waits for its turn in _serve_backlog
-            self._process(robot, conn)
+        if not self.fair.waits(robot, conn):     # else it waits for its turn in fair.serve_backlog
+            self.fair.turn(robot, conn)
 
-    def _flush(self, robot, only=None):
+    def flush(self, robot, only=None):
         """Write what the robot's session produced; ``only``: just that client's output (cheap, right after
         its request), else every client's plus the per-robot checks (once a poll at least)."""
         if not robot.conns:                       # (the session has no client without a connection)
@@ -551,7 +570,7 @@ class SimServer(FairInput):
         except OSError:
             pass
         robot.faults.forget(conn.id)
-        self._backlog.pop((robot.index, conn.id), None)
+        self.fair.forget(robot, conn)
         robot.session.disconnect(conn.id)
         robot._log("closed", conn=conn.id, reason=reason)
 

@@ -3,9 +3,9 @@
 A server calls ``connect``/``receive_data(conn, bytes)``/``disconnect``/``advance(now)`` and takes
 ``data_to_send(conn)`` (one bytes object per frame, so each goes out in one send); the control channel
 uses the control methods (``enter_node``, ``stop_project`` ...). A server that shares its input fairly
-between clients (tmsim/net/fairness.py) calls ``buffer_data`` and then ``process`` in bounded turns instead of
-``receive_data``; the session decodes, limits its CPERR answers to bad packets (CPERR_BURST, CPERR_PER_S
-in tmsim/limits.py) and logs ``frame_in`` either way. The node state follows an explicit transition table;
+between clients (tmsim/net/fairness.py) calls ``buffer_data`` and then ``turn(conn, budget)`` in bounded turns
+(a ``TurnBudget`` of tmsim/limits.py) instead of ``receive_data``; the session decodes, limits its CPERR
+answers to bad packets (CPERR_BURST, CPERR_PER_S in tmsim/limits.py) and logs ``frame_in`` either way. The node state follows an explicit transition table;
 the scripts of all clients are run strictly in arrival order, one at a time.
 """
 from __future__ import annotations
@@ -14,7 +14,16 @@ import re
 from collections import deque
 from dataclasses import dataclass, field
 
-from tmsim.limits import CPERR_BURST, CPERR_PER_S, SERVE_SCAN, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN
+from tmsim.limits import (
+    CPERR_BURST,
+    CPERR_PER_S,
+    RECEIVE_TURN,
+    WORK_CHAR,
+    WORK_LINE,
+    WORK_LOG_BYTES,
+    WORK_TOKEN,
+    TurnBudget,
+)
 from tmsim.protocol import codec
 from tmsim.robot.eventlog import text as _text
 from tmsim.robot.model import RobotModel
@@ -41,7 +50,7 @@ TRANSITIONS = {
     (EXITING, "robot_fault"): STOPPED,
 }
 
-# outcome of one turn of a connection's input (``process``)
+# outcome of one turn of a connection's input (``turn``)
 INPUT_DONE = "done"                 # no complete item is left in the receive buffer
 INPUT_LEFT = "left"                 # a bound of the turn ended it: input may be left for the next turn
 FRAME_LIMIT = "frame_limit"         # the connection's received frames reached ``frame_limit``
@@ -188,7 +197,7 @@ class ListenSession:
     # ---- input --------------------------------------------------------------------------------
     def handle(self, conn: int, item):
         """Process one decoded item (codec.Frame / BadFrame / Garbage) from connection ``conn``, as it is
-        (no CPERR limit, no ``frame_in`` event: ``process`` adds those)."""
+        (no CPERR limit, no ``frame_in`` event: ``turn`` adds those)."""
         self.last_packet = self.now
         if isinstance(item, codec.Garbage):
             self.log("garbage", conn=conn, bytes=len(item.raw))
@@ -426,13 +435,13 @@ class ListenSession:
         self.buffer_data(conn, data)
         total = 0
         while True:
-            handled, outcome = self.process(conn, SERVE_SCAN, SERVE_SCAN)
+            handled, outcome = self.turn(conn, RECEIVE_TURN)
             total += handled
             if outcome != INPUT_LEFT:
                 return total
 
     def buffer_data(self, conn: int, data: bytes):
-        """Bytes received from connection ``conn``, kept for ``process`` (unknown connection: ignored)."""
+        """Bytes received from connection ``conn``, kept for ``turn`` (unknown connection: ignored)."""
         client = self.clients.get(conn)
         if client is not None:
             client.rbuf += data
@@ -447,19 +456,22 @@ class ListenSession:
         client = self.clients.get(conn)
         return 0 if client is None else client.suppressed
 
-    def process(self, conn: int, max_items: int, max_decoded: int, max_waiting: int | None = None,
-                frame_limit: int | None = None) -> tuple[int, str]:
-        """One turn of connection ``conn``'s buffered input: at most ``max_decoded`` items decoded and
-        ``max_items`` of them handled; the turn also ends once ``max_waiting`` scripts wait to start, or
-        right after the item that brings the connection's received frames to ``frame_limit``. Returns
-        (items handled, INPUT_DONE | INPUT_LEFT | FRAME_LIMIT). Bad packets are answered with CPERR at most
-        CPERR_BURST at once, then CPERR_PER_S per second of robot clock; the others are counted (event
-        ``cperr_suppressed`` before the next item handled, or at ``disconnect``)."""
+    def turn(self, conn: int, budget: TurnBudget) -> tuple[int, str]:
+        """One turn of connection ``conn``'s buffered input within ``budget`` (tmsim/limits.py TurnBudget): at
+        most ``budget.decoded`` items decoded and ``budget.items`` of them handled; the turn also ends once
+        ``budget.waiting`` scripts wait to start, when the turn's work is spent, or right after the item that
+        brings the connection's received frames to ``budget.frame_limit``. Returns (items handled, INPUT_DONE |
+        INPUT_LEFT | FRAME_LIMIT). Bad packets are answered with CPERR at most CPERR_BURST at once, then
+        CPERR_PER_S per second of robot clock; the others are counted (event ``cperr_suppressed`` before the
+        next item handled, or at ``disconnect``)."""
+        if budget.work is not None:
+            self.meter.begin(budget.work)
         client = self.clients.get(conn)
         if client is None:
             return 0, INPUT_DONE
+        max_items, max_waiting, frame_limit = budget.items, budget.waiting, budget.frame_limit
         rbuf, handled = client.rbuf, 0
-        for _ in range(max_decoded):
+        for _ in range(budget.decoded):
             if rbuf[:2] == b"$$" and self._cperr_tokens(client) < 1.0:
                 # a '$' followed by another '$' is always a bad packet (header missing, CPERR 01): a run of
                 # them that gets no answer anyway is skipped at once
