@@ -19,7 +19,7 @@ from .frontend.source import SourceFile, Span
 from .ladder.load import attach_ladders, check_operands, is_project_xml, is_xml, read_xml
 
 PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
-VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st", "sysmac_motion.st")
+VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st", "sysmac_motion.st", "sysmac_control.st")
 
 
 @dataclass

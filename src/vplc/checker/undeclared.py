@@ -10,8 +10,8 @@ Failing::
 
     Cuont := Count + 1;        (* ST1001: `Cuont` is not declared; did you mean `Count`? *)
     x : stUnknown;             (* ST1004: unknown data type *)
-    Tune(Run := Go);           (* with Tune : PIDAT;  ST1007: Sysmac instruction `PIDAT` (W502, Control
-                                  Instructions) is not modelled by vplc *)
+    Tune(Run := Go);           (* with Tune : PIDAT_HeatCool;  ST1007: Sysmac instruction `PIDAT_HeatCool` (W502,
+                                  Control Instructions) is not modelled by vplc *)
 """
 from __future__ import annotations
 

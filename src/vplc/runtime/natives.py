@@ -10,6 +10,9 @@ from __future__ import annotations
 from . import iec
 from . import sockets as S
 from .motion_fbs import NATIVE_FBS as MOTION_FBS
+from .sysmac_control import NATIVE_FBS as CONTROL_FBS
+from .sysmac_errors import FUNCTIONS as ERROR_FUNCTIONS
+from .sysmac_errors import NATIVE_FBS as ERROR_FBS
 from .sysmac_fns import FUNCTIONS
 from .testing import FUNCTIONS as TEST_FUNCTIONS
 
@@ -240,4 +243,5 @@ class SktTCPAccept(_SocketFB):
 NATIVE_FBS = {c.__name__: c for c in (SktTCPConnect, SktTCPSend, SktTCPRcv, SktGetTCPStatus, SktClearBuf,
                                       SktClose, SktTCPAccept)}
 NATIVE_FBS.update(MOTION_FBS)           # W508 single-axis motion instructions on virtual axes
-NATIVE_FUNCTIONS = {**FUNCTIONS, **TEST_FUNCTIONS}
+NATIVE_FBS.update(CONTROL_FBS, **ERROR_FBS)     # W502 control and system control instructions
+NATIVE_FUNCTIONS = {**FUNCTIONS, **ERROR_FUNCTIONS, **TEST_FUNCTIONS}

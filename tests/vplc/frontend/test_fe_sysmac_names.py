@@ -9,11 +9,12 @@ from vplc.project import PRELUDE_DIR
 
 
 def test_unmodelled_instruction_type_and_function_are_st1007_with_the_manual(tmp_path):
-    proj = check_text(tmp_path, program("x := CheckReal(1.0); SetAlarm(Code := 1); Tune(); e := _PLC_ErrSta;",
-                                        "Tune : PIDAT; x : BOOL; e : WORD;"))
+    proj = check_text(tmp_path, program("x := CheckReal(1.0); Lock(Index := 1); Tune(); e := _PLC_ErrSta;",
+                                        "Tune : PIDAT_HeatCool; x : BOOL; e : WORD;"))
     errors = [d for d in proj.diagnostics if d.severity == "error"]
     assert [d.code for d in errors] == ["ST1007"] * 4
-    assert "Sysmac instruction `PIDAT` (W502, Control Instructions) is not modelled by vplc" in errors[0].message
+    assert "Sysmac instruction `PIDAT_HeatCool` (W502, Control Instructions) is not modelled by vplc" \
+        in errors[0].message
 
 
 def test_a_misspelt_name_is_still_st1001(tmp_path):
