@@ -18,8 +18,11 @@ from .motion_config import UNITS, AxisConfig
 from .motion_profile import Profile, plan_position, plan_velocity
 
 # ---- ErrorIDs and axis error codes (docs/toolchain/runtime_sysmac.md section 5.3) ---------------------------
-# Omron's W508 error table was not readable in the manual corpus: the values are chosen in Omron's 16#54xx
-# motion-instruction range; the names say what the instruction refused.
+# Omron's own values (W508 appendix, W503 error tables) were not found in any public source we could read (the
+# searches are listed in section 5.3): every value below is our choice. Its first hex digit follows Omron's
+# classification of error codes (W503 NJ-series Troubleshooting Manual, 1-3-1 "Relationship between Event Codes
+# and Error Codes"): 5 = user software error ("an input value to an instruction that is out of range"), 6 =
+# observation error ("a position outside of the motion range"). The names say what was refused.
 ERR_AXIS_UNUSED = 0x5401       # the axis is not a configured virtual axis
 ERR_DISABLED = 0x5402          # motion command while the servo is OFF (Disabled)
 ERR_MOVING = 0x5405            # MC_Home / MC_SetPosition while the axis moves
@@ -32,6 +35,7 @@ ERR_BUFFER_MODE = 0x5415       # BufferMode out of range
 ERR_POSITION = 0x5416          # target (or SetPosition value) outside the software limits, or not finite
 ERR_OVERRIDE = 0x5417          # VelFactor is not a number (NaN)
 ERR_BUFFER_FULL = 0x5418       # a second buffered command while one is already waiting
+ERR_REFERENCE_TYPE = 0x5419    # MC_SetPosition ReferenceType outside its valid range (W508: _mcCommand, _mcFeedback)
 AXIS_SW_LIMIT_POS = 0x6440     # axis minor fault: positive software limit reached (MFaultLvl.Code)
 AXIS_SW_LIMIT_NEG = 0x6441     # axis minor fault: negative software limit reached
 

@@ -354,8 +354,8 @@ class MC_Home(_ExecuteFB):
 
 class MC_SetPosition(_ExecuteFB):
     """W508 MC_SetPosition: the command and actual position become Position (the virtual servo has no following
-    error, so both ReferenceType values give the same result); home becomes defined. Relative and ExecutionMode
-    are reserved."""
+    error, so both ReferenceType values give the same result; _mcLatestCommand, outside the instruction's valid
+    range, is an error); home becomes defined. Relative and ExecutionMode are reserved."""
 
     def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
@@ -369,6 +369,8 @@ class MC_SetPosition(_ExecuteFB):
             return REFUSED
         if axis.state not in (M.STANDSTILL, M.DISABLED):
             return M.ERR_MOVING
+        if self.ReferenceType not in (0, 1):    # W508 (zh) MC_SetPosition: valid range _mcCommand, _mcFeedback
+            return M.ERR_REFERENCE_TYPE
         x = self.Position
         lo, hi = axis.cfg.limit_negative, axis.cfg.limit_positive
         if not math.isfinite(x) or (lo is not None and hi is not None and not lo <= x <= hi):

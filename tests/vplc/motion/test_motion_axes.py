@@ -198,11 +198,14 @@ def test_a_named_axis_the_program_does_not_declare_is_a_load_error(tmp_path_fact
 
 
 def test_the_errorid_table_of_the_docs_is_the_one_the_runtime_uses():
-    """One fact, one home: docs/toolchain/runtime_sysmac.md section 5.3 lists exactly the ERR_* codes of motion.py."""
+    """One fact, one home: the "condition → ErrorID (source)" table of docs/toolchain/runtime_sysmac.md section 5.3
+    lists exactly the ERR_* codes of motion.py, each once and each with the source of its value."""
     import pathlib
     import re
     doc = (pathlib.Path(__file__).resolve().parents[3] / "docs" / "toolchain" / "runtime_sysmac.md").read_text()
-    section = doc[doc.index("## 5. Virtual servo axes"):]
-    listed = {int(m, 16) for m in re.findall(r"^\| 16#([0-9A-F]{4}) \|", section, re.MULTILINE)}
-    assert listed == {v for k, v in vars(M).items() if k.startswith("ERR_")}
+    section = doc[doc.index("#### ErrorIDs: condition → ErrorID (source)"):doc.index("### 5.4")]
+    rows = re.findall(r"^\|[^|\n]+\|[^|\n]+\| 16#([0-9A-F]{4}) \| ([^|\n]+) \|$", section, re.MULTILINE)
+    listed = [int(code, 16) for code, _ in rows]
+    assert sorted(listed) == sorted({v for k, v in vars(M).items() if k.startswith("ERR_")})
+    assert all(source.startswith("chosen") for _, source in rows)     # no Omron value found yet (section 5.3)
     assert f"16#{M.AXIS_SW_LIMIT_POS:04X} positive and 16#{M.AXIS_SW_LIMIT_NEG:04X} negative" in section

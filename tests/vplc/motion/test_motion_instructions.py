@@ -271,6 +271,34 @@ def test_home_defines_home_at_standstill_and_is_refused_while_moving(rig):
     assert rig.r("vel.CommandAborted") and rig.ax("Cmd.Vel") == 0.0
 
 
+@pytest.mark.parametrize("reference", ["_mcCommand", "_mcFeedback"])
+def test_set_position_accepts_the_command_and_the_feedback_reference(rig, reference):
+    """W508 (zh) MC_SetPosition, input variables: ReferenceType 0 _mcCommand or 1 _mcFeedback (initial value
+    _mcCommand); on a virtual servo both set the command and the actual position."""
+    rig.powered()
+    rig.plc.write("Main.setp.ReferenceType", reference)
+    rig.set(setTo=-42.5, doSetPos=True)
+    rig.scan(2)
+    assert rig.r("setp.Done") and not rig.r("setp.Error")
+    assert rig.ax("Cmd.Pos") == -42.5 and rig.ax("Act.Pos") == -42.5 and rig.state() == "Standstill"
+
+
+def test_set_position_refuses_a_reference_type_outside_its_valid_range(rig):
+    """W508 (zh) MC_SetPosition: _mcLatestCommand (2) is a value of _eMC_REFERENCE_TYPE but not in the
+    instruction's valid range: Error with ErrorID in the call of the Execute edge, nothing changed, an axis error
+    until MC_Reset like every instruction error."""
+    rig.powered()
+    rig.plc.write("Main.setp.ReferenceType", "_mcLatestCommand")
+    rig.set(setTo=30.0, doSetPos=True)
+    rig.scan()
+    assert rig.outputs("setp", ("Busy", "Done", "CommandAborted", "Error")) == (False, False, False, True)
+    assert rig.r("setp.ErrorID") == M.ERR_REFERENCE_TYPE and rig.ax("Cmd.Pos") == 0.0
+    assert rig.state() == "ErrorStop" and rig.ax("MFaultLvl.Code") == M.ERR_REFERENCE_TYPE
+    rig.set(doSetPos=False, doReset=True)
+    rig.scan(2)
+    assert not rig.r("setp.Error") and rig.state() == "Standstill"
+
+
 def test_override_scales_the_velocity_and_zero_holds_the_axis_in_motion(rig):
     """W508 MC_SetOverride: VelFactor % of the target velocity while Enabled (above 500 counts as 500, below 0.01 as
     0.01, only 0 as 0, never above the axis maximum); 0 % stops the axis without ending the instruction; back to
