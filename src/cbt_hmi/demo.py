@@ -191,16 +191,19 @@ def with_user_pages(mapping: Mapping, plc, directory: str) -> tuple[Mapping, lis
     variables, kept = dict(shipped["variables"]), {}
     for name, page in pages.items():
         written = [item["variable"] for item in page["inputs"] + ([page["command"]] if page["command"] else [])]
+        written += [page["parameters"]["variable"]] if "parameters" in page else []
         taken = [variable for variable in written if variable in shipped["variables"]]
         if taken:
             errors.append(f"{folder / (name + '.json')}: '{taken[0]}' belongs to the shipped pages: a page of your "
                           "own may show it under 'status', not write it")
             continue
         kept[name] = page
-        for item in page["inputs"] + page["status"] + ([page["command"]] if page["command"] else []):
-            variables.setdefault(item["variable"], table["variables"][item["variable"]])
-    document = {**shipped, "variables": variables, "pages": [*shipped.get("pages", ["index"]), *kept],
-                "custom_pages": kept}
+        shown = [item["variable"] for item in page["inputs"] + page["status"]] + written + \
+            ([page["lamp"]] if "lamp" in page else [])
+        for variable in shown:
+            variables.setdefault(variable, table["variables"][variable])
+    document = {**shipped, "types": {**table["types"], **shipped["types"]}, "variables": variables,
+                "pages": [*shipped.get("pages", ["index"]), *kept], "custom_pages": kept}
     return Mapping(document, f"{mapping.source} + {folder}"), errors
 
 

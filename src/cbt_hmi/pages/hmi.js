@@ -1,75 +1,15 @@
-/* CBT HMI: one script for every page. A page is described in PAGES; forms are built from the PLC-HMI
-   variable table served at /api/mapping, so ranges and enumerations live in one place (src/cbt_hmi/pages/mapping.json).
-   The server checks every write again; the checks here only spare the operator a round trip. */
+/* CBT HMI: one script for every page. A command page is built from its page description (src/cbt_hmi/pages/desc/,
+   carried by the variable table served at /api/mapping under page_descriptions); its fields come from the variable
+   table, so ranges and enumerations live in one place (mapping.json, generated from the program and the
+   descriptions). Main, PnP, Jog / Teach and Program are hand-written (their own scripts). The server checks every
+   write again; the checks here only spare the operator a round trip. */
 "use strict";
 
 const POLL_MS = 50;            // 20 updates per second (issue: >= 10)
 
-const LABELS = {
-  TargetPosition: "Target Position (mm, °)", ArcPoint: "Arc Point (mm, °)", EndPoint: "End Point (mm, °)",
-  Transformation: "Base (mm, °)", TCPOffset: "TCP Offset (mm, °)", MassCenter: "Mass Center (mm, °)",
-  MomentOfInertia: "Moment of Inertia (kg·mm²)", RobotPose: "Robot Pose", MovementCommand: "Motion Command",
-  DataFormat: "Data Format", AccelTime: "Accel Time", BlendingEnable: "Enable Blending",
-  BlendingValue: "Blending", PrecisePositioning: "Enable Precise Point", RobotPoseEnable: "Enable Robot Pose",
-  ExitNode: "Exit Listen Node", ArcAngle: "Arc Angle", Command: "Command",
-  Module: "I/O Module", Channel: "Output Number", Value: "Output ON", Immediate: "Immediate (not queued)",
-  WaitUntilSet: "Done when set", Mode: "Stop Mode",
-  Connect_AddressIP: "Robot IP Address", Connect_Dest_PortIP: "Port", Connect_Time_Out: "Timeout",
-};
+/* the fields' labels by structure member or variable name, from the page descriptions (MAP.labels) */
+const LABELS = {};
 
-const HOME = { X: 400, Y: 0, Z: 400, RX: 180, RY: 0, RZ: 90 };
-const T = (x, y, z, rx = 180, ry = 0, rz = 90) => ({ X: x, Y: y, Z: z, RX: rx, RY: ry, RZ: rz });
-const MOTION = { MovementCommand: 1, DataFormat: 1, Speed: 50, AccelTime: 200, BlendingEnable: false,
-  BlendingValue: 0, PrecisePositioning: false, RobotPoseEnable: false };   // ExitNode: engineer only, left as it is
-const PNP_SEGMENTS = ["Approach pick", "Pick", "Retreat", "Approach place", "Place", "Retreat"];
-const PNP_PRESET = [        // same cycle as the initial values in examples/GlobalVariables.st
-  { ...MOTION, TargetPosition: T(350, -200, 400), BlendingEnable: true, BlendingValue: 50 },
-  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, -200, 250), PrecisePositioning: true },
-  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, -200, 400) },
-  { ...MOTION, TargetPosition: T(350, 200, 400), BlendingEnable: true, BlendingValue: 50 },
-  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, 200, 250), PrecisePositioning: true },
-  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, 200, 400) },
-];
-
-const PAGES = {
-  connect: { title: "Connect", group: "Connect", execLabel: "Connect",
-    inputs: ["Connect_AddressIP", "Connect_Dest_PortIP", "Connect_Time_Out"], legend: "Connection Settings",
-    presets: { "Preset Values": { Connect_AddressIP: "127.0.0.1", Connect_Dest_PortIP: 5890, Connect_Time_Out: 10 } },
-    status: ["Connected", "Busy", "Error", "ErrorID", "ErrorDescrip", "LastConnTime", "LastLostTime", "Reconnecting",
-      "RetryCount"] },
-  changebase: { title: "Change Base",
-    done: () => "the robot accepted the base; it applies to the motions queued after it.", group: "ChangeBase", param: "ChangeBase_Param", legend: "Base Settings",
-    presets: { "Set Default Robot Base": { Transformation: T(0, 0, 0, 0, 0, 0), ExitNode: false } } },
-  changetcp: { title: "Change TCP", view: false,
-    done: () => "the robot accepted the tool; it applies to the motions queued after it.", group: "ChangeTCP", param: "ChangeTCP_Param", legend: "Tool Settings",
-    presets: { "Set Null Tool Offset": { TCPOffset: T(0, 0, 0, 0, 0, 0), Weight: 0,
-      MomentOfInertia: { Ixx: 0, Iyy: 0, Izz: 0 }, MassCenter: T(0, 0, 0, 0, 0, 0), ExitNode: false } } },
-  moverel: { title: "Move Relative",
-    done: (c) => (c.BlendingEnable === "TRUE" ? "the robot accepted the motion (blended: the next one may follow)." : "the robot arrived at the target."), group: "MoveRel", param: "MoveRel_Param",
-    presets: { "Preset Values": { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 20,
-      TargetPosition: T(0, 0, 0, 0, 0, 0) } } },
-  moveabs: { title: "Move Absolute",
-    done: (c) => (c.BlendingEnable === "TRUE" ? "the robot accepted the motion (blended: the next one may follow)." : "the robot arrived at the target."), group: "MoveAbs", param: "MoveAbs_Param",
-    presets: { "Preset Values": { ...MOTION, TargetPosition: { ...HOME },
-      RobotPose: { Pose1: 0, Pose2: 0, Pose3: 0 } } } },
-  movecircle: { title: "Move Circle",
-    done: (c) => (c.BlendingEnable === "TRUE" ? "the robot accepted the motion (blended: the next one may follow)." : "the robot arrived at the target."), group: "MoveCircle", param: "MoveCircle_Param",
-    presets: { "Preset Values": { DataFormat: 0, ArcPoint: T(450, 50, 400), EndPoint: T(400, 100, 400),
-      Speed: 30, AccelTime: 200, BlendingEnable: false, BlendingValue: 0, ArcAngle: 0,
-      PrecisePositioning: false, ExitNode: false } } },
-  setoutput: { title: "Digital Output",
-    done: (c) => (c.WaitUntilSet === "TRUE" && c.Immediate !== "TRUE" ? "the robot switched the output." : "the robot accepted the command."), group: "SetOutput", param: "SetOutput_Param", legend: "Output Settings",
-    presets: { "Close Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: true, Immediate: false,
-      WaitUntilSet: true, ExitNode: false },
-      "Open Gripper (End Module DO0)": { Module: 1, Channel: 0, Value: false, Immediate: false,
-      WaitUntilSet: true, ExitNode: false } } },
-  stop: { title: "Stop Motion", group: "Stop", param: "Stop_Param", legend: "Stop Settings", execLabel: "Stop",
-    release: "the robot stopped and its queue is cleared",   // a push button: Execute is reset once the stop is
-                             // done, which releases the robot
-    act: true,               // its presets send the stop when pressed (issue 25 item 2)
-    presets: { "Stop Immediately": { Mode: 1 }, "Stop and Discard All": { Mode: 3 } } },
-};
-const DEFAULT_STATUS = ["Busy", "Done", "CommandAborted", "Error", "ErrorID", "ErrorDescrip", "CmdID_Ack"];
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
 let MAP = null;
@@ -484,10 +424,12 @@ function robotStatusStrip() {
 function indicators(active) {
   const div = document.createElement("div");
   div.className = "indicators";
-  div.innerHTML = `<span data-status="${active}" class="lamp active">${active.endsWith("Active") ? "Active" : "Busy"}</span>
-    <span data-status="Robot_Paused" class="lamp paused">Paused</span>
-    <span data-status="Robot_Stopping" class="lamp stopping">Stopping</span>`;
-  return [div, [active, "Robot_Paused", "Robot_Stopping"]];
+  const lamps = [[active, "active", active.endsWith("Active") ? "Active" : "Busy"],
+    ["Robot_Paused", "paused", "Paused"], ["Robot_Stopping", "stopping", "Stopping"]]
+    .filter(([name]) => MAP.variables[name]);      // a user's program has no robot connection state
+  div.innerHTML = lamps.map(([name, kind, text]) => `<span data-status="${name}" class="lamp ${kind}">${text}</span>`)
+    .join("\n    ");
+  return [div, lamps.map(([name]) => name)];
 }
 
 async function executeCommand(execVar, values, what) {
@@ -523,19 +465,35 @@ function releaseWhenFinished(group, what, doneText) {
   setTimeout(check, POLL_MS);
 }
 
-async function fbPage(key) {
-  const page = PAGES[key], group = page.group;
+/* the Done text of a page description: the first entry whose "when" matches the form (checkbox TRUE/FALSE, the
+   selected enumeration name) */
+function doneText(page, context) {
+  const same = (want, have) => have === (want === true ? "TRUE" : want === false ? "FALSE" : String(want));
+  const hit = (page.done || []).find((d) => Object.entries(d.when || {}).every(([k, v]) => same(v, context[k])));
+  return hit ? hit.text : undefined;
+}
+
+/* A command page built from its page description (cbt_hmi/pages/desc/<key>.json): the FB instance's parameter
+   structure (or the described inputs) as fields, the presets, Execute, the lamps and the command status block. */
+async function fbPage(key, page) {
+  const group = page.instance, param = page.parameters ? page.parameters.variable : "";
+  const execVar = page.command.variable, execLabel = page.command.label;
   const main = frame(page.title, false);
+  Object.assign(LABELS, page.labels || {});
+  hideRobotPill();                           // custom.js: a user's program without the robot connection
   const params = document.createElement("div");
   params.className = "params";
-  if (page.param) {
-    buildStruct(params, page.param, MAP.variables[page.param].type, page.legend || "Motion Settings");
+  if (param) {
+    buildStruct(params, param, MAP.variables[param].type, page.parameters.legend);
   } else {
     const fs = document.createElement("fieldset");
-    fs.innerHTML = `<legend>${page.legend}</legend>`;
+    fs.innerHTML = `<legend>${page.legend || "Settings"}</legend>`;
     const grid = document.createElement("div");
     grid.className = "grid wide";
-    for (const v of page.inputs) grid.append(makeField(v, MAP.variables[v], LABELS[v] || v));
+    for (const item of page.inputs) {
+      LABELS[item.variable] = item.label;
+      grid.append(makeField(item.variable, MAP.variables[item.variable], item.unit ? `${item.label} (${item.unit})` : item.label));
+    }
     fs.append(grid);
     params.append(fs);
   }
@@ -543,82 +501,82 @@ async function fbPage(key) {
   side.className = "side";
   const buttons = document.createElement("div");
   buttons.className = "buttons";
-  Object.keys(page.presets).forEach((name, i) => {
+  const presets = page.presets || {};
+  Object.keys(presets).forEach((name, i) => {
     const b = document.createElement("button");
     b.className = "wide"; b.id = i ? `btn-preset-${i + 1}` : "btn-preset"; b.textContent = name;
-    if (page.act) b.disabled = !mayWrite(`${group}_Execute`);
+    if (page.act) b.disabled = !mayWrite(execVar);
     b.onclick = () => {
       if (page.act) {                          // Stop page: "Stop Immediately" stops now, not only fills the form
-        if (page.param) fillFrom(params, page.param, page.presets[name]);
-        sendStop(page.presets[name].Mode, name);
+        if (param) fillFrom(params, param, presets[name]);
+        sendStop(presets[name].Mode, name);
         return;
       }
-      if (page.param) fillFrom(params, page.param, page.presets[name]);
-      else for (const [v, val] of Object.entries(page.presets[name])) setInput(params.querySelector(`[data-path="${v}"]`), val);
-      refreshLimits(params, page.param || "");
+      if (param) fillFrom(params, param, presets[name]);
+      else for (const [v, val] of Object.entries(presets[name])) setInput(params.querySelector(`[data-path="${v}"]`), val);
+      refreshLimits(params, param);
       message(exec.disabled ? `${name}: fields filled; sending them needs ${ACCESS.role === "monitor" ?
-        "the operator address" : "the engineer address"}.` : `${name}: fields filled, press ${page.execLabel || "Execute"} to send.`);
+        "the operator address" : "the engineer address"}.` : `${name}: fields filled, press ${execLabel} to send.`);
     };
     buttons.append(b);
   });
   const exec = document.createElement("button");
-  exec.className = "primary" + (key === "connect" ? "" : " wide");     // red is the header's Stop key only
-  exec.id = "btn-execute"; exec.textContent = page.execLabel || "Execute";
-  exec.disabled = !mayWrite(`${group}_Execute`);
+  exec.className = "primary" + (page.reset ? "" : " wide");     // red is the header's Stop key only
+  exec.id = "btn-execute"; exec.textContent = execLabel;
+  exec.disabled = !mayWrite(execVar);
   exec.onclick = () => {
-    const result = collect(params, page.param || "");
+    const result = collect(params, param);
     if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }
-    executeCommand(`${group}_Execute`, result.values, page.title).then((sent) => {
+    executeCommand(execVar, result.values, page.title).then((sent) => {
       if (sent && page.release) releaseWhenFinished(group, page.title, page.release);
-      else if (sent) watchResult(group, page.title, page.done && page.done(formContext(params, page.param)));
+      else if (sent) watchResult(group, page.title, doneText(page, formContext(params, param)));
     });
   };
   buttons.append(exec);
-  if (key === "connect") {
+  if (page.reset) {                            // Disconnect: the command's variable FALSE ends what it holds
     const off = document.createElement("button");
-    off.id = "btn-disconnect"; off.textContent = "Disconnect";
+    off.id = "btn-" + page.reset.label.toLowerCase().replace(/[^a-z0-9]+/g, "-");
+    off.textContent = page.reset.label;
     off.onclick = async () => {
-      try { await api("/api/write", { values: { Connect_Execute: false } }); message("Disconnect: the PLC closes the connection to the robot.", "ok"); }
-      catch (e) { message("Disconnect: " + e.message, "error"); }
+      try { await api("/api/write", { values: { [execVar]: false } }); message(`${page.reset.label}: ${page.reset.text}`, "ok"); }
+      catch (e) { message(`${page.reset.label}: ${e.message}`, "error"); }
     };
     buttons.append(off);
   }
-  const statusNames = page.status || DEFAULT_STATUS;
-  const [lamps, lampNames] = indicators(MAP.variables[`${group}_Active`] ? `${group}_Active` : `${group}_Busy`);
-  side.append(buttons, ...(key === "connect" ? [] : [lamps]),
-    statusTable("Command Status", statusNames.map((s) => [s, `${group}_${s}`])));
+  const statusRows = page.status.map((item) => [item.label, item.variable]);
+  const [lamps, lampNames] = page.lamp ? indicators(page.lamp) : [null, []];
+  side.append(buttons, ...(lamps ? [lamps] : []), statusTable("Command Status", statusRows));
   const left = document.createElement("div");
   left.className = "left";
   left.append(params);
   let redraw;
-  if (key === "connect") {
+  if (page.robot_status) {
     const box = document.createElement("div");
     box.className = "area connectinfo";
-    box.innerHTML = `<h2>Robot</h2>${robotStatusStrip()}<p>The PLC connects to the robot's Listen node (TMflow, port 5890)
-      and checks it every 500 ms; a silent link is reported 1.0 to 1.5 s later (16#2006), then it reconnects by
-      itself while Connect is on (Reconnecting, RetryCount).</p>`;
+    box.innerHTML = `<h2>Robot</h2>${robotStatusStrip()}<p></p>`;
+    box.querySelector("p").textContent = page.robot_status;
     left.append(box);
   }
   if (page.view !== false) {                 // Change TCP needs its whole panel for the tool data
     const view = document.createElement("div");
     view.id = "robotview";
     left.append(view);
-    redraw = robotView(view, () => motionPreview(key, params, page.param));
+    redraw = robotView(view, () => motionPreview(key, params, param));
   } else {
     params.classList.add("full");
     redraw = () => {};
   }
   main.append(left, side);
-  const toRead = page.param ? [page.param] : page.inputs;
+  const inputs = page.inputs.map((item) => item.variable);
   try {
-    const data = await readVars(toRead);
-    if (page.param) fillFrom(params, page.param, data.values[page.param]);
-    else for (const v of page.inputs) setInput(params.querySelector(`[data-path="${v}"]`), data.values[v]);
+    const data = await readVars(param ? [param] : inputs);
+    if (param) fillFrom(params, param, data.values[param]);
+    else for (const v of inputs) setInput(params.querySelector(`[data-path="${v}"]`), data.values[v]);
   } catch (e) { message("Cannot read the current parameters: " + e.message, "error"); }
-  watchLimits(params, page.param || "");
+  watchLimits(params, param);
   params.addEventListener("input", redraw);        // the target preview follows the typing
   params.addEventListener("change", redraw);
-  startPolling([...statusNames.map((s) => `${group}_${s}`), ...lampNames, "Connect_Connected", "ReadPos_Valid",
+  startPolling([...statusRows.map(([, v]) => v), ...lampNames, "Connect_Connected", "ReadPos_Valid",
     "ReadPos_Position", ...ROBOT_STATUS]);
 }
 
@@ -639,12 +597,18 @@ async function boot() {
     return;
   }
   document.body.dataset.role = ACCESS.role;
-  if (MAP.custom_pages && MAP.custom_pages[key]) customPage(key);    // custom.js: a page description file
+  Object.assign(LABELS, MAP.labels || {});
+  const described = (MAP.page_descriptions || {})[key] || (MAP.custom_pages || {})[key];
+  if (described && described.instance) fbPage(key, described);        // a page driving an FB instance
+  else if (described) customPage(key);                                // custom.js: a page of the user's cell
   else if (key === "main") (MAP.variables.Connect_Connected ? mainPage() : customIndexPage());
   else if (key === "pnp") pnpPage();
   else if (key === "jog") jogPage();
   else if (key === "program") programPage();
-  else fbPage(key);
+  else {                                     // the server serves only the pages of the table: not reached
+    frame("CBT HMI", true);
+    message(`No page '${key}' is described.`, "error");
+  }
 }
 
 document.addEventListener("DOMContentLoaded", boot);

@@ -9,6 +9,21 @@
 let pnpParams = null;
 let pnpGeometry = null;
 
+/* the segments and the preset cycle (same as the initial values in examples/GlobalVariables.st); the PnP page
+   stays hand-written: a path drawing with six editable segments is more than a page description says */
+const PNP_SEGMENTS = ["Approach pick", "Pick", "Retreat", "Approach place", "Place", "Retreat"];
+const T = (x, y, z, rx = 180, ry = 0, rz = 90) => ({ X: x, Y: y, Z: z, RX: rx, RY: ry, RZ: rz });
+const MOTION = { MovementCommand: 1, DataFormat: 1, Speed: 50, AccelTime: 200, BlendingEnable: false,
+  BlendingValue: 0, PrecisePositioning: false, RobotPoseEnable: false };   // ExitNode: engineer only, left as it is
+const PNP_PRESET = [
+  { ...MOTION, TargetPosition: T(350, -200, 400), BlendingEnable: true, BlendingValue: 50 },
+  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, -200, 250), PrecisePositioning: true },
+  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, -200, 400) },
+  { ...MOTION, TargetPosition: T(350, 200, 400), BlendingEnable: true, BlendingValue: 50 },
+  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, 200, 250), PrecisePositioning: true },
+  { ...MOTION, MovementCommand: 0, DataFormat: 1, Speed: 30, TargetPosition: T(350, 200, 400) },
+];
+
 const PNP_STATES = ["Idle", "Running", "Stopping", "Stopped", "Faulted"];   // ePnP_State, in its order
 const PNP_STATE_TEXT = {
   Idle: "Ready. Press Start to run the cycle.",
