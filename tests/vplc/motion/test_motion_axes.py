@@ -28,6 +28,9 @@ def test_velocity_motion_stops_on_the_software_limit_and_the_axis_goes_to_errors
     assert rig.ax("Cmd.Pos") == 150.0
     assert rig.ax("MFaultLvl.Active") and rig.ax("MFaultLvl.Code") == M.AXIS_SW_LIMIT_POS
     assert rig.r("vel.CommandAborted") and rig.r("err.AxisErrorID") == M.AXIS_SW_LIMIT_POS
+    # the stop is the axis' fault, not the instruction's: Error FALSE, ErrorID 0 (as a limit input ends a move on
+    # the Sysmac simulator in kmu2030/UAMotionLink's tests, docs/toolchain/runtime_sysmac.md section 5.3)
+    assert not rig.r("vel.Error") and rig.r("vel.ErrorID") == 0
     rig.set(doVel=False)
     rig.scan()
     rig.set(doAbs1=True, pos1=0.0)
@@ -51,6 +54,19 @@ def test_reset_clears_the_axis_error_and_returns_to_standstill(limited):
     rig.set(doAbs1=True, pos1=100.0)
     rig.scan(3)
     assert rig.r("abs1.Active")
+
+
+def test_reset_without_an_axis_error_is_done_and_changes_nothing(limited):
+    """W508 MC_Reset on an axis without error: Done, no Failure, the axis keeps its state and position (as the
+    UAMotionLink tests expect on the Sysmac simulator, section 5.3)."""
+    rig = limited.powered()
+    rig.set(doAbs1=True, pos1=40.0)
+    rig.scan(2000)
+    assert rig.r("abs1.Done") and rig.state() == "Standstill"
+    rig.set(doReset=True)
+    rig.scan()
+    assert rig.outputs("rst", ("Busy", "Done", "Failure", "Error")) == (False, True, False, False)
+    assert rig.state() == "Standstill" and rig.ax("Cmd.Pos") == 40.0 and not rig.ax("MFaultLvl.Active")
 
 
 def test_reset_waits_until_an_axis_stopping_on_a_limit_has_stopped(limited):
