@@ -413,7 +413,7 @@ def test_event_log_is_bounded_per_robot_and_overall():
         assert srv.event_limit * 32 <= 40_000
         robot = srv.robots[0]
         for n in range(3 * srv.event_limit):
-            robot._log("io", point="x", value=n)
+            robot.log.event("io", point="x", value=n)
         assert srv.event_limit // 2 <= len(robot.events) <= srv.event_limit
         assert robot.events[-1]["value"] == 3 * srv.event_limit - 1      # the newest are kept
     finally:

@@ -96,7 +96,7 @@ def test_events_are_paged_by_absolute_index_across_the_log_trimming():
     client = ControlClient(srv.control.port)
     try:
         for n in range(250):
-            srv.robots[0]._log("io", point="x", value=n)
+            srv.robots[0].log.event("io", point="x", value=n)
         first = client.ask({"cmd": "events", "since": 0})["result"]
         assert first["first"] > 0 and first["events"][0] is not None
         nxt = client.ask({"cmd": "events", "since": first["next"]})["result"]
@@ -112,7 +112,7 @@ def test_events_of_large_frames_are_paged_by_bytes_and_a_reading_client_is_never
     client = ControlClient(srv.control.port)
     try:
         for n in range(60):                                   # 60 events of ~120 KB: 7 MB in all
-            srv.robots[0]._log("frame_in", conn=1, raw="r" * 60_000, header="TMSTA", data="d" * 60_000, n=n)
+            srv.robots[0].log.event("frame_in", conn=1, raw="r" * 60_000, header="TMSTA", data="d" * 60_000, n=n)
         since, seen = 0, []
         while True:
             page = client.ask({"cmd": "events", "since": since})

@@ -269,7 +269,7 @@ def test_the_event_log_file_is_renamed_and_begun_anew_at_its_size_bound(tmp_path
     h = Harness(log_path=str(path))
     try:
         for n in range(200):
-            h.robot._log("io", point="x", value="y" * 5000, n=n)
+            h.robot.log.event("io", point="x", value="y" * 5000, n=n)
         assert h.srv.log_file.rotations >= 4
     finally:
         h.close()

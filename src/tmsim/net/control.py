@@ -307,7 +307,7 @@ class ControlChannel:
                                f"robot{'s' if count > 1 else ''}; {robot_numbering(count)} of the start-up lines")
             robot = self.server.robots[index]
             if "plc_time" in request:
-                robot._log("control", cmd=name, plc_time=plc_time(request))
+                robot.log.event("control", cmd=name, plc_time=plc_time(request))
             result = command(robot, request)
             return _Streamed(ok=True, result=result) if type(result) is _Streamed else {"ok": True, "result": result}
         except (ValueError, TypeError, TransitionError) as exc:

@@ -11,80 +11,113 @@ a client that leaves more than SVR_OUTBOX_MAX bytes unread is dropped (tmsim/lim
 """
 from __future__ import annotations
 
+import contextlib
 import selectors
 import socket
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 from tmsim.limits import SVR_CLIENTS_MAX, SVR_OUTBOX_MAX
 from tmsim.net.tcp_listener import Listener, receive
 from tmsim.protocol.svr_session import DEFAULT_STREAM, SvrSession
 from tmsim.robot.svr_source import RobotDataSource
 
+if TYPE_CHECKING:
+    from tmsim.net.server import Robot, SimServer
 
-class _Conn:
+
+class SvrConn:
+    """One Ethernet Slave client socket of a robot."""
     __slots__ = ("sock", "id", "wbuf", "robot")
 
-    def __init__(self, sock, conn_id, robot):
+    def __init__(self, sock: socket.socket, conn_id: int, robot: Robot):
         self.sock, self.id, self.robot = sock, conn_id, robot
         self.wbuf = bytearray()
+
+
+@dataclass(eq=False)
+class SlaveService:
+    """The Ethernet Slave of one robot (``Robot.slave``): the data table's values, the sans-I/O session, the
+    listening socket and the client connections."""
+    source: RobotDataSource
+    session: SvrSession
+    listener: Listener | None = None
+    conns: dict[int, SvrConn] = field(default_factory=dict)
+
+    @property
+    def port(self) -> int | None:
+        """The port it listens on (None before it listens)."""
+        return None if self.listener is None else self.listener.port
 
 
 class EthernetSlave:
     """Ethernet Slave of every robot of ``server``; ``port`` 0 = ephemeral ports."""
 
-    def __init__(self, server, port=0, period=0.1, mode=1, items=DEFAULT_STREAM, variables=()):
+    def __init__(self, server: SimServer, port: int = 0, period: float = 0.1, mode: int = 1,
+                 items: Iterable[str] = DEFAULT_STREAM, variables: Iterable = ()):
         self.server = server
-        self.listeners = []
+        self.listeners: list[Listener] = []
         self._next_conn = 1
         server.handle("svr_listen", self._accept)
         server.handle("svr_conn", self._read)
         try:
             for robot in server.robots:
-                robot.svr_source = RobotDataSource(robot, robot._log)
-                robot.svr = SvrSession(robot.svr_source, robot._log, items, mode, period, variables=variables)
-                robot.svr_conns = {}
-                self._listen(robot, port + robot.index if port else 0)
+                log = robot.log.event
+                source = RobotDataSource(robot, log)
+                service = SlaveService(source, SvrSession(source, log, items, mode, period, variables=variables))
+                robot.attach_slave(service)
+                self._listen(robot, service, port + robot.index if port else 0)
         except OSError:
             self.close()
             raise
 
-    def _listen(self, robot, port):
-        robot.svr_listener = Listener(self.server.selector, self.server.host, port, ("svr_listen", None, robot),
-                                      f"open the Ethernet Slave of robot {robot.index + 1} on {{where}}")
-        robot.svr_port = robot.svr_listener.port
-        self.listeners.append(robot.svr_listener)
-        robot._log("svr_listening", host=self.server.host, port=robot.svr_port)
+    def _listen(self, robot: Robot, service: SlaveService, port: int) -> None:
+        service.listener = Listener(self.server.selector, self.server.host, port, ("svr_listen", None, robot),
+                                    f"open the Ethernet Slave of robot {robot.index + 1} on {{where}}")
+        self.listeners.append(service.listener)
+        robot.log.event("svr_listening", host=self.server.host, port=service.port)
 
     # ---- per poll -----------------------------------------------------------------------------
-    def poll(self, now):
+    def poll(self, now: float) -> None:
         """Stream the data tables that are due and send what is waiting (called by SimServer.poll)."""
         for robot in self.server.robots:
-            if robot.svr_listener is not None:
-                robot.svr_listener.tick(now)
-            if robot.svr.clients:
-                robot.svr.advance(now)
+            service = robot.slave
+            if service is None:
+                continue
+            if service.listener is not None:
+                service.listener.tick(now)
+            if service.session.clients:
+                service.session.advance(now)
                 self._flush(robot)
 
-    def _accept(self, _none, robot):
+    def _accept(self, _none: None, robot: Robot) -> None:
+        service = _service(robot)
+        listener = service.listener
+        if listener is None:
+            return
         for _ in range(16):
-            accepted = robot.svr_listener.accept(self.server.now, robot._log, prefix="svr_")
+            accepted = listener.accept(self.server.now, robot.log.event, prefix="svr_")
             if accepted is None:
                 return
             sock, addr = accepted
-            if len(robot.svr_conns) >= SVR_CLIENTS_MAX:
-                robot._log("svr_rejected_connection", peer=addr[0], reason=f"more than {SVR_CLIENTS_MAX} clients")
+            if len(service.conns) >= SVR_CLIENTS_MAX:
+                robot.log.event("svr_rejected_connection", peer=addr[0],
+                                reason=f"more than {SVR_CLIENTS_MAX} clients")
                 sock.close()
                 continue
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            conn = _Conn(sock, self._next_conn, robot)
+            conn = SvrConn(sock, self._next_conn, robot)
             self._next_conn += 1
-            robot.svr_conns[conn.id] = conn
-            robot.svr.connect(conn.id, addr[0])
+            service.conns[conn.id] = conn
+            service.session.connect(conn.id, addr[0])
             self.server.selector.register(sock, selectors.EVENT_READ, ("svr_conn", None, conn))
 
-    def _read(self, _none, conn):
+    def _read(self, _none: None, conn: SvrConn) -> None:
         robot = conn.robot
-        if conn.id not in robot.svr_conns:
+        service = _service(robot)
+        if conn.id not in service.conns:
             return
         data, failed = receive(conn.sock)
         if failed or data == b"":
@@ -93,19 +126,21 @@ class EthernetSlave:
         if data is None:
             return
         try:
-            robot.svr.receive_data(conn.id, data)
+            service.session.receive_data(conn.id, data)
         except Exception as exc:          # noqa: BLE001 - safety net: one bad client never stops the others
-            robot._log("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
+            robot.log.event("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
             self._drop(robot, conn, "internal error while handling this Ethernet Slave client")
             return
         self._flush(robot)
 
-    def _flush(self, robot):
-        for conn_id in list(robot.svr.clients):
-            conn = robot.svr_conns.get(conn_id)
-            if conn is None or (not conn.wbuf and not robot.svr.has_output(conn_id)):
+    def _flush(self, robot: Robot) -> None:
+        service = _service(robot)
+        session = service.session
+        for conn_id in list(session.clients):
+            conn = service.conns.get(conn_id)
+            if conn is None or (not conn.wbuf and not session.has_output(conn_id)):
                 continue
-            frames = robot.svr.data_to_send(conn_id)
+            frames = session.data_to_send(conn_id)
             try:
                 for frame in frames:
                     if conn.wbuf:
@@ -120,44 +155,53 @@ class EthernetSlave:
             if len(conn.wbuf) > SVR_OUTBOX_MAX:
                 self._drop(robot, conn, f"client does not read (more than {SVR_OUTBOX_MAX} bytes waiting)")
 
-    def _drop(self, robot, conn, reason):
-        if robot.svr_conns.pop(conn.id, None) is None:
+    def _drop(self, robot: Robot, conn: SvrConn, reason: str) -> None:
+        service = _service(robot)
+        if service.conns.pop(conn.id, None) is None:
             return
-        try:
+        with contextlib.suppress(KeyError, ValueError):
             self.server.selector.unregister(conn.sock)
-        except (KeyError, ValueError):
-            pass
         conn.sock.close()
-        robot.svr.disconnect(conn.id)
-        robot._log("svr_closed", conn=conn.id, reason=reason)
+        service.session.disconnect(conn.id)
+        robot.log.event("svr_closed", conn=conn.id, reason=reason)
 
     # ---- fault injection ----------------------------------------------------------------------
-    def inject(self, robot, fault, **params):
+    def inject(self, robot: Robot, fault: str, **params: Any) -> None:
         """``stall`` (enabled=True): no data table and no answers, connections stay open;
         ``corrupt_checksum`` (count=1): the next frames leave with a wrong checksum;
         ``disconnect``: every Ethernet Slave client of the robot is closed now;
         ``refuse_writes`` (status=6): every well-formed write is answered with that status code (1..7), nothing is
         written. ValueError when unknown."""
-        robot.svr.inject(fault, **params)         # checks the fault and its parameters; arms the protocol's
+        service = _service(robot)
+        service.session.inject(fault, **params)   # checks the fault and its parameters; arms the protocol's
         if fault == "disconnect":                 # ... the sockets are this adapter's
-            for conn in list(robot.svr_conns.values()):
+            for conn in list(service.conns.values()):
                 self._drop(robot, conn, "fault: disconnect")
-        robot._log("svr_fault", fault=fault, params=params)
+        robot.log.event("svr_fault", fault=fault, params=params)
 
-    def clear_faults(self, robot):
-        robot.svr.clear_faults()
-        robot._log("svr_fault", fault="cleared", params={})
+    def clear_faults(self, robot: Robot) -> None:
+        _service(robot).session.clear_faults()
+        robot.log.event("svr_fault", fault="cleared", params={})
 
-    def close(self):
+    def close(self) -> None:
         for robot in self.server.robots:
-            for conn in list(robot.svr_conns.values()):
-                self._drop(robot, conn, "simulator closed")
+            if robot.slave is not None:
+                for conn in list(robot.slave.conns.values()):
+                    self._drop(robot, conn, "simulator closed")
         for listener in self.listeners:
             listener.close()
         self.listeners = []
 
 
-def _send(sock, data) -> int:
+def _service(robot: Robot) -> SlaveService:
+    """The robot's Ethernet Slave (every robot of a server that runs one has it from the start)."""
+    service = robot.slave
+    if service is None:
+        raise RuntimeError(f"robot {robot.index + 1} has no Ethernet Slave")
+    return service
+
+
+def _send(sock: socket.socket, data: bytes | bytearray) -> int:
     try:
         return sock.send(data)
     except (BlockingIOError, InterruptedError):

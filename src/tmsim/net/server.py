@@ -24,6 +24,7 @@ import selectors
 import socket
 import threading
 import time
+from typing import Any
 
 from tmsim.limits import (
     EVENT_BYTES_MAX,
@@ -39,16 +40,18 @@ from tmsim.limits import (
     TURN_WORK,
 )
 from tmsim.net.control import ControlChannel
-from tmsim.net.ethernet_slave import EthernetSlave
+from tmsim.net.ethernet_slave import EthernetSlave, SlaveService, SvrConn
 from tmsim.net.fairness import FairScheduler
 from tmsim.net.fairness import is_greedy as _is_greedy
 from tmsim.net.tcp_listener import Listener, receive
 from tmsim.protocol.listen_session import STOPPED, ListenSession
+from tmsim.protocol.svr_session import SvrSession
 from tmsim.robot.eventlog import EventLog, LogFile
 from tmsim.robot.eventlog import text as _text
 from tmsim.robot.faults import FaultState
 from tmsim.robot.faults import check_params as check_fault_params
 from tmsim.robot.model import RobotModel
+from tmsim.robot.svr_source import RobotDataSource
 from tmsim.tmscript.profiles import Profile
 
 RBUF_READ_BELOW = FRAME_DATA_MAX + 64     # a receive buffer this full holds a complete item: process it first
@@ -73,31 +76,78 @@ class Conn:
         return self._session.unanswered_bad(self.id)
 
 
-class Robot(EventLog):
-    """Control interface of one simulated robot (``SimServer.robots[i]``)."""
+class Robot:
+    """Control interface of one simulated robot (``SimServer.robots[i]``) and the services it holds: its event
+    log (``log``), its Listen node (``session``, ``listener``, ``conns``), its output-side faults (``faults``)
+    and, when the server runs one, its Ethernet Slave (``slave``, attached by tmsim/net/ethernet_slave.py)."""
 
-    def __init__(self, server, index, port, send_message, auto_enter, profile, timeouts, frames=(None, None)):
+    def __init__(self, server: SimServer, index: int, port: int, send_message: str, auto_enter: bool,
+                 profile: Profile, timeouts: tuple[float | None, float | None],
+                 frames: tuple[Any, Any] = (None, None)):
         self._server = server
-        self.index = index
-        self.port = port
-        self._init_event_log()
-        self.faults = FaultState()
-        self.session = ListenSession(RobotModel(bases=frames[0], tools=frames[1]),
-                                     send_message, self._log,
+        self.index: int = index
+        self.port: int = port
+        self.log: EventLog = EventLog(index, server.event_limit, server.event_bytes_limit, server.log_file)
+        self.faults: FaultState = FaultState()
+        self.session: ListenSession = ListenSession(RobotModel(bases=frames[0], tools=frames[1]),
+                                     send_message, self.log.event,
                                      auto_enter=auto_enter, data_timeout=timeouts[0], connection_timeout=timeouts[1],
                                      profile=profile)
-        self.listener = None
-        self.port_hold = None                  # the Listen-node port, bound but not listening while it is closed
+        self.log.follow(self.session)          # events carry the session's robot clock, bill its work meter
+        self.listener: Listener | None = None
+        self.port_hold: socket.socket | None = None    # the Listen-node port, bound but not listening while closed
         self.conns: dict[int, Conn] = {}
-        self.reading_paused = False
-        # The robot's Ethernet Slave service (tmsim/net/ethernet_slave.py fills it in when the server runs one;
-        # all stay None / empty with --no-svr): the data table's values, the sans-I/O session, its connections,
-        # its listening socket and port.
-        self.svr_source = None
-        self.svr = None
-        self.svr_conns: dict = {}
-        self.svr_listener = None
-        self.svr_port = None
+        self.reading_paused: bool = False
+        self.slave: SlaveService | None = None  # the robot's Ethernet Slave; None with --no-svr
+
+    def attach_slave(self, service: SlaveService) -> None:
+        """The server runs an Ethernet Slave: this robot's (tmsim/net/ethernet_slave.py builds it)."""
+        self.slave = service
+
+    # ---- the Ethernet Slave's parts (None / empty with --no-svr) ------------------------------
+    @property
+    def svr(self) -> SvrSession | None:
+        """The Ethernet Slave's sans-I/O session."""
+        return None if self.slave is None else self.slave.session
+
+    @property
+    def svr_source(self) -> RobotDataSource | None:
+        """The Ethernet Slave's data table values (and the writes acted out on the robot)."""
+        return None if self.slave is None else self.slave.source
+
+    @property
+    def svr_conns(self) -> dict[int, SvrConn]:
+        """The Ethernet Slave's client connections."""
+        return {} if self.slave is None else self.slave.conns
+
+    @property
+    def svr_port(self) -> int | None:
+        """The port the Ethernet Slave listens on."""
+        return None if self.slave is None else self.slave.port
+
+    # ---- the event log (``log``), read by the control channel, the demo and the tests -----------
+    @property
+    def events(self) -> list[dict]:
+        """The events kept in memory, oldest first."""
+        return self.log.events
+
+    @property
+    def events_dropped(self) -> int:
+        """Events removed from the front of ``events`` so far."""
+        return self.log.events_dropped
+
+    @property
+    def event_bytes(self) -> int:
+        """Bytes the kept events count."""
+        return self.log.event_bytes
+
+    def event_sizes(self, start: int, count: int) -> list[int]:
+        """Bytes the event log counts for events[start:start + count]."""
+        return self.log.event_sizes(start, count)
+
+    def wait_event(self, kind: str, timeout: float = 5.0, since: int = 0, **fields: Any) -> dict | None:
+        """First event of ``kind`` whose fields equal ``fields`` (see EventLog.wait_event)."""
+        return self.log.wait_event(kind, timeout, since, **fields)
 
     # ---- control ------------------------------------------------------------------------------
     def enter_listen_node(self):
@@ -139,7 +189,7 @@ class Robot(EventLog):
                     self._server.drop(self, conn, "fault: disconnect")
             else:
                 self.faults.arm(fault, **params)
-            self._log("fault", fault=fault, params=params)
+            self.log.event("fault", fault=fault, params=params)
 
     def clear_faults(self):
         with self._server.lock:
@@ -148,7 +198,7 @@ class Robot(EventLog):
             self.faults.adopt(held)          # frames already held back still leave at their time
             self.session.clear_reply_errors()
             self._server.apply_refuse(self)
-            self._log("fault", fault="cleared", params={})
+            self.log.event("fault", fault="cleared", params={})
 
     def state(self) -> dict:
         with self._server.lock:
@@ -230,7 +280,7 @@ class SimServer:
         robot.listener = Listener(self.selector, self.host, robot.port, ("listen", robot, None),
                                   f"listen on {{where}} for robot {robot.index + 1}", backlog=128, held=held)
         robot.port = robot.listener.port
-        robot._log("listening", host=self.host, port=robot.port)
+        robot.log.event("listening", host=self.host, port=robot.port)
 
     def _close_listener(self, robot, hold_port: bool = True):
         """The port stays held (refusing connections) while the robot's server is down, so it comes back on it."""
@@ -251,7 +301,7 @@ class SimServer:
 
     def log_server(self, kind, **fields):
         """An event of the server as a whole (control channel): logged in robot 0's log."""
-        self.robots[0]._log(kind, **fields)
+        self.robots[0].log.event(kind, **fields)
 
     def apply_refuse(self, robot):
         if robot.faults.refuse and robot.listener is not None:
@@ -281,6 +331,8 @@ class SimServer:
                 self.svr = None
             self.selector.close()
             if self.log_file is not None:
+                for robot in self.robots:
+                    robot.log.stop_writing()
                 self.log_file.close()
                 self.log_file = None
 
@@ -368,7 +420,7 @@ class SimServer:
     def _set_reading(self, robot, reading: bool):
         """Back-pressure: stop reading this robot's clients while its script buffer is full."""
         robot.reading_paused = not reading
-        robot._log("reading_resumed" if reading else "reading_paused", buffered=robot.session.waiting_scripts)
+        robot.log.event("reading_resumed" if reading else "reading_paused", buffered=robot.session.waiting_scripts)
         for conn in robot.conns.values():
             if reading and robot.session.input_bytes(conn.id):
                 self.fair.requeue(robot, conn)    # input read before the pause
@@ -420,7 +472,7 @@ class SimServer:
             except Exception as exc:          # safety net: one bad client never stops the others
                 if robot is None or conn is None:
                     raise
-                robot._log("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
+                robot.log.event("internal_error", conn=conn.id, error=f"{type(exc).__name__}: {exc}")
                 self.drop(robot, conn, "internal error while handling this client")
             if robot is not None:
                 if robot not in self._touched:
@@ -436,7 +488,7 @@ class SimServer:
         try:
             robot.session.advance(self._now)
         except Exception as exc:          # noqa: BLE001 - safety net, see docstring
-            robot._log("internal_error", conn=None, error=f"{type(exc).__name__}: {exc}")
+            robot.log.event("internal_error", conn=None, error=f"{type(exc).__name__}: {exc}")
             robot.session.internal_error(f"internal error of the simulator ({type(exc).__name__})")
 
     def _start_touched(self):
@@ -453,14 +505,14 @@ class SimServer:
 
     def _accept(self, robot, _conn):
         for _ in range(64):
-            accepted = robot.listener.accept(self._now, robot._log)
+            accepted = robot.listener.accept(self._now, robot.log.event)
             if accepted is None:
                 return
             sock, addr = accepted
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             if len(robot.conns) >= LISTEN_CLIENTS_MAX:
-                robot._log("rejected_connection", peer=addr[0], reason=f"more than {LISTEN_CLIENTS_MAX} clients")
+                robot.log.event("rejected_connection", peer=addr[0], reason=f"more than {LISTEN_CLIENTS_MAX} clients")
                 sock.close()
                 continue
             conn = Conn(sock, self._next_conn, addr[0], robot.session)
@@ -487,11 +539,11 @@ class SimServer:
             if not data:
                 conn.eof = True
                 self.selector.unregister(conn.sock)
-                robot._log("peer_closed", conn=conn.id)
+                robot.log.event("peer_closed", conn=conn.id)
                 return
             conn.greedy = len(data) == RECV_BYTES
             if robot.faults.black_hole:
-                robot._log("black_hole", conn=conn.id, bytes=len(data))
+                robot.log.event("black_hole", conn=conn.id, bytes=len(data))
                 return
             robot.session.buffer_data(conn.id, data)
         if not self.fair.waits(robot, conn):     # else it waits for its turn in fair.serve_backlog
@@ -515,7 +567,7 @@ class SimServer:
             if frames:
                 for frame in frames:
                     header, _, rest = frame[1:].partition(b",")
-                    robot._log("frame_out", conn=conn_id, raw=_text(frame), header=_header_text(header),
+                    robot.log.event("frame_out", conn=conn_id, raw=_text(frame), header=_header_text(header),
                                data=_text(rest.partition(b",")[2][:-6]))
             else:
                 frames = ()
@@ -572,7 +624,7 @@ class SimServer:
         robot.faults.forget(conn.id)
         self.fair.forget(robot, conn)
         robot.session.disconnect(conn.id)
-        robot._log("closed", conn=conn.id, reason=reason)
+        robot.log.event("closed", conn=conn.id, reason=reason)
 
 
 def _collect_garbage(idle: bool):
