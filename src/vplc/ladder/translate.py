@@ -140,8 +140,9 @@ def unit_source(path: str, unit: XmlUnit) -> LadderSource:
         for section in unit.globals:
             _section(w, section, "global variables")
         w.put("\n")
+    functions = {p.name.upper(): _function_outputs(p) for p in unit.pous if p.kind == "FUNCTION"}
     for pou in unit.pous:
-        errors += _pou(w, pou)
+        errors += _pou(w, pou, functions)
         if pou.ladder is not None:
             pou.ladder.path = path
             ladders.append(pou.ladder)
@@ -165,7 +166,15 @@ def _section(w: Writer, s: SectionText, owner: str) -> None:
     w.put("END_VAR\n")
 
 
-def _pou(w: Writer, pou: PouText) -> list[FormatError]:
+def _function_outputs(pou: PouText) -> dict[str, str]:
+    """Output name (upper; ``""`` for the result) -> declared type of a FUNCTION of the unit."""
+    outs = {v.name.upper(): v.type for s in pou.sections if s.kind == "VAR_OUTPUT" for v in s.vars}
+    if pou.return_type:
+        outs[""] = pou.return_type
+    return outs
+
+
+def _pou(w: Writer, pou: PouText, functions: dict[str, dict[str, str]] | None = None) -> list[FormatError]:
     """Write one POU; returns the wiring errors of its rungs (each rung with one is left out of the ST text)."""
     errors = []
     w.put(_comment(pou.comment))
@@ -175,7 +184,7 @@ def _pou(w: Writer, pou: PouText) -> list[FormatError]:
         _section(w, s, pou.name)
     if pou.ladder is not None:
         names = {v.name.upper() for s in pou.sections for v in s.vars}
-        compiler = RungCompiler(w, pou, names)
+        compiler = RungCompiler(w, pou, names, functions or {})
         compiler.body(pou.ladder)
         errors = compiler.errors
     else:
@@ -191,9 +200,12 @@ def _error(where: str, message: str, code: str) -> FormatError:
 class RungCompiler:
     """Compiles the rungs of one POU; collects the hidden variables it needs."""
 
-    def __init__(self, w: Writer, pou: PouText, names: set[str]) -> None:
+    def __init__(self, w: Writer, pou: PouText, names: set[str],
+                 functions: dict[str, dict[str, str]] | None = None) -> None:
         self.w = w
         self.pou = pou.name
+        self.functions = functions or {}      # output types of the unit's own functions (typed carriers)
+        self.hidden_types: dict[str, str] = {}      # helper name -> its type when not BOOL
         prefix = "_ld"
         while any(n.startswith(prefix.upper()) for n in names):
             prefix += "x"
@@ -202,9 +214,11 @@ class RungCompiler:
         self.lines: list[tuple] = []          # (Txt | str, label | None, statement)
         self.errors: list[FormatError] = []   # every rung's wiring errors, not only the first
 
-    def new(self, kind: str) -> str:
+    def new(self, kind: str, type_name: str | None = None) -> str:
         name = f"{self.prefix}{kind}{len(self.hidden) + 1}"
         self.hidden.append(name)
+        if type_name is not None:
+            self.hidden_types[name] = type_name
         return name
 
     def emit(self, text, label: str | None = None, indent: str = "") -> None:
@@ -258,7 +272,7 @@ class RungCompiler:
         if self.hidden:
             w.put("VAR (* ladder helper variables *)\n")
             for name in self.hidden:
-                w.put(f"    {name} : BOOL;\n", f"{self.pou}:ladder helper variables")
+                w.put(f"    {name} : {self.hidden_types.get(name, 'BOOL')};\n", f"{self.pou}:ladder helper variables")
             w.put("END_VAR\n")
         for text, label in self.lines:
             w.put(text, label, statement=label is not None)
@@ -274,6 +288,7 @@ class RungCompiler:
         self.out: dict[tuple[str, str | None], Txt] = {}
         self.guard: dict[str, Txt] = {}
         consumers: dict[tuple[str, str | None], int] = {}
+        readers: dict[tuple[str, str | None], list[tuple[Element, Pin]]] = {}
         deps: dict[str, set[str]] = {e.id: set() for e in rung.elements}
         users: dict[str, list[str]] = {e.id: [] for e in rung.elements}
         problems: list[FormatError] = []
@@ -297,10 +312,13 @@ class RungCompiler:
                         problems.append(exc)
                         continue
                     consumers[key] = consumers.get(key, 0) + 1
+                    readers.setdefault(key, []).append((e, pin))
                     if src.kind != "left_rail":
                         deps[e.id].add(src.id)
                         users[src.id].append(e.id)
         self.consumers = consumers
+        self.readers = readers
+        self.carried: set[int] = set()        # output-variable elements a function call writes directly
         order, stuck = self._order(rung, deps, users)
         if stuck:
             problems.append(_error(self.where, "the rung is wired in a loop (" + ", ".join(stuck[:6])
@@ -460,6 +478,10 @@ class RungCompiler:
 
     def el_out_var(self, e: Element) -> None:
         lab = self.label(e)
+        if id(e) in self.carried:              # the function call wrote the variable itself
+            if e.kind == "inout_var":
+                self.out[(e.id, None)] = Txt(e.var).marked(lab)
+            return
         value = self.power(e, e.power_in)
         var = Txt(e.var).marked(lab)
         line = var + " := " + (("NOT " + value.at_least(3)) if e.negated else value) + ";"
@@ -550,21 +572,7 @@ class RungCompiler:
         for name, value in inouts.items():
             self.out[(e.id, name)] = value
         if not e.instance:
-            result = next((p for p in e.outputs if p.name.upper() != "ENO"), None)
-            others = [p for p in e.outputs if p is not result and p.name.upper() != "ENO"
-                      and self.consumers.get((e.id, p.name), 0)]
-            if others:
-                raise _error(lab, f"output `{others[0].name}` of a function is wired; only the result of a "
-                                  "function can be wired in a ladder", codes.LADDER_FUNCTION_WIRING)
-            if result is not None:
-                if self.consumers.get((e.id, result.name), 0) > 1:
-                    raise _error(lab, "the result of a function feeds several elements; write it to a variable "
-                                      "and read that variable where it is needed", codes.LADDER_FUNCTION_WIRING)
-                call = (self.comparison(e, values, lab) if e.type_name.upper() in COMPARE
-                        else (e.type_name + "(" + call_args + ")").marked(lab))
-                self.out[(e.id, result.name)] = ("NOT " + call) if result.negated else call
-                if en is not None and en.text != TRUE:
-                    self.guard[e.id] = en
+            self.function(e, en, call_args, values, lab)
             return
         call = (e.instance + "(" + call_args + ");").marked(lab)
         if en is None or en.text == TRUE:
@@ -575,3 +583,61 @@ class RungCompiler:
             if pin.name.upper() != "ENO":
                 value = Txt(f"{e.instance}.{pin.name}")      # the wire belongs to the element reading it
                 self.out[(e.id, pin.name)] = ("NOT " + value).with_prec(3) if pin.negated else value
+
+    # ---- functions --------------------------------------------------------------------------
+    POWER_READERS = frozenset({"contact", "coil", "jump", "return", "inline_st"})
+
+    def function(self, e: Element, en: Txt | None, call_args: Txt, values: list[Txt], lab: str) -> None:
+        """A function box. Its result read by one element is an expression in that element (``Q := F(..)``,
+        ``IF F(..) AND ...``). Sysmac also wires a function like a function block (W502: each output pin of the
+        box is a wire): its result to several elements, its other outputs, its result behind EN to a contact.
+        The function is then called once, in its place in the power flow, and each wired output lands in a
+        carrier the readers read: an output variable wired to it (written by the call itself), a BOOL helper
+        when only contacts, coils and other power readers read it, or a helper of the output's declared type
+        for a function of the same file."""
+        result = next((p for p in e.outputs if p.name.upper() != "ENO"), None)
+        wired = [p for p in e.outputs if p.name.upper() != "ENO" and self.consumers.get((e.id, p.name), 0)]
+        guarded = en is not None and en.text != TRUE
+        simple = all(p is result for p in wired) and (
+            result is None or self.consumers.get((e.id, result.name), 0) <= 1 and not (
+                guarded and any(r.kind not in ("out_var", "inout_var")
+                                for r, _pin in self.readers.get((e.id, result.name), []))))
+        if simple:
+            if result is not None:
+                call = (self.comparison(e, values, lab) if e.type_name.upper() in COMPARE
+                        else (e.type_name + "(" + call_args + ")").marked(lab))
+                self.out[(e.id, result.name)] = ("NOT " + call) if result.negated else call
+                if guarded:
+                    self.guard[e.id] = en
+            return
+        carriers = {p.name: self._carrier(e, p, p is result, lab) for p in wired}
+        extra = [f"{p.name} => {carriers[p.name]}" for p in wired if p is not result]
+        if e.type_name.upper() in COMPARE:
+            call = self.comparison(e, values, lab)
+        else:
+            sep = ", " if call_args.text and extra else ""
+            call = (e.type_name + "(" + call_args + sep + ", ".join(extra) + ")").marked(lab)
+        line = (carriers[result.name] + " := " + call + ";") if result is not None and result.name in carriers \
+            else call + ";"
+        self.stmt(("IF " + en + " THEN " + line + " END_IF;") if guarded and en is not None else line, lab)
+        for p in wired:
+            value = Txt(carriers[p.name])
+            self.out[(e.id, p.name)] = ("NOT " + value).with_prec(3) if p.negated else value
+
+    def _carrier(self, e: Element, pin: Pin, is_result: bool, lab: str) -> str:
+        readers = self.readers.get((e.id, pin.name), [])
+        if not pin.negated:
+            for r, _rpin in readers:
+                if r.kind in ("out_var", "inout_var") and not r.negated and id(r) not in self.carried:
+                    self.carried.add(id(r))
+                    return r.var
+        if all(r.kind in self.POWER_READERS or (r.kind == "block" and rpin.name.upper() == "EN")
+               for r, rpin in readers):
+            return self.new("F")
+        declared = self.functions.get(e.type_name.upper(), {}).get("" if is_result else pin.name.upper())
+        if declared is not None and not pin.negated:
+            return self.new("V", declared)
+        reader = next(r for r, rpin in readers if r.kind not in self.POWER_READERS)
+        raise _error(lab, f"output `{pin.name}` of the function feeds {reader.describe()} but no variable; wire it "
+                          "to a variable as well (vplc cannot tell the type of a helper for the output of a "
+                          f"function declared elsewhere)", codes.LADDER_FUNCTION_WIRING)
