@@ -119,11 +119,10 @@ def _axis(t: dict[str, Any], path: str, index: int) -> AxisConfig:
     if units not in UNITS:
         raise AxisConfigError(f"{where}: `units` {units!r} is not one of {', '.join(UNITS)}")
 
-    def number_of(key: str, default=None, *, positive=False, required=False):
-        v = t.get(key, default)
+    def optional(key: str, *, positive: bool = False) -> float | None:
+        """The number under ``key`` (None when absent), checked: finite, > 0 when ``positive``, maxima >= 0."""
+        v = t.get(key)
         if v is None:
-            if required:
-                raise AxisConfigError(f"{where}: `{key}` is missing")
             return None
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise AxisConfigError(f"{where}: `{key}` must be a finite number (got {v!r})")
@@ -133,20 +132,29 @@ def _axis(t: dict[str, Any], path: str, index: int) -> AxisConfig:
             raise AxisConfigError(f"{where}: `{key}` must not be negative (got {v!r})")
         return float(v)
 
-    vmax = number_of("max_velocity", positive=True, required=True)
-    amax = number_of("max_acceleration", positive=True, required=True)
+    def number_of(key: str, default: float | None = None, *, positive: bool = False) -> float:
+        """The number under ``key``, ``default`` when absent; absent without a default is an error."""
+        v = optional(key, positive=positive)
+        if v is not None:
+            return v
+        if default is None:
+            raise AxisConfigError(f"{where}: `{key}` is missing")
+        return default
+
+    vmax = number_of("max_velocity", positive=True)
+    amax = number_of("max_acceleration", positive=True)
     dmax = number_of("max_deceleration", amax, positive=True)
     jmax = number_of("max_jerk", 0.0)
-    lo = number_of("software_limit_negative")
-    hi = number_of("software_limit_positive")
+    lo = optional("software_limit_negative")
+    hi = optional("software_limit_positive")
     if (lo is None) != (hi is None):
         raise AxisConfigError(f"{where}: give both `software_limit_negative` and `software_limit_positive`, or "
                               "neither")
-    if lo is not None and lo >= hi:
+    if lo is not None and hi is not None and lo >= hi:
         raise AxisConfigError(f"{where}: `software_limit_negative` {lo:g} must be below `software_limit_positive` "
                               f"{hi:g}")
     home = number_of("home_position", 0.0)
-    if lo is not None and not lo <= home <= hi:
+    if lo is not None and hi is not None and not lo <= home <= hi:
         raise AxisConfigError(f"{where}: `home_position` {home:g} is outside the software limits {lo:g} .. {hi:g}")
     homed = t.get("homed", False)
     if not isinstance(homed, bool):
