@@ -7,9 +7,12 @@ from __future__ import annotations
 
 import keyword
 import re
+from dataclasses import dataclass, field
+from typing import Protocol
 
 from ..frontend import ast as A
 from ..frontend import types as T
+from ..frontend.source import Span
 from ..runtime import abi, iec
 from .inline import readonly_inputs
 
@@ -37,17 +40,74 @@ def _width(t):
     return None
 
 
+class CheckedProject(Protocol):
+    """What the code generator reads of a checked project (a ``vplc.project.Project``: the compiler sits below
+    the project layer and does not import it, docs/toolchain/layout.md)."""
+    dialect: str
+    pous: dict[str, T.PouType]
+    types: dict[str, T.Type]
+    globals: dict
+    configurations: list[A.Configuration]
+    programs: list[T.PouType]
+
+    def lookup_pou(self, text: str, from_ns: str | None = None) -> T.PouType | None: ...
+
+
+class CodeWriter:
+    """The generated module as it is written: its lines, the ST location (file, line) each line implements, the
+    current indentation and the numbering of temporaries. The statement and expression generators share one."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.linemap: dict[int, tuple[str, int]] = {}
+        self.ind = 0
+        self.loc = ("", 0)
+        self._tmp = 0
+
+    def emit(self, text: str) -> None:
+        self.lines.append("    " * self.ind + text)
+        self.linemap[len(self.lines)] = self.loc
+
+    def tmp(self, prefix: str = "_t") -> str:
+        """A fresh local name (prefixes: ``abi.TEMP_PREFIXES``)."""
+        self._tmp += 1
+        return f"{prefix}{self._tmp}"
+
+    def at(self, span: Span | None) -> None:
+        """Lines emitted from now on implement the ST source at ``span``."""
+        if span is not None:
+            self.loc = (span.file.path, span.line)
+
+
+@dataclass
+class Scope:
+    """Where the expressions being generated are read: the instance whose variables they name (``s``, or the
+    instance of an FB call compiled in place), the FOR variables whose range is known, the inputs of an inlined
+    call read from the value just stored, and the FB instances already fetched into locals."""
+    self_name: str = "s"
+    loop_index: dict[int, tuple[str, int, int]] = field(default_factory=dict)   # id(FOR variable) -> (loop var, lo, hi)
+    forward: dict[int, str] = field(default_factory=dict)        # id(input variable) -> code of its value
+    inst_temps: dict[str, str] = field(default_factory=dict)     # code of an FB instance -> local holding it
+
+
 class ExprGen:
-    def __init__(self, proj) -> None:
+    """Typed ST expressions -> Python expression text, written for the statement generator (codegen.CodeGen),
+    which sets the ``scope`` and says where a sub-expression may be computed beforehand (``spill_ok``). It owns
+    the names of generated things (structure and POU classes, constants), which the statement generator uses too.
+
+    ``out`` receives the statements a deep expression is split into; ``optimise`` False hands every structured
+    input over as a copy (tests); ``inline_cache`` is the inline analysis' memo of this compilation."""
+
+    def __init__(self, proj: CheckedProject, out: CodeWriter, *, optimise: bool, inline_cache: dict) -> None:
         self.proj = proj
+        self.out = out
+        self.optimise = optimise
+        self.inline_cache = inline_cache
         self.consts: dict[str, object] = {}
-        self.struct_names: dict[int, tuple] = {}
+        self.struct_names: dict[int, tuple[T.StructType, str]] = {}
         self.pou_names: dict[int, str] = {}
-        self.current = None
-        self.self_name = "s"        # the instance whose variables the code being generated reads
-        self.loop_index: dict[int, tuple] = {}   # id(FOR variable) -> (python loop variable, lo, hi): see st_For
-        self.forward: dict[int, str] = {}        # id(input variable) -> code of its value: see CodeGen.fb_call
-        self.inst_temps: dict[str, str] = {}     # code of an FB instance -> local holding it: see CodeGen.fb_call
+        self.scope = Scope()
+        self.spill_ok = False      # set by the statement generator where a value may be computed beforehand
 
     # ---- names of generated things ----------------------------------------------------------
     def struct_name(self, t) -> str:
@@ -123,8 +183,6 @@ class ExprGen:
         return "None"
 
     # ---- expressions --------------------------------------------------------------------------
-    spill_ok = False      # set by the statement generator where a value may be computed beforehand
-
     def expr(self, e) -> str:
         code = getattr(self, "ex_" + type(e).__name__)(e)
         if e.conv is not None:
@@ -138,8 +196,8 @@ class ExprGen:
         if not self.spill_ok:
             raise NotImplementedError("an expression nested this deeply in a loop or IF condition; "
                                       "compute part of it into a variable first")
-        tmp = self.tmp("_x")
-        self.emit(f"{tmp} = {code}")
+        tmp = self.out.tmp("_x")
+        self.out.emit(f"{tmp} = {code}")
         return tmp
 
     def cond(self, e) -> str:
@@ -213,10 +271,10 @@ class ExprGen:
         if kind == "EnumValueSymbol":
             return str(sym.value)
         if kind == "VarSymbol":
-            known = self.forward.get(id(sym))
+            known = self.scope.forward.get(id(sym))
             if known is not None:
                 return known
-            container, key = _cell(sym, self.self_name)
+            container, key = _cell(sym, self.scope.self_name)
             if container.endswith(".__dict__"):            # plain attribute access: the fast path
                 return f"{container[:-len('.__dict__')]}.{key[1:-1]}"
             if container == _G_MEMBERS:
@@ -228,7 +286,7 @@ class ExprGen:
 
     def ex_Member(self, e) -> str:
         base = self.expr_raw(e.base)
-        base = self.inst_temps.get(base, base)
+        base = self.scope.inst_temps.get(base, base)
         sym = e.sym
         name = sym.name if sym is not None else e.member
         bt = T.base_of(e.base.ty) if e.base.ty is not None else None
@@ -257,11 +315,13 @@ class ExprGen:
             first = e.indices[0]
             if isinstance(first, A.Literal) and isinstance(first.value, int) and lo <= first.value <= hi:
                 return f"{base}[{first.value - lo}]"
-            known = self.loop_index.get(id(first.sym)) if isinstance(first, A.Name) and first.conv is None else None
+            known = self.scope.loop_index.get(id(first.sym)) \
+                if isinstance(first, A.Name) and first.conv is None else None
             if known is not None and lo <= known[1] and known[2] <= hi:    # a FOR variable that stays in range
                 return f"{base}[{_offset(known[0], lo)}]"
             if isinstance(first, (A.Name, A.Member)) and _plain(idx[0]):   # cheap to read twice: check inline
-                return f"{base}[{_offset(idx[0], lo)} if {lo} <= {idx[0]} <= {hi} else {abi.IX1}({idx[0]}, {lo}, {hi}, {what})]"
+                return f"{base}[{_offset(idx[0], lo)} if {lo} <= {idx[0]} <= {hi} " \
+                       f"else {abi.IX1}({idx[0]}, {lo}, {hi}, {what})]"
             return f"{base}[{abi.IX1}({idx[0]}, {lo}, {hi}, {what})]"
         dims = self.const(tuple(at.dims), "_d")
         return f"{base}[{abi.IXN}(({', '.join(idx)},), {dims}, {what})]"
@@ -328,7 +388,7 @@ class ExprGen:
         bits = t.bits if t.bits > 1 else 64
         if bits == 64 and signed and op in ("+", "-"):
             # 64-bit values are Python big integers past 2**62: comparing is cheaper than wrapping every time
-            z = self.tmp("_z")
+            z = self.out.tmp("_z")
             half = 1 << 63
             return f"({z} if {-half} <= ({z} := {r}) <= {half - 1} else {iec.wrap_expr(z, 64, True)})"
         return iec.wrap_expr(r, bits, signed)
@@ -349,7 +409,7 @@ class ExprGen:
     def ref(self, e) -> str:
         """(container, key) tuple addressing the lvalue ``e``."""
         if isinstance(e, A.Name):
-            container, key = _cell(e.sym, self.self_name)
+            container, key = _cell(e.sym, self.scope.self_name)
             return f"({container}, {key})"
         if isinstance(e, A.Member):
             bt = T.unalias(e.base.ty) if e.base.ty is not None else None
@@ -374,7 +434,7 @@ class ExprGen:
     def aggregate_arg(self, ba) -> str:
         if ba.from_element:
             ref = self.ref(ba.expr)
-            if getattr(self, "optimise", False) and ref.endswith(", 0)"):
+            if self.optimise and ref.endswith(", 0)"):
                 return ref[1:-len(", 0)")]          # from the first element: the array itself, no view
             return f"{abi.VIEW}(*{ref})"
         pt, at = T.unalias(ba.param.type), T.unalias(ba.expr.ty)
@@ -390,12 +450,14 @@ class ExprGen:
         if ba.from_element and isinstance(pt, T.ArrayType):
             n = pt.count() if not pt.open else None
             view = f"{abi.VIEW}(*{self.ref(ba.expr)})"
-            return f"{abi.COPY}({view})" if n is None else f"_fill({abi.COPY}({view}), {n}, lambda: {self.default(pt.element, None, repr(p.name))})"
+            if n is None:
+                return f"{abi.COPY}({view})"
+            return f"_fill({abi.COPY}({view}), {n}, lambda: {self.default(pt.element, None, repr(p.name))})"
         return self.store_conv(self.expr(ba.expr), ba.expr, p.type)
 
     def by_reference(self, pt, p, ba) -> bool:
         """A structure or array the function only reads is handed over as it is, not copied."""
-        return getattr(self, "optimise", False) and not pt.native and not is_scalar(p.type) and \
+        return self.optimise and not pt.native and not is_scalar(p.type) and \
             not ba.from_element and ba.expr.conv is None and p.name.upper() in readonly_inputs(pt, self.inline_cache)
 
     # ---- calls -------------------------------------------------------------------------------
