@@ -27,9 +27,10 @@ import threading
 from tmsim.limits import NODE_TIMEOUT_MAX_S, SPEEDUP_MAX
 from tmsim.net.control import robot_numbering
 from tmsim.net.server import SimServer
+from tmsim.protocol.listen_session import IN_NODE
 from tmsim.protocol.svr_session import DEFAULT_STREAM
 from tmsim.protocol.svr_table import ITEMS, SvrValueError, parse_variable
-from tmsim.robot.camera import Camera, camera_of, parse_option
+from tmsim.robot.camera import Camera, parse_option
 from tmsim.tmscript.profiles import STOP_TAGS, VERSIONS, Profile
 
 SVR_FORMATS = {"binary": 1, "string": 2, "json": 3}
@@ -207,21 +208,22 @@ def main(argv=None) -> int:
                                             items=svr_items, variables=variables))
         for robot in server.robots:
             for job in vision_jobs:
-                camera_of(robot.session.robot).define(**job)
+                robot.camera().define(**job)
         server.start()
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)
         return 1
     for robot in server.robots:
-        node = "in Listen node" if robot.session.state == "in_node" else "project running, not in Listen node"
+        node = "in Listen node" if robot.session.node_state() == IN_NODE else "project running, not in Listen node"
         slave = f", Ethernet Slave on {args.host}:{robot.svr_port}" if server.svr is not None else ""
         print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node}){slave}", flush=True)
     if server.control is not None:
         print(f"control channel: {args.control_host}:{server.control.port} "
               f"(JSON lines; {robot_numbering(len(server.robots))})", flush=True)
-    if server.svr is not None:
+    slave = server.robots[0].slave
+    if slave is not None:
         print(f"Ethernet Slave data table: every {args.svr_period:g} s, {args.svr_format}, "
-              f"{len(server.robots[0].svr.stream_items)} items", flush=True)
+              f"{len(slave.session.config()['items'])} items", flush=True)
     if args.speedup != 1.0:
         print(f"robot clock runs {args.speedup:g} x faster than real time", flush=True)
     print("Press Ctrl-C to stop.", flush=True)

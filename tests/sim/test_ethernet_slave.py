@@ -69,7 +69,7 @@ def test_manual_17_4_1_status_replies_are_exact(h, request_frame, reply):
 
 
 def test_status_02_write_permission_and_reads_still_allowed_17_1(h):
-    h.robot.svr.write_permission = False
+    h.robot.svr.configure(write_permission=False)
     peer = h.connect_svr()
     peer.send(b"$TMSVR,15,S2,2,Ctrl_DO0=1,*74\r\n")
     assert h.until(lambda: peer.frames) and peer.frames[0].raw == b"$TMSVR,23,S2,0,02,WritePermission,*6A\r\n"

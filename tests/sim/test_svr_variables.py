@@ -69,7 +69,7 @@ def test_status_codes_for_variables_17_4_1(h):
     for content in ("g_count=1.5", 'g_count="x"', "g_pos={1,2,3}", "g_ok=2", 'g_name=abc', "g_count={1,2}"):
         assert ask(h, peer, "S6,2," + content) == f"S6,0,07,ValueError;{content.split('=')[0]}".encode(), content
     assert h.robot.svr.variables["g_count"] == 5                      # nothing of a refused write is performed
-    h.robot.svr.write_permission = False
+    h.robot.svr.configure(write_permission=False)
     assert ask(h, peer, "S7,2,g_count=1") == b"S7,0,02,WritePermission"
     assert ask(h, peer, "S8,12,g_count") == b"S8,12,g_count=5"       # reading needs no write permission
 

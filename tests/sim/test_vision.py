@@ -117,8 +117,10 @@ def test_a_bad_job_definition_is_refused_with_its_reason(kwargs, words):
 
 def test_the_control_channel_sets_and_removes_jobs_and_shows_the_camera():
     class Robot:
-        class session:
-            robot = object.__new__(type("M", (), {}))
+        model = object.__new__(type("M", (), {}))
+
+        def camera(self):
+            return camera_of(self.model)
     channel = ControlChannel.__new__(ControlChannel)
     channel.server = type("Server", (), {"lock": threading.Lock()})()
     robot = Robot()

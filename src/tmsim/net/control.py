@@ -36,6 +36,7 @@ import json
 import math
 import selectors
 import socket
+from typing import TYPE_CHECKING
 
 from tmsim.limits import (
     CONTROL_ANSWER_BYTES,
@@ -63,7 +64,10 @@ from tmsim.protocol.control import (
     text_field,
 )
 from tmsim.protocol.listen_session import TransitionError
-from tmsim.robot.camera import camera_of
+
+if TYPE_CHECKING:
+    from tmsim.net.ethernet_slave import SlaveService
+    from tmsim.net.server import Robot
 
 
 class _Client:
@@ -101,7 +105,7 @@ class ControlChannel:
         self.turns_deferred = 0                               # turns that left requests for a later turn
         self._commands = {
             "ping": lambda robot, req: "pong",
-            "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.state,
+            "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.node_state(),
                                            "svr_port": r.svr_port} for r in server.robots],
             "state": lambda robot, req: self._state(robot),
             "events": self._events,
@@ -111,8 +115,8 @@ class ControlChannel:
             "start_project": lambda robot, req: robot.start_project(),
             "inject": lambda robot, req: robot.inject(text_field(req, "fault"), **fault_params(req)),
             "clear_faults": lambda robot, req: robot.clear_faults(),
-            "estop": lambda robot, req: _svr(robot).set_estop(bool_field(req, "pressed", True)),
-            "operation_mode": lambda robot, req: _svr(robot).set_auto_mode(operation_mode(req.get("mode"))),
+            "estop": lambda robot, req: _svr(robot).source.set_estop(bool_field(req, "pressed", True)),
+            "operation_mode": lambda robot, req: _svr(robot).source.set_auto_mode(operation_mode(req.get("mode"))),
             "svr_config": self._svr_config,
             "svr_inject": self._svr_inject,
             "svr_clear_faults": self._svr_clear_faults,
@@ -321,7 +325,7 @@ class ControlChannel:
         return _Streamed(state) if robot.session.variable_bytes() > CONTROL_TURN_BYTES else state
 
     def _svr_config(self, robot, request):
-        _svr(robot)
+        session = _svr(robot).session
         items = request.get("items")
         if items is not None and not (isinstance(items, list) and all(isinstance(i, str) for i in items)):
             raise RequestError(f"'items' must be a list of item names, got {show(items)}")
@@ -334,14 +338,13 @@ class ControlChannel:
             raise RequestError(f"'period' must be a finite number of seconds, got {show(period)}")
         with self.server.lock:
             permission = bool_field(request, "write_permission", True) if "write_permission" in request else None
-            robot.svr.configure(items, mode, period, write_permission=permission)
-        return {"items": robot.svr.stream_items, "mode": robot.svr.stream_mode, "period": robot.svr.period,
-                "write_permission": robot.svr.write_permission}
+            session.configure(items, mode, period, write_permission=permission)
+            return session.config()
 
     def _set_input(self, robot, request):
         """An input of the robot changes as a wired sensor would change it (RobotDataSource.set_input checks the
         item and the value and names either when it is refused)."""
-        source = _svr(robot)
+        source = _svr(robot).source
         name = text_field(request, "name")
         if "value" not in request:
             raise RequestError(f"'value' missing: the new value of {name} (0 or 1; volts in -10..10 if analog)")
@@ -359,16 +362,16 @@ class ControlChannel:
     def _vision_job(self, robot, request):
         """A vision job of the robot's project and what it finds (tmsim/robot/camera.py checks every value)."""
         with self.server.lock:
-            return camera_of(robot.session.robot).define(
+            return robot.camera().define(
                 name=request.get("job"), objects=request.get("objects", []), passed=request.get("pass", True),
                 seconds=request.get("seconds", 0.2), capture=request.get("capture"), variable=request.get("variable"))
 
     def _vision_remove(self, robot, request):
         with self.server.lock:
-            return camera_of(robot.session.robot).remove(text_field(request, "job"))
+            return robot.camera().remove(text_field(request, "job"))
 
     def _vision(self, robot, _request):
-        return camera_of(robot.session.robot).state()
+        return robot.camera().state()
 
     def _events(self, robot, request):
         since = int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")
@@ -392,11 +395,12 @@ def robot_numbering(count: int) -> str:
     return f'"robot": 0 to {count - 1} are robots 1 to {count}'
 
 
-def _svr(robot):
-    source = robot.svr_source
-    if source is None:
+def _svr(robot: Robot) -> SlaveService:
+    """The robot's Ethernet Slave; RequestError when the simulator runs none."""
+    service = robot.slave
+    if service is None:
         raise RequestError("the Ethernet Slave is not running (simulator started with --no-svr)")
-    return source
+    return service
 
 
 def request(port: int, payload: dict, host="127.0.0.1", timeout=5.0) -> dict:

@@ -44,8 +44,9 @@ from tmsim.net.ethernet_slave import EthernetSlave, SlaveService, SvrConn
 from tmsim.net.fairness import FairScheduler
 from tmsim.net.fairness import is_greedy as _is_greedy
 from tmsim.net.tcp_listener import Listener, receive
-from tmsim.protocol.listen_session import STOPPED, ListenSession
+from tmsim.protocol.listen_session import ListenSession
 from tmsim.protocol.svr_session import SvrSession
+from tmsim.robot.camera import Camera, camera_of
 from tmsim.robot.eventlog import EventLog, LogFile
 from tmsim.robot.eventlog import text as _text
 from tmsim.robot.faults import FaultState
@@ -99,6 +100,10 @@ class Robot:
         self.conns: dict[int, Conn] = {}
         self.reading_paused: bool = False
         self.slave: SlaveService | None = None  # the robot's Ethernet Slave; None with --no-svr
+
+    def camera(self) -> Camera:
+        """The robot's virtual camera (its vision jobs, tmsim/robot/camera.py)."""
+        return camera_of(self.session.robot)
 
     def attach_slave(self, service: SlaveService) -> None:
         """The server runs an Ethernet Slave: this robot's (tmsim/net/ethernet_slave.py builds it)."""
@@ -306,7 +311,7 @@ class SimServer:
     def apply_refuse(self, robot):
         if robot.faults.refuse and robot.listener is not None:
             self._close_listener(robot)
-        elif not robot.faults.refuse and robot.listener is None and robot.session.state != STOPPED:
+        elif not robot.faults.refuse and robot.listener is None and robot.session.project_running():
             self.open_port(robot)
 
     def close_robot_sockets(self, robot, reason="project stopped"):
@@ -393,7 +398,7 @@ class SimServer:
             self._start_touched()
             for robot in self.robots:
                 self.flush(robot)
-                if robot.session.state == STOPPED and (robot.listener is not None or robot.conns):
+                if not robot.session.project_running() and (robot.listener is not None or robot.conns):
                     self.close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
                 if robot.reading_paused and not self.fair.buffer_full(robot, 0.5):
                     self._set_reading(robot, True)

@@ -5,8 +5,9 @@ A server calls ``connect``/``receive_data(conn, bytes)``/``disconnect``/``advanc
 uses the control methods (``enter_node``, ``stop_project`` ...). A server that shares its input fairly
 between clients (tmsim/net/fairness.py) calls ``buffer_data`` and then ``turn(conn, budget)`` in bounded turns
 (a ``TurnBudget`` of tmsim/limits.py) instead of ``receive_data``; the session decodes, limits its CPERR
-answers to bad packets (CPERR_BURST, CPERR_PER_S in tmsim/limits.py) and logs ``frame_in`` either way. The node state follows an explicit transition table;
-the scripts of all clients are run strictly in arrival order, one at a time.
+answers to bad packets (CPERR_BURST, CPERR_PER_S in tmsim/limits.py) and logs ``frame_in`` either way. The
+node state follows an explicit transition table; the scripts of all clients are run strictly in arrival order,
+one at a time.
 """
 from __future__ import annotations
 
@@ -557,6 +558,14 @@ class ListenSession:
 
     def is_connected(self, conn: int) -> bool:
         return conn in self.clients
+
+    def node_state(self) -> str:
+        """The node's state: STOPPED ("project_stopped"), IDLE ("not_in_node"), IN_NODE or EXITING."""
+        return self.state
+
+    def project_running(self) -> bool:
+        """The robot's project runs (in the Listen node or not)."""
+        return self.state != STOPPED
 
     # ---- control (the control channel, fault injection) ---------------------------------------------
     def enter_node(self, source="control"):

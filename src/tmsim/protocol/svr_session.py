@@ -98,6 +98,11 @@ class SvrSession:
         if write_permission is not None:
             self.write_permission = bool(write_permission)
 
+    def config(self) -> dict:
+        """What ``configure`` set: the streamed items in order, the mode, the period and the write permission."""
+        return {"items": self.stream_items, "mode": self.stream_mode, "period": self.period,
+                "write_permission": self.write_permission}
+
     def declare(self, item: Item, value=None):
         """Add (or redeclare) a global variable of the robot's project (``svr_table.variable_item`` /
         ``parse_variable``); ``value`` None = zeros / empty texts. SvrConfigError names what is wrong."""

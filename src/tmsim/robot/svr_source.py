@@ -66,7 +66,7 @@ class RobotDataSource:
     def values(self, names) -> dict:
         """{name: value} of one consistent moment (joints and poses computed once)."""
         session, model = self.robot.session, self.model
-        running = session.state != "project_stopped"
+        running = session.project_running()
         if running and self.run_since is None:
             self.run_since = session.now
         elif not running:
@@ -140,7 +140,7 @@ class RobotDataSource:
 
     def _stick(self, button):
         session, model = self.robot.session, self.model
-        running = session.state != "project_stopped"
+        running = session.project_running()
         if button == "PlayPause":
             button = "Play" if not running or model.paused else "Pause"
         self.log("stick", button=button)
