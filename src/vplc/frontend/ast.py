@@ -29,6 +29,19 @@ class Node:
     """Base of all nodes."""
 
 
+class InNamespace:
+    """A top-level item the parser found inside NAMESPACE blocks: ``declared_namespace`` is their names joined
+    with backslashes (None outside any). Not a dataclass field: it takes no part in equality or the AST dumps."""
+    declared_namespace: str | None = None
+
+
+class LoadedFrom:
+    """Where the loader (vplc.project) found a file: ``in_prelude`` for the prelude every project sees,
+    ``vendor`` for its Sysmac files (their objects are the vendor's). Not dataclass fields."""
+    in_prelude: bool = False
+    vendor: bool = False
+
+
 # ----------------------------------------------------------------------------------------------
 # Names and type references
 # ----------------------------------------------------------------------------------------------
@@ -388,13 +401,13 @@ class TypeDecl(Node):
 
 
 @dataclass(eq=True)
-class TypeBlock(Node):
+class TypeBlock(Node, InNamespace):
     decls: list[TypeDecl]
     span: Span = _ann()
 
 
 @dataclass(eq=True)
-class Pou(Node):
+class Pou(Node, InNamespace):
     """FUNCTION, FUNCTION_BLOCK or PROGRAM."""
     kind: str                      # 'FUNCTION' | 'FUNCTION_BLOCK' | 'PROGRAM'
     name: str
@@ -410,7 +423,7 @@ class Pou(Node):
 
 
 @dataclass(eq=True)
-class GlobalVarList(Node):
+class GlobalVarList(Node, InNamespace):
     """Top-level VAR_GLOBAL sections of a file (a global variable list); ``name`` is the file stem."""
     sections: list[VarSection]
     name: str | None = None
@@ -439,7 +452,7 @@ class ProgramInstance(Node):
 
 @dataclass(eq=True)
 class Resource(Node):
-    name: str
+    name: str | None               # None: the implicit resource of a configuration without RESOURCE
     on: str | None
     sections: list[VarSection]
     tasks: list[TaskDecl]
@@ -448,7 +461,7 @@ class Resource(Node):
 
 
 @dataclass(eq=True)
-class Configuration(Node):
+class Configuration(Node, InNamespace):
     """CONFIGURATION ... END_CONFIGURATION. Programs/tasks written directly in the configuration
     (without RESOURCE) are put in one implicit resource with ``name`` None."""
     name: str
@@ -461,7 +474,7 @@ Item = TypeBlock | Pou | GlobalVarList | Configuration
 
 
 @dataclass(eq=True)
-class CompilationUnit(Node):
+class CompilationUnit(Node, LoadedFrom):
     """One source file. ``comments``: (style, start, end) of every comment, style "(*", "/*" or "//"."""
     items: list[Item]
     span: Span = _ann()

@@ -1,5 +1,12 @@
-"""Token cursor, error reporting and recovery shared by the parser modules."""
+"""The token cursor the parsers share: position, look-ahead, spans, error reporting and recovery.
+
+One :class:`TokenCursor` exists per parsed file; the expression, statement and declaration parsers each
+hold it (see parser.py) and advance it together.
+"""
 from __future__ import annotations
+
+from collections.abc import Container
+from typing import NoReturn
 
 from . import codes
 from .diagnostics import DiagnosticBag
@@ -7,12 +14,25 @@ from .lexer import Token
 from .source import SourceFile, Span
 
 # Words that can never be identifiers (IEC 61131-3 keywords the parser relies on).
-RESERVED = frozenset(["IF", "THEN", "ELSIF", "ELSE", "END_IF", "CASE", "OF", "END_CASE", "FOR", "TO", "BY", "DO", "END_FOR", "WHILE", "END_WHILE", "REPEAT", "UNTIL", "END_REPEAT", "EXIT", "CONTINUE", "RETURN", "VAR", "VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT", "VAR_TEMP", "VAR_GLOBAL", "VAR_EXTERNAL", "VAR_STAT", "VAR_ACCESS", "VAR_CONFIG", "END_VAR", "CONSTANT", "RETAIN", "NON_RETAIN", "TYPE", "END_TYPE", "STRUCT", "END_STRUCT", "ARRAY", "FUNCTION", "END_FUNCTION", "FUNCTION_BLOCK", "END_FUNCTION_BLOCK", "PROGRAM", "END_PROGRAM", "CONFIGURATION", "END_CONFIGURATION", "RESOURCE", "END_RESOURCE", "AND", "OR", "XOR", "NOT", "MOD", "TRUE", "FALSE", "STRING", "WSTRING"])
+RESERVED = frozenset([
+    "IF", "THEN", "ELSIF", "ELSE", "END_IF", "CASE", "OF", "END_CASE", "FOR", "TO", "BY", "DO", "END_FOR",
+    "WHILE", "END_WHILE", "REPEAT", "UNTIL", "END_REPEAT", "EXIT", "CONTINUE", "RETURN", "VAR", "VAR_INPUT",
+    "VAR_OUTPUT", "VAR_IN_OUT", "VAR_TEMP", "VAR_GLOBAL", "VAR_EXTERNAL", "VAR_STAT", "VAR_ACCESS", "VAR_CONFIG",
+    "END_VAR", "CONSTANT", "RETAIN", "NON_RETAIN", "TYPE", "END_TYPE", "STRUCT", "END_STRUCT", "ARRAY",
+    "FUNCTION", "END_FUNCTION", "FUNCTION_BLOCK", "END_FUNCTION_BLOCK", "PROGRAM", "END_PROGRAM", "CONFIGURATION",
+    "END_CONFIGURATION", "RESOURCE", "END_RESOURCE", "AND", "OR", "XOR", "NOT", "MOD", "TRUE", "FALSE", "STRING",
+    "WSTRING"
+])
 
 # Keywords that end a statement list; recovery stops in front of them.
-BLOCK_END = frozenset(["END_IF", "ELSIF", "ELSE", "END_CASE", "END_FOR", "END_WHILE", "UNTIL", "END_REPEAT", "END_FUNCTION", "END_FUNCTION_BLOCK", "END_PROGRAM", "END_VAR", "END_TYPE", "END_STRUCT", "END_CONFIGURATION", "END_RESOURCE"])
+BLOCK_END = frozenset([
+    "END_IF", "ELSIF", "ELSE", "END_CASE", "END_FOR", "END_WHILE", "UNTIL", "END_REPEAT", "END_FUNCTION",
+    "END_FUNCTION_BLOCK", "END_PROGRAM", "END_VAR", "END_TYPE", "END_STRUCT", "END_CONFIGURATION", "END_RESOURCE"
+])
 
-ITEM_START = frozenset(["FUNCTION", "FUNCTION_BLOCK", "PROGRAM", "TYPE", "CONFIGURATION", "VAR_GLOBAL", "NAMESPACE", "END_NAMESPACE"])
+ITEM_START = frozenset([
+    "FUNCTION", "FUNCTION_BLOCK", "PROGRAM", "TYPE", "CONFIGURATION", "VAR_GLOBAL", "NAMESPACE", "END_NAMESPACE"
+])
 
 STMT_START = frozenset(["IF", "CASE", "FOR", "WHILE", "REPEAT", "EXIT", "CONTINUE", "RETURN"])
 
@@ -23,7 +43,10 @@ class ParseError(Exception):
     """Internal: an error was reported at the current token; unwind to the nearest recovery point."""
 
 
-class ParserBase:
+class TokenCursor:
+    """The tokens of one file (pragmas set aside), the current position, the nesting depth and the END_*
+    words the enclosing constructs expect; reports syntax errors into ``diags``."""
+
     def __init__(self, src: SourceFile, tokens: list[Token], diags: DiagnosticBag) -> None:
         self.src = src
         self.diags = diags
@@ -52,7 +75,7 @@ class ParserBase:
         t = self.toks[self.i]
         return t.kind == "IDENT" and t.up == word
 
-    def at_any_kw(self, words) -> bool:
+    def at_any_kw(self, words: Container[str]) -> bool:
         t = self.toks[self.i]
         return t.kind == "IDENT" and t.up in words
 
@@ -107,11 +130,11 @@ class ParserBase:
         text = t.text if len(t.text) <= 40 else t.text[:37] + "..."
         return f"`{text}`"
 
-    def fail(self, message: str, code: str = codes.UNEXPECTED_TOKEN, t: Token | None = None):
+    def fail(self, message: str, code: str = codes.UNEXPECTED_TOKEN, t: Token | None = None) -> NoReturn:
         self.diags.error(code, message, self.tok_span(t))
         raise ParseError()
 
-    def fail_expected(self, what: str, context: str = ""):
+    def fail_expected(self, what: str, context: str = "") -> NoReturn:
         found = self.describe(self.tok)
         ctx = f" {context}" if context else ""
         code = codes.MISSING_END if self.tok.kind == "EOF" or self.at_any_kw(BLOCK_END) else codes.UNEXPECTED_TOKEN

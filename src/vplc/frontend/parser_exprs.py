@@ -1,5 +1,8 @@
 """Expression grammar (IEC 61131-3 precedence, left-associative binary operators).
 
+:class:`ExpressionParser` reads expressions, call arguments and qualified names from a :class:`TokenCursor`;
+the statement and declaration parsers (parser_stmts.py, parser.py) hold one and call it.
+
 Precedence, lowest first: OR; XOR; AND &; = <>; < > <= >=; + -; * / MOD; unary - + NOT; **; postfix.
 """
 from __future__ import annotations
@@ -10,8 +13,8 @@ import re
 
 from . import ast as A
 from . import codes
-from .lexer import decode_string
-from .parser_base import RESERVED
+from .lexer import Token, decode_string
+from .parser_base import RESERVED, TokenCursor
 
 BINARY_PREC = {"OR": 1, "XOR": 2, "AND": 3, "&": 3, "=": 4, "<>": 4, "<": 5, ">": 5, "<=": 5, ">=": 5,
                "+": 6, "-": 6, "*": 7, "/": 7, "MOD": 7}
@@ -75,15 +78,21 @@ def parse_ymd(text: str) -> int | None:
         return None
 
 
-class ExpressionsMixin:
+class ExpressionParser:
+    """Expressions at the cursor's position: each method consumes one construct and returns its AST node."""
+
+    def __init__(self, cursor: TokenCursor) -> None:
+        self.cur = cursor
+
     # grammar: expression := unary { binop unary }   (precedence climbing, BINARY_PREC)
     def expression(self, min_prec: int = 1) -> A.Expr:
-        self.enter()
-        start = self.tok.start
+        cur = self.cur
+        cur.enter()
+        start = cur.tok.start
         left = self.unary()
         chain = 0
         while True:
-            t = self.tok
+            t = cur.tok
             if t.kind == "OP":
                 op = t.text
             elif t.kind == "IDENT" and t.up in ("OR", "XOR", "AND", "MOD"):
@@ -93,240 +102,251 @@ class ExpressionsMixin:
             prec = BINARY_PREC.get(op)
             if prec is None or prec < min_prec:
                 break
-            self.advance()
+            cur.advance()
             right = self.expression(prec + 1)
             chain += 1
-            if chain + self.depth > 2 * 200:
-                self.fail("expression has too many operators in a row (over 400); split it using "
-                          "intermediate variables", codes.NESTING_TOO_DEEP)
-            left = A.Binary("AND" if op == "&" else op, left, right, span=self.span_from(start))
-        self.leave()
+            if chain + cur.depth > 2 * 200:
+                cur.fail("expression has too many operators in a row (over 400); split it using "
+                         "intermediate variables", codes.NESTING_TOO_DEEP)
+            left = A.Binary("AND" if op == "&" else op, left, right, span=cur.span_from(start))
+        cur.leave()
         return left
 
     # grammar: unary := ('-' | '+' | NOT) unary | power
     def unary(self) -> A.Expr:
-        t = self.tok
+        cur = self.cur
+        t = cur.tok
         if (t.kind == "OP" and t.text in "-+" and t.text) or (t.kind == "IDENT" and t.up == "NOT"):
-            self.advance()
-            self.enter()
+            cur.advance()
+            cur.enter()
             operand = self.unary()
-            self.leave()
+            cur.leave()
             op = "NOT" if t.kind == "IDENT" else t.text
-            return A.Unary(op, operand, span=self.span_from(t.start))
+            return A.Unary(op, operand, span=cur.span_from(t.start))
         return self.power()
 
     # grammar: power := postfix { '**' unary }
     def power(self) -> A.Expr:
-        start = self.tok.start
+        cur = self.cur
+        start = cur.tok.start
         left = self.postfix()
-        while self.at_op("**"):
-            self.advance()
-            self.enter()
-            right = self.unary() if (self.at_op("-") or self.at_op("+")) else self.postfix()
-            self.leave()
-            left = A.Binary("**", left, right, span=self.span_from(start))
+        while cur.at_op("**"):
+            cur.advance()
+            cur.enter()
+            right = self.unary() if (cur.at_op("-") or cur.at_op("+")) else self.postfix()
+            cur.leave()
+            left = A.Binary("**", left, right, span=cur.span_from(start))
         return left
 
     # grammar: postfix := primary { '.' ident | '.' digit | '[' expr {',' expr} ']' | '(' args ')' }
     def postfix(self) -> A.Expr:
-        start = self.tok.start
+        cur = self.cur
+        start = cur.tok.start
         node = self.primary()
         while True:
-            if self.at_op("."):
-                self.advance()
-                t = self.tok
+            if cur.at_op("."):
+                cur.advance()
+                t = cur.tok
                 if t.kind == "INT":
-                    self.advance()
-                    node = A.BitAccess(node, self.decimal_value(t), span=self.span_from(start))
+                    cur.advance()
+                    node = A.BitAccess(node, self.decimal_value(t), span=cur.span_from(start))
                     continue
-                name = self.ident("a member name after `.`")
-                node = A.Member(node, name.text, span=self.span_from(start))
-            elif self.at_op("["):
-                self.advance()
+                name = cur.ident("a member name after `.`")
+                node = A.Member(node, name.text, span=cur.span_from(start))
+            elif cur.at_op("["):
+                cur.advance()
                 idx = [self.expression()]
-                while self.accept_op(","):
+                while cur.accept_op(","):
                     idx.append(self.expression())
-                self.expect_op("]", "to close the index")
-                node = A.Index(node, idx, span=self.span_from(start))
-            elif self.at_op("("):
+                cur.expect_op("]", "to close the index")
+                node = A.Index(node, idx, span=cur.span_from(start))
+            elif cur.at_op("("):
                 if not isinstance(node, (A.Name, A.Member, A.Index)):
                     break
                 args = self.call_args()
-                node = A.Call(node, args, span=self.span_from(start))
-            elif self.at_op("^"):
-                self.fail("pointer dereference `^` is not supported; IEC 61131-3 2nd edition and Sysmac "
-                          "libraries do not use pointers")
+                node = A.Call(node, args, span=cur.span_from(start))
+            elif cur.at_op("^"):
+                cur.fail("pointer dereference `^` is not supported; IEC 61131-3 2nd edition and Sysmac "
+                         "libraries do not use pointers")
             else:
                 break
         return node
 
     # grammar: args := '(' [ arg { ',' arg } ] ')' ; arg := [NOT] ident ('=>' [expr]) | ident ':=' expr | expr
     def call_args(self) -> list[A.Arg]:
-        self.expect_op("(")
+        cur = self.cur
+        cur.expect_op("(")
         args: list[A.Arg] = []
-        if self.accept_op(")"):
+        if cur.accept_op(")"):
             return args
         while True:
-            start = self.tok.start
-            t, nxt = self.tok, self.peek()
+            start = cur.tok.start
+            t, nxt = cur.tok, cur.peek()
             negated = False
-            if t.kind == "IDENT" and t.up == "NOT" and nxt.kind == "IDENT" and self.peek(2).text == "=>":
+            if t.kind == "IDENT" and t.up == "NOT" and nxt.kind == "IDENT" and cur.peek(2).text == "=>":
                 negated = True
-                self.advance()
-                t, nxt = self.tok, self.peek()
+                cur.advance()
+                t, nxt = cur.tok, cur.peek()
             if t.kind == "IDENT" and nxt.kind == "OP" and nxt.text in (":=", "=>") and t.up not in RESERVED:
-                self.advance()
-                self.advance()
+                cur.advance()
+                cur.advance()
                 if nxt.text == "=>":
-                    value = None if (self.at_op(",") or self.at_op(")")) else self.expression()
-                    args.append(A.Arg(t.text, value, True, negated, span=self.span_from(start)))
+                    value = None if (cur.at_op(",") or cur.at_op(")")) else self.expression()
+                    args.append(A.Arg(t.text, value, True, negated, span=cur.span_from(start)))
                 else:
-                    args.append(A.Arg(t.text, self.expression(), span=self.span_from(start)))
+                    args.append(A.Arg(t.text, self.expression(), span=cur.span_from(start)))
             else:
-                args.append(A.Arg(None, self.expression(), span=self.span_from(start)))
-            if self.accept_op(","):
+                args.append(A.Arg(None, self.expression(), span=cur.span_from(start)))
+            if cur.accept_op(","):
                 continue
-            self.expect_op(")", "to close the argument list")
+            cur.expect_op(")", "to close the argument list")
             return args
 
     # grammar: qualname := ['\'|'\\'] ident { ('\'|'\\') ident }
     def qualname(self, what: str = "a name") -> tuple[A.QualName, str | None]:
         """Parse a possibly namespace-qualified name. Returns (name, enum_value) where enum_value is set
         when the last part was ``Type#Value``."""
-        start = self.tok.start
-        self.accept_op("\\\\") or self.accept_op("\\")
+        cur = self.cur
+        start = cur.tok.start
+        cur.accept_op("\\\\") or cur.accept_op("\\")
         parts: list[str] = []
         while True:
-            t = self.tok
+            t = cur.tok
             if t.kind == "TYPED":
-                self.advance()
+                cur.advance()
                 parts.append(t.text[:-1])
-                value = self.tok
+                value = cur.tok
                 if value.kind != "IDENT":
-                    self.fail_expected("an enumeration value after `#`")
-                self.advance()
-                return A.QualName(parts[-1], tuple(parts[:-1]), span=self.span_from(start)), value.text
-            parts.append(self.ident(what).text)
-            if (self.at_op("\\") or self.at_op("\\\\")) and self.peek().kind in ("IDENT", "TYPED"):
-                self.advance()
+                    cur.fail_expected("an enumeration value after `#`")
+                cur.advance()
+                return A.QualName(parts[-1], tuple(parts[:-1]), span=cur.span_from(start)), value.text
+            parts.append(cur.ident(what).text)
+            if (cur.at_op("\\") or cur.at_op("\\\\")) and cur.peek().kind in ("IDENT", "TYPED"):
+                cur.advance()
                 continue
-            return A.QualName(parts[-1], tuple(parts[:-1]), span=self.span_from(start)), None
+            return A.QualName(parts[-1], tuple(parts[:-1]), span=cur.span_from(start)), None
 
     # grammar: primary := literal | typed_literal | enum_literal | qualname | '(' expression ')'
     def primary(self) -> A.Expr:
-        t = self.tok
+        cur = self.cur
+        t = cur.tok
         kind = t.kind
         start = t.start
         if kind == "INT":
-            self.advance()
-            return A.Literal("int", self.decimal_value(t), None, t.text, span=self.tok_span(t))
+            cur.advance()
+            return A.Literal("int", self.decimal_value(t), None, t.text, span=cur.tok_span(t))
         if kind == "BASED":
-            self.advance()
-            return A.Literal("int", self.based_value(t), None, t.text, span=self.tok_span(t))
+            cur.advance()
+            return A.Literal("int", self.based_value(t), None, t.text, span=cur.tok_span(t))
         if kind == "REAL":
-            self.advance()
-            return A.Literal("real", float(t.text.replace("_", "")), None, t.text, span=self.tok_span(t))
+            cur.advance()
+            return A.Literal("real", float(t.text.replace("_", "")), None, t.text, span=cur.tok_span(t))
         if kind in ("STRING", "WSTRING"):
-            self.advance()
+            cur.advance()
             value, err = decode_string(t.text[1:-1], kind == "WSTRING")
             if err:
-                self.diags.error(codes.BAD_ESCAPE, err, self.tok_span(t))
-            return A.Literal(kind.lower(), value, None, t.text, span=self.tok_span(t))
+                cur.diags.error(codes.BAD_ESCAPE, err, cur.tok_span(t))
+            return A.Literal(kind.lower(), value, None, t.text, span=cur.tok_span(t))
         if kind in ("TIME", "DATE", "TOD", "DT"):
-            self.advance()
+            cur.advance()
             return self.temporal_literal(t)
         if kind == "TYPED":
             prefix = t.text[:-1].upper()
             if prefix in INT_PREFIXES or prefix in REAL_PREFIXES or prefix in ("BOOL", "STRING", "WSTRING"):
                 return self.typed_literal(t, prefix)
-            name, value = self.qualname()
-            return A.EnumLiteral(name, value, span=self.span_from(start))
+            name, enum_value = self.qualname()
+            assert enum_value is not None           # qualname() starting at `Type#` always reads the value
+            return A.EnumLiteral(name, enum_value, span=cur.span_from(start))
         if kind == "IDENT":
-            if t.up in ("MOD", "AND", "OR", "XOR") and self.peek().kind == "OP" and self.peek().text == "(":
-                self.advance()      # functional form of an operator: MOD(a, b), AND(a, b, c)
-                return A.Name(A.QualName(t.up, span=self.tok_span(t)), span=self.tok_span(t))
+            if t.up in ("MOD", "AND", "OR", "XOR") and cur.peek().kind == "OP" and cur.peek().text == "(":
+                cur.advance()      # functional form of an operator: MOD(a, b), AND(a, b, c)
+                return A.Name(A.QualName(t.up, span=cur.tok_span(t)), span=cur.tok_span(t))
             if t.up in ("TRUE", "FALSE"):
-                self.advance()
-                return A.Literal("bool", t.up == "TRUE", None, t.text, span=self.tok_span(t))
+                cur.advance()
+                return A.Literal("bool", t.up == "TRUE", None, t.text, span=cur.tok_span(t))
         if kind == "IDENT" or (kind == "OP" and t.text in ("\\", "\\\\")):
-            name, value = self.qualname()
-            if value is not None:
-                return A.EnumLiteral(name, value, span=self.span_from(start))
-            return A.Name(name, span=self.span_from(start))
+            name, enum_value = self.qualname()
+            if enum_value is not None:
+                return A.EnumLiteral(name, enum_value, span=cur.span_from(start))
+            return A.Name(name, span=cur.span_from(start))
         if kind == "OP" and t.text == "(":
-            self.advance()
+            cur.advance()
             inner = self.expression()
-            self.expect_op(")", "to close the parenthesis")
+            cur.expect_op(")", "to close the parenthesis")
             return inner
         if kind == "ADDRESS":
-            self.fail("direct addresses (`%IX0.0`) are only allowed after AT in a declaration")
-        self.fail_expected("an expression")
+            cur.fail("direct addresses (`%IX0.0`) are only allowed after AT in a declaration")
+        cur.fail_expected("an expression")
 
-    def decimal_value(self, t) -> int:
+    def decimal_value(self, t: Token) -> int:
         """A decimal integer literal; one far beyond 64 bits is reported here, before Python's int() refuses
         it (more than 4,300 digits), and the checker's range rule does the rest."""
+        cur = self.cur
         digits = t.text.replace("_", "")
         if len(digits) > MAX_INT_DIGITS:
-            self.diags.error(codes.BAD_LITERAL, f"integer literal of {len(digits):,} digits: the largest integer types "
-                             f"(LINT, ULINT, LWORD) hold at most 20 digits", self.tok_span(t))
+            cur.diags.error(codes.BAD_LITERAL, f"integer literal of {len(digits):,} digits: the largest integer types "
+                            f"(LINT, ULINT, LWORD) hold at most 20 digits", cur.tok_span(t))
             return 0
         return int(digits)
 
-    def based_value(self, t) -> int:
+    def based_value(self, t: Token) -> int:
+        cur = self.cur
         base_text, digits = t.text.split("#", 1)
         base = int(base_text)
         digits = digits.replace("_", "")
         if base not in (2, 8, 16):
-            self.diags.error(codes.BAD_LITERAL, f"base {base} is not allowed in `{t.text}`; use 2#, 8# or 16#",
-                             self.tok_span(t))
+            cur.diags.error(codes.BAD_LITERAL, f"base {base} is not allowed in `{t.text}`; use 2#, 8# or 16#",
+                            cur.tok_span(t))
             return 0
         try:
             return int(digits, base)
         except ValueError:
-            self.diags.error(codes.BAD_LITERAL, f"`{t.text}` contains digits that are not valid in base {base}",
-                             self.tok_span(t))
+            cur.diags.error(codes.BAD_LITERAL, f"`{t.text}` contains digits that are not valid in base {base}",
+                            cur.tok_span(t))
             return 0
 
-    def typed_literal(self, prefix_tok, prefix: str) -> A.Expr:
-        self.advance()
+    def typed_literal(self, prefix_tok: Token, prefix: str) -> A.Expr:
+        cur = self.cur
+        cur.advance()
         start = prefix_tok.start
         sign = ""
-        if self.at_op("-") or self.at_op("+"):
-            sign = self.advance().text
-        t = self.tok
-        text = self.src.text[start:t.end]
+        if cur.at_op("-") or cur.at_op("+"):
+            sign = cur.advance().text
+        t = cur.tok
+        text = cur.src.text[start:t.end]
         if t.kind in ("INT", "BASED", "REAL") and prefix not in ("STRING", "WSTRING"):
-            self.advance()
+            cur.advance()
             if t.kind == "REAL":
                 if prefix not in REAL_PREFIXES:
-                    self.fail(f"`{text}`: a {prefix} literal cannot have a fraction", codes.BAD_LITERAL, t)
+                    cur.fail(f"`{text}`: a {prefix} literal cannot have a fraction", codes.BAD_LITERAL, t)
                 value = float(t.text.replace("_", ""))
             else:
                 value = self.based_value(t) if t.kind == "BASED" else self.decimal_value(t)
             if sign == "-":
                 value = -value
             if prefix in REAL_PREFIXES:
-                return A.Literal("real", float(value), prefix, text, span=self.span_from(start))
+                return A.Literal("real", float(value), prefix, text, span=cur.span_from(start))
             if prefix == "BOOL":
                 if value not in (0, 1):
-                    self.fail(f"`{text}`: BOOL literals are 0, 1, TRUE or FALSE", codes.BAD_LITERAL, t)
-                return A.Literal("bool", bool(value), prefix, text, span=self.span_from(start))
-            return A.Literal("int", value, prefix, text, span=self.span_from(start))
+                    cur.fail(f"`{text}`: BOOL literals are 0, 1, TRUE or FALSE", codes.BAD_LITERAL, t)
+                return A.Literal("bool", bool(value), prefix, text, span=cur.span_from(start))
+            return A.Literal("int", value, prefix, text, span=cur.span_from(start))
         if t.kind == "IDENT" and t.up in ("TRUE", "FALSE") and prefix == "BOOL" and not sign:
-            self.advance()
-            return A.Literal("bool", t.up == "TRUE", prefix, text, span=self.span_from(start))
+            cur.advance()
+            return A.Literal("bool", t.up == "TRUE", prefix, text, span=cur.span_from(start))
         if t.kind in ("STRING", "WSTRING") and prefix in ("STRING", "WSTRING") and not sign:
-            self.advance()
-            value, err = decode_string(t.text[1:-1], prefix == "WSTRING")
+            cur.advance()
+            chars, err = decode_string(t.text[1:-1], prefix == "WSTRING")
             if err:
-                self.diags.error(codes.BAD_ESCAPE, err, self.tok_span(t))
-            return A.Literal(prefix.lower(), value, prefix, text, span=self.span_from(start))
-        self.fail_expected(f"a {prefix} value after `{prefix_tok.text}`")
+                cur.diags.error(codes.BAD_ESCAPE, err, cur.tok_span(t))
+            return A.Literal(prefix.lower(), chars, prefix, text, span=cur.span_from(start))
+        cur.fail_expected(f"a {prefix} value after `{prefix_tok.text}`")
 
-    def temporal_literal(self, t) -> A.Literal:
+    def temporal_literal(self, t: Token) -> A.Literal:
+        cur = self.cur
         prefix, body = t.text.split("#", 1)
         up = prefix.upper()
-        span = self.tok_span(t)
+        span = cur.tok_span(t)
         if t.kind == "TIME":
             value = parse_duration(body)
             kind = "ltime" if up in ("LTIME", "LT") else "time"
@@ -342,10 +362,10 @@ class ExpressionsMixin:
             value = None if day is None or tod is None else day * 1_000_000_000 + tod
             kind = "dt"
         if value is None:
-            self.diags.error(codes.BAD_LITERAL, f"`{t.text}` is not a valid {kind.upper()} literal", span)
+            cur.diags.error(codes.BAD_LITERAL, f"`{t.text}` is not a valid {kind.upper()} literal", span)
             value = 0
         elif not -(1 << 63) <= value < (1 << 63):
-            self.diags.error(codes.BAD_LITERAL,
-                             f"`{t.text}` is outside the range of {kind.upper()} (64-bit nanoseconds, "
-                             "about ±106751 days)", span)
+            cur.diags.error(codes.BAD_LITERAL,
+                            f"`{t.text}` is outside the range of {kind.upper()} (64-bit nanoseconds, "
+                            "about ±106751 days)", span)
         return A.Literal(kind, value, None, t.text, span=span)

@@ -1,17 +1,29 @@
-"""Statement grammar, with recovery at `;` and at the next block keyword."""
+"""Statement grammar, with recovery at `;` and at the next block keyword.
+
+:class:`StatementParser` reads statement lists from a :class:`TokenCursor`, handing expressions to the
+:class:`ExpressionParser` it is given; the declaration parser (parser.py) holds both.
+"""
 from __future__ import annotations
 
 from . import ast as A
 from . import codes
-from .parser_base import BLOCK_END, ITEM_START, ParseError
+from .parser_base import BLOCK_END, ITEM_START, ParseError, TokenCursor
+from .parser_exprs import ExpressionParser
 
 
-class StatementsMixin:
+class StatementParser:
+    """Statements at the cursor's position; expressions inside them are read by ``exprs`` (same cursor)."""
+
+    def __init__(self, cursor: TokenCursor, exprs: ExpressionParser) -> None:
+        self.cur = cursor
+        self.exprs = exprs
+
     # grammar: statement_list := { statement }   (until one of `terminators`)
     def statement_list(self, terminators: frozenset[str], case_labels: bool = False) -> list[A.Stmt]:
+        cur = self.cur
         body: list[A.Stmt] = []
         while True:
-            t = self.tok
+            t = cur.tok
             if t.kind == "EOF":
                 return body
             if t.kind == "IDENT" and (t.up in terminators or t.up in BLOCK_END or
@@ -19,143 +31,150 @@ class StatementsMixin:
                 return body
             if case_labels and self.looks_like_case_label():
                 return body
-            before = self.i
+            before = cur.i
             try:
                 stmt = self.statement()
                 if stmt is not None:
                     body.append(stmt)
             except ParseError:
-                self.sync_statement()
-                if self.i == before:
-                    if self.at_any_kw(terminators) or self.at_any_kw(BLOCK_END):
+                cur.sync_statement()
+                if cur.i == before:
+                    if cur.at_any_kw(terminators) or cur.at_any_kw(BLOCK_END):
                         return body
-                    self.advance()
+                    cur.advance()
 
     # grammar: statement := assignment | call | if | case | for | while | repeat | EXIT | CONTINUE | RETURN | ';'
     def statement(self) -> A.Stmt | None:
-        t = self.tok
+        cur = self.cur
+        t = cur.tok
         start = t.start
         if t.kind == "OP" and t.text == ";":
-            self.advance()
-            return A.Empty(span=self.span_from(start))
+            cur.advance()
+            return A.Empty(span=cur.span_from(start))
         if t.kind == "IDENT":
             handler = self._STMT_DISPATCH.get(t.up)
             if handler is not None:
-                self.enter()
-                self.end_stack.append(self._END_WORD.get(t.up, ""))
+                cur.enter()
+                cur.end_stack.append(self._END_WORD.get(t.up, ""))
                 try:
                     return handler(self)
                 finally:
-                    self.end_stack.pop()
-                    self.leave()
-        target = self.postfix()
+                    cur.end_stack.pop()
+                    cur.leave()
+        target = self.exprs.postfix()
         if isinstance(target, (A.Literal, A.EnumLiteral)):
-            text = self.src.text[target.span.start:target.span.end]
-            self.fail(f"a statement cannot start with the value `{text}`; if it is a CASE label, put `:` after it",
-                      codes.UNEXPECTED_TOKEN, t)
-        if self.at_op(":="):
-            self.advance()
-            value = self.expression()
+            text = cur.src.text[target.span.start:target.span.end]
+            cur.fail(f"a statement cannot start with the value `{text}`; if it is a CASE label, put `:` after it",
+                     codes.UNEXPECTED_TOKEN, t)
+        if cur.at_op(":="):
+            cur.advance()
+            value = self.exprs.expression()
             self.end_statement()
-            return A.Assign(target, value, span=self.span_from(start))
+            return A.Assign(target, value, span=cur.span_from(start))
         if isinstance(target, A.Call):
             self.end_statement()
-            return A.CallStmt(target, span=self.span_from(start))
-        if self.at_op("=") :
-            self.fail("`=` compares values; use `:=` to assign", codes.EQUALS_TO_ASSIGN)
-        if isinstance(target, (A.Name, A.Member, A.Index)) and self.tok.kind in ("IDENT", "INT", "REAL"):
-            self.fail_expected("`:=` or `;`", f"after `{self.src.text[target.span.start:target.span.end]}` "
-                               "(missing `;` on the previous line?)")
-        self.fail_expected("`:=` or a call", "to make a statement")
+            return A.CallStmt(target, span=cur.span_from(start))
+        if cur.at_op("=") :
+            cur.fail("`=` compares values; use `:=` to assign", codes.EQUALS_TO_ASSIGN)
+        if isinstance(target, (A.Name, A.Member, A.Index)) and cur.tok.kind in ("IDENT", "INT", "REAL"):
+            cur.fail_expected("`:=` or `;`", f"after `{cur.src.text[target.span.start:target.span.end]}` "
+                              "(missing `;` on the previous line?)")
+        cur.fail_expected("`:=` or a call", "to make a statement")
 
     def end_statement(self) -> None:
-        if self.at_op(";"):
-            self.advance()
+        cur = self.cur
+        if cur.at_op(";"):
+            cur.advance()
             return
-        prev = self.toks[self.i - 1]
-        self.diags.error(codes.MISSING_SEMICOLON, f"missing `;` after this statement (found {self.describe(self.tok)})",
-                         self.tok_span(prev))
+        prev = cur.toks[cur.i - 1]
+        cur.diags.error(codes.MISSING_SEMICOLON, f"missing `;` after this statement (found {cur.describe(cur.tok)})",
+                        cur.tok_span(prev))
         raise ParseError()
 
     # grammar: if := IF expr THEN stmts { ELSIF expr THEN stmts } [ ELSE stmts ] END_IF [';']
     def if_statement(self) -> A.If:
-        start = self.advance().start
+        cur = self.cur
+        start = cur.advance().start
         branches = []
         bstart = start
-        cond = self.expression()
-        self.expect_kw("THEN", "after the IF condition")
+        cond = self.exprs.expression()
+        cur.expect_kw("THEN", "after the IF condition")
         body = self.statement_list(frozenset(("ELSIF", "ELSE", "END_IF")))
-        branches.append(A.IfBranch(cond, body, span=self.span_from(bstart)))
+        branches.append(A.IfBranch(cond, body, span=cur.span_from(bstart)))
         else_body = None
         while True:
-            if self.at_kw("ELSIF"):
-                bstart = self.advance().start
-                cond = self.expression()
-                self.expect_kw("THEN", "after the ELSIF condition")
+            if cur.at_kw("ELSIF"):
+                bstart = cur.advance().start
+                cond = self.exprs.expression()
+                cur.expect_kw("THEN", "after the ELSIF condition")
                 body = self.statement_list(frozenset(("ELSIF", "ELSE", "END_IF")))
-                branches.append(A.IfBranch(cond, body, span=self.span_from(bstart)))
-            elif self.at_kw("ELSE"):
-                self.advance()
+                branches.append(A.IfBranch(cond, body, span=cur.span_from(bstart)))
+            elif cur.at_kw("ELSE"):
+                cur.advance()
                 else_body = self.statement_list(frozenset(("END_IF",)))
             else:
                 break
         self.expect_end("END_IF", "IF", start)
-        return A.If(branches, else_body, span=self.span_from(start))
+        return A.If(branches, else_body, span=cur.span_from(start))
 
     def expect_end(self, word: str, opener: str, start: int) -> None:
-        if self.accept_kw(word):
-            self.accept_op(";")
+        cur = self.cur
+        if cur.accept_kw(word):
+            cur.accept_op(";")
             return
-        line, col = self.src.line_col(start)
-        t = self.tok
-        self.diags.error(codes.MISSING_END, f"missing `{word}` for the {opener} at line {line}; found "
-                         f"{self.describe(t)}", self.tok_span())
-        if t.kind == "IDENT" and t.up.startswith("END_") and t.up not in self.end_stack:
-            self.advance()          # a mistyped END_xxx that nothing encloses: take it as this one's end
-            self.accept_op(";")
+        line, col = cur.src.line_col(start)
+        t = cur.tok
+        cur.diags.error(codes.MISSING_END, f"missing `{word}` for the {opener} at line {line}; found "
+                        f"{cur.describe(t)}", cur.tok_span())
+        if t.kind == "IDENT" and t.up.startswith("END_") and t.up not in cur.end_stack:
+            cur.advance()          # a mistyped END_xxx that nothing encloses: take it as this one's end
+            cur.accept_op(";")
 
     # grammar: case := CASE expr OF { labels ':' stmts } [ ELSE stmts ] END_CASE [';']
     def case_statement(self) -> A.Case:
-        start = self.advance().start
-        selector = self.expression()
-        self.expect_kw("OF", "after the CASE selector")
+        cur = self.cur
+        start = cur.advance().start
+        selector = self.exprs.expression()
+        cur.expect_kw("OF", "after the CASE selector")
         branches = []
         else_body = None
         while True:
-            if self.at_kw("ELSE"):
-                self.advance()
-                self.accept_op(":")
+            if cur.at_kw("ELSE"):
+                cur.advance()
+                cur.accept_op(":")
                 else_body = self.statement_list(frozenset(("END_CASE",)))
                 break
-            if self.at_kw("END_CASE") or self.tok.kind == "EOF" or self.at_any_kw(BLOCK_END):
+            if cur.at_kw("END_CASE") or cur.tok.kind == "EOF" or cur.at_any_kw(BLOCK_END):
                 break
-            bstart = self.tok.start
+            bstart = cur.tok.start
             try:
                 labels = [self.case_label()]
-                while self.accept_op(","):
+                while cur.accept_op(","):
                     labels.append(self.case_label())
-                self.expect_op(":", "after the CASE labels")
+                cur.expect_op(":", "after the CASE labels")
             except ParseError:
-                self.sync_statement()
+                cur.sync_statement()
                 continue
             body = self.statement_list(frozenset(("ELSE", "END_CASE")), case_labels=True)
-            branches.append(A.CaseBranch(labels, body, span=self.span_from(bstart)))
+            branches.append(A.CaseBranch(labels, body, span=cur.span_from(bstart)))
         self.expect_end("END_CASE", "CASE", start)
-        return A.Case(selector, branches, else_body, span=self.span_from(start))
+        return A.Case(selector, branches, else_body, span=cur.span_from(start))
 
     # grammar: case_label := expr [ '..' expr ]
-    def case_label(self):
-        start = self.tok.start
-        lo = self.expression()
-        if self.accept_op(".."):
-            hi = self.expression()
-            return A.CaseRange(lo, hi, span=self.span_from(start))
+    def case_label(self) -> A.Expr | A.CaseRange:
+        cur = self.cur
+        start = cur.tok.start
+        lo = self.exprs.expression()
+        if cur.accept_op(".."):
+            hi = self.exprs.expression()
+            return A.CaseRange(lo, hi, span=cur.span_from(start))
         return lo
 
     def looks_like_case_label(self) -> bool:
         """True when the next tokens are `label {, label} :` (a new CASE branch, not a statement)."""
-        j = self.i
-        toks = self.toks
+        cur = self.cur
+        j = cur.i
+        toks = cur.toks
         n = len(toks)
         while j < n:
             t = toks[j]
@@ -187,41 +206,45 @@ class StatementsMixin:
 
     # grammar: for := FOR ident ':=' expr TO expr [ BY expr ] DO stmts END_FOR [';']
     def for_statement(self) -> A.For:
-        start = self.advance().start
-        vt = self.ident("the FOR loop variable")
-        var = A.Name(A.QualName(vt.text, span=self.tok_span(vt)), span=self.tok_span(vt))
-        self.expect_op(":=", "after the FOR loop variable")
-        first = self.expression()
-        self.expect_kw("TO", "in the FOR statement")
-        last = self.expression()
-        step = self.expression() if self.accept_kw("BY") else None
-        self.expect_kw("DO", "in the FOR statement")
+        cur = self.cur
+        start = cur.advance().start
+        vt = cur.ident("the FOR loop variable")
+        var = A.Name(A.QualName(vt.text, span=cur.tok_span(vt)), span=cur.tok_span(vt))
+        cur.expect_op(":=", "after the FOR loop variable")
+        first = self.exprs.expression()
+        cur.expect_kw("TO", "in the FOR statement")
+        last = self.exprs.expression()
+        step = self.exprs.expression() if cur.accept_kw("BY") else None
+        cur.expect_kw("DO", "in the FOR statement")
         body = self.statement_list(frozenset(("END_FOR",)))
         self.expect_end("END_FOR", "FOR", start)
-        return A.For(var, first, last, step, body, span=self.span_from(start))
+        return A.For(var, first, last, step, body, span=cur.span_from(start))
 
     # grammar: while := WHILE expr DO stmts END_WHILE [';']
     def while_statement(self) -> A.While:
-        start = self.advance().start
-        cond = self.expression()
-        self.expect_kw("DO", "after the WHILE condition")
+        cur = self.cur
+        start = cur.advance().start
+        cond = self.exprs.expression()
+        cur.expect_kw("DO", "after the WHILE condition")
         body = self.statement_list(frozenset(("END_WHILE",)))
         self.expect_end("END_WHILE", "WHILE", start)
-        return A.While(cond, body, span=self.span_from(start))
+        return A.While(cond, body, span=cur.span_from(start))
 
     # grammar: repeat := REPEAT stmts UNTIL expr END_REPEAT [';']
     def repeat_statement(self) -> A.Repeat:
-        start = self.advance().start
+        cur = self.cur
+        start = cur.advance().start
         body = self.statement_list(frozenset(("UNTIL", "END_REPEAT")))
-        self.expect_kw("UNTIL", "to end the REPEAT body")
-        cond = self.expression()
+        cur.expect_kw("UNTIL", "to end the REPEAT body")
+        cond = self.exprs.expression()
         self.expect_end("END_REPEAT", "REPEAT", start)
-        return A.Repeat(body, cond, span=self.span_from(start))
+        return A.Repeat(body, cond, span=cur.span_from(start))
 
     # grammar: EXIT ';' | CONTINUE ';' | RETURN ';'
     def simple_statement(self) -> A.Stmt:
-        t = self.advance()
-        node = {"EXIT": A.Exit, "CONTINUE": A.Continue, "RETURN": A.Return}[t.up](span=self.tok_span(t))
+        cur = self.cur
+        t = cur.advance()
+        node = {"EXIT": A.Exit, "CONTINUE": A.Continue, "RETURN": A.Return}[t.up](span=cur.tok_span(t))
         self.end_statement()
         return node
 
