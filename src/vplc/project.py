@@ -9,6 +9,7 @@ from .checker import calls, recursion
 from .checker import portable as portable_rule
 from .checker.body import BodyChecker
 from .checker.declare import Declarer
+from .checker.exprs import ExprChecker
 from .checker.scope import Ambiguous, Tables
 from .frontend import ast as A
 from .frontend import codes
@@ -223,7 +224,7 @@ def check_units(ctx: Context, proj: Project) -> None:
         proj.configurations.append(cfg)
     # initial values of type declarations and globals
     for decl, shell, unit in ctx.type_decls:
-        ck = BodyChecker(ctx, None, unit)
+        ck = ExprChecker.for_unit(ctx, unit)
         if decl.init is not None:
             ck.initial_value(decl.init, shell, f"initial value of {decl.name}")
         if isinstance(shell, T.StructType):
@@ -231,18 +232,18 @@ def check_units(ctx: Context, proj: Project) -> None:
                 if f.init is not None:
                     ck.initial_value(f.init, f.type, f"initial value of {f.name}")
     for gl, unit in ctx.global_lists + ctx.configurations:
-        ck = BodyChecker(ctx, None, unit)
+        ck = ExprChecker.for_unit(ctx, unit)
         for section in gl.sections:
             for d in section.vars:
                 if d.init is not None and d.sym is not None:
                     ck.initial_value(d.init, d.sym.type, f"initial value of {d.name}")
     edges: dict = {}
     for pou, unit in ctx.pou_units:
-        ck = BodyChecker(ctx, pou, unit)
-        ck.check_pou()
+        body = BodyChecker.for_pou(ctx, pou, unit)
+        body.check_pou()
         pt = pou.sym
         edges.setdefault(pt, []).extend(
-            [(callee, span) for callee, span in ck.calls_made if callee.kind != "fb" or callee is pt])
+            [(callee, span) for callee, span in body.exprs.calls_made if callee.kind != "fb" or callee is pt])
         edges[pt].extend(recursion.instance_edges(pt, [d for s in pou.sections if s.kind in ("VAR", "VAR_STAT")
                                                        for d in s.vars]))
         if pou.kind == "PROGRAM" and not getattr(unit, "in_prelude", False):
@@ -259,7 +260,7 @@ def check_units(ctx: Context, proj: Project) -> None:
 
 
 def check_configuration(ctx: Context, cfg: A.Configuration, unit) -> None:
-    ck = BodyChecker(ctx, None, unit)
+    ck = ExprChecker.for_unit(ctx, unit)
     for res in cfg.resources:
         tasks = {}
         for task in res.tasks:

@@ -55,7 +55,7 @@ def check_write(ck, target: A.Expr, what: str = "assignment") -> None:
                         f"`{sym.name}` is a CONSTANT and cannot be written; remove CONSTANT from its "
                         "section or use another variable", target.span)
         return
-    if target is root and any(v is sym for v in ck.for_vars):
+    if target is root and any(v is sym for v in ck.flow.for_vars):
         ctx.diags.error(codes.WRITE_FOR_VARIABLE,
                         f"`{sym.name}` is the variable of an enclosing FOR loop and must not be written "
                         "inside the loop; use a WHILE loop or another variable", target.span)
@@ -70,7 +70,7 @@ def check_write(ck, target: A.Expr, what: str = "assignment") -> None:
                                 "itself writes its outputs", target.span)
                 return
             key = ck.text(target.base).upper()
-            if p is not None and p.direction == "in" and key in ck.called_instances:
+            if p is not None and p.direction == "in" and key in ck.flow.called_instances:
                 ctx.diags.warning(codes.WRITE_INPUT_AFTER_CALL,
                                   f"input `{target.member}` of `{ck.text(target.base)}` is written after "
                                   "the instance was called; the value takes effect only at the next call. Pass it "

@@ -5,31 +5,39 @@ from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from . import assign_target, calls, case_labels, duplicates, external_globals, function_result, unused
-from .exprs import ExprChecker
+from .exprs import ExprChecker, Flow
 from .symbols import VarSymbol
 
 
-class BodyChecker(ExprChecker):
-    def __init__(self, ctx, pou: A.Pou | None, unit, scope: dict | None = None) -> None:
+class BodyChecker:
+    """Checks one POU: its declarations' initial values, then its statements, handing every expression to
+    ``exprs`` (the POU's expression checker) and keeping ``flow`` (FOR variables, instances called) that
+    ``exprs`` reads when a call writes an argument. ``in_prelude``: the POU is the prelude's (no ST1901/ST1009)."""
+
+    def __init__(self, ctx, pou: A.Pou, exprs: ExprChecker, flow: Flow, in_prelude: bool = False) -> None:
         self.ctx = ctx
         self.pou = pou
-        self.pt = pou.sym if pou is not None else None
-        self.ns = unit.namespace if unit is not None else None
-        self.in_prelude = getattr(unit, "in_prelude", False)
-        self.scope = scope if scope is not None else {}
-        self.result_sym = None
-        self.implicit_globals: dict = {}
-        self.for_vars: list[VarSymbol] = []
+        self.exprs = exprs
+        self.flow = flow
+        self.in_prelude = in_prelude
         self.loop_depth = 0
-        self.calls_made: list = []
-        self.called_instances: set[str] = set()
-        if pou is not None and pou.kind == "FUNCTION":
-            self.result_sym = VarSymbol(pou.name, self.pt.ret or T.VOID, "RESULT", self.pt)
+
+    @classmethod
+    def for_pou(cls, ctx, pou: A.Pou, unit: A.CompilationUnit | None) -> BodyChecker:
+        """The checker of ``pou``, declared in ``unit``, with its expression checker."""
+        result_sym = None
+        if pou.kind == "FUNCTION":
+            result_sym = VarSymbol(pou.name, pou.sym.ret or T.VOID, "RESULT", pou.sym)
+        flow = Flow()
+        exprs = ExprChecker(ctx, unit.namespace if unit is not None else None, result_sym=result_sym, in_pou=True,
+                            flow=flow)
+        return cls(ctx, pou, exprs, flow, unit.in_prelude if unit is not None else False)
 
     # ---- declarations ---------------------------------------------------------------------------
     def check_pou(self) -> None:
         pou = self.pou
-        self.scope = duplicates.check_locals(self.ctx, pou)
+        exprs = self.exprs
+        exprs.scope = duplicates.check_locals(self.ctx, pou)
         for section in pou.sections:
             for decl in section.vars:
                 sym = decl.sym
@@ -54,15 +62,15 @@ class BodyChecker(ExprChecker):
                     self.ctx.diags.error(codes.WRITE_CONSTANT,
                                          f"CONSTANT `{decl.name}` needs an initial value", decl.name_span)
                 if decl.init is not None:
-                    self.initial_value(decl.init, sym.type, f"initial value of {decl.name}")
+                    exprs.initial_value(decl.init, sym.type, f"initial value of {decl.name}")
                 if section.kind == "VAR_IN_OUT" and decl.init is not None:
                     self.ctx.diags.error(codes.TYPE_MISMATCH,
                                          f"in-out parameter `{decl.name}` cannot have an initial value",
                                          decl.init.span)
         self.block(pou.body)
-        function_result.check(self, pou)
-        unused.check(self, pou)
-        external_globals.check(self, pou)
+        function_result.check(self.ctx, pou, exprs.result_sym)
+        unused.check(self.ctx, pou, self.in_prelude)
+        external_globals.check(self.ctx, pou, exprs.implicit_globals, self.in_prelude)
 
     # ---- statements -----------------------------------------------------------------------------
     def block(self, stmts: list[A.Stmt]) -> None:
@@ -73,31 +81,33 @@ class BodyChecker(ExprChecker):
         pass
 
     def s_Assign(self, s: A.Assign):
-        tt = self.expr(s.target)
-        vt = self.expr(s.value, tt)
-        assign_target.check_write(self, s.target)
-        self.coerce(s.value, vt, tt, f"assignment to `{self.text(s.target)}`")
+        exprs = self.exprs
+        tt = exprs.expr(s.target)
+        vt = exprs.expr(s.value, tt)
+        assign_target.check_write(exprs, s.target)
+        exprs.coerce(s.value, vt, tt, f"assignment to `{exprs.text(s.target)}`")
 
     def s_CallStmt(self, s: A.CallStmt):
-        calls.check_call(self, s.call, None, statement=True)
+        calls.check_call(self.exprs, s.call, None, statement=True)
         if s.call.binding is not None and s.call.binding.kind == "fb":
-            self.called_instances.add(self.text(s.call.callee).upper())
+            self.flow.called_instances.add(self.exprs.text(s.call.callee).upper())
 
     def condition(self, e: A.Expr, what: str) -> None:
-        t = self.expr(e, T.BOOL)
+        t = self.exprs.expr(e, T.BOOL)
         if not T.is_error(t) and T.base_of(t) is not T.BOOL:
             self.ctx.diags.error(codes.CONDITION_TYPE, f"the {what} condition must be BOOL, not {t.name}", e.span)
 
     def branches(self, bodies) -> None:
         """Check alternative statement lists: an FB called in one branch is not 'already called' in a sibling
         branch (ST1303), but may have been called after the whole construct."""
-        before = set(self.called_instances)
+        flow = self.flow
+        before = set(flow.called_instances)
         after = set(before)
         for body in bodies:
-            self.called_instances = set(before)
+            flow.called_instances = set(before)
             self.block(body)
-            after |= self.called_instances
-        self.called_instances = after
+            after |= flow.called_instances
+        flow.called_instances = after
 
     def s_If(self, s: A.If):
         for b in s.branches:
@@ -105,27 +115,28 @@ class BodyChecker(ExprChecker):
         self.branches([b.body for b in s.branches] + [s.else_body or []])
 
     def s_Case(self, s: A.Case):
-        st = self.expr(s.selector)
-        case_labels.check(self, s, st)
+        st = self.exprs.expr(s.selector)
+        case_labels.check(self.exprs, s, st)
         self.branches([b.body for b in s.branches] + [s.else_body or []])
 
     def s_For(self, s: A.For):
-        vt = self.expr(s.var)
+        exprs = self.exprs
+        vt = exprs.expr(s.var)
         sym = s.var.sym
         if not T.is_error(vt) and not T.is_int(vt):
             self.ctx.diags.error(codes.CONDITION_TYPE,
                                  f"the FOR variable must be an integer, not {vt.name}", s.var.span)
         elif isinstance(sym, VarSymbol):
-            assign_target.check_write(self, s.var)
+            assign_target.check_write(exprs, s.var)
         for e in (s.start, s.end, s.step):
             if e is not None:
-                et = self.expr(e, vt)
-                self.coerce(e, et, vt, "FOR bound")
-        self.for_vars.append(sym)
+                et = exprs.expr(e, vt)
+                exprs.coerce(e, et, vt, "FOR bound")
+        self.flow.for_vars.append(sym)
         self.loop_depth += 1
         self.block(s.body)
         self.loop_depth -= 1
-        self.for_vars.pop()
+        self.flow.for_vars.pop()
 
     def s_While(self, s: A.While):
         self.condition(s.cond, "WHILE")

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 from ..frontend import ast as A
 from ..frontend import builtins as B
@@ -29,8 +30,41 @@ def lit_string_type(value: str, wide: bool) -> T.StringType:
     return T.StringType(max(1, len(value)), wide, capacity=len(value), explicit=False)
 
 
+@dataclass
+class Flow:
+    """What the statements around an expression tell the rules that check a write (assign_target.py): the
+    variables of the enclosing FOR loops, which must not be written, and the function block instances already
+    called on this path (ST1303). The statement checker (body.py) keeps it; the expression checker reads it
+    when a call writes an output or in-out argument."""
+    for_vars: list[VarSymbol] = field(default_factory=list)
+    called_instances: set[str] = field(default_factory=set)
+
+
 class ExprChecker:
-    """Mixin of BodyChecker: needs ctx, scope, pt, ns, result_sym."""
+    """Types the expressions of one POU body, or of a unit's initial values and task properties.
+
+    ``ctx`` is the project being checked (symbol tables, diagnostics, dialect); ``ns`` the namespace of the
+    file, for name lookup; ``scope`` the POU's variables by upper-case name (empty outside a POU);
+    ``result_sym`` a FUNCTION's result variable; ``in_pou`` makes lookups record globals used without
+    VAR_EXTERNAL (``implicit_globals``, read by external_globals.py); ``flow`` is shared with the statement
+    checker. Calls bound here are collected in ``calls_made`` (recursion.py).
+    """
+
+    def __init__(self, ctx, ns: str | None, scope: dict[str, VarSymbol] | None = None,
+                 result_sym: VarSymbol | None = None, in_pou: bool = False, flow: Flow | None = None) -> None:
+        self.ctx = ctx
+        self.ns = ns
+        self.scope: dict[str, VarSymbol] = scope if scope is not None else {}
+        self.result_sym = result_sym
+        self.in_pou = in_pou
+        self.flow = flow if flow is not None else Flow()
+        self.implicit_globals: dict[str, VarSymbol] = {}
+        self.calls_made: list = []
+
+    @classmethod
+    def for_unit(cls, ctx, unit: A.CompilationUnit | None) -> ExprChecker:
+        """The checker of the expressions outside any POU in ``unit`` (initial values, task properties)."""
+        return cls(ctx, unit.namespace if unit is not None else None)
 
     # ---- names --------------------------------------------------------------------------------
     def lookup_var(self, name: str) -> VarSymbol | None:
@@ -43,7 +77,7 @@ class ExprChecker:
         if self.result_sym is not None and up == self.result_sym.name.upper():
             return self.result_sym
         g = self.ctx.tables.globals.get(up)
-        if g is not None and self.pou is not None:
+        if g is not None and self.in_pou:
             self.implicit_globals.setdefault(up, g)      # used without VAR_EXTERNAL (external_globals.py)
         return g
 

@@ -18,7 +18,9 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import ast as A
 from ..frontend import codes
+from .symbols import VarSymbol
 
 SHOWN = 8           # names listed in the message; the rest are counted
 
@@ -32,17 +34,17 @@ def _system_globals(ctx) -> frozenset:
     return names
 
 
-def check(ck, pou) -> None:
-    if ck.ctx.dialect != "sysmac" or ck.in_prelude or not ck.implicit_globals:
+def check(ctx, pou: A.Pou, implicit_globals: dict[str, VarSymbol], in_prelude: bool) -> None:
+    if ctx.dialect != "sysmac" or in_prelude or not implicit_globals:
         return
-    system = _system_globals(ck.ctx)
-    names = [g.name for up, g in ck.implicit_globals.items() if up not in system]
+    system = _system_globals(ctx)
+    names = [g.name for up, g in implicit_globals.items() if up not in system]
     if not names:
         return
     shown = ", ".join(f"`{n}`" for n in names[:SHOWN]) + (f" and {len(names) - SHOWN} more" if len(names) > SHOWN
                                                           else "")
-    ck.ctx.diags.warning(codes.SYSMAC_MISSING_EXTERNAL,
-                         f"{pou.name} uses the global variable{'s' if len(names) > 1 else ''} {shown} "
-                         "without VAR_EXTERNAL; Sysmac Studio refuses a global that the POU does not declare as an "
-                         "external variable", pou.name_span or pou.span,
-                         ["declare each in `VAR_EXTERNAL ... END_VAR` with the global's type"])
+    ctx.diags.warning(codes.SYSMAC_MISSING_EXTERNAL,
+                      f"{pou.name} uses the global variable{'s' if len(names) > 1 else ''} {shown} "
+                      "without VAR_EXTERNAL; Sysmac Studio refuses a global that the POU does not declare as an "
+                      "external variable", pou.name_span or pou.span,
+                      ["declare each in `VAR_EXTERNAL ... END_VAR` with the global's type"])

@@ -19,6 +19,7 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .symbols import VarSymbol
 
 
 def _assigns(stmts, result) -> bool | None:
@@ -41,10 +42,10 @@ def _assigns(stmts, result) -> bool | None:
     return False
 
 
-def check(ck, pou: A.Pou) -> None:
-    if pou.kind != "FUNCTION" or pou.native or ck.result_sym is None or ck.result_sym.type is T.VOID:
+def check(ctx, pou: A.Pou, result_sym: VarSymbol | None) -> None:
+    if pou.kind != "FUNCTION" or pou.native or result_sym is None or result_sym.type is T.VOID:
         return
-    if not _assigns(pou.body, ck.result_sym):
-        ck.ctx.diags.warning(codes.RESULT_NOT_ASSIGNED,
+    if not _assigns(pou.body, result_sym):
+        ctx.diags.warning(codes.RESULT_NOT_ASSIGNED,
                              f"FUNCTION {pou.name} does not assign its result `{pou.name}` on every path; "
                              "the result is then 0 / empty", pou.name_span or pou.span)

@@ -12,11 +12,12 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import ast as A
 from ..frontend import codes
 
 
-def check(ck, pou) -> None:
-    if pou.native or ck.in_prelude:
+def check(ctx, pou: A.Pou, in_prelude: bool) -> None:
+    if pou.native or in_prelude:
         return
     for section in pou.sections:
         if section.kind not in ("VAR", "VAR_TEMP", "VAR_STAT"):
@@ -24,5 +25,5 @@ def check(ck, pou) -> None:
         for decl in section.vars:
             sym = decl.sym
             if sym is not None and not sym.used:
-                ck.ctx.diags.warning(codes.UNUSED_VARIABLE,
-                                     f"`{decl.name}` is declared but never used; remove it", decl.name_span)
+                ctx.diags.warning(codes.UNUSED_VARIABLE,
+                                  f"`{decl.name}` is declared but never used; remove it", decl.name_span)
