@@ -92,7 +92,7 @@ def _namespace(container: ET.Element, ns: str | None, units: dict) -> None:
         elif item.tag in ("DataTypeDecl", "UserDefinedTypeDecl"):
             unit.types.append(_data_type(item))
         elif item.tag in POUS:
-            using = [u.text.strip() for u in item.iterfind("UsingDirective") if (u.text or "").strip()]
+            using = [(u.text or "").strip() for u in item.iterfind("UsingDirective") if (u.text or "").strip()]
             if len(using) > 1 or (using and ns is not None):
                 raise FormatError(item.get("name", ""), "UsingDirective " + ", ".join(using) + ": vplc resolves "
                                   "the names of a POU in one namespace only; qualify the names instead")
@@ -109,7 +109,7 @@ def _no_using(gns: ET.Element) -> None:
         for c in el:
             if c.tag == "UsingDirective" and (c.text or "").strip():
                 name = el.get("name")
-                raise FormatError(f"{el.tag}{' ' + name if name else ''}", f"UsingDirective {c.text.strip()} "
+                raise FormatError(f"{el.tag}{' ' + name if name else ''}", f"UsingDirective {(c.text or '').strip()} "
                                   "is read on a POU only; vplc does not model it here: qualify the names instead")
 
 
@@ -214,6 +214,8 @@ def _data_type(dt: ET.Element) -> TypeText:
             raise FormatError(where, f'StructTypeSpecAdditionalProperties offsetType="{offset}": the schema allows '
                               "NJ, CJ and User")
     _add_data(dt, where)
+    if spec is None:
+        raise FormatError(where, "data type specification `?` is not supported")
     if kind == "StructTypeSpec":
         # overlap="true": Sysmac's union, the members sharing one memory image (W501 6-3-6)
         word = "UNION" if spec.get("overlap", "false") in ("true", "1") else "STRUCT"
@@ -262,7 +264,7 @@ def _pou(el: ET.Element) -> PouText:
     rt = el.find("ResultType")
     if rt is not None:
         out.return_type = type_text(rt, f"{name}:result")
-    params = []
+    params: list[tuple[int, str, ET.Element, ET.Element, bool]] = []
     for holder in [*el.iterfind("Parameters"), *el.iterfind("ParameterSet")]:
         for lst in holder:
             if lst.tag not in PARAMS:

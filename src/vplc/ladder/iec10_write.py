@@ -98,7 +98,7 @@ def resolve_pins(rung: Rung) -> None:
 
 def _out_pins(e: Element) -> list[str | None]:
     if e.kind == "block":
-        return [p.name for p in e.inouts] + [p.name for p in e.outputs]
+        return [*(p.name for p in e.inouts), *(p.name for p in e.outputs)]
     if e.kind in ("left_rail", "contact", "coil", "in_var", "inout_var", "inline_st"):
         return [None]
     return []
@@ -127,7 +127,7 @@ def _element(r: ET.Element, e: Element, ids, end_label: str | None) -> None:
     elif e.kind == "jump":
         attrs["targetNetworkLabel"] = e.var
     elif e.kind == "return":
-        attrs["targetNetworkLabel"] = end_label
+        attrs["targetNetworkLabel"] = end_label or ""           # a RETURN always has the end label
     elif e.kind == "block":
         attrs["typeName"] = e.type_name
         if e.instance:

@@ -132,10 +132,10 @@ def layout_rung(rung: Rung, number: int) -> RungLayout:
         first = next(((pin, c) for pin in [*e.inouts, *e.inputs] for c in pin.conns if c.ref in lay.placed), None)
         if first is not None:                          # line up with the wire that feeds the first connected pin
             pin, c = first
-            src = lay.placed[c.ref]
-            outs = pin_rows(src.element)[1] if src.element.kind == "block" else []
+            feeder = lay.placed[c.ref]
+            outs = pin_rows(feeder.element)[1] if feeder.element.kind == "block" else []
             offset = outs.index(c.pin) if c.pin in outs else 0
-            want = max(0, src.row + offset - (names.index(pin.name) if pin.name in names else 0))
+            want = max(0, feeder.row + offset - (names.index(pin.name) if pin.name in names else 0))
         row = max(want, desired.get(e.id, 0))
         while any((col[e.id], r) in taken for r in range(row, row + rows)):
             row += 1

@@ -57,7 +57,7 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
     try:
         out = []
         warnings: list = []
-        units = reader(root, warnings) if reader is iec10_read.read else reader(root)
+        units = iec10_read.read(root, warnings) if reader is iec10_read.read else reader(root)
         rules: dict[str, list[str]] = {}
         for where, message in warnings:                  # spellings of earlier vplc exports, read as meant
             rules.setdefault(message, []).append(where)
@@ -69,9 +69,9 @@ def read_xml(path: str, diags) -> list[tuple[LadderSource, str | None]]:
                           "schema: export the file again", Span(place, 0, 1))
         for unit in units:
             src = unit_source(path, unit)
-            for exc in src.errors:                           # rungs that could not be translated, all of them
-                place = LadderSource(path, "", [(0, 1, exc.where)])
-                diags.error(exc.code, exc.message, Span(place, 0, 1))
+            for bad in src.errors:                           # rungs that could not be translated, all of them
+                place = LadderSource(path, "", [(0, 1, bad.where)])
+                diags.error(bad.code, bad.message, Span(place, 0, 1))
             out.append((src, unit.namespace))
         return out
     except FormatError as exc:
@@ -102,10 +102,10 @@ def attach_ladders(unit: A.CompilationUnit) -> None:
     layouts = getattr(src, "layouts", None) or {}
     for item in unit.items:
         if isinstance(item, A.Pou) and item.name.upper() in ladders:
-            item.ladder = ladders[item.name.upper()]
+            item.ladder = ladders[item.name.upper()]  # type: ignore[attr-defined]  # rides on the node, read by getattr
         elif isinstance(item, A.TypeBlock) and layouts:
             for decl in item.decls:             # Sysmac's member layout (CJ, User), written back by the export
-                decl.offset_type = layouts.get(decl.name.upper())
+                decl.offset_type = layouts.get(decl.name.upper())  # type: ignore[attr-defined]  # read by the export
 
 
 def _raw_text(path: str) -> str:

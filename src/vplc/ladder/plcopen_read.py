@@ -82,6 +82,8 @@ def type_text(t: ET.Element | None, where: str) -> str:
         return f"STRUCT\n{fields}END_STRUCT"
     if tag in ("subrangeSigned", "subrangeUnsigned"):
         r = c.find("range")
+        if r is None:
+            raise FormatError(where, f"<{tag}> without <range>")
         return f"{type_text(c.find('baseType'), where)}({r.get('lower')}..{r.get('upper')})"
     if tag == "pointer":
         raise FormatError(where, "POINTER types are not supported; pass the variable as an in-out instead")
@@ -288,7 +290,8 @@ def group_rungs(elements: list[Element], comments: list[tuple[float, str]]) -> l
         for m in members:
             used |= rail_of_ref.get(m.id, set())
             used |= {c.ref for pin in [*m.inputs, *m.inouts] for c in pin.conns if c.ref in rails}
-        rung_elements = [by_id[r] for r in sorted(used, key=order.get)] + sorted(members, key=lambda m: order[m.id])
+        rung_elements = [by_id[r] for r in sorted(used, key=lambda r: order[r])] + \
+            sorted(members, key=lambda m: order[m.id])
         rungs.append(Rung(rung_elements, label=pending_label))
         pending_label = ""
     if pending_label:

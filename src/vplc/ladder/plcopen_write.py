@@ -57,7 +57,7 @@ def ld_body(body: ET.Element, ladder: LadderBody) -> None:
             ids[e.id] = new_id()
         height = lay.height + 20
 
-        def where(e: Element) -> tuple[float, float]:
+        def where(e: Element, lay=lay, top: float = top, rung=rung) -> tuple[float, float]:
             p = lay.placed.get(e.id)
             if p is not None:
                 return p.x, top + p.y
@@ -75,7 +75,6 @@ def ld_body(body: ET.Element, ladder: LadderBody) -> None:
         for e in rung.elements:
             _element(ld, e, ids, where(e), height, lay.width)
         top += height + RUNG_GAP
-    return ld
 
 
 def _conns(parent: ET.Element, conns, ids) -> None:

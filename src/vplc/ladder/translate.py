@@ -89,7 +89,9 @@ class Txt:
 
 def _joined(parts: list[Txt], sep: str, prec: int) -> Txt:
     """``parts`` joined by ``sep`` in one pass (adding them one by one would copy the text once per part)."""
-    texts, marks, n = [], [], 0
+    texts: list[str] = []
+    marks: list[tuple[int, int, str]] = []
+    n = 0
     for i, t in enumerate(parts):
         if i:
             texts.append(sep)
@@ -226,7 +228,7 @@ class RungCompiler:
 
     # ---- the body ---------------------------------------------------------------------------
     def body(self, ladder: LadderBody) -> None:
-        labels = {}
+        labels: dict[str, int] = {}
         for n, rung in enumerate(ladder.rungs):
             if rung.label:
                 if rung.label.upper() in labels:
@@ -250,7 +252,7 @@ class RungCompiler:
                         self.jump_flags[id(el)] = self.new("J")
         for flag in self.jump_flags.values():
             self.emit(f"{flag} := FALSE;\n")
-        flags_by_rung = {}
+        flags_by_rung: dict[int, list[str]] = {}
         for n, rung in enumerate(ladder.rungs):
             for el in rung.elements:
                 if id(el) in self.jump_flags:
@@ -394,9 +396,9 @@ class RungCompiler:
                          codes.LADDER_MISSING_CONNECTION)
         return value
 
-    def power(self, e: Element, pin: Pin) -> Txt:
-        if not pin.conns:
-            raise _error(self.label(e), "nothing is connected to its input" if pin.name == "" else
+    def power(self, e: Element, pin: Pin | None) -> Txt:
+        if pin is None or not pin.conns:
+            raise _error(self.label(e), "nothing is connected to its input" if pin is None or pin.name == "" else
                          f"input `{pin.name}` is not connected", codes.LADDER_MISSING_CONNECTION)
         terms = [self.source(e, c) for c in pin.conns]
         if any(t.text == TRUE for t in terms):
@@ -485,7 +487,8 @@ class RungCompiler:
         value = self.power(e, e.power_in)
         var = Txt(e.var).marked(lab)
         line = var + " := " + (("NOT " + value.at_least(3)) if e.negated else value) + ";"
-        guards = {self.guard[c.ref].text: self.guard[c.ref] for c in e.power_in.conns if c.ref in self.guard}
+        conns = e.power_in.conns if e.power_in is not None else []
+        guards = {self.guard[c.ref].text: self.guard[c.ref] for c in conns if c.ref in self.guard}
         if guards:
             line = "IF " + " OR ".join(guards) + " THEN " + line + " END_IF;"
         self.stmt(line, lab)
@@ -607,7 +610,7 @@ class RungCompiler:
                 call = (self.comparison(e, values, lab) if e.type_name.upper() in COMPARE
                         else (e.type_name + "(" + call_args + ")").marked(lab))
                 self.out[(e.id, result.name)] = ("NOT " + call) if result.negated else call
-                if guarded:
+                if guarded and en is not None:
                     self.guard[e.id] = en
             return
         carriers = {p.name: self._carrier(e, p, p is result, lab) for p in wired}

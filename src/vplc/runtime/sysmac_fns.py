@@ -22,6 +22,8 @@ def _value_bytes(v, t) -> bytes:
         b = T.base_of(b.base)
     if isinstance(b, T.StringType):
         return v.encode("latin-1", "replace")
+    if not isinstance(b, T.ElementaryType):
+        raise RuntimeFaultError(f"the memory image of a {b} is not modelled by vplc")
     if b.kind == "real":
         return struct.pack("<f" if b.bits == 32 else "<d", v)
     if b.kind == "bool":

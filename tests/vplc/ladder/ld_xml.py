@@ -45,7 +45,8 @@ def coil(lid, var, *refs, y=0, **attrs):
 
 
 def invar(lid, expr, y=0):
-    return f'<inVariable localId="{lid}">{_pos(y)}<connectionPointOut/><expression>{escape(expr)}</expression></inVariable>'
+    return (f'<inVariable localId="{lid}">{_pos(y)}<connectionPointOut/><expression>{escape(expr)}</expression>'
+            '</inVariable>')
 
 
 def outvar(lid, expr, *refs, y=0):

@@ -59,7 +59,8 @@ def test_wrong_pin_type_contact_on_an_integer(tmp_path):
     d = one(program(tmp_path, V, [rail(1), contact(2, "N", 1), coil(3, "Q", 2)]))
     assert d.code == "ST2105"
     assert d.render().splitlines()[0].endswith(
-        "main.xml:Main:rung 1:contact N: error[ST2105]: the contact's operand `N` is INT; a contact needs a BOOL variable")
+        "main.xml:Main:rung 1:contact N: error[ST2105]: the contact's operand `N` is INT; "
+        "a contact needs a BOOL variable")
 
 
 def test_wrong_pin_type_integer_output_into_a_coil_is_a_type_mismatch(tmp_path):
@@ -214,9 +215,12 @@ def test_damaged_files_give_diagnostics_never_a_traceback(tmp_path):
 
     mutations = [
         lambda s: re.sub(r'refLocalId="\d+"', maybe(0.2, lambda m: f'refLocalId="{rnd.randint(0, 60)}"'), s),
-        lambda s: re.sub(r'formalParameter="\w*"', maybe(0.2, lambda m: f'formalParameter="{rnd.choice(["EN", "ENO", "Q", "X"])}"'), s),
-        lambda s: re.sub(r'(edge|storage)="\w+"', maybe(0.3, lambda m: f'{m.group(1)}="{rnd.choice(["none", "set", "odd"])}"'), s),
-        lambda s: re.sub(r"<variable>\w+</variable>", maybe(0.2, lambda m: f"<variable>{rnd.choice(['N', 'T', '1', 'A.B'])}</variable>"), s),
+        lambda s: re.sub(r'formalParameter="\w*"',
+                         maybe(0.2, lambda m: f'formalParameter="{rnd.choice(["EN", "ENO", "Q", "X"])}"'), s),
+        lambda s: re.sub(r'(edge|storage)="\w+"',
+                         maybe(0.3, lambda m: f'{m.group(1)}="{rnd.choice(["none", "set", "odd"])}"'), s),
+        lambda s: re.sub(r"<variable>\w+</variable>",
+                         maybe(0.2, lambda m: f"<variable>{rnd.choice(['N', 'T', '1', 'A.B'])}</variable>"), s),
         lambda s: "\n".join(line for line in s.split("\n") if rnd.random() > 0.05),
     ]
     path = tmp_path / "m.xml"

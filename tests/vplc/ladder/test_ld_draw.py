@@ -48,7 +48,8 @@ def test_the_example_is_drawn_one_rung_per_command(tmp_path, capsys):
 def test_contact_and_coil_variants_are_marked(tmp_path, capsys):
     src = program(tmp_path, {"A": "BOOL", "B": "BOOL", "Q": "BOOL", "R": "BOOL"},
                   [comment(9, "variants", y=-10), rail(1), contact(2, "A", 1, edge="rising"),
-                   contact(3, "B", 2, negated="true"), coil(4, "Q", 3, storage="set"), coil(5, "R", 3, y=40, negated="true"),
+                   contact(3, "B", 2, negated="true"), coil(4, "Q", 3, storage="set"),
+                   coil(5, "R", 3, y=40, negated="true"),
                    right(6, 4, 5)])
     out = tmp_path / "v.svg"
     assert draw(capsys, src, "--pou", "Main", "-o", out)[0] == 0

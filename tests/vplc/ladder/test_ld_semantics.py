@@ -20,7 +20,8 @@ def test_series_contacts_and_normally_closed_contact_drive_a_coil(tmp_path):
 def test_parallel_branches_are_a_wired_or(tmp_path):
     # A -+- Q ; B (parallel with A) ; C in series after the join
     r = Run.of(tmp_path, {"A": "BOOL", "B": "BOOL", "C": "BOOL", "Q": "BOOL"},
-               [rail(1), contact(2, "A", 1), contact(3, "B", 1, y=20), contact(4, "C", 2, 3), coil(5, "Q", 4), right(6, 5)])
+               [rail(1), contact(2, "A", 1), contact(3, "B", 1, y=20), contact(4, "C", 2, 3), coil(5, "Q", 4),
+                right(6, 5)])
     assert r.scan(A=False, B=True, C=True)["Q"] is True
     assert r.scan(A=True, B=False, C=True)["Q"] is True
     assert r.scan(A=True, B=True, C=False)["Q"] is False
@@ -39,7 +40,8 @@ def test_a_branch_point_feeding_two_coils_is_evaluated_once_before_either_coil(t
 def test_negated_set_and_reset_coils(tmp_path):
     r = Run.of(tmp_path, {"S": "BOOL", "R": "BOOL", "Latch": "BOOL", "N": "BOOL"},
                [rail(1), contact(2, "S", 1), coil(3, "Latch", 2, storage="set"), right(4, 3),
-                contact(5, "R", 1, y=40), coil(6, "Latch", 5, y=40, storage="reset"), coil(7, "N", 5, y=60, negated="true")])
+                contact(5, "R", 1, y=40), coil(6, "Latch", 5, y=40, storage="reset"),
+                coil(7, "N", 5, y=60, negated="true")])
     assert r.scan(S=True)["Latch"] is True
     assert r.scan(S=False)["Latch"] is True, "a set coil holds without power"
     assert r["N"] is True
@@ -66,14 +68,16 @@ def test_edge_contact_memory_follows_the_variable_even_without_power(tmp_path):
 
 
 def test_rising_edge_coil_is_on_for_one_scan(tmp_path):
-    r = Run.of(tmp_path, {"A": "BOOL", "P": "BOOL"}, [rail(1), contact(2, "A", 1), coil(3, "P", 2, edge="rising"), right(4, 3)])
+    r = Run.of(tmp_path, {"A": "BOOL", "P": "BOOL"},
+               [rail(1), contact(2, "A", 1), coil(3, "P", 2, edge="rising"), right(4, 3)])
     assert [r.scan(A=a)["P"] for a in (False, True, True, False, True)] == [False, True, False, False, True]
 
 
 def test_function_block_with_en_off_is_not_called_and_keeps_its_outputs(tmp_path):
     body = [rail(1), contact(2, "Run", 1), contact(3, "Start", 1, y=20),
             block(4, "TON", {"EN": 2, "IN": 3, "PT": 5}, ["ENO", "Q", "ET"], instance="T", y=0),
-            invar(5, "T#3ms", y=40), coil(6, "Eno", (4, "ENO")), coil(7, "Q", (4, "Q"), y=20), outvar(8, "Et", (4, "ET"), y=40),
+            invar(5, "T#3ms", y=40), coil(6, "Eno", (4, "ENO")), coil(7, "Q", (4, "Q"), y=20),
+            outvar(8, "Et", (4, "ET"), y=40),
             right(9, 6, 7)]
     r = Run.of(tmp_path, {"Run": "BOOL", "Start": "BOOL", "Eno": "BOOL", "Q": "BOOL", "Et": "TIME", "T": "TON"}, body)
     r.scan(Run=True, Start=True)

@@ -63,8 +63,8 @@ def _errors(tmp_path, text):
 
 
 def test_addresses_vplc_cannot_place_are_st1110(tmp_path):
-    errors = _errors(tmp_path, "VAR_GLOBAL\n    A AT %W480 : BOOL;\n    B AT %W1.00 : INT;\n    C AT %D10 : STRING[8];\n"
-                               "    D AT %W511 : DINT;\n    E AT %A100 : WORD;\nEND_VAR\n")
+    errors = _errors(tmp_path, "VAR_GLOBAL\n    A AT %W480 : BOOL;\n    B AT %W1.00 : INT;\n"
+                               "    C AT %D10 : STRING[8];\n    D AT %W511 : DINT;\n    E AT %A100 : WORD;\nEND_VAR\n")
     assert [c for c, _ in errors] == ["ST1110"] * 5
     assert "bit" in errors[0][1] and "512 words" in errors[3][1] and "Auxiliary" in errors[4][1]
 

@@ -97,7 +97,7 @@ def test_receive_with_timeout_zero_waits_through_the_motion_for_the_queue_tag_w5
     data = ("M1," + SCRIPT).encode()
     body = b"TMSCT,%d,%s," % (len(data), data)
     raw = [e["raw"] for e in c.robot.events if e["kind"] == "frame_in"]
-    assert raw == ["$%s*%02X\r\n" % (body.decode(), reduce(lambda a, b: a ^ b, body))]
+    assert raw == [f"${body.decode()}*{reduce(lambda a, b: a ^ b, body):02X}\r\n"]
     # the motion completed where the program asked, then the program closed its socket
     ends = [e for e in c.robot.events if e["kind"] == "motion_end"]
     assert len(ends) == 1 and ends[0]["joints"] == (90.0, -30.0, 110.0, 10.0, 90.0, 45.0)
