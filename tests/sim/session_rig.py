@@ -26,9 +26,9 @@ class S:
         return self.out(conn)
 
     def out(self, conn=1):
-        frames = self.s.clients[conn].outbox[:]
+        queued = self.s.clients[conn].outbox[:]          # (frame, header, data) each; no frame_out event here
         self.s.clients[conn].outbox.clear()
-        return [f.decode("utf-8", "backslashreplace") for f in frames]
+        return [frame.decode("utf-8", "backslashreplace") for frame, _header, _data in queued]
 
     def advance(self, seconds, dt=0.01):
         end = self.t + seconds

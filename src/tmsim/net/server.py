@@ -48,7 +48,6 @@ from tmsim.protocol.listen_session import ListenSession
 from tmsim.protocol.svr_session import SvrSession
 from tmsim.robot.camera import Camera, camera_of
 from tmsim.robot.eventlog import EventLog, LogFile
-from tmsim.robot.eventlog import text as _text
 from tmsim.robot.faults import FaultState
 from tmsim.robot.faults import check_params as check_fault_params
 from tmsim.robot.model import RobotModel
@@ -568,14 +567,7 @@ class SimServer:
             conn_id = conn.id
             if not session.is_connected(conn_id):
                 continue
-            frames = session.data_to_send(conn_id)
-            if frames:
-                for frame in frames:
-                    header, _, rest = frame[1:].partition(b",")
-                    robot.log.event("frame_out", conn=conn_id, raw=_text(frame), header=_header_text(header),
-                               data=_text(rest.partition(b",")[2][:-6]))
-            else:
-                frames = ()
+            frames = session.data_to_send(conn_id)          # the session logs them (event frame_out)
             if faulty:
                 robot.faults.queue(conn_id, frames, now)
                 chunks, close = robot.faults.take(conn_id, now)
@@ -648,10 +640,3 @@ def _send(sock, data) -> int:
     except (BlockingIOError, InterruptedError):
         return 0
 
-
-_HEADERS = {b"TMSCT": "TMSCT", b"TMSTA": "TMSTA", b"CPERR": "CPERR"}
-
-
-def _header_text(raw: bytes) -> str:
-    """The header as text; the three known headers share one string each (the event log keeps many)."""
-    return _HEADERS.get(raw) or _text(raw)

@@ -63,6 +63,14 @@ _PRIORITY = re.compile(r"^\s*(ScriptExit|StopAndClearBuffer)\s*\(\s*(\d)\s*\)\s*
 _PRIORITY_ARGS = {"ScriptExit": (0, 1), "StopAndClearBuffer": (0, 1, 2)}
 
 
+# a frame queued for a client: (the frame's bytes, its header, its data as given to the codec)
+Outgoing = tuple[bytes, str, bytes | str]
+
+
+def _outgoing(header: str, data: bytes | str) -> Outgoing:
+    return codec.encode(header, data), header, data
+
+
 @dataclass
 class Packet:
     conn: int
@@ -85,7 +93,7 @@ class Client:
     cperr_tokens: float = float(CPERR_BURST)        # CPERR answers to bad packets still allowed (a bucket)
     suppressed: int = 0                 # bad packets not answered since the last ``cperr_suppressed`` event
     frames_in: int = 0                  # well-formed frames received
-    outbox: list = field(default_factory=list)
+    outbox: list[Outgoing] = field(default_factory=list)    # frames not handed out yet (``data_to_send``)
     rbuf: bytearray = field(default_factory=bytearray)      # bytes received and not processed yet
 
 
@@ -135,7 +143,7 @@ class ListenSession:
         self.variables, self.types = {}, {}
         self.entered_at = self.last_packet = self.now
         self.exit_path = None
-        self.push(codec.encode("TMSCT", "0," + self.send_message))
+        self.push("TMSCT", "0," + self.send_message)
 
     def _on_stop_project(self, **_):
         self.robot.stop_and_clear()
@@ -181,17 +189,22 @@ class ListenSession:
                 self.log("cperr_suppressed", conn=conn, count=client.suppressed)
             self.log("disconnect", conn=conn)
 
-    def send(self, conn, frame: bytes):
+    def send(self, conn: int, header: str, data: bytes | str) -> None:
+        """Queue the frame ``header``/``data`` for connection ``conn`` (unknown connection: nothing)."""
         client = self.clients.get(conn)
         if client is not None:
-            client.outbox.append(frame)
+            client.outbox.append(_outgoing(header, data))
 
-    def push(self, frame: bytes, ip_filter=None) -> int:
-        """Queue ``frame`` for every client (of address ``ip_filter``); returns how many get it."""
+    def push(self, header: str, data: bytes | str, ip_filter: str | None = None) -> int:
+        """Queue the frame ``header``/``data`` for every client (of address ``ip_filter``); returns how many get
+        it."""
+        return self._push(_outgoing(header, data), ip_filter)
+
+    def _push(self, out: Outgoing, ip_filter: str | None) -> int:
         count = 0
         for client in self.clients.values():
             if ip_filter is None or client.peer == ip_filter:
-                client.outbox.append(frame)
+                client.outbox.append(out)
                 count += 1
         return count
 
@@ -204,13 +217,13 @@ class ListenSession:
             self.log("garbage", conn=conn, bytes=len(item.raw))
         elif isinstance(item, codec.BadFrame):
             self.log("bad_frame", conn=conn, code=item.code, reason=item.reason)
-            self.send(conn, codec.encode("CPERR", item.code))
+            self.send(conn, "CPERR", item.code)
         elif item.header == "TMSTA":
             self._tmsta(conn, item.data)
         elif item.header == "TMSCT":
             self._tmsct(conn, item.data)
         else:
-            self.send(conn, codec.encode("CPERR", codec.CPERR_HEADER))
+            self.send(conn, "CPERR", codec.CPERR_HEADER)
 
     def _tmsta(self, conn, data: bytes):
         text = data.decode("utf-8", "replace")
@@ -224,9 +237,9 @@ class ListenSession:
                 tag = None
             reply = f"01,{param},{self.robot.tag_status(tag) if tag is not None else 'none'}"
         else:
-            self.send(conn, codec.encode("CPERR", codec.CPERR_DATA))
+            self.send(conn, "CPERR", codec.CPERR_DATA)
             return
-        self.send(conn, codec.encode("TMSTA", reply))
+        self.send(conn, "TMSTA", reply)
 
     def _tmsct(self, conn, data: bytes):
         ident, comma, body = data.partition(b",")
@@ -235,7 +248,7 @@ class ListenSession:
         except UnicodeDecodeError:
             ident_text, script = "", ""
         if not comma or not ident_text or not ident_text.isalnum():
-            self.send(conn, codec.encode("CPERR", codec.CPERR_DATA))
+            self.send(conn, "CPERR", codec.CPERR_DATA)
             return
         packet = Packet(conn, ident_text, script)
         if self.state not in (IN_NODE, EXITING):
@@ -250,7 +263,7 @@ class ListenSession:
 
     def _not_in_node(self, packet):
         self.log("rejected", conn=packet.conn, id=packet.id, reason="not in the Listen node")
-        self.send(packet.conn, codec.encode("CPERR", codec.CPERR_NOT_IN_NODE))
+        self.send(packet.conn, "CPERR", codec.CPERR_NOT_IN_NODE)
 
     # ---- priority commands --------------------------------------------------------------------
     def _priority(self, packet, name, arg):
@@ -279,7 +292,7 @@ class ListenSession:
 
     # ---- script execution ---------------------------------------------------------------------
     def _reply(self, packet, status):
-        self.send(packet.conn, codec.encode("TMSCT", f"{packet.id},{status}"))
+        self.send(packet.conn, "TMSCT", f"{packet.id},{status}")
 
     def _pump(self):
         """Resume the running script if it may continue, then run buffered scripts in order until
@@ -391,9 +404,9 @@ class ListenSession:
             self._step(result)
 
     def _listen_send(self, ip_filter, sub, payload):
-        frame = codec.encode("TMSTA", f"{sub},".encode() + payload)
-        recipients = self.push(frame, ip_filter)
-        self.meter.add(len(frame) * recipients // WORK_LOG_BYTES)     # sending it and its event, per client
+        out = _outgoing("TMSTA", f"{sub},".encode() + payload)
+        recipients = self._push(out, ip_filter)
+        self.meter.add(len(out[0]) * recipients // WORK_LOG_BYTES)     # sending it and its event, per client
 
     # ---- time ---------------------------------------------------------------------------------
     def advance(self, now: float):
@@ -407,7 +420,7 @@ class ListenSession:
             kind = event.pop("kind")
             self.log(kind, **event)
             if kind == "tag_reached":
-                self.push(codec.encode("TMSTA", f"01,{event['tag']:02d},true"))
+                self.push("TMSTA", f"01,{event['tag']:02d},true")
         if self.robot.fault:
             reason, self.robot.fault = self.robot.fault, None
             self.fire("robot_fault", reason=reason)
@@ -516,12 +529,17 @@ class ListenSession:
 
     def data_to_send(self, conn: int) -> list[bytes]:
         """The frames for connection ``conn`` produced so far (one bytes object per frame, so each can go out
-        in one send); the session forgets them."""
+        in one send); the session forgets them and logs each as event ``frame_out`` (its header and data as it
+        built them: nobody parses the frames it sends)."""
         client = self.clients.get(conn)
         if client is None or not client.outbox:
             return []
-        frames, client.outbox = client.outbox, []
-        return frames
+        queued, client.outbox = client.outbox, []
+        log = self.log
+        for frame, header, data in queued:
+            log("frame_out", conn=conn, raw=_text(frame), header=header,
+                data=data if type(data) is str else _text(data))
+        return [out[0] for out in queued]
 
     def has_work_for(self, conn: int) -> bool:
         """True while a script of ``conn`` runs or waits (its replies are still to come)."""
