@@ -220,10 +220,10 @@ def main(argv=None) -> int:
     if server.control is not None:
         print(f"control channel: {args.control_host}:{server.control.port} "
               f"(JSON lines; {robot_numbering(len(server.robots))})", flush=True)
-    slave = server.robots[0].slave
-    if slave is not None:
+    first_slave = server.robots[0].slave
+    if first_slave is not None:
         print(f"Ethernet Slave data table: every {args.svr_period:g} s, {args.svr_format}, "
-              f"{len(slave.session.config()['items'])} items", flush=True)
+              f"{len(first_slave.session.config()['items'])} items", flush=True)
     if args.speedup != 1.0:
         print(f"robot clock runs {args.speedup:g} x faster than real time", flush=True)
     print("Press Ctrl-C to stop.", flush=True)

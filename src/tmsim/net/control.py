@@ -175,7 +175,7 @@ class ControlChannel:
             return
         while not client.closing:
             line, used = next_line(client.rbuf)
-            if not used:
+            if line is None:                    # no complete line yet (used == 0)
                 if len(client.rbuf) > CONTROL_LINE_MAX:
                     client.closing = True
                     self.server.log_server("control_closed", reason="request line too long")

@@ -135,10 +135,10 @@ def decode(buf: bytes | bytearray, headers=HEADERS) -> tuple[Frame | Garbage | B
 
 def decode_all(buf: bytearray, headers=HEADERS) -> list[Frame | Garbage | BadFrame]:
     """Decode every complete item at the front of ``buf`` and remove it from the buffer."""
-    items = []
+    items: list[Frame | Garbage | BadFrame] = []
     while buf:
         item, used = decode(buf, headers)
-        if not used:
+        if item is None or not used:        # (decode gives an item exactly when it consumed bytes)
             break
         del buf[:used]
         items.append(item)

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import re
 from collections import deque
+from collections.abc import Generator
 from dataclasses import dataclass, field
+from typing import Any
 
 from tmsim.limits import (
     CPERR_BURST,
@@ -81,7 +83,7 @@ class Packet:
 @dataclass
 class Running:
     packet: Packet
-    gen: object
+    gen: Generator[Any, Any, tuple[str, bool]]     # the script checked, then run (``_script``)
     wait: tuple | None = None          # ("tag", tag, deadline or None), ("delay", None, deadline) or
                                        # ("room" | "idle" | "turn", None, None): see _resume_waits
 
@@ -111,19 +113,20 @@ class ListenSession:
         self.send_message = send_message
         self.log = log or (lambda kind, **fields: None)
         self.state = STOPPED
-        self.exit_path = None
+        self.exit_path: str | None = None
         self.now = 0.0
         self.clients: dict[int, Client] = {}
         self.pending: deque[Packet] = deque()
         self.running: Running | None = None
-        self.variables, self.types = {}, {}
+        self.variables: dict[str, Any] = {}          # the node's variables, while it stays in the node
+        self.types: dict[str, Any] = {}              # ... and their declared types
         self.faults = {"reply_error": 0}
         # node parameters (seconds; None or <= 0 = none): no packet / no client while in the node -> Fail exit
         self.data_timeout = data_timeout if data_timeout and data_timeout > 0 else None
         self.connection_timeout = connection_timeout if connection_timeout and connection_timeout > 0 else None
         self.last_packet = 0.0
         self.entered_at = 0.0
-        self.last_error = None                          # text of the last robot error (failed motion)
+        self.last_error: str | None = None              # text of the last robot error (failed motion)
         self.fire("start_project")
         if auto_enter:
             self.fire("enter_node")
@@ -354,6 +357,8 @@ class ListenSession:
 
     def _step(self, value):
         run = self.running
+        if run is None:                     # (called only while a script runs)
+            return
         try:
             request = run.gen.send(value)
         except StopIteration as stop:
@@ -538,7 +543,7 @@ class ListenSession:
         log = self.log
         for frame, header, data in queued:
             log("frame_out", conn=conn, raw=_text(frame), header=header,
-                data=data if type(data) is str else _text(data))
+                data=data if isinstance(data, str) else _text(data))
         return [out[0] for out in queued]
 
     def has_work_for(self, conn: int) -> bool:

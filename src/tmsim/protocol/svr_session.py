@@ -71,6 +71,9 @@ class SvrSession:
         self.clients: dict[int, Client] = {}
         self.now = 0.0
         self.write_permission = write_permission   # §17.1 IP filter "Write Permission" of the clients
+        self.stream_items: list[str] = []           # the streamed data table, set by configure
+        self.stream_mode = 1
+        self.period = 0.0
         self.configure(stream_items, stream_mode, period)
         self.next_stream = 0.0
         self.stream_id = 0
@@ -241,13 +244,13 @@ class SvrSession:
         self._out(conn, codec.encode("CPERR", code))
 
     def _tmsvr(self, conn, data: bytes):
-        ident, comma1, rest = data.partition(b",")
+        raw_ident, comma1, rest = data.partition(b",")
         mode_field, comma2, content = rest.partition(b",")
-        if not comma1 or not ident.isalnum() or not ident.isascii():
+        if not comma1 or not raw_ident.isalnum() or not raw_ident.isascii():
             self.log("svr_bad_frame", conn=conn, code=codec.CPERR_DATA, reason="transaction ID is not alphanumeric")
             self._send_cperr(conn, codec.CPERR_DATA)          # §17.4 "ID": CPERR 04 for a non-alphanumeric byte
             return
-        ident = ident.decode("ascii")
+        ident = raw_ident.decode("ascii")
         mode = int(mode_field) if mode_field.isdigit() and len(mode_field) <= 3 else None
         if not comma2 or (mode not in WRITE_MODES and mode not in READ_MODES):
             self._status(conn, ident, NOT_SUPPORT)

@@ -23,6 +23,7 @@ import json
 import math
 import struct
 from dataclasses import dataclass
+from typing import Any
 
 from tmsim.limits import SVR_ARRAY_MAX, SVR_STRING_MAX
 
@@ -50,7 +51,7 @@ class Item:
 
 
 def _items():
-    f6 = dict(type="float", size=6)
+    f6: dict[str, Any] = {"type": "float", "size": 6}
     table = [
         Item("Robot_Link", "byte"),                                   # §17.2: always sent, read only
         # Appendix D, system items
@@ -243,7 +244,7 @@ def encode_string(pairs) -> str:
 
 def split_string(content: str, with_values: bool) -> list[tuple[str, str | None]]:
     """Mode 2 content -> [(name, value text)]; mode 12 -> [(name, None)]."""
-    out = []
+    out: list[tuple[str, str | None]] = []
     for line in content.split("\r\n"):
         if with_values:
             name, eq, value = line.partition("=")
@@ -267,8 +268,10 @@ def parse_string_value(item: Item, text: str):
     return _parse_scalar(item, text)
 
 
-def _split_elements(inner):
-    parts, current, quoted = [], [], False
+def _split_elements(inner: str) -> list[str]:
+    parts: list[str] = []
+    current: list[str] = []
+    quoted = False
     for ch in inner:
         if ch == '"':
             quoted = not quoted

@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from typing import Any
 
 # fault -> parameter -> (kind, default, low, high); kind "choice": high holds the allowed values
-PARAMS = {
+PARAMS: dict[str, dict[str, tuple[str, Any, Any, Any]]] = {
     "reply_delay": {"seconds": ("number", 0.5, 0.0, 3600.0), "count": ("int", None, 1, 10 ** 6)},
     "split_replies": {"size": ("int", 1, 1, 65536)},
     "glue_replies": {"count": ("int", 2, 2, 1000), "max_wait": ("number", 0.05, 0.0, 60.0)},
@@ -45,7 +46,7 @@ def check_params(fault: str, params: dict) -> dict:
     if unknown:
         raise ValueError(f"bad parameter for fault '{fault}': unknown parameter '{unknown[0]}' "
                          f"(known: {', '.join(spec) or 'none'})")
-    checked = {}
+    checked: dict[str, Any] = {}
     for name, (kind, default, low, high) in spec.items():
         value = params.get(name, default)
         if value is None:

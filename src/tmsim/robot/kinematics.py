@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import operator
+from collections.abc import Sequence
 
 ALPHA = (-90.0, 0.0, 0.0, 90.0, 90.0, 0.0)
 A = (0.0, 329.0, 311.5, 0.0, 0.0, 0.0)
@@ -82,7 +83,8 @@ def matrix_to_pose(m):
 
 def _frames(joints):
     """Base-to-link transforms T0 (identity) .. T6 (flange); each step is T(i-1) * DH(i), unrolled."""
-    rows = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0))
+    rows: Sequence[tuple[float, float, float, float]] = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0),
+                                                         (0.0, 0.0, 1.0, 0.0))
     frames = [[list(r) for r in rows] + [[0.0, 0.0, 0.0, 1.0]]]
     for i in range(6):
         th = math.radians(joints[i] + OFFSET[i])
@@ -99,7 +101,8 @@ def forward(joints, tool=None):
     """Flange (or TCP when ``tool`` matrix given) pose matrix in the robot base frame.
 
     The loop of ``_frames`` without keeping the intermediate frames (same arithmetic)."""
-    rows = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0))
+    rows: Sequence[tuple[float, float, float, float]] = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0),
+                                                         (0.0, 0.0, 1.0, 0.0))
     for i in range(6):
         th = math.radians(joints[i] + OFFSET[i])
         ct, st, ca, sa, a, d = math.cos(th), math.sin(th), _COS_ALPHA[i], _SIN_ALPHA[i], A[i], D[i]

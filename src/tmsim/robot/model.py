@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from typing import Any
 
 from tmsim.limits import FIFO_ITEMS_MAX, WORK_PLAN, WORK_PVT_CARTESIAN
 from tmsim.robot import kinematics as kin
 from tmsim.robot.errors import classify
-from tmsim.robot.motion import MotionError, MotionRequest, Planner
+from tmsim.robot.motion import MotionError, MotionRequest, Plan, Planner, PvtPlan
 from tmsim.tmscript.work import WorkMeter
 
 HOME_JOINTS = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0)
@@ -32,7 +33,7 @@ class RobotModel:
         self.tool_mass = 0.0
         self.load = 0.0
         self.io = {}
-        self.fifo = deque()
+        self.fifo: deque[tuple[str, Any]] = deque()
         self.active = None
         self.meter = WorkMeter()   # the robot's turn budget, shared with its session (tmsim/tmscript/work.py)
         self.owed = 0.0            # seconds of robot clock not run yet: the turn's budget ended the tick
@@ -181,6 +182,7 @@ class RobotModel:
     def _run_motion(self, request):
         self.meter.add(WORK_PVT_CARTESIAN if request.function == "PVTPoint" and self.pvt_mode == 1 else WORK_PLAN)
         planner = Planner(self._matrix(self.base_pose), self._matrix(self.tool_pose))    # cached matrices
+        plan: Plan | PvtPlan
         try:
             if request.function == "PVTPoint":
                 if self.pvt_mode is None:

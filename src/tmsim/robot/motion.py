@@ -25,6 +25,7 @@ Duration of one motion (trapezoidal speed profile):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -93,7 +94,7 @@ class Plan:
     duration: float            # motion time without settling/blending adjustments
     ta: float
     total: float               # time until the next FIFO item starts
-    cartesian: object = None   # callable s -> TCP matrix in robot coordinates, None = joint interpolation
+    cartesian: Callable[[float], list] | None = None   # s -> TCP matrix in robot coordinates; None = joint interpolation
     end_pose: list = field(default_factory=list)
     tool: object = None
     start_pose: list = field(default_factory=list)
@@ -128,7 +129,7 @@ class PvtPlan(Plan):
     v0: tuple = ()
     p1: tuple = ()
     v1: tuple = ()
-    to_joints: object = None   # Cartesian mode: callable (pose, reference joints) -> joints
+    to_joints: Callable[[list, list], list] | None = None   # Cartesian mode: (pose, reference joints) -> joints
 
     def joints_at(self, t, reference=None):
         if t >= self.duration:

@@ -11,6 +11,8 @@ channel).
 from __future__ import annotations
 
 import datetime
+from collections.abc import Callable
+from typing import Any
 
 from tmsim.protocol.svr_table import ITEMS
 from tmsim.robot import kinematics as kin
@@ -77,7 +79,7 @@ class RobotDataSource:
 
     def _build_getters(self):
         """One function per item (the per-frame cost is one call per item)."""
-        getters = {name: (lambda m, v=value: v) for name, value in _CONSTANT.items()}
+        getters: dict[str, Callable[..., Any]] = {name: (lambda m, v=value: v) for name, value in _CONSTANT.items()}
         for name in ITEMS:
             key = io_key(name)
             if key is not None:

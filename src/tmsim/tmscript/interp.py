@@ -364,7 +364,8 @@ def _eval(node, ctx, line):
     if _is_io(node):
         key, _member = yield from _io_key(node, ctx, line)
         return ctx.robot.io.get(key, 0)
-    if isinstance(node, ast.Member) and isinstance(node.obj, ast.Index) and node.obj.obj.id == "IO":
+    # the static check admits an index only on a name, so node.obj.obj is an ast.Name here
+    if isinstance(node, ast.Member) and isinstance(node.obj, ast.Index) and node.obj.obj.id == "IO":  # type: ignore[attr-defined]
         return _io_array(node, ctx.robot)                # IO["Module"].DI: the whole array (2.x)
     if isinstance(node, ast.Member):                    # Robot[0].X
         return _robot_member(node.name, ctx.robot)

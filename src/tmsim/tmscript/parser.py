@@ -25,7 +25,9 @@ can parse a long line in pieces between its other robots' turns (``iter_lines``)
 from __future__ import annotations
 
 import re
+from collections.abc import Generator
 from dataclasses import dataclass, field
+from typing import Any
 
 from tmsim.limits import DEPTH_MAX, HEX_DIGITS_MAX, INT_MAX, PARSE_SLICE, STATEMENTS_MAX, STRING_MAX, TOKENS_MAX
 
@@ -179,7 +181,7 @@ _TOO_LONG = f"script longer than {TOKENS_MAX} elements (names, numbers, operator
 
 def tokenize(text: str) -> list[tuple[str, object]]:
     """Return (kind, value) tokens: num, str, name, op; raises ScriptSyntaxError."""
-    tokens = []
+    tokens: list[tuple[str, object]] = []
     for _ in _tokenize(text, tokens):
         pass
     return tokens
@@ -364,7 +366,7 @@ class _Parser:
         raise ScriptSyntaxError(f"unexpected {_describe((kind, value))}")
 
     def items(self, closer):
-        items = []
+        items: list[object] = []
         if self.accept(closer):
             return items
         while True:
@@ -420,7 +422,7 @@ def _describe(tok):
     return f"'{value}'"
 
 
-_CACHE: dict[str, object] = {}
+_CACHE: dict[str, tuple[object, int]] = {}
 _CACHE_SIZE = 4096
 _CACHE_LINE = 512          # longer lines are not kept: the cache stays below ~4 MB
 
@@ -441,7 +443,7 @@ def _simple_call(text: str):
     match = _SIMPLE_CALL.fullmatch(text)
     if match is None or match.group(1) in ("true", "false"):
         return None
-    body, args = match.group(2), []
+    body, args = match.group(2), list[Str | Bool | Num]()
     if body.strip(" \t"):
         for piece in body.split(","):
             piece = piece.strip(" \t")
@@ -473,7 +475,7 @@ def _parse(text: str) -> tuple[object, int]:
     return cached
 
 
-def _finish(steps):
+def _finish(steps: Generator[Any, Any, tuple[object, int]]) -> tuple[object, int]:
     """Run a generator of the parser to its end; its return value."""
     while True:
         try:
@@ -489,7 +491,7 @@ def _parse_steps(text: str):
     try:
         stmt = _simple_call(text)
         if stmt is None:
-            tokens = []
+            tokens: list[tuple[str, object]] = []
             yield from _tokenize(text, tokens)
             cost = len(tokens)
             stmt = yield from _Parser(tokens).steps()
