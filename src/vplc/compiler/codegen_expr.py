@@ -136,9 +136,9 @@ class ExprGen:
         if init is not None and not isinstance(init, (A.ArrayInit, A.StructInit)):
             return self.store_conv(self.expr(init), init, t)
         u = T.unalias(t)
-        if init is None and isinstance(getattr(u, "decl", None), A.TypeDecl) and u.decl.init is not None \
-                and not isinstance(u, T.StructType):
-            return self.default(t, u.decl.init, path)
+        decl = getattr(u, "decl", None)         # the declaration of a user type, with its initial value
+        if init is None and isinstance(decl, A.TypeDecl) and decl.init is not None and not isinstance(u, T.StructType):
+            return self.default(t, decl.init, path)
         if isinstance(u, T.SubrangeType):
             return str(u.lo if u.lo > 0 or u.hi < 0 else 0)
         if isinstance(u, T.EnumType):
@@ -311,7 +311,7 @@ class ExprGen:
         if at.open:
             return f"{base}[{abi.IXO}({idx[0]}, {base}, {what})]"
         if len(at.dims) == 1:
-            lo, hi = at.dims[0]
+            lo, hi = _fixed(at.dims[0])
             first = e.indices[0]
             if isinstance(first, A.Literal) and isinstance(first.value, int) and lo <= first.value <= hi:
                 return f"{base}[{first.value - lo}]"
@@ -556,6 +556,14 @@ def _one_group(code: str) -> bool:
             if depth == 0 and i < len(code) - 1:
                 return False
     return depth == 0
+
+
+def _fixed(dim: tuple[int | None, int | None]) -> tuple[int, int]:
+    """The bounds of a dimension of an array that is not open (T.ArrayType.open is False)."""
+    lo, hi = dim
+    if lo is None or hi is None:
+        raise NotImplementedError("an open array dimension where the bounds must be known")
+    return lo, hi
 
 
 def _offset(code: str, lo: int) -> str:

@@ -63,8 +63,8 @@ def _count(stmts, budget: list, cache: dict) -> bool:
         elif isinstance(st, A.Case):
             if not _safe_expr(st.selector):
                 return False
-            for br in st.branches:
-                if not _count(br.body, budget, cache):
+            for case_br in st.branches:
+                if not _count(case_br.body, budget, cache):
                     return False
             if not _count(st.else_body or [], budget, cache):
                 return False
