@@ -11,6 +11,7 @@ import time
 import pytest
 from browser import Browser
 from fake_plc import FakePlc, command_program
+from panel_metrics import cut_texts, page_metrics
 from selenium.webdriver.common.by import By
 
 from cbt_hmi.web.mapping import Mapping
@@ -90,7 +91,8 @@ def test_an_alarm_goes_through_its_states_on_the_page(browser, stack):
     stack.set(RS_EStop=True)
     browser.wait_for(lambda d: "Emergency stop pressed" in browser.banner(), "the E-stop in the banner")
     assert browser.viewport_overflow() == []
-    assert "High" in browser.banner() and "release the emergency stop, then press Play on the Main screen" in browser.banner()
+    assert "High" in browser.banner()
+    assert "release the emergency stop, then press Play on the Main screen" in browser.banner()
     browser.wait_for(lambda d: browser.alarm_rows() and browser.alarm_rows()[0].endswith("active, unack."), "the row")
     assert browser.driver.find_element(By.ID, "alarm-banner").get_attribute("data-priority") == "high"
     assert text(browser, "pill-robot") == "Robot E-stop"
@@ -113,7 +115,8 @@ def test_an_alarm_goes_through_its_states_on_the_page(browser, stack):
 
 def test_one_alarm_per_cause_with_its_consequences_and_priority(browser, stack):
     browser.open(stack.server.page_url("index", "operator"))
-    stack.set(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001, MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")
+    stack.set(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001,
+              MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")
     browser.wait_for(lambda d: any("16#3001" in r for r in browser.alarm_rows()), "the command's alarm")
     stack.set(RS_EStop=True, RS_RobotError=True, RS_ErrorCode=0x10001,
               RS_ErrorText="Emergency stop: the robot stopped its motion and its project; release it to go on",
@@ -135,6 +138,38 @@ def test_one_alarm_per_cause_with_its_consequences_and_priority(browser, stack):
     finally:
         stack.set(MoveAbs_Error=False, MoveAbs_ErrorID=0, MoveRel_Error=False, MoveRel_ErrorID=0,
                   Connect_Connected=True, Connect_Reconnecting=False, Connect_ErrorID=0)
+
+
+@pytest.mark.parametrize("size", [(800, 480), (1280, 800)], ids=["800x480", "1280x800"])
+def test_alarm_rows_are_touch_targets_and_main_cuts_no_text_while_alarms_stand(browser, stack, size):
+    """The alarm list's rows are tapped (the whole alarm on the message line): each is a control of at least 34 px
+    (they were 18 px), and the robot tile's state and the list's texts read whole with an E-stop, a robot error, a
+    lost link and a failed command standing."""
+    d = browser.driver
+    dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
+    d.set_window_size(size[0] + dw, size[1] + dh)
+    d.get("about:blank")
+    browser.open(stack.server.page_url("index", "operator"))
+    stack.set(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001,
+              MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")
+    try:
+        browser.wait_for(lambda d: any("16#3001" in r for r in browser.alarm_rows()), "the command's alarm")
+        stack.set(RS_EStop=True, RS_RobotError=True, RS_ErrorCode=0x10001, RS_ErrorText="Emergency stop",
+                  Robot_InListenNode=False)
+        browser.wait_for(lambda d: len(browser.alarm_rows()) >= 2, "two alarms listed")
+        browser.screenshot(f"alarm_rows_{size[0]}x{size[1]}")
+        rows = d.execute_script("return [...document.querySelectorAll('#alarm-history tr')].slice(1)"
+                                ".map(r => [r.getBoundingClientRect().height, r.onclick !== null])")
+        assert rows and all(height >= 34 and tapped for height, tapped in rows), rows
+        found = page_metrics(browser)
+        assert found == {"small": [], "text": [], "contrast": []}, found
+        assert cut_texts(browser) == []
+        assert text(browser, "robot-safety") == "E-STOP pressed, auto mode"
+        assert browser.viewport_overflow() == []
+    finally:
+        stack.set(MoveAbs_Error=False, MoveAbs_ErrorID=0, RS_EStop=False, RS_RobotError=False, RS_ErrorText="",
+                  Robot_InListenNode=True)
+        browser._fit()
 
 
 def test_acknowledge_is_shared_by_two_browser_sessions(browser, stack):
@@ -176,7 +211,8 @@ def test_the_list_the_acknowledge_and_the_history_survive_a_reload_and_a_server_
     browser.click("btn-alarm-ack")
     browser.wait_for(lambda d: browser.alarm_rows()[0].endswith("active, ack."), "acknowledged")
     browser.driver.refresh()
-    browser.wait_for(lambda d: browser.alarm_rows() and browser.alarm_rows()[0].endswith("active, ack."), "after reload")
+    browser.wait_for(lambda d: browser.alarm_rows() and browser.alarm_rows()[0].endswith("active, ack."),
+                     "after reload")
     assert browser.banner() == ""
     stack.set(RS_EStop=False)
     browser.wait_for(lambda d: browser.alarm_rows() == [], "normal")

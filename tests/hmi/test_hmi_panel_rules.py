@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 from fake_plc import FakePlc, command_program, scanning, serving
-from panel_metrics import page_metrics
+from panel_metrics import cut_texts, page_metrics
 
 from cbt_hmi.web.mapping import Mapping
 
@@ -136,9 +136,11 @@ def test_disabled_fields_and_keys_look_disabled(stack):
     outline and a grey label), text still readable (the issue: disabled fields looked editable)."""
     browser = open_sized(stack, "setoutput", "operator", (800, 480))
     looks = browser.driver.execute_script("""
-        const look = (el) => { const s = getComputedStyle(el); return [el.disabled, s.backgroundColor, s.borderTopStyle]; };
+        const look = (el) => { const s = getComputedStyle(el);
+          return [el.disabled, s.backgroundColor, s.borderTopStyle]; };
         const box = document.querySelector('[data-path="SetOutput_Param.ExitNode"]');
-        return [[look(document.querySelector('[data-path="SetOutput_Param.Module"]')), look(document.getElementById('btn-execute'))],
+        return [[look(document.querySelector('[data-path="SetOutput_Param.Module"]')),
+                 look(document.getElementById('btn-execute'))],
                 [box.disabled, getComputedStyle(box).outlineStyle, getComputedStyle(box.nextElementSibling).color]];""")
     for disabled, background, border in looks[0]:
         assert disabled and background == "rgb(227, 231, 235)" and border == "dashed", (disabled, background, border)
@@ -148,3 +150,30 @@ def test_disabled_fields_and_keys_look_disabled(stack):
         "const el = document.querySelector('[data-path=\"SetOutput_Param.Module\"]'), s = getComputedStyle(el);"
         "return [el.disabled, s.backgroundColor, s.borderTopStyle];")
     assert not disabled and background == "rgb(255, 255, 255)" and border == "solid"
+
+
+@pytest.mark.parametrize("size", SIZES, ids=["800x480", "1280x800"])
+@pytest.mark.parametrize("name", PAGES)
+def test_no_label_or_value_is_cut(stack, name, size):
+    """Every label and value an operator needs reads whole: nothing cut with "…" or hidden past its box ("Motion
+    Comma…", "Safety / mo…", "CBT Commands – …" were); the alarm banner's line shows the whole alarm when tapped."""
+    browser = open_sized(stack, name, "engineer", size)
+    browser.wait_for(lambda d: d.execute_script("return document.querySelectorAll('[data-status]').length > 0"),
+                     "the page's status values")
+    browser.wait_for(lambda d: cut_texts(browser) == [], f"every text whole: {cut_texts(browser)}")
+
+
+@pytest.mark.parametrize("size", SIZES, ids=["800x480", "1280x800"])
+def test_the_ladder_drawing_reads_at_the_panels_body_text_size(ladder_stack, size):
+    """At the Program page's 100 % every text of the ladder drawing (names, pins, values, comments) is at least
+    14 px: 100 % is the panel's reading size; 60 % and 80 % are the operator's overview."""
+    browser = open_sized(ladder_stack, "program", "operator", size)
+    browser.driver.execute_script("sessionStorage.removeItem('hmi.ladderZoom')")
+    browser.driver.refresh()
+    browser.wait_for(lambda d: d.execute_script("return document.querySelector('.ladder svg') !== null"),
+                     "the ladder drawing")
+    assert browser.driver.find_element("id", "ladder-zoom").text == "100 %"
+    browser.screenshot(f"panel_program_100_{size[0]}x{size[1]}")
+    found = page_metrics(browser)
+    assert found == {"small": [], "text": [], "contrast": []}, found
+    assert cut_texts(browser) == []                   # the title beside "Robot not connected" too

@@ -107,8 +107,9 @@ function drawAlarms() {
     tr.dataset.number = a.number;
     tr.insertCell().textContent = a.time.slice(11, 19);
     tr.insertCell().textContent = PRIORITY_SHOWN[a.priority];
-    tr.insertCell().textContent = (a.first_out ? "① " : "") + alarmLine(a) +
-      (a.details.length ? ` (+${a.details.length})` : "");
+    const line = document.createElement("span");     // at most two lines: the row stays one 34 px touch target
+    line.textContent = (a.first_out ? "① " : "") + alarmLine(a) + (a.details.length ? ` (+${a.details.length})` : "");
+    tr.insertCell().append(line);
     tr.insertCell().textContent = STATE_SHOWN[a.state];
     tr.onclick = () => message(alarmWhole(a));
   }
@@ -152,11 +153,11 @@ function robotTile(container) {
   area.className = "robot-tile";
   area.innerHTML = `<div class="row"><table class="robot-state">
       <tr><td>Project</td><td id="robot-project" data-invalid></td></tr>
-      <tr><td>Robot error</td><td id="robot-error" data-invalid></td></tr>
+      <tr><td>Robot error</td><td><span id="robot-error" data-invalid></span></td></tr>
       <tr><td>Safety / mode</td><td id="robot-safety" data-invalid></td></tr>
       <tr><td>Link</td><td id="robot-link" data-invalid></td></tr></table>
-    <div class="buttons"><button id="btn-project-play">Play</button><button id="btn-alarm-ack-all">Acknowledge all</button>
-      <button id="btn-project-stop">Stop Project</button><button id="btn-alarm-history">History</button>
+    <div class="buttons"><button id="btn-project-play">Play</button><button id="btn-project-stop">Stop Project</button>
+      <button id="btn-alarm-ack-all">Acknowledge all</button><button id="btn-alarm-history">History</button>
       <button id="btn-back-to-node" hidden>Back to Listen Node</button></div></div>
     <div class="alarm-list" aria-label="Alarms"><table id="alarm-history"></table></div>
     <dialog id="alarm-log-dialog"><header><h1>Alarm history (controller time, newest first)</h1></header>

@@ -91,6 +91,7 @@ async function customPage(key) {
   left.className = "left";
   left.append(params);
   main.append(left, side);
+  uncutLabels(params);
   if (names.length) {
     try {
       const data = await readVars(names);

@@ -147,6 +147,14 @@ function makeField(path, spec, label) {
   return box;
 }
 
+/* A field whose label does not fit its grid cell ("Motion Command" at 800x480) takes two cells: a label the
+   operator needs is never cut with "…". Run once the page is laid out. */
+function uncutLabels(root) {
+  for (const label of root.querySelectorAll(".field > label")) {
+    if (label.scrollWidth > label.clientWidth + 1) label.parentElement.classList.add("span2");
+  }
+}
+
 /* builds fieldsets for a struct variable (or array element) rooted at `path` */
 function buildStruct(container, path, typeName, legendText) {
   const def = typeDef(typeName);
@@ -380,7 +388,7 @@ async function sendStop(mode, what) {
 }
 
 function mainPage() {
-  const main = frame("CBT Commands – Main", true);
+  const main = frame("Main", true);
   main.innerHTML = `<div class="areas">
     <div class="area"><h2>Configuration</h2><div class="tiles">
       <a href="connect.html" id="nav-connect">Connect</a><a href="changebase.html" id="nav-changebase">Change Base</a>
@@ -389,7 +397,7 @@ function mainPage() {
       <a href="moverel.html" id="nav-moverel">Move Relative</a><a href="moveabs.html" id="nav-moveabs">Move Absolute</a>
       <a href="movecircle.html" id="nav-movecircle">Move Circle</a><a href="pnp.html" id="nav-pnp">PnP Sequence</a>
       <a href="stop.html" id="nav-stop" class="stop">Stop Motion</a></div></div>${cellArea()}
-    </div><div class="viewcol"><div id="robotview"></div>${robotStatusStrip()}</div>`;
+      ${robotStatusStrip()}</div><div class="viewcol"><div id="robotview"></div></div>`;
   for (const [key, page] of Object.entries(MAP.custom_pages || {})) {
     document.getElementById(`nav-${key}`).textContent = page.title;     // the user's text, never as HTML
   }
@@ -567,6 +575,7 @@ async function fbPage(key, page) {
     redraw = () => {};
   }
   main.append(left, side);
+  uncutLabels(params);
   const inputs = page.inputs.map((item) => item.variable);
   try {
     const data = await readVars(param ? [param] : inputs);

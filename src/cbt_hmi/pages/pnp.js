@@ -151,7 +151,7 @@ function drawPnP() {
       d = `M${x1},${y1} Q${lx},${cy} ${x2},${y2}`; ly = (y1 + y2) / 4 + cy / 2 - 14;
     } else { d = `M${x1},${y1} L${x2},${y2}`; ly += 18; }
     out += `<path class="seg" id="seg-${i}" d="${d}"/>`;
-    labels.push(`<g class="edit" id="edit-${i}" data-seg="${i}"><rect x="${lx - 86}" y="${ly - 14}" width="172" height="28"/>
+    labels.push(`<g class="edit" id="edit-${i}" data-seg="${i}"><rect x="${lx - 86}" y="${ly - 17}" width="172" height="34"/>
       <text x="${lx}" y="${ly + 5}" text-anchor="middle">${i + 1} ${PNP_SEGMENTS[i]} ✎</text></g>`);
   }
   pts.forEach((p) => { out += `<circle class="pt" cx="${X(p)}" cy="${Y(p)}" r="3.5"/>`; });
@@ -206,6 +206,7 @@ function openSegment(i) {
     } catch (e) { message(`Segment ${i + 1}: ${e.message}`, "error"); }
   };
   dialog.showModal();
+  uncutLabels(body);                  // laid out only now that the dialog is open
 }
 
 async function loadPnP() {

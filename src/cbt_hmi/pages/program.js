@@ -6,7 +6,10 @@
    (a value without room is shortened with "…"; tapping it shows it whole on the message line). */
 "use strict";
 
-const LADDER_ZOOMS = [0.6, 0.8, 1, 1.3, 1.6];             // from 130 % every text of the drawing is 14 px or more
+/* 100 % is the panel's reading size: the drawing is scaled so that its smallest text (pin names and values, 11 px in
+   the drawing's own units) reads at 14 px, the body text of the 9-inch panel; 60 % and 80 % are an overview */
+const LADDER_ZOOMS = [0.6, 0.8, 1, 1.3, 1.6];
+const READING_PX = 14;
 const LADDER = { zoom: Number(sessionStorage.getItem("hmi.ladderZoom")) || 1 };
 const SVG_NS = "http://www.w3.org/2000/svg";
 const COMMENT_LINE = 16;                       // px between two lines of a wrapped rung comment (12 px text)
@@ -57,12 +60,16 @@ function wrapComments(svg, rungs) {
   svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
   svg.querySelector(":scope > rect").setAttribute("height", height);
   svg.dataset.width = String(width); svg.dataset.height = String(height);
+  const sizes = [...svg.querySelectorAll("text")].filter((t) => t.textContent.trim())
+    .map((t) => parseFloat(getComputedStyle(t).fontSize)).filter((px) => px > 0);
+  svg.dataset.base = String(sizes.length ? READING_PX / Math.min(...sizes) : 1);
 }
 
 function applyZoom(holder) {
   for (const svg of holder.querySelectorAll("svg.ld")) {
-    svg.setAttribute("width", Math.round(Number(svg.dataset.width) * LADDER.zoom));
-    svg.setAttribute("height", Math.round(Number(svg.dataset.height) * LADDER.zoom));
+    const scale = Number(svg.dataset.base) * LADDER.zoom;
+    svg.setAttribute("width", (Number(svg.dataset.width) * scale).toFixed(2));
+    svg.setAttribute("height", (Number(svg.dataset.height) * scale).toFixed(2));
   }
   document.getElementById("ladder-zoom").textContent = `${Math.round(LADDER.zoom * 100)} %`;
   document.getElementById("ladder-out").disabled = LADDER.zoom === LADDER_ZOOMS[0];
@@ -88,7 +95,7 @@ function showValue(t, text, fixed) {
 }
 
 async function programPage() {
-  const main = frame("Program – Ladder Monitor", false);
+  const main = frame("Ladder Monitor", false);
   main.classList.add("program");
   main.innerHTML = `<div class="ladder-bar"><label for="rung-jump">Rung</label><select id="rung-jump"></select>
     <span class="ladder-zoomctl"><button type="button" id="ladder-out" aria-label="Zoom out" title="Zoom out">−</button>

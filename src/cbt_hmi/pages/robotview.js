@@ -291,7 +291,7 @@ function robotViewStyle() {
   style.textContent = `.robotview .viewfoot { align-items: center; font-size: 14px; color: #3d4852; min-height: 34px; }
     .robotview .viewfoot .pos { font-size: 14px; color: #3d4852; min-width: 0; overflow: hidden;
       text-overflow: ellipsis; white-space: nowrap; }
-    .robotview .viewfoot .note { flex: 1; min-width: 0; color: #5a2a91; }
+    .robotview .viewfoot .note { flex: 1; min-width: 0; color: #5a2a91; white-space: normal; line-height: 16px; }
     .robotview .viewfoot .note.refused { color: #b0211a; font-weight: bold; order: -1; flex: none; }
     .robotview .zoom { display: flex; align-items: center; gap: 4px; flex: none; }
     .robotview .zoom #side-axis { font-size: 14px; margin-right: 6px; }
