@@ -605,6 +605,12 @@ class RungCompiler:
             result is None or self.consumers.get((e.id, result.name), 0) <= 1 and not (
                 guarded and any(r.kind not in ("out_var", "inout_var")
                                 for r, _pin in self.readers.get((e.id, result.name), []))))
+        if not wired and any(pin.conns for pin in e.inouts) and e.type_name.upper() not in COMPARE:
+            # nothing reads an output, but the function works on an in-out (W502 Inc, ClearString, AryMove ...):
+            # the box runs where the rung gives it power, its result discarded
+            call = (e.type_name + "(" + call_args + ");").marked(lab)
+            self.stmt(("IF " + en + " THEN " + call + " END_IF;") if guarded and en is not None else call, lab)
+            return
         if simple:
             if result is not None:
                 call = (self.comparison(e, values, lab) if e.type_name.upper() in COMPARE

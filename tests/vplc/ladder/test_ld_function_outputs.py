@@ -116,3 +116,14 @@ def test_a_function_with_its_outputs_wired_survives_the_sysmac_export(tmp_path):
     r = Run(back)
     r.scan(N=12)
     assert (r["Twice"], r["Q"], r["H"], r["H2"]) == (24, True, 6, 6)
+
+
+def test_a_function_working_on_an_in_out_runs_though_nothing_reads_its_result(tmp_path):
+    """W502 Inc(InOut) in a rung: while the contact gives EN power, each scan adds 1; no output is wired."""
+    body = [rail(1), contact(2, "Go", 1), invar(3, "N"),
+            block(4, "Inc", {"EN": 2}, ["ENO", "Out"], inouts={"InOut": 3})]
+    r = Run.of(tmp_path, {"Go": "BOOL", "N": "INT"}, body)
+    r.scan(Go=True)
+    r.scan(Go=True)
+    r.scan(Go=False)
+    assert r["N"] == 2
