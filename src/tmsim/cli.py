@@ -17,6 +17,7 @@ users). Every number is range-checked before anything starts; a bad one is one l
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import math
 import signal
@@ -41,10 +42,12 @@ def build_parser() -> argparse.ArgumentParser:
         prog="tmflow-sim",
         description="TMflow Listen Node simulator (TM5-700 model). Serves the external-script protocol "
                     "(TMSCT/TMSTA/CPERR) on one TCP port per robot.")
-    parser.add_argument("--host", default="127.0.0.1", metavar="ADDRESS", help="address to listen on (default 127.0.0.1)")
+    parser.add_argument("--host", default="127.0.0.1", metavar="ADDRESS",
+                        help="address to listen on (default 127.0.0.1)")
     parser.add_argument("--port", type=int, default=5890, metavar="PORT",
                         help="port of robot 1; further robots use the next ports (default 5890, 0 = any free port)")
-    parser.add_argument("--robots", type=int, default=1, metavar="N", help="number of independent robots (1..512, default 1)")
+    parser.add_argument("--robots", type=int, default=1, metavar="N",
+                        help="number of independent robots (1..512, default 1)")
     timing = parser.add_mutually_exclusive_group()
     timing.add_argument("--realtime", action="store_true", help="motions take their real duration (default)")
     timing.add_argument("--speedup", type=float, default=1.0, metavar="K",
@@ -53,7 +56,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help="append every event as one JSON line to FILE (renamed to FILE.1 at 64 MiB)")
     parser.add_argument("--no-auto-enter", action="store_true",
                         help="start with the flow outside the Listen node (enter it via the control channel)")
-    parser.add_argument("--send-message", default="Listen1", metavar="TEXT", help="the node's Send Message (default Listen1)")
+    parser.add_argument("--send-message", default="Listen1", metavar="TEXT",
+                        help="the node's Send Message (default Listen1)")
     parser.add_argument("--control-port", type=int, default=None, metavar="PORT",
                         help="port of the local JSON control channel (default: the port before robot 1's, 5889 "
                              "for 5890, or any free port when that one is taken; 0 = any free port)")
@@ -231,10 +235,8 @@ def main(argv=None) -> int:
     gc.freeze()      # what start-up built lives for good: keep it out of every later collection
     done = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: done.set())
-    try:
+    with contextlib.suppress(KeyboardInterrupt):
         server.serve_forever(done)          # the main thread serves: fastest replies
-    except KeyboardInterrupt:
-        pass
     server.close()
     print("simulator stopped", flush=True)
     return 0

@@ -39,7 +39,8 @@ class Peer:
                 return
             self.raw_reads.append(data)
             self.rbuf += data
-            self.frames.extend(item for item in codec.decode_all(self.rbuf, self.headers) if isinstance(item, codec.Frame))
+            self.frames.extend(item for item in codec.decode_all(self.rbuf, self.headers)
+                               if isinstance(item, codec.Frame))
 
     def texts(self):
         return [(f.header, f.data.decode("utf-8", "replace")) for f in self.frames]

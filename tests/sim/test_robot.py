@@ -64,7 +64,8 @@ def test_line_in_percent_uses_the_tcp_speed_limit():
 def test_blending_shortens_and_precise_positioning_lengthens_the_motion():
     def duration(blend, precise):
         robot = RobotModel()
-        robot.enqueue_motion(req("PTP", "JPP", [30, 0, 90, 0, 90, 0], speed=50, accel=300, blend=blend, precise=precise))
+        robot.enqueue_motion(req("PTP", "JPP", [30, 0, 90, 0, 90, 0], speed=50, accel=300, blend=blend,
+                                 precise=precise))
         _, events = run_until_idle(robot)
         return end_time(events, "PTP")
     plain = duration(0, False)
@@ -171,7 +172,8 @@ def test_wrist_singularity_falls_back_to_the_numerical_solver():
 
 
 def test_forward_model_home_pose():
-    assert kin.matrix_to_pose(kin.forward([0, 0, 90, 0, 90, 0])) == pytest.approx([417.5, -122.3, 359.7, 180, 0, 90], abs=1e-6)
+    assert kin.matrix_to_pose(kin.forward([0, 0, 90, 0, 90, 0])) == pytest.approx([417.5, -122.3, 359.7, 180, 0, 90],
+                                                                                abs=1e-6)
 
 
 def test_inverse_kinematics_round_trip_for_random_poses():

@@ -8,7 +8,7 @@ from tmsim.tmscript.static_check import check_script
 def check(script, variables=None):
     lines = split_lines(script)
     check_script(lines, variables or {})
-    return [l.number for l in lines if l.error], [l.number for l in lines if l.warnings and not l.error], lines
+    return [ln.number for ln in lines if ln.error], [ln.number for ln in lines if ln.warnings and not ln.error], lines
 
 
 @pytest.mark.parametrize("line", [

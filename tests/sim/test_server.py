@@ -354,7 +354,8 @@ def test_poll_is_deterministic_for_the_same_inputs():
 def test_listen_send_int_array_goes_out_as_little_endian_binary(harness):
     peer = harness.connect()
     replies = harness.request(peer, sct("1", "int[] v = {1,2}\r\nListenSend(93,v)"), count=2)
-    assert replies[0][0] == "TMSTA" and peer.frames[0].data == b"93," + (1).to_bytes(4, "little") + (2).to_bytes(4, "little")
+    assert replies[0][0] == "TMSTA" and \
+        peer.frames[0].data == b"93," + (1).to_bytes(4, "little") + (2).to_bytes(4, "little")
     assert codec.checksum(peer.frames[0].raw[1:-5]) == int(peer.frames[0].raw[-4:-2], 16)
 
 

@@ -197,7 +197,8 @@ def test_priority_command_needs_a_literal_argument(node):
 
 def test_script_exit_drains_queue_and_rejects_scripts_meanwhile(node):
     node.send(1, sct("1", PTP_LONG))
-    out = node.send(1, b'$TMSCT,78,2,ChangeBase("RobotBase")\r\nChangeTCP("NOTOOL")\r\nScriptExit()\r\nChangeLoad(10.1),*6C\r\n')
+    out = node.send(1, b'$TMSCT,78,2,ChangeBase("RobotBase")\r\nChangeTCP("NOTOOL")\r\nScriptExit()\r\n'
+                       b'ChangeLoad(10.1),*6C\r\n')
     assert out[-1] == codec.encode("TMSCT", "2,OK").decode()
     assert node.s.state == EXITING
     assert node.send(1, sct("3", "QueueTag(1)")) == ["$CPERR,2,F1,*3F\r\n"]
@@ -374,7 +375,8 @@ def test_receive_data_takes_bytes_whole_split_and_glued_and_data_to_send_hands_o
     assert n.s.receive_data(1, raw[7:40]) == 1
     assert n.s.receive_data(1, raw[40:]) == 2
     frames = n.s.data_to_send(1)
-    assert [f.decode() for f in frames] == [codec.encode("TMSCT", "A,OK").decode(), codec.encode("TMSCT", "B,OK").decode(),
+    assert [f.decode() for f in frames] == [codec.encode("TMSCT", "A,OK").decode(),
+                                           codec.encode("TMSCT", "B,OK").decode(),
                                            codec.encode("TMSTA", "00,true,Listen1").decode()]
     assert n.s.data_to_send(1) == [] and n.s.receive_data(9, raw) == 0          # unknown connection: ignored
 

@@ -4,6 +4,7 @@ Cartesian PVT streams or a control-channel flood leaves robot 2 served. Each tes
 loopback with the virtual clock and asserts on the server's own counters (work of a turn, turns ended by
 the budget) and on the order of the answers, never on wall time; the latency figures are in
 bench/bench_fairness.py."""
+import contextlib
 import json
 import math
 import socket
@@ -246,10 +247,8 @@ def test_a_state_with_large_variables_is_encoded_over_several_turns_and_arrives_
         answer = bytearray()
 
         def whole():
-            try:
+            with contextlib.suppress(BlockingIOError):
                 answer.extend(asker.recv(1 << 20))
-            except BlockingIOError:
-                pass
             return answer.endswith(b"\n")
         assert h.until(whole, timeout=30)
         state = json.loads(answer)

@@ -1,5 +1,6 @@
 """Robot servers under hostile load (issue 12, Medium/Low): event log bounded in bytes, fault clearing with
 held bytes, descriptor exhaustion. Virtual clock, loopback only."""
+import contextlib
 import os
 import resource
 import socket
@@ -17,7 +18,7 @@ def test_clearing_faults_while_split_replies_are_held_delivers_every_byte_and_le
         peer = h.connect()
         h.robot.inject("split_replies", size=1)
         for n in range(3):
-            peer.send(sct(str(n), "int v%d = %d" % (n, n)))
+            peer.send(sct(str(n), f"int v{n} = {n}"))
         h.run(0.02)                                    # a few one-byte pieces have left
         assert 0 < sum(map(len, peer.raw_reads)) < 30
         h.robot.clear_faults()
@@ -106,10 +107,8 @@ def _flood(h, sock, data, chunk=65536, max_steps=20_000):
     sock.setblocking(False)
     sent, steps = 0, 0
     while sent < len(data) and steps < max_steps:
-        try:
+        with contextlib.suppress(BlockingIOError):
             sent += sock.send(data[sent:sent + chunk])
-        except BlockingIOError:
-            pass
         h.step()
         steps += 1
     return sent
@@ -157,10 +156,8 @@ def test_a_well_behaved_client_is_served_before_a_flooding_one():
         first_polite = next(i for i, e in enumerate(this_poll) if e.get("conn") == polite_conn(h, polite))
         assert first_polite <= 4, this_poll[:first_polite]    # nothing of the flooder's went first
         while sent < len(flood):
-            try:
+            with contextlib.suppress(BlockingIOError):
                 sent += flooder.sock.send(flood[sent:])
-            except BlockingIOError:
-                pass
             h.step()
         assert h.until(lambda: len(flooder.frames) == 8000, timeout=30)
         assert {t for _, t in flooder.texts()} == {"00,true,Listen1"}     # nothing lost, each once
@@ -176,7 +173,8 @@ def polite_conn(h, peer):
 
 def test_listen_send_fan_out_to_lazy_clients_is_bounded_in_memory(monkeypatch):
     """Probe: a 60 KB ListenSend to many clients that never read (old: 3.6 GB). Unsent output is bounded per
-    client (LISTEN_OUTBOX_MAX) and per robot (OUTBOX_TOTAL_MAX: the laziest client is dropped); the event log by bytes."""
+    client (LISTEN_OUTBOX_MAX) and per robot (OUTBOX_TOTAL_MAX: the laziest client is dropped); the event log by
+    bytes."""
     from tmsim.net import server
     monkeypatch.setattr(server, "OUTBOX_TOTAL_MAX", 1 << 20)    # the kernel buffers must fill first: keep it short
     h = Harness()
@@ -218,7 +216,8 @@ def test_buffered_scripts_are_bounded_in_bytes_not_only_in_count():
         big = sct("B", "int q = 1\r\n" + "\r\n".join(["q++"] * 6000)[:60_000])
         _flood(h, peer.sock, big * 30, max_steps=300)          # 900 KB; the kernel's buffers take what we do not
         pending = h.robot.session.pending
-        assert h.robot.reading_paused and sum(len(p.script) for p in pending) <= h.srv.pending_bytes_limit + 8 * len(big)
+        assert h.robot.reading_paused and \
+            sum(len(p.script) for p in pending) <= h.srv.pending_bytes_limit + 8 * len(big)
         assert len(pending) < 20
     finally:
         h.close()

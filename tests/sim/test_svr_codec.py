@@ -124,7 +124,8 @@ def test_binary_value_of_the_wrong_size_is_a_value_error():
 
 @pytest.mark.parametrize("kind, content", [
     ("binary", b"\x05\x00Ab"), ("binary", b"\x01"), ("binary", b""), ("string", "Ctrl_DO0"), ("string", "=1"),
-    ("json", "Ctrl_DO0=1"), ("json", '[{"Value": 1}]'), ("json", "[" * 60000 + "]" * 60000), ("json", '[{"Item": "Ctrl_DO0"}]'), ("json", "[]"),
+    ("json", "Ctrl_DO0=1"), ("json", '[{"Value": 1}]'), ("json", "[" * 60000 + "]" * 60000),
+    ("json", '[{"Item": "Ctrl_DO0"}]'), ("json", "[]"),
 ])
 def test_content_that_does_not_match_its_mode_is_invalid_data(kind, content):
     split = {"binary": table.split_binary, "string": table.split_string, "json": table.split_json}[kind]
@@ -133,7 +134,8 @@ def test_content_that_does_not_match_its_mode_is_invalid_data(kind, content):
 
 
 def test_docs_item_table_matches_the_data_table():
-    """docs/simulator.md lists every item with the type, size and access of tmsim/protocol/svr_table.py (one fact, one home)."""
+    """docs/simulator.md lists every item with the type, size and access of tmsim/protocol/svr_table.py (one fact,
+    one home)."""
     import pathlib
     import re
     text = (pathlib.Path(__file__).resolve().parents[2] / "docs" / "simulator.md").read_text(encoding="utf-8")

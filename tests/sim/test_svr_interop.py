@@ -112,7 +112,7 @@ class DriverSvrClient:
 
     def floats(self, name):
         raw = self.fields[name]
-        return list(struct.unpack("<%df" % (len(raw) // 4), raw))
+        return list(struct.unpack(f"<{len(raw) // 4}f", raw))
 
     def integer(self, name):
         return int.from_bytes(self.fields[name], "little", signed=True)

@@ -53,7 +53,8 @@ def test_writes_in_string_binary_and_json_mode_change_the_value(h):
     assert ask(h, peer, b"W2,1," + bytes.fromhex("0400") + b"g_ok" + bytes.fromhex("0100") + b"\x00") == b"W2,0,00,OK"
     assert ask(h, peer, 'W3,3,[{"Item":"g_ss","Value":["a","b","c"]}]') == b"W3,0,00,OK"
     assert h.robot.svr.variables["g_count"] == -7 and h.robot.svr.variables["g_name"] == "Cell 2"
-    assert ask(h, peer, "Q4,12,g_ok\r\ng_pos\r\ng_ss") == b'Q4,12,g_ok=false\r\ng_pos={0,0,1,0,0,0}\r\ng_ss={"a","b","c"}'
+    assert ask(h, peer, "Q4,12,g_ok\r\ng_pos\r\ng_ss") == \
+        b'Q4,12,g_ok=false\r\ng_pos={0,0,1,0,0,0}\r\ng_ss={"a","b","c"}'
 
 
 def test_status_codes_for_variables_17_4_1(h):

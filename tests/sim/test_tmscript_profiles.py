@@ -126,7 +126,8 @@ def test_manual_11_6_robot_attributes_payload_and_instant_camera_light():
     node.advance(0.1)
     node.out(1)
     frames = node.send(1, sct("B", "Robot[0].InstantCameraLight = 1\r\n"
-                                   'ListenSend(90, GetString(Robot[0].Payload) + "," + GetString(Robot[0].CameraLight))'))
+                                   'ListenSend(90, GetString(Robot[0].Payload) + ","'
+                                   ' + GetString(Robot[0].CameraLight))'))
     assert frames[0].split(",", 3)[3].startswith("2.5,1,")
     assert reply(node, "Robot[0].Payload = 1") == ok("ERROR;1")
 
@@ -172,7 +173,7 @@ def _call_with(name, params, position, bad):
     valid = {"string": f'"{fmt[0]}"', "float": "0", "float[]": "{417,0,300,180,0,90}", "int": "1",
              "int[]": "{0,2,4}", "bool": "false", "any": '"x"'}
     args = [valid[p] for p in params]
-    args[position] = "{0,2,%s}" % bad if params[position] == "int[]" else bad
+    args[position] = f"{{0,2,{bad}}}" if params[position] == "int[]" else bad
     return f"{name}({','.join(args)})"
 
 

@@ -32,6 +32,7 @@ turn (back-pressure).
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import selectors
@@ -285,10 +286,8 @@ class ControlChannel:
         self.backlog.pop(sock, None)
         if self.clients.pop(sock, None) is not None and reason:
             self.server.log_server("control_closed", reason=reason)
-        try:
+        with contextlib.suppress(KeyError, ValueError):
             self.server.selector.unregister(sock)
-        except (KeyError, ValueError):
-            pass
         sock.close()
 
     def close(self):

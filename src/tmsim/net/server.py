@@ -18,6 +18,7 @@ Limits (per robot unless noted):
 """
 from __future__ import annotations
 
+import contextlib
 import gc
 import math
 import selectors
@@ -610,14 +611,10 @@ class SimServer:
         if robot.conns.pop(conn.id, None) is None:
             return
         if not conn.eof:
-            try:
+            with contextlib.suppress(KeyError, ValueError):
                 self.selector.unregister(conn.sock)
-            except (KeyError, ValueError):
-                pass
-        try:
+        with contextlib.suppress(OSError):
             conn.sock.close()
-        except OSError:
-            pass
         robot.faults.forget(conn.id)
         self.fair.forget(robot, conn)
         robot.session.disconnect(conn.id)

@@ -7,6 +7,7 @@ says so once, and ``tick(now)`` watches it again; pending connections wait in th
 """
 from __future__ import annotations
 
+import contextlib
 import selectors
 import socket
 
@@ -75,10 +76,8 @@ class Listener:
         ``Listener(..., held=...)``: connection attempts are refused as by a closed port, but no other program can
         take the port meanwhile (a robot whose project stopped comes back on the same port). None when not held."""
         if self.paused_until is None:
-            try:
+            with contextlib.suppress(KeyError, ValueError):
                 self._selector.unregister(self.sock)
-            except (KeyError, ValueError):
-                pass
         self.paused_until = None
         host = self.sock.getsockname()[0]
         self.sock.close()

@@ -68,7 +68,7 @@ def encode(header: str, data: bytes | str) -> bytes:
     if isinstance(data, str):
         data = data.encode("utf-8")
     body = header.encode("ascii") + b"," + str(len(data)).encode("ascii") + b"," + data + b","
-    return b"$" + body + b"*" + ("%02X" % checksum(body)).encode("ascii") + b"\r\n"
+    return b"$" + body + b"*" + f"{checksum(body):02X}".encode("ascii") + b"\r\n"
 
 
 def parse_length(field: bytes) -> int | None:

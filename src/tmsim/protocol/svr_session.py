@@ -45,7 +45,8 @@ DEFAULT_STREAM = (
 )
 
 
-FAULTS = ("stall", "corrupt_checksum", "disconnect", "refuse_writes")    # fault injection (docs/simulator.md), clear_faults() ends
+# fault injection (docs/simulator.md); clear_faults() ends them
+FAULTS = ("stall", "corrupt_checksum", "disconnect", "refuse_writes")
 
 
 class SvrConfigError(ValueError):

@@ -93,7 +93,7 @@ ITEMS: dict[str, Item] = _items()
 _U16 = struct.Struct("<H")
 # item name -> (length-prefixed name, packer of its value) for the binary format
 _PACKERS = {item.name: (_U16.pack(len(item.name.encode())) + item.name.encode(),
-                        None if item.type == "string" else struct.Struct("<%d%s" % (item.size, _PACK[item.type])))
+                        None if item.type == "string" else struct.Struct(f"<{item.size}{_PACK[item.type]}"))
             for item in ITEMS.values()}
 
 
@@ -144,7 +144,7 @@ def _packer(item: Item):
         return known
     name = item.name.encode("utf-8")
     return (_U16.pack(len(name)) + name,
-            None if item.type == "string" else struct.Struct("<%d%s" % (item.size, _PACK[item.type])))
+            None if item.type == "string" else struct.Struct(f"<{item.size}{_PACK[item.type]}"))
 
 
 def binary_value(item: Item, value) -> bytes:
@@ -208,7 +208,7 @@ def decode_binary_value(item: Item, data: bytes):
     width = _WIDTH[item.type]
     if len(data) != width * item.size:
         raise SvrValueError(f"{item.name} needs {width * item.size} bytes, got {len(data)}")
-    values = list(struct.unpack("<%d%s" % (item.size, _PACK[item.type]), data))
+    values = list(struct.unpack(f"<{item.size}{_PACK[item.type]}", data))
     if item.type == "float":
         values = [float(v) for v in values]
     return values if item.size > 1 else values[0]
@@ -234,7 +234,7 @@ def _string_scalar(item, value):
 def _float_text(value) -> str:
     """The float32 value with the digits it carries (7 significant), no exponent for usual values."""
     (single,) = struct.unpack("<f", struct.pack("<f", float(value)))
-    text = "%.7g" % single
+    text = f"{single:.7g}"
     return "0" if text in ("-0", "0") else text
 
 
@@ -349,7 +349,8 @@ def variable_item(name: str, kind: str, size: int = 1, access: str = "rw") -> It
     """The Item of a global variable; SvrValueError names what is wrong."""
     if not (isinstance(name, str) and 0 < len(name) <= 64 and name.isascii()
             and (name[0].isalpha() or name[0] == "_") and all(c.isalnum() or c == "_" for c in name)):
-        raise SvrValueError(f"variable name {str(name)[:70]!r}: 1..64 letters, digits or '_', not starting with a digit")
+        raise SvrValueError(f"variable name {str(name)[:70]!r}: 1..64 letters, digits or '_', "
+                            f"not starting with a digit")
     if name in ITEMS:
         raise SvrValueError(f"variable name {name!r} is a predefined item of the data table")
     if kind not in VARIABLE_TYPES:

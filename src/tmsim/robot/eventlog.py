@@ -122,7 +122,7 @@ class LogFile:
 
     def __init__(self, path: str | os.PathLike[str]):
         self.path = str(path)
-        self._file = open(self.path, "ab", buffering=0)
+        self._file = open(self.path, "ab", buffering=0)  # noqa: SIM115 - open for the server's life, closed by close()
         self.size = self._file.tell()
         self.rotations = 0
 
@@ -130,7 +130,7 @@ class LogFile:
         if self.size >= LOG_FILE_BYTES_MAX:
             self._file.close()
             os.replace(self.path, self.path + ".1")
-            self._file = open(self.path, "ab", buffering=0)
+            self._file = open(self.path, "ab", buffering=0)  # noqa: SIM115 - as in __init__
             self.size = 0
             self.rotations += 1
         data = text.encode("utf-8", "backslashreplace")

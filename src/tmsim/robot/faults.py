@@ -1,15 +1,24 @@
 """Fault injection on the outgoing side of one robot (what the server writes, and when).
 
-| fault                | parameters (range)                | effect                                               |
-|----------------------|-----------------------------------|------------------------------------------------------|
-| reply_delay          | seconds=0.5 (0..3600), count=None (1..10^6) | every frame (or the next ``count``) leaves ``seconds`` later (virtual time) |
-| split_replies        | size=1 (1..65536)                 | frames are written in ``size``-byte pieces, one piece per poll |
-| glue_replies         | count=2 (2..1000), max_wait=0.05 (0..60) | frames are held until ``count`` are waiting (or ``max_wait`` s passed), then sent in one send |
-| corrupt_checksum     | count=1, match="" (text)          | the next ``count`` frames (containing ``match``) carry a wrong checksum |
-| close_after          | frames=1                          | the connection is closed after ``frames`` more received frames (replies to them are sent first) |
-| close_mid_frame      | -                                 | the next frame is cut in half and the connection closed |
-| black_hole           | enabled=True                      | received bytes are discarded, nothing is answered    |
-| refuse_connections   | enabled=True                      | the listening socket is closed (connects are refused); existing clients stay |
+fault                parameters (range)
+    effect
+reply_delay          seconds=0.5 (0..3600), count=None (1..10^6)
+    every frame (or the next ``count``) leaves ``seconds`` later (virtual time)
+split_replies        size=1 (1..65536)
+    frames are written in ``size``-byte pieces, one piece per poll
+glue_replies         count=2 (2..1000), max_wait=0.05 (0..60)
+    frames are held until ``count`` are waiting (or ``max_wait`` s passed), then sent in one send
+corrupt_checksum     count=1, match="" (text)
+    the next ``count`` frames (containing ``match``) carry a wrong checksum
+close_after          frames=1
+    the connection is closed after ``frames`` more received frames (replies to them are sent first)
+close_mid_frame      -
+    the next frame is cut in half and the connection closed
+black_hole           enabled=True
+    received bytes are discarded, nothing is answered
+refuse_connections   enabled=True
+    the listening socket is closed (connects are refused); existing clients stay
+
 Session-level faults handled in server.Robot.inject: reply_error, leave_node, stop_project, disconnect.
 Parameters are checked by ``check_params`` (PARAMS below); a value outside its range is a ValueError.
 Clearing the faults (``adopt``) keeps what is held back: it still leaves, whole and in order.

@@ -94,7 +94,7 @@ class Plan:
     duration: float            # motion time without settling/blending adjustments
     ta: float
     total: float               # time until the next FIFO item starts
-    cartesian: Callable[[float], list] | None = None   # s -> TCP matrix in robot coordinates; None = joint interpolation
+    cartesian: Callable[[float], list] | None = None   # s -> TCP matrix in robot coordinates; None: joint motion
     end_pose: list = field(default_factory=list)
     tool: object = None
     start_pose: list = field(default_factory=list)

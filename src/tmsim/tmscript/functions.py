@@ -1,7 +1,7 @@
 """The one table of the TM script language the simulator knows: functions (overloads with parameter and
 return types, queued or immediate), data formats, Robot[0] attributes and IO points, each with the TMflow
-versions that have it. The checker (tmsim.tmscript.static_check) and the interpreter (tmsim.tmscript.interp) read only this table;
-docs/simulator.md lists it ("Version profiles").
+versions that have it. The checker (tmsim.tmscript.static_check) and the interpreter (tmsim.tmscript.interp) read
+only this table; docs/simulator.md lists it ("Version profiles").
 
 Sources: TMscript 2.24 manual (ch. 11 parameterized objects, ch. 13 motion functions, ch. 15 Listen Node);
 "1.8" is what TMflow 1.68-1.84 offer to external scripts (../shared/tm_protocol.md §7), i.e. everything
@@ -13,8 +13,9 @@ V18, V224 = "1.8", "2.24"
 ALL = (V18, V224)
 NEW = (V224,)                    # only in the 2.x function set
 
-F, I, S, B, FA, IA, ANY, VOID, BYTE, BA = ("float", "int", "string", "bool", "float[]", "int[]", "any", "void",
-                                           "byte", "byte[]")
+# one letter per type keeps the table below readable (I is int)
+F, I, S, B, FA, IA, ANY, VOID, BYTE, BA = (  # noqa: E741
+    "float", "int", "string", "bool", "float[]", "int[]", "any", "void", "byte", "byte[]")
 P6 = (F,) * 6
 
 # function -> (queued on the motion FIFO?, [(parameter types, return type, versions), ...])

@@ -69,7 +69,7 @@ class Context:
         self.stop_and_clear = stop_and_clear    # () -> None
         self.log_line = log_line                # (line) -> None
         self.log_event = log_event or (lambda kind, **fields: None)     # (kind, **fields) -> None
-        self.meter = meter or WorkMeter()       # the turn's work (tmsim/tmscript/work.py): a spent turn suspends the script
+        self.meter = meter or WorkMeter()       # the turn's work (tmscript/work.py): a spent turn suspends the script
 
 
 def run_script(lines, ctx: Context):
@@ -331,7 +331,7 @@ def _eval(node, ctx, line):
     if isinstance(node, (ast.Num, ast.Str, ast.Bool)):
         return node.value
     if isinstance(node, ast.Name):
-        return ctx.vars[node.id] if node.id in ctx.vars else node.id     # else: unquoted string constant
+        return ctx.vars.get(node.id, node.id)     # not a variable: an unquoted string constant
     ctx.steps += 1
     if isinstance(node, ast.Array):
         if len(node.items) > ARRAY_MAX:

@@ -10,7 +10,8 @@ One statement per line. Grammar (informal)::
     expr      = or ;  or = and {"||" and} ; and = cmp {"&&" cmp} ; cmp = add [CMPOP add]
     add       = mul {("+"|"-") mul} ; mul = unary {("*"|"/"|"%") unary} ; unary = ("-"|"!"|"+") unary | postfix
     postfix   = primary { "[" expr "]" | "." NAME }
-    primary   = NUMBER | STRING | true | false | NAME ["(" [expr {"," expr}] ")"] | "{" [expr {"," expr}] "}" | "(" expr ")"
+    primary   = NUMBER | STRING | true | false | NAME ["(" [expr {"," expr}] ")"] | "{" [expr {"," expr}] "}"
+              | "(" expr ")"
 
 Bounds (tmsim/limits.py), each a syntax error of its line (``ERROR;line``): at most TOKENS_MAX tokens per
 script (a line that is a call with constant arguments only - a motion line - counts as one), DEPTH_MAX
@@ -433,8 +434,8 @@ _CACHE_LINE = 512          # longer lines are not kept: the cache stays below ~4
 # arrays, escapes, comments, hex, '+' signs, malformed numbers) returns None and takes the full path,
 # which yields the same tree for these lines (tests/sim/test_script.py compares both).
 _LITERAL = r"""(?:-?[ \t]*(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|"[^"\\,]*"|(?:true|false)(?!\w))"""
-_SIMPLE_CALL = re.compile(r"[ \t]*([A-Za-z_]\w*)[ \t]*\(((?:[ \t]*%s[ \t]*(?:,[ \t]*%s[ \t]*)*)?|[ \t]*)\)[ \t]*"
-                          % (_LITERAL, _LITERAL))
+_SIMPLE_CALL = re.compile(rf"[ \t]*([A-Za-z_]\w*)[ \t]*\(((?:[ \t]*{_LITERAL}[ \t]*(?:,[ \t]*{_LITERAL}[ \t]*)*)?"
+                          rf"|[ \t]*)\)[ \t]*")
 
 
 def _simple_call(text: str):

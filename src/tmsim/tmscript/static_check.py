@@ -12,7 +12,7 @@ from __future__ import annotations
 from tmsim.tmscript import functions as table
 from tmsim.tmscript import parser as ast
 
-F, I, S, B, FA, IA, ANY, VOID = "float", "int", "string", "bool", "float[]", "int[]", "any", "void"
+F, I, S, B, FA, IA, ANY, VOID = "float", "int", "string", "bool", "float[]", "int[]", "any", "void"  # noqa: E741 (as functions.py)
 
 
 class CheckError(Exception):
