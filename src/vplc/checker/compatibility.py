@@ -35,5 +35,15 @@ def compatible(src: T.Type, dst: T.Type) -> bool:
     if isinstance(s, T.ArrayType) and isinstance(d, T.ArrayType):
         if len(s.dims) != len(d.dims) or not compatible(s.element, d.element):
             return False
-        return d.open or all((sh - sl) == (dh - dl) for (sl, sh), (dl, dh) in zip(s.dims, d.dims, strict=False))
+        if d.open:
+            return True
+        if s.open:          # the length of an ARRAY[*] in-out is the caller's: it fits no fixed-size array
+            return False
+        return all(_length(sd) == _length(dd) for sd, dd in zip(s.dims, d.dims, strict=False))
     return False
+
+
+def _length(dim: tuple[int | None, int | None]) -> int | None:
+    """Elements in one array dimension (None for an open one)."""
+    lo, hi = dim
+    return None if lo is None or hi is None else hi - lo + 1

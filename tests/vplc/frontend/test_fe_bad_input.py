@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import pytest
+from fe_helpers import check_text
 
 from vplc.frontend import codes
 from vplc.frontend.diagnostics import DiagnosticBag
@@ -45,7 +46,8 @@ def test_missing_file_gives_diagnostic_and_exit_1(tmp_path, run_cli):
 
 
 def test_one_million_character_line_of_valid_code_checks(tmp_path, run_cli):
-    path = _write(tmp_path, "wide.st", "PROGRAM P VAR x : INT; END_VAR x := 1;" + " " * 1_000_000 + "x := x; END_PROGRAM")
+    path = _write(tmp_path, "wide.st",
+                  "PROGRAM P VAR x : INT; END_VAR x := 1;" + " " * 1_000_000 + "x := x; END_PROGRAM")
     result = run_cli("check", path)
     assert result.returncode == 0, result.stdout
 
@@ -57,3 +59,29 @@ def test_a_path_that_cannot_be_read_gives_st0005(tmp_path):
     [d] = diags.items
     assert d.code == codes.FILE_UNREADABLE == "ST0005" and d.is_error
     assert d.message.startswith("cannot read `") and "`: " in d.message   # then the OS's reason
+
+
+OPEN_ARRAY = """
+FUNCTION_BLOCK Fixed
+VAR_IN_OUT Data : ARRAY[0..3] OF INT; END_VAR
+Data[0] := 1;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK Open
+VAR_IN_OUT Data : ARRAY[*] OF INT; END_VAR
+VAR Copy : ARRAY[0..3] OF INT; Inner : Fixed; END_VAR
+Copy := Data;
+Inner(Data := Data);
+Data := Copy;
+END_FUNCTION_BLOCK
+"""
+
+
+def test_an_open_array_where_a_fixed_size_array_is_expected_is_a_type_error_not_a_traceback(tmp_path):
+    """The length of an ARRAY[*] in-out is the caller's: it fits no fixed-size array (copying into the open array
+    is allowed). The checker compared the bounds of both and stopped on the open one's missing bounds."""
+    proj = check_text(tmp_path, OPEN_ARRAY)
+    errors = [(d.code, d.span.file.line_col(d.span.start)[0]) for d in proj.diagnostics if d.is_error]
+    assert errors == [(codes.TYPE_MISMATCH, 10), (codes.ARGUMENT_TYPE, 11)]
+    assert "cannot use a value of type ARRAY[*] OF INT where ARRAY[0..3] OF INT is expected" in \
+        proj.diagnostics[0].message
