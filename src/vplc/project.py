@@ -1,6 +1,7 @@
 """Load ST files into a checked project: ``load_project(paths) -> Project`` (docs/toolchain/frontend_api.md)."""
 from __future__ import annotations
 
+import contextlib
 import gc
 import os
 from dataclasses import dataclass, field
@@ -184,10 +185,10 @@ def _load(paths, dialect: str, include_prelude: bool, portable: bool) -> Project
                 attach_ladders(unit)
                 proj.units.append(unit)
             continue
-        src = read_source(path, diags)
-        if src is None:
+        source = read_source(path, diags)
+        if source is None:
             continue
-        unit = parse(src, diags)
+        unit = parse(source, diags)
         unit.namespace = None if os.path.abspath(path) in prelude_abs else namespace_of(path)
         unit.in_prelude = os.path.abspath(path) in prelude_abs
         unit.vendor = unit.in_prelude and os.path.basename(path) in VENDOR_PRELUDE
@@ -205,7 +206,7 @@ def check_units(ctx: Context, proj: Project) -> None:
     dec = Declarer(ctx)
     for unit in proj.units:
         dec.register(unit)
-    for decl, shell, unit in ctx.type_decls:
+    for _decl, shell, unit in ctx.type_decls:
         if getattr(unit, "vendor", False):
             ctx.vendor_objects.add(id(shell))
     for pou, unit in ctx.pou_units:
@@ -254,8 +255,8 @@ def check_units(ctx: Context, proj: Project) -> None:
     proj._tables = ctx.tables
     for (ns, name), obj in ctx.tables.pous.entries.items():
         proj.pous[f"{ns}\\{name}" if ns else name] = obj
-    for (ns, name), obj in ctx.tables.types.entries.items():
-        proj.types[f"{ns}\\{name}" if ns else name] = obj
+    for (ns, name), ty in ctx.tables.types.entries.items():
+        proj.types[f"{ns}\\{name}" if ns else name] = ty
     proj.globals = dict(ctx.tables.globals)
 
 
@@ -280,10 +281,8 @@ def check_configuration(ctx: Context, cfg: A.Configuration, unit) -> None:
             if inst.task is not None and inst.task.upper() not in tasks:
                 ctx.diags.error(codes.UNDECLARED, f"task `{inst.task}` is not declared in this resource", inst.span)
             pt = None
-            try:
+            with contextlib.suppress(Ambiguous):
                 pt = ctx.tables.pous.lookup(inst.program.name, inst.program.namespace, unit.namespace)
-            except Ambiguous:
-                pass
             if pt is None or pt.kind != "program":
                 ctx.diags.error(codes.UNDECLARED, f"`{inst.program.text()}` is not a PROGRAM", inst.span)
                 continue

@@ -35,7 +35,8 @@ def check_slice(ck, element, param_type, param_name: str) -> None:
     index = const_int(element.indices[0], ck.ctx, ck.scope)
     if index is None:
         return
-    lo, hi = base.dims[0]
+    _, hi = base.dims[0]
+    assert hi is not None                   # not open (returned above)
     remaining = hi - index + 1
     if 0 < remaining < param_type.count():
         ck.ctx.diags.error(codes.OUT_OF_BOUNDS, f"only {remaining} element(s) of `{ck.text(element.base)}` remain from "

@@ -147,7 +147,7 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
         if p.direction == "inout" and p.index not in bound:
             ctx.diags.error(codes.MISSING_IN_OUT, f"in-out parameter `{p.name}` of {pt.name} must be given "
                             f"(`{p.name} := <variable>`)", e.span)
-    e.binding = CallBinding(kind, pt.ret if kind == "function" else T.VOID, pou=pt, instance=instance,
+    e.binding = CallBinding(kind, (pt.ret or T.VOID) if kind == "function" else T.VOID, pou=pt, instance=instance,
                             args=[bound[i] for i in sorted(bound)])
     return e.binding.ty
 
@@ -163,7 +163,7 @@ def _iec_alias(pt: T.PouType, name: str):
 
 def _unknown_param(ck, arg: A.Arg, pt: T.PouType) -> None:
     names = [p.name for p in pt.params]
-    close = difflib.get_close_matches(arg.name.upper(), [n.upper() for n in names], n=1, cutoff=0.7)
+    close = difflib.get_close_matches((arg.name or "").upper(), [n.upper() for n in names], n=1, cutoff=0.7)
     notes = [f"did you mean `{names[[n.upper() for n in names].index(close[0])]}`?"] if close else []
     notes.append(f"parameters of {pt.name}: " + (", ".join(names) or "none"))
     ck.ctx.diags.error(codes.UNKNOWN_PARAMETER, f"{pt.name} has no parameter `{arg.name}`", arg.span, notes)
@@ -193,9 +193,9 @@ def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
         return ba
     have = ck.expr(value, None if isinstance(pty, T.ArrayType) or is_generic(pty) else p.type)
     if isinstance(pty, T.ArrayType) and isinstance(value, A.Index) and not isinstance(T.unalias(have), T.ArrayType) \
-            and not T.is_error(have):
-        if (is_generic(pty.element) and pty.element.accepts(have)) or (
-                compatible(have, pty.element) and T.same_type(T.base_of(have), T.base_of(pty.element))):
+            and not T.is_error(have) and (
+                (is_generic(pty.element) and pty.element.accepts(have)) or (
+                    compatible(have, pty.element) and T.same_type(T.base_of(have), T.base_of(pty.element)))):
             ba.from_element = True
             array_bounds.check_slice(ck, value, pty, p.name)
             if p.direction == "inout":
@@ -242,19 +242,21 @@ def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
         if arg.output:
             ctx.diags.error(codes.WRONG_DIRECTION, f"{b.name} has no outputs; `=>` cannot be used", arg.span)
             continue
+        value = arg.value
+        assert value is not None            # only an output (`=>`) may leave its value out
         if arg.name is None:
-            values.append(arg.value)
+            values.append(value)
             continue
         up = arg.name.upper()
         if up in formal_names:
-            by_name[formal_names.index(up)] = arg.value
+            by_name[formal_names.index(up)] = value
         elif up.startswith("IN") and up[2:].isdigit() and b.max_args is None:
-            by_name[int(up[2:]) - 1] = arg.value
+            by_name[int(up[2:]) - 1] = value
         else:
             ctx.diags.error(codes.UNKNOWN_PARAMETER, f"{b.name} has no parameter `{arg.name}`"
                             + (f"; its parameters are {', '.join(b.formal_names)}" if b.formal_names else ""),
                             arg.span)
-            ck.expr(arg.value)
+            ck.expr(value)
     if by_name:
         if values:
             ctx.diags.error(codes.NON_FORMAL_AFTER_FORMAL,
@@ -281,11 +283,12 @@ def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
     if hint is None and expected is not None and b.name in ("MAX", "MIN", "LIMIT", "SEL", "MUX", "ABS", "ADD",
                                                             "MUL", "SUB", "DIV", "MOD", "MOVE"):
         hint = expected
+    arg_types: list[T.Type] = []
     for i, v in enumerate(values):
-        if types_[i] is None:
-            types_[i] = ck.expr(v, hint)
+        t = types_[i]
+        arg_types.append(t if t is not None else ck.expr(v, hint))
     try:
-        ret, convs = b.resolve(types_, ctx.dialect)
+        ret, convs = b.resolve(arg_types, ctx.dialect)
     except B.SignatureError as err:
         span = values[err.arg_index].span if err.arg_index is not None and err.arg_index < n else e.span
         ctx.diags.error(codes.ARGUMENT_TYPE, f"{b.name}: {err}", span)
@@ -295,6 +298,6 @@ def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
         if conv is not None and v.conv is None and not T.is_error(conv):
             v.conv = conv
         name = b.formal_names[i] if i < len(b.formal_names) else f"IN{i + 1}"
-        args.append(BoundArg(T.Param(name, "in", types_[i], i), v))
+        args.append(BoundArg(T.Param(name, "in", arg_types[i], i), v))
     e.binding = CallBinding("builtin", ret, builtin=b, args=args)
     return ret

@@ -4,7 +4,7 @@ from __future__ import annotations
 from ..frontend import ast as A
 
 
-def const_int(e: A.Expr, ctx, scope, _depth: int = 0) -> int | None:
+def const_int(e: A.Expr | None, ctx, scope, _depth: int = 0) -> int | None:
     """Value of a constant integer expression, or None. ``scope`` maps NAME → VarSymbol (locals) or None."""
     if _depth > 50 or e is None:
         return None

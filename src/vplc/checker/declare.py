@@ -35,9 +35,9 @@ class Declarer:
         self.meter = data_size.Meter(ctx)
 
     # ---- pass 1: names --------------------------------------------------------------------------
-    def register(self, unit: A.CompilationUnit) -> None:
-        file_unit = unit
+    def register(self, file_unit: A.CompilationUnit) -> None:
         views: dict[str, NamespaceView] = {}
+        unit: A.CompilationUnit | NamespaceView
         for item in file_unit.items:
             inner = getattr(item, "declared_namespace", None)
             if inner:
@@ -95,9 +95,10 @@ class Declarer:
                 if isinstance(decl.spec, A.SubrangeTypeRef) and isinstance(shell.target, T.SubrangeType):
                     shell.target.alias = decl.name
         self.struct_cycles()
-        for decl, shell, unit in self.ctx.type_decls:   # alias cycles
+        for decl, shell, _unit in self.ctx.type_decls:   # alias cycles
             if isinstance(shell, T.AliasType):
-                seen, t = set(), shell
+                seen: set[int] = set()
+                t: T.Type = shell
                 while isinstance(t, T.AliasType):
                     if id(t) in seen:
                         self.ctx.diags.error(codes.UNKNOWN_TYPE, f"data type {decl.name} is defined in terms of itself",
@@ -221,7 +222,7 @@ class Declarer:
             cap = n - 1 if ctx.dialect == "sysmac" else n
             return T.StringType(n, ref.wide, capacity=cap)
         if isinstance(ref, A.ArrayTypeRef):
-            dims = []
+            dims: list[tuple[int | None, int | None]] = []
             for d in ref.dims:
                 if d.lo is None:
                     ctx.note_edition3("an open array bound `ARRAY[*]`", d.span)
@@ -240,7 +241,7 @@ class Declarer:
         if isinstance(ref, A.SubrangeTypeRef):
             base = T.base_of(self.resolve(ref.base, unit, scope))
             lo, hi = const_int(ref.lo, ctx, scope), const_int(ref.hi, ctx, scope)
-            if not T.is_int(base) or lo is None or hi is None or hi < lo:
+            if not isinstance(base, T.ElementaryType) or not T.is_int(base) or lo is None or hi is None or hi < lo:
                 ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
                                 "a subrange needs an integer base type and constant bounds lo..hi",
                                 ref.span)

@@ -11,6 +11,7 @@ Failing::
 from __future__ import annotations
 
 from ..frontend import codes
+from .symbols import VarSymbol
 
 CODE = codes.DUPLICATE_NAME
 
@@ -27,7 +28,7 @@ def report(ctx, what: str, name: str, span, previous) -> None:
 
 def check_locals(ctx, pou) -> dict:
     """Build the local scope of a POU (NAME → VarSymbol), reporting duplicates; returns the scope."""
-    scope = {}
+    scope: dict[str, VarSymbol | None] = {}
     for section in pou.sections:
         for decl in section.vars:
             up = decl.name.upper()

@@ -50,11 +50,11 @@ class ExprChecker:
     checker. Calls bound here are collected in ``calls_made`` (recursion.py).
     """
 
-    def __init__(self, ctx, ns: str | None, scope: dict[str, VarSymbol] | None = None,
+    def __init__(self, ctx, ns: str | None, scope: dict[str, VarSymbol | None] | None = None,
                  result_sym: VarSymbol | None = None, in_pou: bool = False, flow: Flow | None = None) -> None:
         self.ctx = ctx
         self.ns = ns
-        self.scope: dict[str, VarSymbol] = scope if scope is not None else {}
+        self.scope: dict[str, VarSymbol | None] = scope if scope is not None else {}
         self.result_sym = result_sym
         self.in_pou = in_pou
         self.flow = flow if flow is not None else Flow()
@@ -159,9 +159,11 @@ class ExprChecker:
     def real_fits(self, e, t) -> None:
         """ST1107 for a real literal that overflows its type (REAL ±3.4028235E38, LREAL ±1.7976931E308)."""
         value = e.value
-        limit = _REAL_ROUNDS_TO_MAX if T.is_real(t) and T.base_of(t).bits == 32 else math.inf
+        base = T.base_of(t)
+        real = base if isinstance(base, T.ElementaryType) and base.kind == "real" else None
+        limit = _REAL_ROUNDS_TO_MAX if real is not None and real.bits == 32 else math.inf
         if isinstance(value, float) and (math.isinf(value) or abs(value) >= limit):
-            rt = T.base_of(t) if T.is_real(t) else T.LREAL
+            rt = real if real is not None else T.LREAL
             self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
                                  f"{e.text or value} does not fit in {rt.name} (±{rt.hi:.8g})", e.span)
 
@@ -174,9 +176,10 @@ class ExprChecker:
             return t
         if exp is not None and isinstance(T.base_of(exp), T.ElementaryType) and \
                 T.base_of(exp).kind in ("int", "uint", "bit", "real"):
-            if not T.literal_fits(value, exp):
-                rng = f"{exp.lo}..{exp.hi}" if not isinstance(exp, T.SubrangeType) else f"{exp.lo}..{exp.hi}"
-                self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE, f"{value} does not fit in {exp.name} ({rng})", e.span)
+            # literal_fits() is True for every type without bounds
+            if isinstance(exp, (T.SubrangeType, T.ElementaryType)) and not T.literal_fits(value, exp):
+                self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE, f"{value} does not fit in {exp.name} "
+                                     f"({exp.lo}..{exp.hi})", e.span)
             return T.base_of(exp)
         for t in (T.DINT, T.LINT, T.ULINT):
             if T.literal_fits(value, t):

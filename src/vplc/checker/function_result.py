@@ -29,12 +29,12 @@ def _assigns(stmts, result) -> bool | None:
             return True
         if isinstance(s, A.Return):
             return False
-        if isinstance(s, A.If) and s.else_body is not None:
-            if all(_assigns(b.body, result) for b in s.branches) and _assigns(s.else_body, result):
-                return True
-        if isinstance(s, A.Case) and s.else_body is not None:
-            if all(_assigns(b.body, result) for b in s.branches) and _assigns(s.else_body, result):
-                return True
+        if isinstance(s, A.If) and s.else_body is not None and \
+                all(_assigns(b.body, result) for b in s.branches) and _assigns(s.else_body, result):
+            return True
+        if isinstance(s, A.Case) and s.else_body is not None and \
+                all(_assigns(cb.body, result) for cb in s.branches) and _assigns(s.else_body, result):
+            return True
         if isinstance(s, A.CallStmt) and s.call.binding is not None:
             for ba in s.call.binding.args:
                 if ba.param.direction == "out" and isinstance(ba.expr, A.Name) and ba.expr.sym is result:

@@ -65,7 +65,7 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
         elif isinstance(node, A.VarSection) and node.kind == "VAR_STAT":
             ctx.diags.warning(codes.PORTABLE_NOT_EDITION_2,
                               "VAR_STAT is not IEC 61131-3 2nd edition; use VAR", node.span)
-    for style, start, end in unit.comments or ():
+    for style, start, _end in unit.comments or ():
         if style != "(*":
             ctx.diags.warning(codes.PORTABLE_NOT_EDITION_2,
                               f"`{style}` comments are not IEC 61131-3 2nd edition; write (* ... *)",

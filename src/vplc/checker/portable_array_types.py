@@ -42,7 +42,7 @@ def check_unit(ctx, unit: A.CompilationUnit) -> None:
                 if isinstance(T.unalias(ba.param.type), T.ArrayType) and (
                         _anonymous_array(ba.param.type) or _anonymous_array(ba.expr.ty)):
                     _warn(ctx, ba.expr.span, f"array passed to `{ba.param.name}` of {node.binding.pou.name}")
-        elif isinstance(node, A.Assign) and node.target.ty is not None and node.value.ty is not None:
-            if isinstance(T.unalias(node.target.ty), T.ArrayType) and (
+        elif isinstance(node, A.Assign) and node.target.ty is not None and node.value.ty is not None and \
+                isinstance(T.unalias(node.target.ty), T.ArrayType) and (
                     _anonymous_array(node.target.ty) or _anonymous_array(node.value.ty)):
-                _warn(ctx, node.span, "whole array assigned")
+            _warn(ctx, node.span, "whole array assigned")

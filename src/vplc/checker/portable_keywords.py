@@ -21,7 +21,8 @@ from ..frontend import codes
 SFC = ["STEP", "END_STEP", "INITIAL_STEP", "TRANSITION", "END_TRANSITION", "FROM", "ACTION", "END_ACTION"]
 CONFIG = ["TASK", "ON", "WITH", "READ_ONLY", "READ_WRITE", "SINGLE", "INTERVAL", "PRIORITY", "AT", "VAR_ACCESS"]
 OTHER = ["EN", "ENO", "R_EDGE", "F_EDGE"]
-TYPES = ["BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL", "TIME", "DATE", "TIME_OF_DAY", "TOD", "DATE_AND_TIME", "DT", "BYTE", "WORD", "DWORD", "LWORD"]
+TYPES = ["BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL", "TIME", "DATE",
+         "TIME_OF_DAY", "TOD", "DATE_AND_TIME", "DT", "BYTE", "WORD", "DWORD", "LWORD"]
 KIND = {**{w: "a keyword of the sequential function chart (SFC)" for w in SFC},
         **{w: "a keyword of the configuration grammar" for w in CONFIG},
         **{w: "a reserved IEC 61131-3 keyword" for w in OTHER},

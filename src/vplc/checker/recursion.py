@@ -56,9 +56,9 @@ def instance_edges(pt: T.PouType, decls) -> list:
     """Edges from FB/program instances declared inside ``pt`` (an FB containing itself recurses)."""
     out = []
     for d in decls:
-        t = d.sym.type if d.sym is not None else None
-        while isinstance(T.unalias(t), T.ArrayType):
-            t = T.unalias(t).element
-        if isinstance(T.unalias(t), T.PouType):
-            out.append((T.unalias(t), d.span))
+        t = T.unalias(d.sym.type) if d.sym is not None else None
+        while isinstance(t, T.ArrayType):
+            t = T.unalias(t.element)
+        if isinstance(t, T.PouType):
+            out.append((t, d.span))
     return out

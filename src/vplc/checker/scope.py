@@ -6,6 +6,7 @@ library namespace where it is unique (else ST1003 ambiguous). ``Ns\\Name`` looks
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Generic, TypeGuard, TypeVar
 
 from ..frontend import types as T
 from .symbols import EnumValueSymbol, VarSymbol
@@ -14,8 +15,7 @@ GENERIC_TYPES: dict[str, T.SpecialType] = {}
 
 
 def _generic(name: str, pred, shown: str | None = None) -> None:
-    t = T.SpecialType(shown or name, "generic")
-    t.accepts = pred  # type: ignore[attr-defined]
+    t = T.SpecialType(shown or name, "generic", pred)
     GENERIC_TYPES[name] = t
 
 
@@ -38,7 +38,7 @@ _generic("ANY_DATE", T.is_date_like)
 _generic("ANY_ENUM", lambda t: isinstance(T.base_of(t), T.EnumType), "an enumeration")
 
 
-def is_generic(t: T.Type) -> bool:
+def is_generic(t: T.Type) -> TypeGuard[T.SpecialType]:
     return isinstance(t, T.SpecialType) and t.kind == "generic"
 
 
@@ -48,13 +48,16 @@ class Ambiguous(Exception):
         self.candidates = candidates
 
 
-@dataclass
-class NamedTable:
-    """Maps (namespace, NAME) → object; namespace '' is the global namespace."""
-    entries: dict[tuple[str, str], object] = field(default_factory=dict)
-    by_name: dict[str, list[tuple[str, object]]] = field(default_factory=dict)
+E = TypeVar("E")
 
-    def add(self, ns: str | None, name: str, obj) -> object | None:
+
+@dataclass
+class NamedTable(Generic[E]):
+    """Maps (namespace, NAME) → entry; namespace '' is the global namespace."""
+    entries: dict[tuple[str, str], E] = field(default_factory=dict)
+    by_name: dict[str, list[tuple[str, E]]] = field(default_factory=dict)
+
+    def add(self, ns: str | None, name: str, obj: E) -> E | None:
         """Register; returns the previous object with the same key (a duplicate) or None."""
         key = ((ns or "").upper(), name.upper())
         prev = self.entries.get(key)
@@ -64,7 +67,7 @@ class NamedTable:
         self.by_name.setdefault(name.upper(), []).append((ns or "", obj))
         return None
 
-    def lookup(self, name: str, namespace: tuple[str, ...] = (), from_ns: str | None = None):
+    def lookup(self, name: str, namespace: tuple[str, ...] = (), from_ns: str | None = None) -> E | None:
         up = name.upper()
         if namespace:
             return self.entries.get(("\\".join(namespace).upper(), up))
@@ -90,8 +93,8 @@ class NamedTable:
 
 @dataclass
 class Tables:
-    pous: NamedTable = field(default_factory=NamedTable)
-    types: NamedTable = field(default_factory=NamedTable)
+    pous: NamedTable[T.PouType] = field(default_factory=NamedTable)
+    types: NamedTable[T.Type] = field(default_factory=NamedTable)
     globals: dict[str, VarSymbol] = field(default_factory=dict)
     enum_values: dict[str, list[EnumValueSymbol]] = field(default_factory=dict)
 

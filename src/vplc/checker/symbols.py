@@ -27,7 +27,8 @@ class VarSymbol:
     global_list: str | None = None
     target: VarSymbol | None = None
     used: bool = False
-    at_address: Any = None          # a global in a Sysmac memory area: (area, bank, word, bit, layout, words), at_address.py
+    at_address: Any = None          # a global in a Sysmac memory area (at_address.py):
+                                    # (area, bank, word, bit, layout, words)
 
     @property
     def is_global(self) -> bool:

@@ -35,6 +35,12 @@ class InNamespace:
     declared_namespace: str | None = None
 
 
+class ArrayOutputMark:
+    """Set by the checker on ``instance.Output`` when that output is an array: ``fb_array_output`` names it
+    (``FbType.Output``) for the rule on indexing it (ST1008). Not a dataclass field."""
+    fb_array_output: str | None = None
+
+
 class LoadedFrom:
     """Where the loader (vplc.project) found a file: ``in_prelude`` for the prelude every project sees,
     ``vendor`` for its Sysmac files (their objects are the vendor's). Not dataclass fields."""
@@ -172,7 +178,7 @@ class EnumLiteral(Expr):
 
 
 @dataclass(eq=True)
-class Member(Expr):
+class Member(Expr, ArrayOutputMark):
     """``base.member``."""
     base: Expr
     member: str

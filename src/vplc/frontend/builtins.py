@@ -126,7 +126,8 @@ def _mux(args, dialect):
 
 
 def _shift(args, dialect):
-    _need(lambda t: T.is_bits(t) and T.base_of(t) is not T.BOOL or T.is_int(t), args[0], 0, "a bit string (BYTE..LWORD)")
+    _need(lambda t: T.is_bits(t) and T.base_of(t) is not T.BOOL or T.is_int(t), args[0], 0,
+          "a bit string (BYTE..LWORD)")
     _need(T.is_int, args[1], 1, "an integer")
     return (T.base_of(args[0]) if not T.is_error(args[0]) else T.ERROR), [None, None]
 
@@ -177,7 +178,7 @@ def _string_fn(pattern: str) -> Callable:
                 _need(T.is_string, a, i, "a STRING")
             else:
                 _need(T.is_int, a, i, "an integer")
-        wide = any(T.is_string(a) and T.base_of(a).wide for a in args)
+        wide = any(isinstance(bt := T.base_of(a), T.StringType) and bt.wide for a in args)
         return (default_string(dialect, wide)), [None] * len(args)
     return resolve
 
@@ -185,7 +186,7 @@ def _string_fn(pattern: str) -> Callable:
 def _concat(args, dialect):
     for i, a in enumerate(args):
         _need(T.is_string, a, i, "a STRING")
-    wide = any(T.is_string(a) and T.base_of(a).wide for a in args)
+    wide = any(isinstance(bt := T.base_of(a), T.StringType) and bt.wide for a in args)
     return default_string(dialect, wide), [None] * len(args)
 
 
@@ -388,8 +389,11 @@ def lookup(name: str) -> Builtin | None:
         return b
     if up.startswith("TRUNC_") and up[6:] in T.ELEMENTARY and T.is_int(T.ELEMENTARY[up[6:]]):
         target = T.ELEMENTARY[up[6:]]
-        b = Builtin(up, 1, 1, lambda args, d, _t=target: (_need(T.is_real, args[0], 0, "REAL or LREAL"), (_t, [None]))[1],
-                    ("IN",))
+
+        def truncate(args, dialect, _t=target):
+            _need(T.is_real, args[0], 0, "REAL or LREAL")
+            return _t, [None]
+        b = Builtin(up, 1, 1, truncate, ("IN",))
         BUILTINS[up] = b
         return b
     return None

@@ -108,7 +108,8 @@ def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None
     bad_start = -1
     while pos < n:
         m = match(text, pos)
-        kind = m.lastgroup
+        assert m is not None            # the last alternative, BAD, matches any one character
+        kind = m.lastgroup or "BAD"     # every alternative is a named group
         end = m.end()
         if kind == "BAD":
             if bad_start < 0:

@@ -31,7 +31,7 @@ def _wrap(e: A.Expr, need: bool) -> str:
     return f"({s})" if need else s
 
 
-def _expr(e: A.Expr) -> str:
+def _expr(e: A.Expr | None) -> str:
     if isinstance(e, A.Literal):
         return e.text or repr(e.value)
     if isinstance(e, A.Name):
@@ -140,11 +140,11 @@ def statement(s: A.Stmt, level: int) -> list[str]:
         return out + [f"{pad}END_IF;"]
     if isinstance(s, A.Case):
         out = [f"{pad}CASE {_expr(s.selector)} OF"]
-        for b in s.branches:
+        for cb in s.branches:
             labels = ", ".join(f"{_expr(lb.lo)}..{_expr(lb.hi)}" if isinstance(lb, A.CaseRange) else _expr(lb)
-                               for lb in b.labels)
+                               for lb in cb.labels)
             out.append(f"{pad}{IND}{labels}:")
-            out += statements(b.body, level + 2)
+            out += statements(cb.body, level + 2)
         if s.else_body is not None:
             out.append(f"{pad}ELSE")
             out += statements(s.else_body, level + 2)

@@ -7,6 +7,7 @@ object per declaration. ``unalias(t)`` strips alias types.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -111,7 +112,7 @@ class ArrayType(Type):
     def count(self) -> int:
         n = 1
         for lo, hi in self.dims:
-            n *= 0 if lo is None else (hi - lo + 1)
+            n *= 0 if lo is None or hi is None else (hi - lo + 1)
         return n
 
     def __eq__(self, other: object) -> bool:
@@ -220,11 +221,17 @@ class PouType(Type):
 
 class SpecialType(Type):
     """VOID (no value), ERROR (after a reported error: compatible with everything, silences cascades),
-    and the generic ANY_* families used only in builtin signatures."""
+    and the generic ANY_* families used only in builtin signatures (kind "generic", with the test of their
+    members in ``member``)."""
 
-    def __init__(self, name: str, kind: str) -> None:
+    def __init__(self, name: str, kind: str, member: Callable[[Type], bool] | None = None) -> None:
         self.name = name
         self.kind = kind
+        self.member = member
+
+    def accepts(self, t: Type) -> bool:
+        """A generic family: is ``t`` one of its members? (VOID and ERROR have none.)"""
+        return self.member is not None and self.member(t)
 
 
 VOID = SpecialType("VOID", "void")
@@ -444,7 +451,7 @@ def literal_fits(value: int, t: Type) -> bool:
     t = unalias(t)
     if isinstance(t, SubrangeType):
         return t.lo <= value <= t.hi
-    if isinstance(t, ElementaryType) and t.kind in ("int", "uint", "bit"):
+    if isinstance(t, ElementaryType) and t.kind in ("int", "uint", "bit") and t.lo is not None and t.hi is not None:
         return t.lo <= value <= t.hi
     return True
 
