@@ -100,7 +100,7 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def check_vision_jobs(args) -> tuple[list[str], list[dict]]:
+def check_vision_jobs(args: argparse.Namespace) -> tuple[list[str], list[dict]]:
     """(one line per --vision-job that cannot be defined, the jobs as camera.define arguments)."""
     problems, jobs = [], []
     for spec in getattr(args, "vision_job", []):
@@ -114,7 +114,7 @@ def check_vision_jobs(args) -> tuple[list[str], list[dict]]:
     return problems, jobs
 
 
-def check_variables(args) -> tuple[list[str], list]:
+def check_variables(args: argparse.Namespace) -> tuple[list[str], list]:
     """(one line per --svr-var that cannot be declared, the declared (Item, value) pairs)."""
     problems, variables, seen = [], [], set()
     for spec in args.svr_var:
@@ -132,7 +132,7 @@ def check_variables(args) -> tuple[list[str], list]:
 
 
 
-def check_args(args) -> tuple[list[str], int | None, list[str]]:
+def check_args(args: argparse.Namespace) -> tuple[list[str], int | None, list[str]]:
     """(one line per argument outside its range, Ethernet Slave port or None, its data-table items)."""
     problems = []
     if not 1 <= args.robots <= 512:
@@ -169,7 +169,7 @@ def check_args(args) -> tuple[list[str], int | None, list[str]]:
     return problems, svr_port, svr_items
 
 
-def control_port(args) -> int:
+def control_port(args: argparse.Namespace) -> int:
     """--control-port as given; by default the port before robot 1's (5889 for 5890), so two simulators on
     different --port values do not collide, and any free port (printed at start) when that one is taken."""
     if args.control_port is not None:
@@ -186,7 +186,7 @@ def control_port(args) -> int:
     return derived
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     problems, svr_port, svr_items = check_args(args)

@@ -37,7 +37,8 @@ import json
 import math
 import selectors
 import socket
-from typing import TYPE_CHECKING
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
 
 from tmsim.limits import (
     CONTROL_ANSWER_BYTES,
@@ -67,19 +68,19 @@ from tmsim.protocol.control import (
 from tmsim.protocol.listen_session import TransitionError
 
 if TYPE_CHECKING:
-    from tmsim.net.ethernet_slave import SlaveService
-    from tmsim.net.server import Robot
+    from tmsim.net.ethernet_slave import EthernetSlave, SlaveService
+    from tmsim.net.server import Robot, SimServer
 
 
 class _Client:
     __slots__ = ("sock", "rbuf", "wbuf", "closing", "encoding", "pieces")
 
-    def __init__(self, sock):
+    def __init__(self, sock: socket.socket):
         self.sock = sock
         self.rbuf = bytearray()
         self.wbuf = bytearray()
         self.closing = False
-        self.encoding = None                # the pieces of a large answer still to encode (an iterator)
+        self.encoding: Iterator[str] | None = None    # the pieces of a large answer still to encode (an iterator)
         self.pieces: list[str] = []         # ... and those encoded so far
 
 
@@ -93,7 +94,7 @@ _PIECES = json.JSONEncoder(allow_nan=False, ensure_ascii=False)
 
 
 class ControlChannel:
-    def __init__(self, server, host="127.0.0.1", port=0):
+    def __init__(self, server: SimServer, host: str = "127.0.0.1", port: int = 0):
         self.server = server
         server.handle("control_listen", self._accept)
         server.handle("control_conn", self._serve_client)
@@ -128,7 +129,7 @@ class ControlChannel:
         }
 
     # ---- sockets ------------------------------------------------------------------------------
-    def _accept(self, _robot, _conn):
+    def _accept(self, _robot: None, _conn: None) -> None:
         accepted = self.listener.accept(self.server.now, self.server.log_server, prefix="control_")
         if accepted is None:
             return
@@ -140,11 +141,11 @@ class ControlChannel:
         self.clients[sock] = _Client(sock)
         self.server.selector.register(sock, selectors.EVENT_READ, ("control_conn", None, sock))
 
-    def tick(self, now):
+    def tick(self, now: float) -> None:
         """Called once a poll: resume accepting after a pause."""
         self.listener.tick(now)
 
-    def _serve_client(self, _robot, sock):
+    def _serve_client(self, _robot: None, sock: socket.socket) -> None:
         """The socket is ready: write what waits, then read; the requests are answered in the client's turn
         (``serve_backlog``, right after in the same poll). A client who has requests left over from its
         last turn is not read meanwhile."""
@@ -164,7 +165,7 @@ class ControlChannel:
         client.rbuf += data
         self.backlog[sock] = client             # its turn comes in serve_backlog, between the robots' turns
 
-    def _turn(self, client):
+    def _turn(self, client: _Client) -> None:
         """Answer at most CONTROL_TURN_REQUESTS requests of ``client``, and none more once the answers of this
         turn reach CONTROL_TURN_BYTES (a turn is bounded in work: 15 clients each sending 64 KiB of requests
         must not hold the robots' servers); the rest waits in ``backlog`` for the next turn."""
@@ -210,7 +211,7 @@ class ControlChannel:
         if client.closing and not client.wbuf:
             self._close(sock)
 
-    def serve_backlog(self):
+    def serve_backlog(self) -> None:
         """One turn for every client with requests left over (round robin). A client that does not read its
         answers piles them up and is closed at CONTROL_OUTBOX_MAX (``_answer``)."""
         for sock, client in list(self.backlog.items()):
@@ -282,7 +283,7 @@ class ControlChannel:
             return False
         return True
 
-    def _close(self, sock, reason=None):
+    def _close(self, sock: socket.socket, reason: str | None = None) -> None:
         self.backlog.pop(sock, None)
         if self.clients.pop(sock, None) is not None and reason:
             self.server.log_server("control_closed", reason=reason)
@@ -290,7 +291,7 @@ class ControlChannel:
             self.server.selector.unregister(sock)
         sock.close()
 
-    def close(self):
+    def close(self) -> None:
         for sock in list(self.clients):
             self._close(sock)
         self.listener.close()
@@ -319,11 +320,11 @@ class ControlChannel:
             return error_answer(f"internal error of the simulator ({type(exc).__name__}: {exc})")
 
     @staticmethod
-    def _state(robot):
+    def _state(robot: Robot) -> dict:
         state = robot.state()
         return _Streamed(state) if robot.session.variable_bytes() > CONTROL_TURN_BYTES else state
 
-    def _svr_config(self, robot, request):
+    def _svr_config(self, robot: Robot, request: dict) -> dict:
         session = _svr(robot).session
         items = request.get("items")
         if items is not None and not (isinstance(items, list) and all(isinstance(i, str) for i in items)):
@@ -340,7 +341,7 @@ class ControlChannel:
             session.configure(items, mode, period, write_permission=permission)
             return session.config()
 
-    def _set_input(self, robot, request):
+    def _set_input(self, robot: Robot, request: dict) -> None:
         """An input of the robot changes as a wired sensor would change it (RobotDataSource.set_input checks the
         item and the value and names either when it is refused)."""
         source = _svr(robot).source
@@ -350,29 +351,35 @@ class ControlChannel:
         with self.server.lock:
             source.set_input(name, request["value"])
 
-    def _svr_inject(self, robot, request):
-        _svr(robot)
-        self.server.svr.inject(robot, text_field(request, "fault"), **fault_params(request))
+    def _svr_inject(self, robot: Robot, request: dict) -> None:
+        self._slave_adapter(robot).inject(robot, text_field(request, "fault"), **fault_params(request))
 
-    def _svr_clear_faults(self, robot, _request):
-        _svr(robot)
-        self.server.svr.clear_faults(robot)
+    def _svr_clear_faults(self, robot: Robot, _request: dict) -> None:
+        self._slave_adapter(robot).clear_faults(robot)
 
-    def _vision_job(self, robot, request):
+    def _slave_adapter(self, robot: Robot) -> EthernetSlave:
+        """The server's Ethernet Slave adapter; RequestError when the simulator runs none."""
+        _svr(robot)
+        adapter = self.server.svr
+        if adapter is None:
+            raise RequestError(_NO_SLAVE)
+        return adapter
+
+    def _vision_job(self, robot: Robot, request: dict) -> Any:
         """A vision job of the robot's project and what it finds (tmsim/robot/camera.py checks every value)."""
         with self.server.lock:
             return robot.camera().define(
                 name=request.get("job"), objects=request.get("objects", []), passed=request.get("pass", True),
                 seconds=request.get("seconds", 0.2), capture=request.get("capture"), variable=request.get("variable"))
 
-    def _vision_remove(self, robot, request):
+    def _vision_remove(self, robot: Robot, request: dict) -> Any:
         with self.server.lock:
             return robot.camera().remove(text_field(request, "job"))
 
-    def _vision(self, robot, _request):
+    def _vision(self, robot: Robot, _request: dict) -> Any:
         return robot.camera().state()
 
-    def _events(self, robot, request):
+    def _events(self, robot: Robot, request: dict) -> dict:
         since = int_field(request, "since", 0, 0, None, "since must be 0 or more, got {}")
         first = robot.events_dropped
         start = max(since, first)
@@ -394,15 +401,18 @@ def robot_numbering(count: int) -> str:
     return f'"robot": 0 to {count - 1} are robots 1 to {count}'
 
 
+_NO_SLAVE = "the Ethernet Slave is not running (simulator started with --no-svr)"
+
+
 def _svr(robot: Robot) -> SlaveService:
     """The robot's Ethernet Slave; RequestError when the simulator runs none."""
     service = robot.slave
     if service is None:
-        raise RequestError("the Ethernet Slave is not running (simulator started with --no-svr)")
+        raise RequestError(_NO_SLAVE)
     return service
 
 
-def request(port: int, payload: dict, host="127.0.0.1", timeout=5.0) -> dict:
+def request(port: int, payload: dict, host: str = "127.0.0.1", timeout: float = 5.0) -> dict:
     """Send one control request and return the decoded answer (helper for scripts and tests)."""
     with socket.create_connection((host, port), timeout=timeout) as sock:
         sock.sendall((json.dumps(payload) + "\n").encode())

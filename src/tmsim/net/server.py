@@ -21,10 +21,12 @@ from __future__ import annotations
 import contextlib
 import gc
 import math
+import os
 import selectors
 import socket
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 from tmsim.limits import (
@@ -64,7 +66,7 @@ class Conn:
     """One client socket of a robot; what it received waits in the robot's session (``buffer_data``)."""
     __slots__ = ("sock", "id", "wbuf", "eof", "peer", "greedy", "_session")
 
-    def __init__(self, sock, conn_id, peer, session):
+    def __init__(self, sock: socket.socket, conn_id: int, peer: str, session: ListenSession):
         self.sock, self.id, self.peer = sock, conn_id, peer
         self.wbuf = bytearray()
         self.eof = False
@@ -155,27 +157,27 @@ class Robot:
         return self.log.wait_event(kind, timeout, since, **fields)
 
     # ---- control ------------------------------------------------------------------------------
-    def enter_listen_node(self):
+    def enter_listen_node(self) -> None:
         with self._server.lock:
             self.session.enter_node()
 
-    def leave_listen_node(self):
+    def leave_listen_node(self) -> None:
         with self._server.lock:
             self.session.leave_node()
 
-    def stop_project(self):
+    def stop_project(self) -> None:
         with self._server.lock:
             self.session.stop_project()
             self._server.close_robot_sockets(self)
 
-    def start_project(self, enter_node=None):
+    def start_project(self, enter_node: bool | None = None) -> None:
         with self._server.lock:
             self.session.start_project(enter_node=False)
             self._server.open_port(self)
             if self._server.auto_enter if enter_node is None else enter_node:
                 self.session.enter_node()
 
-    def inject(self, fault: str, **params):
+    def inject(self, fault: str, **params: Any) -> None:
         """Arm a fault (see docs/simulator.md, 'Fault injection'); raises ValueError when unknown or when a
         parameter is out of its range (faults.PARAMS)."""
         checked = check_fault_params(fault, params)
@@ -196,7 +198,7 @@ class Robot:
                 self.faults.arm(fault, **params)
             self.log.event("fault", fault=fault, params=params)
 
-    def clear_faults(self):
+    def clear_faults(self) -> None:
         with self._server.lock:
             held = self.faults
             self.faults = FaultState()
@@ -214,11 +216,13 @@ class Robot:
 
 
 class SimServer:
-    def __init__(self, host="127.0.0.1", port=0, robots=1, speedup=1.0, auto_enter=True,
-                 send_message="Listen1", log_path=None, tag_history=4, event_limit=None,
-                 control_port=None, data_timeout=None, connection_timeout=None, bases=None, tools=None,
-                 manage_gc=False, svr_port=None, svr_options=None, control_host="127.0.0.1",
-                 profile=None):
+    def __init__(self, host: str = "127.0.0.1", port: int = 0, robots: int = 1, speedup: float = 1.0,
+                 auto_enter: bool = True, send_message: str = "Listen1", log_path: str | os.PathLike[str] | None = None,
+                 tag_history: int = 4, event_limit: int | None = None, control_port: int | None = None,
+                 data_timeout: float | None = None, connection_timeout: float | None = None, bases: Any = None,
+                 tools: Any = None, manage_gc: bool = False, svr_port: int | None = None,
+                 svr_options: dict[str, Any] | None = None, control_host: str = "127.0.0.1",
+                 profile: Profile | None = None):
         if not 1 <= robots <= 512:
             raise ValueError(f"robots must be 1..512, got {robots}")
         if not (math.isfinite(speedup) and speedup > 0):
@@ -236,10 +240,11 @@ class SimServer:
         self.robots = [Robot(self, i, port + i if port else 0, send_message, auto_enter, profile,
                              (data_timeout, connection_timeout), (bases, tools)) for i in range(robots)]
         self._next_conn = 1
-        self._thread = None
+        self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._now = 0.0
-        self._dispatch = {"listen": self._accept, "conn": self._read}     # selector key kind -> handler (see handle)
+        # selector key kind -> handler (see handle)
+        self._dispatch: dict[str, Callable[[Any, Any], None]] = {"listen": self._accept, "conn": self._read}
         self._touched: list[Robot] = []       # robots that received data and still have to advance
         # which client's input goes next and how much; a robot's share of PENDING_BYTES_MAX (at least 4 frames)
         self.fair = FairScheduler(self, max(4 * FRAME_DATA_MAX, PENDING_BYTES_MAX // robots))
@@ -247,9 +252,9 @@ class SimServer:
         self._slice_start = self._poll_end = 0.0
         self.started = False
         self.manage_gc = manage_gc            # the CLI: garbage collection between bursts, see _collect_garbage
-        self.control = None
+        self.control: ControlChannel | None = None
         self._control_port = control_port
-        self.svr = None                       # Ethernet Slave (tmsim/net/ethernet_slave.py) when svr_port is not None
+        self.svr: EthernetSlave | None = None  # Ethernet Slave (tmsim/net/ethernet_slave.py) when svr_port is not None
         self._svr = (svr_port, svr_options or {})
         self._control_host = control_host
 
@@ -263,7 +268,7 @@ class SimServer:
         return [r.port for r in self.robots]
 
     # ---- lifecycle ----------------------------------------------------------------------------
-    def start(self):
+    def start(self) -> SimServer:
         with self.lock:
             try:
                 for robot in self.robots:
@@ -278,7 +283,7 @@ class SimServer:
             self.started = True
         return self
 
-    def open_port(self, robot):
+    def open_port(self, robot: Robot) -> None:
         if robot.listener is not None or robot.faults.refuse:
             return
         held, robot.port_hold = robot.port_hold, None
@@ -287,12 +292,13 @@ class SimServer:
         robot.port = robot.listener.port
         robot.log.event("listening", host=self.host, port=robot.port)
 
-    def _close_listener(self, robot, hold_port: bool = True):
+    def _close_listener(self, robot: Robot, hold_port: bool = True) -> None:
         """The port stays held (refusing connections) while the robot's server is down, so it comes back on it."""
-        robot.port_hold = robot.listener.close(hold_port=hold_port)
-        robot.listener = None
+        if robot.listener is not None:
+            robot.port_hold = robot.listener.close(hold_port=hold_port)
+            robot.listener = None
 
-    def handle(self, kind: str, handler):
+    def handle(self, kind: str, handler: Callable[[Any, Any], None]) -> None:
         """Serve the selector keys of ``kind`` with ``handler(robot, conn)``: how a port's TCP adapter (Ethernet
         Slave, control channel) joins the server's one selector and clock."""
         if kind in self._dispatch:
@@ -304,23 +310,23 @@ class SimServer:
         """The robot clock (s) of the poll in progress."""
         return self._now
 
-    def log_server(self, kind, **fields):
+    def log_server(self, kind: str, **fields: Any) -> None:
         """An event of the server as a whole (control channel): logged in robot 0's log."""
         self.robots[0].log.event(kind, **fields)
 
-    def apply_refuse(self, robot):
+    def apply_refuse(self, robot: Robot) -> None:
         if robot.faults.refuse and robot.listener is not None:
             self._close_listener(robot)
         elif not robot.faults.refuse and robot.listener is None and robot.session.project_running():
             self.open_port(robot)
 
-    def close_robot_sockets(self, robot, reason="project stopped"):
+    def close_robot_sockets(self, robot: Robot, reason: str = "project stopped") -> None:
         for conn in list(robot.conns.values()):
             self.drop(robot, conn, reason)
         if robot.listener is not None:
             self._close_listener(robot)
 
-    def close(self):
+    def close(self) -> None:
         self.stop()
         with self.lock:
             for robot in self.robots:
@@ -341,7 +347,7 @@ class SimServer:
                 self.log_file.close()
                 self.log_file = None
 
-    def serve_forever(self, stop_event: threading.Event):
+    def serve_forever(self, stop_event: threading.Event) -> None:
         """Serve in the calling thread on the wall clock (scaled by ``speedup``) until stop_event is set."""
         if not self.started:
             self.start()
@@ -350,24 +356,24 @@ class SimServer:
         while not stop_event.is_set():
             self.poll(offset + (time.monotonic() - origin) * self.speedup, timeout=0.002)
 
-    def start_background(self):
+    def start_background(self) -> SimServer:
         """Serve in a thread on the wall clock (scaled by ``speedup``) until ``stop()``."""
         if not self.started:
             self.start()
         self._stop.clear()
-        self._thread = threading.Thread(target=self.serve_forever, args=(self._stop,), name="tmflow-sim",
-                                        daemon=True)
-        self._thread.start()
+        thread = threading.Thread(target=self.serve_forever, args=(self._stop,), name="tmflow-sim", daemon=True)
+        self._thread = thread
+        thread.start()
         return self
 
-    def stop(self):
+    def stop(self) -> None:
         if self._thread is not None:
             self._stop.set()
             self._thread.join(timeout=5)
             self._thread = None
 
     # ---- one step -----------------------------------------------------------------------------
-    def poll(self, now_s: float, timeout: float = 0.0):
+    def poll(self, now_s: float, timeout: float = 0.0) -> None:
         """Advance to ``now_s`` and serve every socket that is ready; never blocks unless timeout>0.
 
         Replies leave as soon as their request is processed (before the motions it queued are
@@ -410,7 +416,7 @@ class SimServer:
         return self.fair.has_backlog or (self.control is not None and self.control.has_backlog) or \
             any(robot.session.has_turn_work for robot in self.robots)
 
-    def breathe(self, budgeted=False):
+    def breathe(self, budgeted: bool = False) -> None:
         """Between two pieces of work: serve the sockets when IO_SLICE_S has passed since they were
         served. ``budgeted``: not after POLL_BUDGET_S (work that new requests extend - a flood of
         requests must not hold the clock)."""
@@ -422,7 +428,7 @@ class SimServer:
         if not self._starting:
             self._start_touched()
 
-    def _set_reading(self, robot, reading: bool):
+    def _set_reading(self, robot: Robot, reading: bool) -> None:
         """Back-pressure: stop reading this robot's clients while its script buffer is full."""
         robot.reading_paused = not reading
         robot.log.event("reading_resumed" if reading else "reading_paused", buffered=robot.session.waiting_scripts)
@@ -453,7 +459,7 @@ class SimServer:
         """Back-pressure: the robot's script buffer is full; its clients are read again once it is half empty."""
         self._set_reading(robot, False)
 
-    def _serve(self, timeout, quick_only=False):
+    def _serve(self, timeout: float, quick_only: bool = False) -> int:
         """Accept and read every ready socket; the replies are written at once. Robots that received
         something are remembered in ``_touched`` for ``_start_touched``.
 
@@ -486,7 +492,7 @@ class SimServer:
                     self.flush(robot, conn)
         return len(ready)
 
-    def _advance(self, robot):
+    def _advance(self, robot: Robot) -> None:
         """Advance one robot's session; an unexpected error becomes a robot error of that robot (its project
         stops, event ``internal_error``) instead of ending the thread that serves every robot."""
         robot.session.meter.begin(TURN_WORK)
@@ -496,7 +502,7 @@ class SimServer:
             robot.log.event("internal_error", conn=None, error=f"{type(exc).__name__}: {exc}")
             robot.session.internal_error(f"internal error of the simulator ({type(exc).__name__})")
 
-    def _start_touched(self):
+    def _start_touched(self) -> None:
         """Advance the robots that received scripts with dt = 0, so a motion queued now starts now."""
         self._starting = True
         try:
@@ -508,9 +514,12 @@ class SimServer:
         finally:
             self._starting = False
 
-    def _accept(self, robot, _conn):
+    def _accept(self, robot: Robot, _conn: None) -> None:
+        listener = robot.listener
+        if listener is None:                # (closed by a fault since the selector reported it)
+            return
         for _ in range(64):
-            accepted = robot.listener.accept(self._now, robot.log.event)
+            accepted = listener.accept(self._now, robot.log.event)
             if accepted is None:
                 return
             sock, addr = accepted
@@ -526,7 +535,7 @@ class SimServer:
             robot.session.connect(conn.id, addr[0])
             self.selector.register(sock, selectors.EVENT_READ, ("conn", robot, conn))
 
-    def _read(self, robot, conn):
+    def _read(self, robot: Robot, conn: Conn) -> None:
         """Read what ``conn`` sent into the robot's session and give it a turn (unless it waits in the
         backlog). The server never decodes: the session owns the bytes (h11's model)."""
         if conn.id not in robot.conns or conn.eof:
@@ -554,7 +563,7 @@ class SimServer:
         if not self.fair.waits(robot, conn):     # else it waits for its turn in fair.serve_backlog
             self.fair.turn(robot, conn)
 
-    def flush(self, robot, only=None):
+    def flush(self, robot: Robot, only: Conn | None = None) -> None:
         """Write what the robot's session produced; ``only``: just that client's output (cheap, right after
         its request), else every client's plus the per-robot checks (once a poll at least)."""
         if not robot.conns:                       # (the session has no client without a connection)
@@ -607,7 +616,7 @@ class SimServer:
             self.drop(robot, laziest, f"client does not read (its robot's clients have more than "
                                        f"{OUTBOX_TOTAL_MAX} bytes waiting)")
 
-    def drop(self, robot, conn, reason):
+    def drop(self, robot: Robot, conn: Conn, reason: str) -> None:
         if robot.conns.pop(conn.id, None) is None:
             return
         if not conn.eof:
@@ -621,7 +630,7 @@ class SimServer:
         robot.log.event("closed", conn=conn.id, reason=reason)
 
 
-def _collect_garbage(idle: bool):
+def _collect_garbage(idle: bool) -> None:
     """Run the collector between bursts of requests, not in the middle of one (SimServer(manage_gc=True),
     the CLI, which also switches the automatic collector off): young objects when a poll found no
     socket ready, or at the latest after GC_FORCE allocations; older generations as CPython would
@@ -631,7 +640,7 @@ def _collect_garbage(idle: bool):
         gc.collect(2 if old >= 10 else 1 if middle >= 10 else 0)
 
 
-def _send(sock, data) -> int:
+def _send(sock: socket.socket, data: bytes | bytearray) -> int:
     try:
         return sock.send(data)
     except (BlockingIOError, InterruptedError):

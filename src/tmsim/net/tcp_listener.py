@@ -10,6 +10,8 @@ from __future__ import annotations
 import contextlib
 import selectors
 import socket
+from collections.abc import Callable
+from typing import Any
 
 from tmsim.limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS, RECV_BYTES
 
@@ -26,7 +28,7 @@ def receive(sock: socket.socket) -> tuple[bytes | None, str | None]:
 
 
 class Listener:
-    def __init__(self, selector, host: str, port: int, key, what: str, backlog: int = 16,
+    def __init__(self, selector: selectors.BaseSelector, host: str, port: int, key: tuple, what: str, backlog: int = 16,
                  held: socket.socket | None = None):
         """Bind and listen; ``key`` is the selector data of the listener, ``what`` is the OSError's text when the port
         cannot be opened, ``{where}`` standing for host:port (e.g. "listen on {where} for robot 1"). ``held``: a
@@ -49,7 +51,7 @@ class Listener:
         self.paused_until: float | None = None
         selector.register(sock, selectors.EVENT_READ, key)
 
-    def accept(self, now: float, log, prefix: str = ""):
+    def accept(self, now: float, log: Callable[..., None], prefix: str = "") -> tuple[socket.socket, Any] | None:
         """One pending connection as ``(sock, addr)``, or None: none waiting, or an error that ``log`` was told
         (``<prefix>accept_paused`` once per pause when out of descriptors, ``<prefix>accept_error`` otherwise)."""
         try:

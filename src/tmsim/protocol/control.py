@@ -115,7 +115,7 @@ def fault_params(request) -> dict:
     return params
 
 
-def operation_mode(text):
+def operation_mode(text: object) -> bool:
     if text not in ("auto", "manual"):
         raise RequestError(f"operation mode must be \"auto\" or \"manual\", got {show(text)}")
     return text == "auto"

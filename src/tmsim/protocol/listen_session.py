@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 from collections import deque
-from collections.abc import Generator
+from collections.abc import Callable, Generator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -104,8 +104,9 @@ class TransitionError(Exception):
 
 
 class ListenSession:
-    def __init__(self, robot: RobotModel | None = None, send_message="Listen1", log=None,
-                 auto_enter=True, data_timeout=None, connection_timeout=None, profile: Profile | None = None):
+    def __init__(self, robot: RobotModel | None = None, send_message: str = "Listen1",
+                 log: Callable[..., None] | None = None, auto_enter: bool = True, data_timeout: float | None = None,
+                 connection_timeout: float | None = None, profile: Profile | None = None):
         self.profile = profile or Profile()
         self.robot = robot or RobotModel()
         self.robot.tag_history, self.robot.stop_tags = self.profile.tag_history, self.profile.stop_tags
@@ -132,7 +133,7 @@ class ListenSession:
             self.fire("enter_node")
 
     # ---- node state machine -------------------------------------------------------------------
-    def fire(self, event: str, **info):
+    def fire(self, event: str, **info: Any) -> None:
         nxt = TRANSITIONS.get((self.state, event))
         if nxt is None:
             raise TransitionError(f"'{event}' is not possible while the robot is {self.state.replace('_', ' ')}")
@@ -181,11 +182,11 @@ class ListenSession:
             self.pending.clear()
 
     # ---- connections --------------------------------------------------------------------------
-    def connect(self, conn: int, peer="127.0.0.1"):
+    def connect(self, conn: int, peer: str = "127.0.0.1") -> None:
         self.clients[conn] = Client(peer, self.now)
         self.log("connect", conn=conn, peer=peer)
 
-    def disconnect(self, conn: int):
+    def disconnect(self, conn: int) -> None:
         client = self.clients.pop(conn, None)
         if client is not None:
             if client.suppressed:
@@ -212,7 +213,7 @@ class ListenSession:
         return count
 
     # ---- input --------------------------------------------------------------------------------
-    def handle(self, conn: int, item):
+    def handle(self, conn: int, item: codec.Frame | codec.BadFrame | codec.Garbage) -> None:
         """Process one decoded item (codec.Frame / BadFrame / Garbage) from connection ``conn``, as it is
         (no CPERR limit, no ``frame_in`` event: ``turn`` adds those)."""
         self.last_packet = self.now
@@ -414,7 +415,7 @@ class ListenSession:
         self.meter.add(len(out[0]) * recipients // WORK_LOG_BYTES)     # sending it and its event, per client
 
     # ---- time ---------------------------------------------------------------------------------
-    def advance(self, now: float):
+    def advance(self, now: float) -> None:
         dt = max(0.0, now - self.now)
         self.now = max(self.now, now)
         if self.state == IN_NODE and (self.data_timeout or self.connection_timeout):
@@ -459,7 +460,7 @@ class ListenSession:
             if outcome != INPUT_LEFT:
                 return total
 
-    def buffer_data(self, conn: int, data: bytes):
+    def buffer_data(self, conn: int, data: bytes) -> None:
         """Bytes received from connection ``conn``, kept for ``turn`` (unknown connection: ignored)."""
         client = self.clients.get(conn)
         if client is not None:
@@ -499,7 +500,7 @@ class ListenSession:
                 client.suppressed += run
                 continue
             item, used = codec.decode(rbuf)
-            if not used:
+            if item is None:                    # need more bytes (decode consumed none)
                 return handled, INPUT_DONE
             del rbuf[:used]
             if type(item) is codec.BadFrame and not self._may_answer_bad(client):
@@ -591,21 +592,21 @@ class ListenSession:
         return self.state != STOPPED
 
     # ---- control (the control channel, fault injection) ---------------------------------------------
-    def enter_node(self, source="control"):
+    def enter_node(self, source: str = "control") -> None:
         self.fire("enter_node", source=source)
 
-    def leave_node(self, path="Pass", source="control"):
+    def leave_node(self, path: str = "Pass", source: str = "control") -> None:
         self.fire("leave_node", path=path, source=source)
 
-    def stop_project(self, source="control"):
+    def stop_project(self, source: str = "control") -> None:
         self.fire("stop_project", source=source)
 
-    def start_project(self, enter_node=True, source="control"):
+    def start_project(self, enter_node: bool = True, source: str = "control") -> None:
         self.fire("start_project", source=source)
         if enter_node:
             self.fire("enter_node", source=source)
 
-    def robot_error(self, reason: str, source="control"):
+    def robot_error(self, reason: str, source: str = "control") -> None:
         """A robot error from outside the Listen node (the emergency stop): the project stops with it; when
         it is stopped already, the error is latched only."""
         if self.state != STOPPED:
@@ -613,17 +614,17 @@ class ListenSession:
         else:
             self.robot.latch_error(reason, self.now)
 
-    def internal_error(self, reason: str):
+    def internal_error(self, reason: str) -> None:
         """The simulator failed while advancing: a robot error of this robot (arm stops, project stops)."""
         self.robot.stop_and_clear()
         if self.state != STOPPED:
             self.fire("robot_fault", reason=reason)
 
-    def add_reply_errors(self, count: int):
+    def add_reply_errors(self, count: int) -> None:
         """The next ``count`` scripts are answered ERROR;1 without running (fault injection)."""
         self.faults["reply_error"] = min(self.faults["reply_error"] + count, 10 ** 6)
 
-    def clear_reply_errors(self):
+    def clear_reply_errors(self) -> None:
         self.faults["reply_error"] = 0
 
     def snapshot(self) -> dict:
@@ -636,7 +637,7 @@ class ListenSession:
         return data
 
 
-def priority_command(script: str):
+def priority_command(script: str) -> tuple[str, int] | None:
     """(name, arg) of the priority command in a packet, or None. ScriptExit wins; first one wins."""
     found = []
     for text in script.split("\r\n"):

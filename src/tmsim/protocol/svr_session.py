@@ -17,11 +17,16 @@ and performed only when every item passes.
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 from tmsim.protocol import codec
 from tmsim.protocol import svr_table as table
 from tmsim.protocol.svr_table import ITEMS, Item, SvrContentError, SvrValueError
+
+if TYPE_CHECKING:
+    from tmsim.robot.svr_source import RobotDataSource
 
 HEADERS = frozenset({"TMSVR"})
 
@@ -61,8 +66,9 @@ class Client:
 
 
 class SvrSession:
-    def __init__(self, source, log=None, stream_items=DEFAULT_STREAM, stream_mode=1, period=0.1,
-                 write_permission=True, variables=()):
+    def __init__(self, source: RobotDataSource, log: Callable[..., None] | None = None,
+                 stream_items: Iterable[str] = DEFAULT_STREAM, stream_mode: int = 1, period: float = 0.1,
+                 write_permission: bool = True, variables: Iterable = ()):
         self.source = source
         self.log = log or (lambda kind, **fields: None)
         self.items: dict[str, Item] = dict(ITEMS)   # the predefined items and the declared global variables
@@ -82,7 +88,8 @@ class SvrSession:
         self.corrupt = 0          # fault "corrupt_checksum": this many more frames leave with a wrong checksum
         self.refuse = 0           # fault "refuse_writes": every well-formed write is answered with this status
 
-    def configure(self, items=None, mode=None, period=None, write_permission=None):
+    def configure(self, items: Iterable[str] | None = None, mode: int | None = None, period: float | None = None,
+                  write_permission: bool | None = None) -> None:
         """Set the streamed data table (TransmitFile, §17.2): items in order, mode 1/2/3, period in s (0 = off);
         ``write_permission`` False refuses every write (status 02). None keeps what is set."""
         items = list(self.stream_items if items is None else items)
@@ -107,7 +114,7 @@ class SvrSession:
         return {"items": self.stream_items, "mode": self.stream_mode, "period": self.period,
                 "write_permission": self.write_permission}
 
-    def declare(self, item: Item, value=None):
+    def declare(self, item: Item, value: Any = None) -> None:
         """Add (or redeclare) a global variable of the robot's project (``svr_table.variable_item`` /
         ``parse_variable``); ``value`` None = zeros / empty texts. SvrConfigError names what is wrong."""
         if not isinstance(item, Item) or item.name in ITEMS:
@@ -121,15 +128,15 @@ class SvrSession:
         self.log("svr_variable", name=item.name, type=item.type, size=item.size, writable=item.writable)
 
     # ---- connections --------------------------------------------------------------------------
-    def connect(self, conn: int, peer="127.0.0.1"):
+    def connect(self, conn: int, peer: str = "127.0.0.1") -> None:
         self.clients[conn] = Client(peer)
         self.log("svr_connect", conn=conn, peer=peer)
 
-    def disconnect(self, conn: int):
+    def disconnect(self, conn: int) -> None:
         if self.clients.pop(conn, None) is not None:
             self.log("svr_disconnect", conn=conn)
 
-    def receive_data(self, conn: int, data: bytes):
+    def receive_data(self, conn: int, data: bytes) -> None:
         """Bytes received from connection ``conn``: every complete item in them (and in what an earlier call left
         incomplete) is handled at once; a partial frame waits in the session's buffer of that connection (at most
         one frame: a longer declared length is a packet error at once, codec.decode)."""
@@ -154,7 +161,7 @@ class SvrSession:
         return client is not None and bool(client.outbox)
 
     # ---- faults -------------------------------------------------------------------------------
-    def inject(self, fault: str, **params):
+    def inject(self, fault: str, **params: Any) -> None:
         """``stall`` (enabled=True): no data table and no answers, connections stay open; ``corrupt_checksum``
         (count=1): the next frames leave with a wrong checksum; ``refuse_writes`` (status=6): every well-formed
         write is answered with that status code (1..7), nothing is written. (``disconnect`` closes sockets: the
@@ -178,7 +185,7 @@ class SvrSession:
                 raise ValueError(f"'status' of fault 'refuse_writes' must be 1..7 (a §17.4.1 code), got {status!r}")
             self.refuse = status
 
-    def clear_faults(self):
+    def clear_faults(self) -> None:
         self.stalled, self.corrupt, self.refuse = False, 0, 0
 
     def _send(self, conn, data):
@@ -202,7 +209,7 @@ class SvrSession:
             self.log("svr_status", conn=conn, id=ident, code=f"{code:02d}", text=text)
 
     # ---- time ---------------------------------------------------------------------------------
-    def advance(self, now: float):
+    def advance(self, now: float) -> None:
         """Send the data table to every client when a period is due (one frame, however late we are)."""
         self.now = max(self.now, now)
         if not self.period or not self.clients or self.now < self.next_stream or self.stalled:
@@ -229,7 +236,7 @@ class SvrSession:
         return table.encode_json(pairs).encode("utf-8")
 
     # ---- input --------------------------------------------------------------------------------
-    def handle(self, conn: int, item):
+    def handle(self, conn: int, item: codec.Frame | codec.BadFrame | codec.Garbage) -> None:
         """One decoded item (codec.Frame / BadFrame / Garbage, decoded with HEADERS) from ``conn``."""
         if self.stalled:
             self.log("svr_stalled", conn=conn, bytes=len(item.raw))

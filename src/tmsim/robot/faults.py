@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Iterable
 from typing import Any
 
 # fault -> parameter -> (kind, default, low, high); kind "choice": high holds the allowed values
@@ -86,22 +87,22 @@ def check_params(fault: str, params: dict) -> dict:
 
 
 class FaultState:
-    def __init__(self):
+    def __init__(self) -> None:
         self.delay = 0.0
-        self.delay_count = None
+        self.delay_count: int | None = None
         self.split = 0
         self.glue = 0
         self.glue_wait = 0.05
         self.corrupt = 0
         self.corrupt_match = b""
-        self.close_after = None
+        self.close_after: int | None = None
         self.close_mid = False
         self.black_hole = False
         self.refuse = False
         self._queues: dict[int, deque] = {}
         self._partial: dict[int, bytes] = {}
 
-    def arm(self, fault, **params):
+    def arm(self, fault: str, **params: Any) -> None:
         params = check_params(fault, params)
         if fault == "reply_delay":
             self.delay = params["seconds"]
@@ -137,7 +138,7 @@ class FaultState:
                 "close_mid_frame": self.close_mid, "black_hole": self.black_hole,
                 "refuse_connections": self.refuse}
 
-    def queue(self, conn, frames, now):
+    def queue(self, conn: int, frames: Iterable[bytes], now: float) -> None:
         out = self._queues.setdefault(conn, deque())
         for frame in frames:
             if self.corrupt > 0 and self.corrupt_match in frame:
@@ -153,18 +154,18 @@ class FaultState:
         if self.black_hole:
             out.clear()
 
-    def adopt(self, other: FaultState):
+    def adopt(self, other: FaultState) -> None:
         """Take over the frames another (cleared) fault state still holds back."""
         self._queues, self._partial = other._queues, other._partial
 
-    def holding(self, conn) -> bool:
+    def holding(self, conn: int) -> bool:
         return bool(self._queues.get(conn)) or bool(self._partial.get(conn))
 
-    def forget(self, conn):
+    def forget(self, conn: int) -> None:
         self._queues.pop(conn, None)
         self._partial.pop(conn, None)
 
-    def take(self, conn, now):
+    def take(self, conn: int, now: float) -> tuple[list[bytes], bool]:
         """(list of byte chunks to write now, close-after-writing flag)."""
         pending = self._queues.get(conn)
         ready = []

@@ -12,10 +12,24 @@ from __future__ import annotations
 
 import datetime
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from tmsim.protocol.svr_table import ITEMS
 from tmsim.robot import kinematics as kin
+
+if TYPE_CHECKING:
+    from tmsim.protocol.listen_session import ListenSession
+    from tmsim.robot.model import RobotModel
+
+
+class Controller(Protocol):
+    """What the data table needs of the robot it describes (the server's ``Robot``): its Listen-node session
+    (project state, robot model, clock) and the project's start and stop, as the stick buttons act them out."""
+    session: ListenSession
+
+    def start_project(self) -> None: ...
+
+    def stop_project(self) -> None: ...
 
 _SPEED_STEP_S = 0.01          # Joint_Speed / TCP_Speed: difference quotient over this much motion time
 
@@ -48,16 +62,16 @@ def io_key(name: str) -> str | None:
 class RobotDataSource:
     """``robot`` is a ``tmsim.net.server.Robot`` (its ``session`` is the ListenSession with the RobotModel)."""
 
-    def __init__(self, robot, log, origin: datetime.datetime | None = None):
+    def __init__(self, robot: Controller, log: Callable[..., None], origin: datetime.datetime | None = None):
         self.robot = robot
         self.log = log
         self.origin = origin or datetime.datetime.now().replace(microsecond=0)   # virtual time 0 on the clock
         self.project_name = "CBT_Demo"
-        self.run_since = None
+        self.run_since: float | None = None
         self._getters = self._build_getters()
 
     @property
-    def model(self):
+    def model(self) -> RobotModel:
         return self.robot.session.robot
 
     @property
@@ -123,7 +137,7 @@ class RobotDataSource:
         return stamp.strftime("%Y-%m-%dT%H:%M:%S.") + f"{stamp.microsecond // 1000:03d}"
 
     # ---- writing ------------------------------------------------------------------------------
-    def write(self, values: dict):
+    def write(self, values: dict) -> None:
         model = self.model
         for name, value in values.items():
             if name.startswith("Stick_"):
@@ -168,7 +182,7 @@ class RobotDataSource:
             model.project_speed = max(5, model.project_speed - 5)
 
     # ---- operator actions (control channel, tests) --------------------------------------------
-    def set_estop(self, pressed: bool):
+    def set_estop(self, pressed: bool) -> None:
         """Press (the project stops with a robot error) or release the emergency stop."""
         model = self.model
         model.estop = bool(pressed)
@@ -176,7 +190,7 @@ class RobotDataSource:
         if model.estop:
             self.robot.session.robot_error("emergency stop pressed", source="estop")
 
-    def set_input(self, name: str, value):
+    def set_input(self, name: str, value: Any) -> None:
         """An input of the robot changes, as a sensor wired to it would change it: ``Ctrl_DI0``..``Ctrl_DI15`` and
         ``End_DI0``..``End_DI3`` take 0 or 1, ``Ctrl_AI0``/``Ctrl_AI1``/``End_AI0``/``End_AI1`` volts in -10..10
         (Appendix D item names). The data table shows it from its next frame. ValueError naming the item when it is
@@ -195,7 +209,7 @@ class RobotDataSource:
         self.model.io[key] = value
         self.log("io", point=key, value=value, source="input")
 
-    def set_auto_mode(self, auto: bool):
+    def set_auto_mode(self, auto: bool) -> None:
         self.model.auto_mode = bool(auto)
         self.log("operation_mode", mode="auto" if auto else "manual")
 

@@ -19,20 +19,20 @@ from __future__ import annotations
 class WorkMeter:
     __slots__ = ("work", "limit", "turns", "deferred", "max_work", "_counted")
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.work = 0               # work units done in the current turn
-        self.limit = None           # TURN_WORK while the server runs a turn; None = no bound
+        self.limit: int | None = None   # TURN_WORK while the server runs a turn; None = no bound
         self.turns = 0              # turns begun
         self.deferred = 0           # turns that stopped a piece of work for a later turn
         self.max_work = 0           # the most work done in one turn so far
         self._counted = False       # this turn is already counted in ``deferred``
 
-    def begin(self, limit):
+    def begin(self, limit: int | None) -> None:
         self.max_work = max(self.max_work, self.work)
         self.work, self.limit, self._counted = 0, limit, False
         self.turns += 1
 
-    def add(self, units):
+    def add(self, units: int) -> None:
         self.work += units
 
     @property
