@@ -17,12 +17,16 @@ import signal
 import socket
 import sys
 import threading
+from typing import TYPE_CHECKING
 
 from cbt_hmi.web.mapping import Mapping, MappingError
 from cbt_hmi.web.pagedesc import load_pages, program_table
 from cbt_hmi.web.server import HmiServer
 from tmsim.net.control import robot_numbering
 from tmsim.net.server import SimServer
+
+if TYPE_CHECKING:
+    from vplc.api import Plc
 
 LIBRARY, EXAMPLES = pathlib.Path("lib", "CBT_Commands_Lib"), pathlib.Path("examples")
 CONTROL_HOST = "127.0.0.1"     # the simulator's control channel stays on loopback whatever --host says
@@ -155,7 +159,7 @@ def tcp_port(text: str) -> int:
     return port
 
 
-def parse_args(argv):
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="cbt-demo", description=__doc__.splitlines()[0])
     parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     parser.add_argument("--robot-port", type=tcp_port, default=5890, help="robot Listen Node port (default 5890)")
@@ -212,12 +216,16 @@ class Demo:
                  control_port: int | None = None, project: pathlib.Path | None = None,
                  alarm_log: str | None = None, pages: str | None = None):
         self.project, self.alarm_log = project, alarm_log
-        self.pages, self.page_errors = pages, []     # --pages: the user's page descriptions, the ones left out
+        self.pages = pages                        # --pages: the user's page descriptions
+        self.page_errors: list[str] = []          # the ones left out
         self.host, self.robot_port, self.hmi_port = host, robot_port, hmi_port
         self.svr_port = svr_port or (robot_port + 1 if robot_port < 65535 else robot_port - 1)
         self.control_port = control_port          # None: derived from the robot port at start
         self.stop_event = threading.Event()
-        self.sim = self.plc = self.hmi = self.plc_thread = None
+        self.sim: SimServer | None = None          # all four exist once start() has returned
+        self.plc: Plc | None = None
+        self.hmi: HmiServer | None = None
+        self.plc_thread: threading.Thread | None = None
         self.fault: str | None = None            # the PLC's major fault: the PLC stopped, the rest stays up
         self._fault_printed = False
         self._seen: dict[int, int] = {}          # robot index -> events already looked at (absolute count)
@@ -246,72 +254,83 @@ class Demo:
             raise DemoError(f"error: the virtual PLC runtime is missing from this checkout ({exc})") from None
         try:
             project = self.project or find_project(None)
-            self.plc = load_plc([str(project / LIBRARY), str(project / EXAMPLES)])
+            self.plc = plc = load_plc([str(project / LIBRARY), str(project / EXAMPLES)])
         except LoadError as exc:
             raise DemoError(f"error: the example programs do not compile:\n{exc}") from None
         try:
             if self.pages is not None:
-                mapping, self.page_errors = with_user_pages(mapping, self.plc, self.pages)
-            mapping.check_against_plc(self.plc)
+                mapping, self.page_errors = with_user_pages(mapping, plc, self.pages)
+            mapping.check_against_plc(plc)
         except MappingError as exc:
             raise DemoError(f"error: {exc}") from None
-        with self.plc.lock:
-            self.plc.write("Connect_AddressIP", self.host)
-            self.plc.write("Connect_Dest_PortIP", self.robot_port)
-        self.sim = SimServer(host=self.host, port=self.robot_port, robots=1, svr_port=self.svr_port,
-                             control_port=self.control_port, control_host=CONTROL_HOST)
+        with plc.lock:
+            plc.write("Connect_AddressIP", self.host)
+            plc.write("Connect_Dest_PortIP", self.robot_port)
+        self.sim = sim = SimServer(host=self.host, port=self.robot_port, robots=1, svr_port=self.svr_port,
+                                   control_port=self.control_port, control_host=CONTROL_HOST)
         try:
-            self.sim.start_background()
+            sim.start_background()
         except OSError as exc:
             raise DemoError(f"error: robot simulator: {exc.strerror}") from None
-        with self.plc.lock:
-            self.plc.write("Connect_SvrPort", self.sim.robots[0].svr_port)
+        with plc.lock:
+            plc.write("Connect_SvrPort", sim.robots[0].svr_port)
         if self.alarm_log is not None:
             try:
                 pathlib.Path(self.alarm_log).parent.mkdir(parents=True, exist_ok=True)
             except OSError as exc:
                 raise DemoError(f"error: --alarm-log {self.alarm_log}: {exc.strerror}") from None
-        self.hmi = HmiServer(self.plc, mapping, host=self.host, port=self.hmi_port, alarm_log=self.alarm_log)
+        self.hmi = hmi = HmiServer(plc, mapping, host=self.host, port=self.hmi_port, alarm_log=self.alarm_log)
         try:
-            self.hmi.start()
+            hmi.start()
         except OSError as exc:
             raise DemoError(f"error: web HMI on {self.host}:{self.hmi_port}: {exc.strerror}") from None
         self.plc_thread = threading.Thread(target=self._run_plc, name="vplc-realtime", daemon=True)
         self.plc_thread.start()
 
+    def _started(self) -> tuple[Plc, SimServer, HmiServer]:
+        """The PLC, the simulator and the HMI server of a started demo."""
+        if self.plc is None or self.sim is None or self.hmi is None:
+            raise RuntimeError("the demo has not been started (Demo.start)")
+        return self.plc, self.sim, self.hmi
+
     def _run_plc(self) -> None:
         """Scan until the demo stops. A major fault stops the PLC alone: the simulator and the web HMI go on,
         and the HMI shows the fault on every page (docs/hmi.md, "PLC fault") until Ctrl-C."""
         from vplc.api import PlcFault
+        plc, _, _ = self._started()
         try:
-            self.plc.run_realtime(self.stop_event)
+            plc.run_realtime(self.stop_event)
         except PlcFault as exc:
             self.fault = f"PLC major fault - the virtual PLC stopped:\n{exc}"
 
     def banner(self) -> str:
-        period_ms = self.plc.period_ns / 1e6
+        plc, sim, hmi = self._started()
+        if sim.control is None:                    # start() always opens it
+            raise RuntimeError("the simulator's control channel is not open")
+        control_port = sim.control.port
+        period_ms = plc.period_ns / 1e6
         return "\n".join([
             "CBT_Commands_Lib demo is running:",
             f"  robot simulator   TM Listen Node, 1 robot on {self.host}:{self.robot_port}, "
-            f"Ethernet Slave on {self.host}:{self.sim.robots[0].svr_port}",
-            f"  control channel   {CONTROL_HOST}:{self.sim.control.port}, the simulator's JSON-line requests "
+            f"Ethernet Slave on {self.host}:{sim.robots[0].svr_port}",
+            f"  control channel   {CONTROL_HOST}:{control_port}, the simulator's JSON-line requests "
             f"({robot_numbering(1)}):",
             "                    E-stop, project stop/start, cut the link (docs/simulator.md \"Control channel\")",
             f"  virtual PLC       PnP_Example, JogTeach_Example, Commands_Example (ladder) in a {period_ms:g} ms task "
             "(real time)",
-            f"  web HMI           {self.hmi.url} (without a key: monitor only)",
+            f"  web HMI           {hmi.url} (without a key: monitor only)",
             "",
             "Open the operator address in a browser, press Connect, then try the Motion pages:",
-            f"  operator          {self.hmi.page_url('index', 'operator')}",
-            f"  engineer          {self.hmi.page_url('index', 'engineer')}"
+            f"  operator          {hmi.page_url('index', 'operator')}",
+            f"  engineer          {hmi.page_url('index', 'engineer')}"
             "   (also robot address, base, tool, outputs)",
             "The keys are new at every start; keep them to the people who may move the robot.",
             "The Program (Ladder) page shows Commands_Example's rungs live.",
-            *([(f"Your pages from {self.pages}: {', '.join(self.hmi.mapping.document['custom_pages']) or 'none'} "
+            *([(f"Your pages from {self.pages}: {', '.join(hmi.mapping.document['custom_pages']) or 'none'} "
                 "(tiles under \"Your cell\" on Main).")] if self.pages is not None else []),
             "Robot-side events (robot error, project stopped, Listen node left) are printed below as they happen.",
             "Stop the robot's project from another terminal (then press Play on the main page):",
-            f"  {control_line(self.sim.control.port)}",
+            f"  {control_line(control_port)}",
             "Press Ctrl-C to stop.",
         ])
 
@@ -326,9 +345,10 @@ class Demo:
 
     def robot_events(self) -> list[str]:
         """Console lines of the robot-side events logged since the last call."""
-        lines = []
-        with self.sim.lock:
-            for robot in self.sim.robots:
+        lines: list[str] = []
+        _, sim, _ = self._started()
+        with sim.lock:
+            for robot in sim.robots:
                 seen = self._seen.get(robot.index, 0)
                 for event in robot.events[max(0, seen - robot.events_dropped):]:
                     line = robot_event_line(event)
@@ -349,7 +369,7 @@ class Demo:
             self.sim.close()
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     try:
         project = find_project(args.project)

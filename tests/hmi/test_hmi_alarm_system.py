@@ -99,8 +99,8 @@ def test_an_e_stop_is_one_alarm_with_its_consequences_as_details(plant):
     assert alarm["priority"] == "high" and alarm["first_out"] is True
     details = [d["text"] for d in alarm["details"]]
     assert details == ["Robot: Robot error 16#00010001: Emergency stop",
-                       ("Connection 16#4006: Connection to the robot lost, reconnecting — Robot error stopped the project: "
-                        "code and text in CBT_RobotStatus"),
+                       ("Connection 16#4006: Connection to the robot lost, reconnecting — Robot error stopped the "
+                        "project: code and text in CBT_RobotStatus"),
                        "Move Absolute 16#4006: Robot error stopped the project"]
     assert summary["robot"] == "E-stop"
 
@@ -228,7 +228,9 @@ def test_the_history_survives_a_restart_and_keeps_the_newest_entries(mapping, tm
     for n in range(700):                                        # 2100 entries: raised, acknowledged... normal
         plc.vars["RobotStatus_Valid"] = True
         plc.vars["RobotStatus"]["EStop"] = n % 2 == 0
-        plc.scan(); clock.now += 0.1; system.sample()
+        plc.scan()
+        clock.now += 0.1
+        system.sample()
         system.acknowledge(None, "operator")
     system.history.stop()
     kept = [json.loads(line) for line in path.read_text().splitlines()]

@@ -159,8 +159,9 @@ def test_a_taught_point_becomes_the_target_of_move_absolute_and_of_a_pnp_segment
         browser.driver.find_element(By.CSS_SELECTOR, f"#teach-use-target option[value='{target}']").click()
         browser.click("btn-teach-use")
         browser.wait_for(lambda d: "Use point 6" in browser.message(), "the answer: " + browser.message())
-        cell.wait(lambda: [cell.read(f"{target}.TargetPosition")[k] for k in axes]
-                  == pytest.approx([expected[k] for k in axes], abs=1e-3), f"{target} to take the point: " + browser.message())
+        cell.wait(lambda target=target, expected=expected: [cell.read(f"{target}.TargetPosition")[k] for k in axes]
+                  == pytest.approx([expected[k] for k in axes], abs=1e-3),
+                  f"{target} to take the point: " + browser.message())
         browser.wait_for(lambda d: "Use point 6 'Place': now the target of" in browser.message(), "the message")
     browser.driver.find_element(By.CSS_SELECTOR, "#teach-index option[value='16']").click()
     browser.click("btn-teach-use")

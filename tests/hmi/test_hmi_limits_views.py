@@ -74,7 +74,8 @@ def test_a_value_refused_for_one_format_is_sent_for_another(page):
     assert "Speed: 150 is out of range 1..100 % (the FB would refuse it with 16#1013)" in b.message()
     assert plc.writes == []
     select(b, "MoveAbs_Param.DataFormat", "CAP_Abs")
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 180, 0, 90), strict=False):   # a target it can reach
+    # a target it can reach
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 180, 0, 90), strict=False):
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
     b.click("btn-execute")
     b.wait_for(lambda d: ("MoveAbs_Execute", True) in plc.writes, "the command to be sent")
@@ -118,7 +119,8 @@ def test_format_the_fb_refuses_for_the_motion_command_is_refused_on_the_page(pag
 def test_active_paused_and_stopping_lamps_show_the_plc_state(page):
     plc, _, open_page = page
     b = open_page("moveabs")
-    lamps = lambda: [e.get_attribute("data-value") for e in b.driver.find_elements(By.CSS_SELECTOR, ".indicators .lamp")]  # noqa: E731
+    def lamps():
+        return [e.get_attribute("data-value") for e in b.driver.find_elements(By.CSS_SELECTOR, ".indicators .lamp")]
     b.wait_for(lambda d: lamps() == ["false"] * 3, "the lamps off")
     with plc.lock:
         plc.vars["MoveAbs_Active"] = True
@@ -214,7 +216,8 @@ def test_every_page_uses_the_panel_without_dead_space(page, name):
     gap = b.driver.execute_script("""
         const main = document.getElementById('main').getBoundingClientRect();
         let lowest = main.top;
-        for (const el of document.querySelectorAll('#main fieldset, #main canvas, #main svg, #main .status, #main .area, #main .robotview, #main .robot-status'))
+        for (const el of document.querySelectorAll('#main fieldset, #main canvas, #main svg, #main .status, ' +
+                                                   '#main .area, #main .robotview, #main .robot-status'))
           { const r = el.getBoundingClientRect(); if (r.height > 0) lowest = Math.max(lowest, r.bottom); }
         return main.bottom - lowest;""")
     assert gap < 24, f"{name}: {gap:.0f} px unused below the content"

@@ -103,7 +103,8 @@ def text_overlaps(browser) -> list:
         const out = [];
         for (let i = 0; i < boxes.length; i++) for (let j = i + 1; j < boxes.length; j++) {
           const [a, r] = boxes[i], [b, s] = boxes[j];
-          if (r.left < s.right - 1 && s.left < r.right - 1 && r.top < s.bottom - 1 && s.top < r.bottom - 1) out.push([a, b]);
+          if (r.left < s.right - 1 && s.left < r.right - 1 && r.top < s.bottom - 1 && s.top < r.bottom - 1)
+            out.push([a, b]);
         }
         return out;""")
 
@@ -128,7 +129,8 @@ def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(
         assert words and all(v.startswith("16#") and len(v) == 7 for v in words.values()), words
         # every rung in the list; choosing one scrolls it to the top of the view
         options = d.execute_script("return [...document.querySelectorAll('#rung-jump option')].map(o => o.text)")
-        assert len(options) == 11 and options[0].startswith("Commands_Example 1") is False and options[0].startswith("1")
+        assert len(options) == 11 and options[0].startswith("Commands_Example 1") is False
+        assert options[0].startswith("1")
         Select(d.find_element(By.ID, "rung-jump")).select_by_index(7)
         top = d.execute_script("""const h = document.getElementById('ladder').getBoundingClientRect().top;
             return document.querySelector('g.rung[data-rung="8"]').getBoundingClientRect().top - h;""")
@@ -145,7 +147,8 @@ def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(
         check_controls(browser, ["rung-jump", "ladder-in", "ladder-out"])
         width = float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width"))
         d.find_element(By.ID, "ladder-in").click()
-        assert float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width")) == pytest.approx(width * 1.3, abs=1)
+        zoomed = float(d.find_element(By.CSS_SELECTOR, "svg.ld").get_attribute("width"))
+        assert zoomed == pytest.approx(width * 1.3, abs=1)
         small = d.execute_script("return Math.min(...[...document.querySelectorAll('#ladder text')].filter(t => "
                                  "t.textContent.trim()).map(t => parseFloat(getComputedStyle(t).fontSize) * "
                                  "t.getScreenCTM().a))")
@@ -196,7 +199,8 @@ def test_no_two_boxes_touch(system):
               out.push([g.dataset.rung, 'box', 'box']);
           }));
           for (const b of boxes) for (const [t, r] of texts)
-            if (r.left < b.right && b.left < r.right && r.top < b.bottom && b.top < r.bottom) out.push([g.dataset.rung, 'box', t]);
+            if (r.left < b.right && b.left < r.right && r.top < b.bottom && b.top < r.bottom)
+              out.push([g.dataset.rung, 'box', t]);
         }
         return out;""")
     assert touching == []

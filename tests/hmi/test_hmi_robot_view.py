@@ -54,7 +54,8 @@ def page(stack):
 
     def open_page(name: str, size=(800, 480)):
         d = browser.driver
-        dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
+        dw, dh = d.execute_script(
+            "return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
         d.set_window_size(size[0] + dw, size[1] + dh)
         browser.open(server.page_url(name, "engineer"))
         browser.wait_for(lambda _d: _d.execute_script("return ARM.data !== null"), "the arm data")
@@ -109,7 +110,8 @@ def test_the_browser_reach_check_agrees_with_the_simulator(page):
 def red_pixels(b, canvas_id):
     return js(b, """const c = document.getElementById(arguments[0]), d = c.getContext('2d')
         .getImageData(0, 0, c.width, c.height).data; let n = 0;
-        for (let i = 0; i < d.length; i += 4) if (d[i] > 170 && d[i + 1] < 70 && d[i + 2] < 60) n++; return n;""", canvas_id)
+        for (let i = 0; i < d.length; i += 4) if (d[i] > 170 && d[i + 1] < 70 && d[i + 2] < 60) n++;
+        return n;""", canvas_id)
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
@@ -147,7 +149,8 @@ def test_joints_and_angles_have_their_own_limits(page):
     Select(b.field("MoveAbs_Param.MovementCommand")).select_by_visible_text("PTP")
     Select(b.field("MoveAbs_Param.DataFormat")).select_by_visible_text("JPP_Abs")
     b.type_into("MoveAbs_Param.Speed", "10")
-    labels = [e.text for e in b.driver.find_elements(By.CSS_SELECTOR, 'fieldset.pose[data-member="TargetPosition"] label')]
+    labels = [e.text for e in
+              b.driver.find_elements(By.CSS_SELECTOR, 'fieldset.pose[data-member="TargetPosition"] label')]
     assert labels == ["J1", "J2", "J3", "J4", "J5", "J6"]
     legend = b.driver.find_element(By.CSS_SELECTOR, 'fieldset.pose[data-member="TargetPosition"] legend').text
     assert "±270 ±180 ±155 ±180 ±180 ±270" in legend
@@ -159,7 +162,8 @@ def test_joints_and_angles_have_their_own_limits(page):
     Select(b.field("MoveAbs_Param.DataFormat")).select_by_visible_text("CPP_Abs")
     for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (350, 0, 300, 400, 0, 90), strict=False):
         b.type_into(f"MoveAbs_Param.TargetPosition.{axis}", str(value))
-    assert "RX RY RZ ±360°" in b.driver.find_element(By.CSS_SELECTOR, 'fieldset.pose[data-member="TargetPosition"] legend').text
+    legend = b.driver.find_element(By.CSS_SELECTOR, 'fieldset.pose[data-member="TargetPosition"] legend')
+    assert "RX RY RZ ±360°" in legend.text
     b.click("btn-execute")
     b.wait_for(lambda _d: "RX: 400° is out of range" in b.message(), "the angle refusal")
     assert plc.writes == []
@@ -196,8 +200,9 @@ def test_fixed_scale_zoom_buttons_labelled_grid_and_the_arm(page, size):
     frames = kinematics._frames(JOINTS)
     side = b.driver.find_element(By.ID, "view-side")
     s, w, h = scale(), side.get_attribute("width"), side.get_attribute("height")
-    for (px, py), f in zip(arm[1:7], frames[1:], strict=False):                 # drawn where the simulator puts the joints (Y-Z)
-        assert px == pytest.approx(int(w) / 2 + f[1][3] * s, abs=1) and py == pytest.approx(int(h) / 2 - (f[2][3] - 350) * s, abs=1)
+    for (px, py), f in zip(arm[1:7], frames[1:], strict=False):   # drawn where the simulator puts the joints (Y-Z)
+        assert px == pytest.approx(int(w) / 2 + f[1][3] * s, abs=1)
+        assert py == pytest.approx(int(h) / 2 - (f[2][3] - 350) * s, abs=1)
     font = js(b, "return parseFloat(getComputedStyle(document.querySelector('.viewfoot')).fontSize)")
     assert font >= 14
     b.screenshot(f"robotview_arm_{size[0]}x{size[1]}")
@@ -216,7 +221,8 @@ def pnp_example_cycle(plc):
     with plc.lock:
         for i, (y, z) in enumerate([(-200, 400), (-200, 250), (-200, 400), (200, 400), (200, 250), (200, 400)]):
             plc.vars["PnP_MoveParameters"][i].update(MovementCommand=0, DataFormat=1, Speed=30)
-            plc.vars["PnP_MoveParameters"][i]["TargetPosition"].update(X=350.0, Y=float(y), Z=float(z), RX=180.0, RZ=90.0)
+            plc.vars["PnP_MoveParameters"][i]["TargetPosition"].update(X=350.0, Y=float(y), Z=float(z), RX=180.0,
+                                                                       RZ=90.0)
 
 
 PAGES_WITH_VIEWS = ["index", "connect", "changebase", "moverel", "moveabs", "movecircle", "setoutput", "stop", "pnp"]
@@ -253,7 +259,8 @@ def test_move_relative_and_a_pnp_segment_are_refused_out_of_reach(page):
     Select(b.field("MoveRel_Param.MovementCommand")).select_by_visible_text("Line")
     Select(b.field("MoveRel_Param.DataFormat")).select_by_visible_text("CPP_Rel")
     b.type_into("MoveRel_Param.Speed", "10")
-    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (900, 0, 0, 0, 0, 0), strict=False):   # 400 + 900 mm along X
+    # 400 + 900 mm along X
+    for axis, value in zip(("X", "Y", "Z", "RX", "RY", "RZ"), (900, 0, 0, 0, 0, 0), strict=False):
         b.type_into(f"MoveRel_Param.TargetPosition.{axis}", str(value))
     b.wait_for(lambda _d: js(b, "return !!(VIEW.preview && VIEW.preview.refused)"), "the refused preview")
     b.click("btn-execute")

@@ -167,7 +167,8 @@ def test_execute_reports_a_plc_that_is_not_scanning(mapping):
     srv = HmiServer(plc, mapping, port=0)
     srv.start()
     try:
-        status, answer = Client(f"http://127.0.0.1:{srv.port}", srv.access.keys["operator"]).json("/api/execute", {"execute": "Connect_Execute"})
+        operator = Client(f"http://127.0.0.1:{srv.port}", srv.access.keys["operator"])
+        status, answer = operator.json("/api/execute", {"execute": "Connect_Execute"})
         assert status == 503 and "the PLC is not scanning" in answer["error"]
     finally:
         srv.stop()

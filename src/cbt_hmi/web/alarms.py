@@ -129,26 +129,26 @@ class Alarm:
 class History:
     """The newest HISTORY entries in memory and in a JSON-lines file written by a thread of its own."""
 
-    def __init__(self, path: pathlib.Path | None):
+    def __init__(self, path: pathlib.Path | str | None):
         self.path = pathlib.Path(path) if path else None
         self.entries: deque[dict] = deque(maxlen=HISTORY)
         self._queue: queue.SimpleQueue = queue.SimpleQueue()
         self._lines = 0
         self._thread: threading.Thread | None = None
         if self.path is not None and self.path.exists():
-            self._load()
+            self._load(self.path)
 
-    def _load(self) -> None:
+    def _load(self, path: pathlib.Path) -> None:
         try:
-            lines = self.path.read_text(encoding="utf-8").splitlines()
+            lines = path.read_text(encoding="utf-8").splitlines()
         except (OSError, UnicodeDecodeError) as exc:
-            log.warning("HMI alarm history %s not read (%s): starting a new one", self.path, exc)
+            log.warning("HMI alarm history %s not read (%s): starting a new one", path, exc)
             return
         for number, line in enumerate(lines, start=1):
             try:
                 entry = json.loads(line)
             except json.JSONDecodeError:
-                log.warning("%s:%d: not a history entry (skipped)", self.path, number)
+                log.warning("%s:%d: not a history entry (skipped)", path, number)
                 continue
             # entries numbered in order only: a rewrite of the file may have left an entry twice at its end
             if isinstance(entry, dict) and isinstance(entry.get("n"), int) and \
@@ -169,7 +169,8 @@ class History:
 
     def start(self) -> None:
         if self.path is not None:
-            self._thread = threading.Thread(target=self._write, name="hmi-alarm-history", daemon=True)
+            self._thread = threading.Thread(target=self._write, args=(self.path,), name="hmi-alarm-history",
+                                            daemon=True)
             self._thread.start()
 
     def stop(self) -> None:
@@ -178,9 +179,9 @@ class History:
             self._thread.join(timeout=5)
             self._thread = None
 
-    def _write(self) -> None:
+    def _write(self, path: pathlib.Path) -> None:
         """Appends the entries as they come; past twice HISTORY lines the file is rewritten with the kept ones."""
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        path.parent.mkdir(parents=True, exist_ok=True)
         while True:
             batch = [self._queue.get()]
             while not self._queue.empty():
@@ -190,16 +191,16 @@ class History:
             try:
                 if self._lines + len(batch) > 2 * HISTORY:
                     kept = list(self.entries)
-                    temporary = self.path.with_suffix(".tmp")
+                    temporary = path.with_suffix(".tmp")
                     temporary.write_text("".join(json.dumps(e) + "\n" for e in kept), encoding="utf-8")
-                    temporary.replace(self.path)
+                    temporary.replace(path)
                     self._lines = len(kept)
                 elif batch:
-                    with self.path.open("a", encoding="utf-8") as out:
+                    with path.open("a", encoding="utf-8") as out:
                         out.write("".join(json.dumps(e) + "\n" for e in batch))
                     self._lines += len(batch)
             except OSError as exc:
-                log.warning("HMI alarm history not written to %s: %s", self.path, exc)
+                log.warning("HMI alarm history not written to %s: %s", path, exc)
             if done:
                 return
 
@@ -207,7 +208,7 @@ class History:
 class AlarmSystem:
     """Alarms of one PLC. start() samples in a thread; sample() takes one sample (tests call it directly)."""
 
-    def __init__(self, plc, mapping, history_path: pathlib.Path | None = None, clock=time.time,
+    def __init__(self, plc, mapping, history_path: pathlib.Path | str | None = None, clock=time.time,
                  monotonic=time.monotonic, errors: dict | None = None):
         self.plc, self.clock, self.monotonic = plc, clock, monotonic
         self.errors = errors if errors is not None else _load_errors()

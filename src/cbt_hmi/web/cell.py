@@ -15,7 +15,7 @@ from .pagedesc import load_pages, program_table
 from .server import HmiServer
 
 
-def parse_args(argv):
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="python3 -m cbt_hmi.web.cell", description=__doc__.splitlines()[0])
     parser.add_argument("sources", nargs="+", metavar="SOURCE", help="ST files or folders of the program")
     parser.add_argument("--pages", required=True, metavar="DIR", help="folder of page description files (*.json)")
@@ -27,7 +27,7 @@ def parse_args(argv):
     return parser.parse_args(argv)
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     try:
         plc = load_plc(args.sources, task=args.task, programs=args.program)

@@ -7,6 +7,7 @@ is the handler's business (cbt_hmi.web.server); this module only moves bytes.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import math
@@ -178,10 +179,8 @@ class HttpFront:
             sock.close()
 
     def _wake(self) -> None:
-        try:
+        with contextlib.suppress(OSError):       # full (a wake-up is pending anyway) or closed at shutdown
             self._wake_w.send(b"\0")
-        except OSError:
-            pass                                 # full (a wake-up is pending anyway) or closed at shutdown
 
     def _drain_wake(self) -> None:
         try:
@@ -217,10 +216,8 @@ class HttpFront:
             sock.setblocking(False)
             if not self._make_room(peer[0]):
                 self.refused += 1
-                try:
+                with contextlib.suppress(OSError):
                     sock.send(_answer(HTTPStatus.SERVICE_UNAVAILABLE, "the HMI server is busy, retry"))
-                except OSError:
-                    pass
                 sock.close()
                 continue
             connection = _Connection(sock, peer, time.monotonic(), self.limits.idle_s)
@@ -419,7 +416,7 @@ class HttpFront:
         self._next_due = min(self._next_due, connection.deadline)
         self._watch(connection, selectors.EVENT_READ)
 
-    def handle_error(self, request, client_address):
+    def handle_error(self, request, client_address) -> None:
         exc = sys.exc_info()[1]
         if isinstance(exc, (BrokenPipeError, ConnectionResetError, ConnectionAbortedError)):
             log.debug("HMI client %s:%s left before the answer was sent (%s)", *client_address[:2],

@@ -162,15 +162,16 @@ class Mapping:
             bare = actual.rsplit("\\", 1)[-1]
             expected = leaf.type
             same = bare == expected or (expected in ("DATE_AND_TIME", "DT") and bare in ("DATE_AND_TIME", "DT"))
-            if not same and _string_length(expected) is not None and _string_length(bare) is not None:
-                same = _string_length(bare) >= _string_length(expected) or leaf.access == "r"
+            declared_length, expected_length = _string_length(bare), _string_length(expected)
+            if not same and declared_length is not None and expected_length is not None:
+                same = declared_length >= expected_length or leaf.access == "r"
             if not same:
                 problems.append(f"  {path}: the table says {expected}, the PLC program declares {actual}")
         if problems:
             raise MappingError(f"{self.source} does not match the PLC program:\n" + "\n".join(problems))
 
 
-def validate(leaf: Leaf, value):
+def validate(leaf: Leaf, value: object) -> object:
     """Return the value to hand to plc.write, or raise RequestError saying what is wrong."""
     where = f"'{leaf.path}'"
     if leaf.enum is not None:
@@ -229,7 +230,7 @@ def format_dt(value) -> str:
     return moment.strftime("DT#%Y-%m-%d-%H:%M:%S")
 
 
-def jsonable(value):
+def jsonable(value: object) -> object:
     if isinstance(value, dict):
         return {k: jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

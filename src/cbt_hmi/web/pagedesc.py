@@ -28,8 +28,6 @@ line of the item; a page with a mistake is left out and the others are served.""
 from __future__ import annotations
 
 import json
-import json.decoder
-import json.scanner
 import pathlib
 from collections.abc import Callable
 from typing import Any, NamedTuple, NoReturn
@@ -68,19 +66,42 @@ class _Located(dict):
     line = 0
 
 
-def _located_decoder() -> json.JSONDecoder:
-    decoder = json.JSONDecoder()
+def _object_lines(text: str) -> list[int]:
+    """The line of each JSON object's opening brace, in the order the objects close: the order in which the decoder
+    calls ``object_pairs_hook`` (an object is complete only at its closing brace)."""
+    opened: list[int] = []
+    closed: list[int] = []
+    in_string = escaped = False
+    line = 1
+    for char in text:
+        if char == "\n":
+            line += 1
+        if in_string:
+            if escaped:
+                escaped = False
+            elif char == "\\":
+                escaped = True
+            elif char == '"':
+                in_string = False
+        elif char == '"':
+            in_string = True
+        elif char == "{":
+            opened.append(line)
+        elif char == "}" and opened:
+            closed.append(opened.pop())
+    return closed
 
-    def parse_object(s_and_end, strict, scan_once, object_hook, object_pairs_hook, memo=None):
-        text, start = s_and_end
-        value, end = json.decoder.JSONObject(s_and_end, strict, scan_once, None, None, memo)
-        located = _Located(value)
-        located.line = text.count("\n", 0, start) + 1
-        return located, end
 
-    decoder.parse_object = parse_object
-    decoder.scan_once = json.scanner.py_make_scanner(decoder)   # the pure-Python scanner calls parse_object
-    return decoder
+def _decode_located(text: str) -> Any:
+    """The JSON document with every object a _Located that knows its line."""
+    lines = iter(_object_lines(text))
+
+    def located(pairs: list[tuple[str, Any]]) -> _Located:
+        found = _Located(pairs)
+        found.line = next(lines, 0)
+        return found
+
+    return json.loads(text, object_pairs_hook=located)
 
 
 def read_description(path: pathlib.Path) -> _Located:
@@ -92,7 +113,7 @@ def read_description(path: pathlib.Path) -> _Located:
     if len(raw) > MAX_FILE_BYTES:
         raise PageError(f"{path}: larger than {MAX_FILE_BYTES // 1024} KiB: not a page description")
     try:
-        document = _located_decoder().decode(raw.decode("utf-8"))
+        document = _decode_located(raw.decode("utf-8"))
     except UnicodeDecodeError as exc:
         raise PageError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     except json.JSONDecodeError as exc:

@@ -14,6 +14,7 @@ show them (16390 reads 16#4006).
 """
 from __future__ import annotations
 
+import contextlib
 from http import HTTPStatus
 
 from vplc.api import PathError
@@ -46,16 +47,14 @@ class LadderView:
         self.names = sorted(names)
         self.types = {}
         for n in self.names:
-            try:
+            with contextlib.suppress(PathError, KeyError, ValueError, TypeError):
                 self.types[n] = plc.var_type(self.path(n))
-            except (PathError, KeyError, ValueError, TypeError):
-                pass
 
     def path(self, text: str) -> str:
         head = text.split(".", 1)[0].split("[", 1)[0].strip().upper()
         return f"{self.instance}.{text}" if head in self.locals else text
 
-    def read(self, text: str):
+    def read(self, text: str) -> object:
         try:
             return self.plc.read(self.path(text))
         except (PathError, KeyError, ValueError, TypeError):
@@ -93,8 +92,7 @@ class LadderView:
             done.add(e.id)
             if e.kind == "contact":
                 value = raw.get(e.var) is True
-                p = into(e.inputs[0]) and (not value if e.negated else value)
-                power[(e.id, None)] = p
+                power[(e.id, None)] = into(e.inputs[0]) and (not value if e.negated else value)
             elif e.kind == "coil":
                 power[(e.id, None)] = into(e.inputs[0])
             elif e.kind == "in_var":

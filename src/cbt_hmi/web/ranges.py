@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import json
 import pathlib
+from typing import Any
 
 
 class RangeTableError(ValueError):
     """cbt_hmi/pages/ranges.json is unreadable or names something the variable table does not have."""
 
 
-def read_json(path: pathlib.Path, what: str, error: type[Exception]):
+def read_json(path: pathlib.Path, what: str, error: type[Exception]) -> Any:
     """The JSON document in ``path``; ``error`` names the file (and line and column) when it cannot be read."""
     try:
         return json.loads(path.read_text(encoding="utf-8"))

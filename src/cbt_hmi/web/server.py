@@ -37,6 +37,7 @@ import threading
 import time
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler
+from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
@@ -44,6 +45,9 @@ from .alarms import HISTORY, AlarmSystem, plc_fault, stamp
 from .front import MAX_BODY, HttpFront, HttpLimits
 from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, validate
 from .trail import Trail
+
+if TYPE_CHECKING:
+    from .program import ProgramMonitor
 
 MAX_DIGITS = 40                    # digits of one number in a request body (a LINT has 19, an LREAL 17)
 MAX_NAMES = 400
@@ -103,7 +107,7 @@ class HmiServer:
         self._thread: threading.Thread | None = None
         self.requests = 0
         self._execute_lock = threading.Lock()
-        self.program = None            # ProgramMonitor, built at the Program page's first request
+        self.program: ProgramMonitor | None = None     # built at the Program page's first request
         spec = self.mapping.document.get("trail")
         self.trail = Trail(plc, spec["valid"], spec["position"]) if spec else None
         # the alarm list and its history (alarm_log: a JSON-lines file kept across restarts; None: memory only)
@@ -141,7 +145,8 @@ class HmiServer:
         self.alarms.stop()
         if self._httpd:
             self._httpd.shutdown()
-            self._thread.join(timeout=5)
+            if self._thread is not None:
+                self._thread.join(timeout=5)
             self._httpd.server_close()
             self._httpd = None
 
@@ -286,17 +291,19 @@ class _Handler(BaseHTTPRequestHandler):
 
     def __init__(self, request: bytes, client_address, body_late: bool = False):  # noqa: D107
         self.client_address = client_address
-        self.request = self.server = None
+        self.request = None
+        # no socketserver behind the front end: nothing of the base class reads the server
+        self.server = None  # type: ignore[assignment]
         self.rfile, self.wfile = io.BytesIO(request), io.BytesIO()
         self.body_late = body_late
         self.close_connection = True
         self.handle_one_request()
 
-    def log_message(self, format, *args):  # noqa: A002 - signature of the base class
+    def log_message(self, format: str, *args: object) -> None:  # noqa: A002 - signature of the base class
         """Quiet: the demo prints its own status lines; details go to the debug log."""
         log.debug("HMI %s: " + format, self.client_address[0], *args)
 
-    def send_error(self, code, message=None, explain=None):
+    def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
         """Malformed requests (bad request line, oversized headers) get a short JSON answer too."""
         try:
             self.close_connection = True
@@ -329,7 +336,7 @@ class _Handler(BaseHTTPRequestHandler):
             raise RequestError("the address contains control characters")
         return urlsplit(self.path)
 
-    def do_GET(self):  # noqa: N802 - http.server naming
+    def do_GET(self) -> None:  # noqa: N802 - http.server naming
         self.hmi.requests += 1
         try:
             self.hmi.access.check_host(self.headers)
@@ -370,17 +377,18 @@ class _Handler(BaseHTTPRequestHandler):
     def _program(self, url) -> None:
         """The Program page's ladder drawings and their live state (cbt_hmi.web.program)."""
         from .program import ProgramError, ProgramMonitor
-        if self.hmi.program is None:
-            self.hmi.program = ProgramMonitor(self.hmi.plc)
+        program = self.hmi.program
+        if program is None:
+            program = self.hmi.program = ProgramMonitor(self.hmi.plc)
         try:
             if url.path == "/api/program":
-                self._json(HTTPStatus.OK, self.hmi.program.page())
+                self._json(HTTPStatus.OK, program.page())
             else:
-                self._json(HTTPStatus.OK, self.hmi.program.state(parse_qs(url.query).get("pou", [""])[0]))
+                self._json(HTTPStatus.OK, program.state(parse_qs(url.query).get("pou", [""])[0]))
         except ProgramError as exc:
             raise RequestError(str(exc), exc.status) from None
 
-    def do_POST(self):  # noqa: N802 - http.server naming
+    def do_POST(self) -> None:  # noqa: N802 - http.server naming
         self.hmi.requests += 1
         try:
             self.hmi.access.check_host(self.headers)
