@@ -1,5 +1,6 @@
 """A raw JSON-lines client of the simulator's control channel, for the probes that send it hostile lines."""
 import json
+import select
 import socket
 
 
@@ -21,6 +22,18 @@ class ControlClient:
             self.buf += chunk
         line, _, self.buf = self.buf.partition(b"\n")
         return json.loads(line)
+
+    def answer_ready(self) -> bool:
+        """Whether a whole answer has arrived: reads what is there, never waits (for a test that polls the
+        simulator in its own thread, where a blocking read would wait for a poll that never comes)."""
+        while b"\n" not in self.buf:
+            if not select.select([self.sock], [], [], 0)[0]:
+                return False
+            chunk = self.sock.recv(65536)
+            if not chunk:
+                raise ConnectionError("the simulator closed the control connection")
+            self.buf += chunk
+        return True
 
     def ask(self, payload) -> dict:
         self.send_line(payload if isinstance(payload, bytes) else json.dumps(payload).encode())

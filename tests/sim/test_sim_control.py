@@ -1,9 +1,11 @@
 """Control channel under hostile requests (issue 12, "One request kills the simulator", "A control-channel
 client that never reads its answers hangs the whole simulator", "binds whatever --host says").
 Each probe is answered with {"ok": false, "error": ...} and the simulator keeps serving."""
+import json
 import socket
 
 import pytest
+from sim_harness import Harness
 from sim_probe import ControlClient
 
 from tmsim.limits import CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX
@@ -66,20 +68,50 @@ def test_overlong_request_line_is_answered_then_the_connection_closed(channel, l
     other.close()
 
 
-def test_a_client_that_never_reads_its_answers_is_closed_and_never_stalls_the_others(channel):
-    srv, _client = channel
-    lazy = socket.create_connection(("127.0.0.1", srv.control.port), timeout=5)
-    lazy.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-    request = b'{"cmd":"state"}\n'
-    answer_size = len(ControlClient(srv.control.port).ask({"cmd": "state"}).__repr__())
-    lazy.sendall(request * (3 * CONTROL_OUTBOX_MAX // answer_size))     # answers it never reads
-    other = ControlClient(srv.control.port, timeout=5)
-    assert other.ask({"cmd": "ping"})["ok"]                              # the old code blocked here
-    closed = srv.robots[0].wait_event("control_closed", timeout=10)
-    assert closed is not None and "does not read its answers" in closed["reason"]
-    assert other.ask({"cmd": "ping"})["ok"]
-    other.close()
-    lazy.close()
+def test_a_client_that_never_reads_its_answers_is_closed_and_never_stalls_the_others():
+    """The simulator is polled here, turn by turn, and every wait is counted in polls, not in wall-clock seconds:
+    closing the lazy client takes thousands of answers (4 MiB of them, plus what the loopback buffers hold), CPU
+    work that a loaded machine stretched past the 10 s this test once waited for a background thread (flaky)."""
+    h = Harness(control_port=0)
+    port = h.srv.control.port
+
+    def ask(client, payload) -> dict:
+        client.send_line(json.dumps(payload).encode())
+        assert h.until(client.answer_ready, timeout=10), f"no answer to {payload}"
+        return client.answer()
+
+    try:
+        lazy = socket.socket()
+        lazy.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)   # before connecting: its window stays small
+        lazy.connect(("127.0.0.1", port))
+        lazy.setblocking(False)
+        probe = ControlClient(port)
+        answer_size = len(json.dumps(ask(probe, {"cmd": "state"})))
+        unsent = memoryview(b'{"cmd":"state"}\n' * (3 * CONTROL_OUTBOX_MAX // answer_size))   # answers it never reads
+
+        def flooded() -> bool:
+            nonlocal unsent
+            try:
+                unsent = unsent[lazy.send(unsent):]
+            except BlockingIOError:
+                return False
+            except ConnectionError:             # closed for its unread answers before the last request went
+                return True
+            return not unsent
+
+        def closed():
+            return h.robot.wait_event("control_closed", timeout=0)
+        assert h.until(flooded, timeout=10)
+        other = ControlClient(port)
+        assert ask(other, {"cmd": "ping"})["ok"]                             # the old code blocked here
+        assert h.until(closed, timeout=60)      # up to 12,000 polls; the whole flood takes ~3,150 turns of 4
+        assert "does not read its answers" in closed()["reason"]
+        assert ask(other, {"cmd": "ping"})["ok"]
+        for client in (probe, other):
+            client.close()
+        lazy.close()
+    finally:
+        h.close()
 
 
 def test_control_channel_binds_loopback_even_when_the_robots_listen_elsewhere():
