@@ -44,15 +44,24 @@ def _chromium_process():
 @pytest.fixture(scope="module")
 def chromium(_chromium_process):
     """One Chromium per test process (a start costs seconds); each test module gets it with a fresh tab. If a
-    module left it unusable, the next one starts a new Chromium."""
+    module left it unusable, the next one starts a new Chromium. After the module the tab is left on a blank page:
+    an HMI page polls its server 20 times a second for as long as it is open, and the worker goes on with other
+    modules (other folders too) while this Chromium waits for the next HMI module."""
+    browser = None
     if _chromium_process:
         try:
-            return _chromium_process[0].fresh()
+            browser = _chromium_process[0].fresh()
         except WebDriverException:
             broken = _chromium_process.pop()
             try:
                 broken.close()
             except WebDriverException:
                 pass                  # already gone; close() removed its profile directory all the same
-    _chromium_process.append(Browser())
-    return _chromium_process[0]
+    if browser is None:
+        _chromium_process.append(Browser())
+        browser = _chromium_process[0]
+    yield browser
+    try:
+        browser.driver.get("about:blank")
+    except WebDriverException:
+        pass                          # left unusable: the next module replaces it (above)
