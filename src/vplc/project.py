@@ -4,11 +4,11 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
-from dataclasses import dataclass, field
 
 from .checker import calls, recursion
 from .checker import portable as portable_rule
 from .checker.body import BodyChecker
+from .checker.context import Context, Unit
 from .checker.declare import Declarer
 from .checker.exprs import ExprChecker
 from .checker.scope import Ambiguous, Tables
@@ -22,30 +22,6 @@ from .ladder.load import attach_ladders, check_operands, is_project_xml, is_xml,
 
 PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
 VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st", "sysmac_motion.st", "sysmac_control.st")
-
-
-@dataclass
-class Context:
-    dialect: str
-    diags: DiagnosticBag
-    tables: Tables = field(default_factory=Tables)
-    type_decls: list = field(default_factory=list)
-    pou_units: list = field(default_factory=list)
-    global_lists: list = field(default_factory=list)
-    configurations: list = field(default_factory=list)
-    vendor_objects: set = field(default_factory=set)
-    vendor_uses: list = field(default_factory=list)
-    edition3_uses: list = field(default_factory=list)
-
-    def note_vendor(self, obj, span) -> None:
-        if id(obj) in self.vendor_objects and span is not None:
-            what = "system-defined variable" if getattr(obj, "section", None) == "VAR_GLOBAL" else "instruction or type"
-            self.vendor_uses.append((span, obj.name, what))
-
-    def note_edition3(self, what: str, span) -> None:
-        """Record a use of an IEC 61131-3 3rd-edition-only feature (reported by --portable)."""
-        if span is not None:
-            self.edition3_uses.append((span, what))
 
 
 class Project:
@@ -204,8 +180,8 @@ def _load(paths, dialect: str, include_prelude: bool, portable: bool) -> Project
 
 def check_units(ctx: Context, proj: Project) -> None:
     dec = Declarer(ctx)
-    for unit in proj.units:
-        dec.register(unit)
+    for file_unit in proj.units:
+        dec.register(file_unit)
     for _decl, shell, unit in ctx.type_decls:
         if getattr(unit, "vendor", False):
             ctx.vendor_objects.add(id(shell))
@@ -232,9 +208,10 @@ def check_units(ctx: Context, proj: Project) -> None:
             for f in shell.fields.values():
                 if f.init is not None:
                     ck.initial_value(f.init, f.type, f"initial value of {f.name}")
-    for gl, unit in ctx.global_lists + ctx.configurations:
+    with_globals: list[tuple[A.GlobalVarList | A.Configuration, Unit]] = [*ctx.global_lists, *ctx.configurations]
+    for holder, unit in with_globals:
         ck = ExprChecker.for_unit(ctx, unit)
-        for section in gl.sections:
+        for section in holder.sections:
             for d in section.vars:
                 if d.init is not None and d.sym is not None:
                     ck.initial_value(d.init, d.sym.type, f"initial value of {d.name}")

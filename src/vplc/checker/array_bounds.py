@@ -14,9 +14,10 @@ from __future__ import annotations
 
 from ..frontend import codes
 from .consteval import const_int
+from .context import ExprHost
 
 
-def check(ck, e, array_type) -> None:
+def check(ck: ExprHost, e, array_type) -> None:
     for ix, (lo, hi) in zip(e.indices, array_type.dims, strict=False):
         if lo is None:
             continue
@@ -26,7 +27,7 @@ def check(ck, e, array_type) -> None:
                                f"`{ck.text(e.base)}`", ix.span)
 
 
-def check_slice(ck, element, param_type, param_name: str) -> None:
+def check_slice(ck: ExprHost, element, param_type, param_name: str) -> None:
     """Sysmac "array element passed to an array parameter": enough elements must remain from that element."""
     from ..frontend import types as T
     base = T.unalias(element.base.ty) if element.base.ty is not None else None

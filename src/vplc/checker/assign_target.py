@@ -22,6 +22,7 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .context import ExprHost
 from .symbols import VarSymbol
 
 
@@ -31,7 +32,7 @@ def root_name(e: A.Expr) -> A.Name | None:
     return e if isinstance(e, A.Name) else None
 
 
-def check_write(ck, target: A.Expr, what: str = "assignment") -> None:
+def check_write(ck: ExprHost, target: A.Expr, what: str = "assignment") -> None:
     ctx = ck.ctx
     root = root_name(target)
     if root is None:

@@ -30,6 +30,7 @@ import re
 
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 
 # words per area (the CJ-compatible sizes of the NJ's memory for CJ units: CIO 6,144, W 512, H 1,536, D and each EM
 # bank 32,768 words; W501)
@@ -49,7 +50,7 @@ def parse(text: str):
     return area, bank, int(m.group("word")), bit
 
 
-def check_global(ctx, decl, vt: T.Type):
+def check_global(ctx: Context, decl, vt: T.Type):
     """The address of a global in a Sysmac area as (area, bank, word, bit, layout, words in the area), or None;
     reports ST1110."""
     if decl.at is None:
@@ -98,7 +99,7 @@ def check_global(ctx, decl, vt: T.Type):
     return area, bank, word, bit or 0, layout, AREA_WORDS[area]
 
 
-def check_local(ctx, decl) -> None:
+def check_local(ctx: Context, decl) -> None:
     """vplc places global variables in memory areas; an AT of a Sysmac area on a POU's variable is refused."""
     if decl.at is not None and parse(decl.at) is not None:
         ctx.diags.error(codes.AT_ADDRESS,

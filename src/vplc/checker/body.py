@@ -5,7 +5,8 @@ from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from . import assign_target, calls, case_labels, duplicates, external_globals, function_result, unused
-from .exprs import ExprChecker, Flow
+from .context import Context, Flow, Unit
+from .exprs import ExprChecker
 from .symbols import VarSymbol
 
 
@@ -14,7 +15,7 @@ class BodyChecker:
     ``exprs`` (the POU's expression checker) and keeping ``flow`` (FOR variables, instances called) that
     ``exprs`` reads when a call writes an argument. ``in_prelude``: the POU is the prelude's (no ST1901/ST1009)."""
 
-    def __init__(self, ctx, pou: A.Pou, exprs: ExprChecker, flow: Flow, in_prelude: bool = False) -> None:
+    def __init__(self, ctx: Context, pou: A.Pou, exprs: ExprChecker, flow: Flow, in_prelude: bool = False) -> None:
         self.ctx = ctx
         self.pou = pou
         self.exprs = exprs
@@ -23,7 +24,7 @@ class BodyChecker:
         self.loop_depth = 0
 
     @classmethod
-    def for_pou(cls, ctx, pou: A.Pou, unit: A.CompilationUnit | None) -> BodyChecker:
+    def for_pou(cls, ctx: Context, pou: A.Pou, unit: Unit | None) -> BodyChecker:
         """The checker of ``pou``, declared in ``unit``, with its expression checker."""
         result_sym = None
         if pou.kind == "FUNCTION":

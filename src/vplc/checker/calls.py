@@ -21,6 +21,7 @@ from ..frontend import codes
 from ..frontend import types as T
 from . import array_bounds, assign_target
 from .compatibility import compatible
+from .context import ExprHost
 from .scope import Ambiguous, is_generic
 from .symbols import BoundArg, BuiltinSymbol, CallBinding, PouSymbol, VarSymbol
 
@@ -34,7 +35,7 @@ def is_lvalue(e: A.Expr) -> bool:
     return isinstance(e, (A.Member, A.Index, A.BitAccess))
 
 
-def check_call(ck, e: A.Call, expected, statement: bool) -> T.Type:
+def check_call(ck: ExprHost, e: A.Call, expected, statement: bool) -> T.Type:
     """Resolve the callee of ``e`` and bind its arguments; returns the call's result type."""
     ctx = ck.ctx
     callee = e.callee
@@ -87,14 +88,14 @@ def check_call(ck, e: A.Call, expected, statement: bool) -> T.Type:
     return _skip_args(ck, e)
 
 
-def _skip_args(ck, e: A.Call) -> T.Type:
+def _skip_args(ck: ExprHost, e: A.Call) -> T.Type:
     for a in e.args:
         if a.value is not None:
             ck.expr(a.value)
     return T.ERROR
 
 
-def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
+def bind_pou(ck: ExprHost, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
     ctx = ck.ctx
     positional = [p for p in pt.params if p.direction in ("in", "inout")]
     if kind == "fb" and ctx.dialect == "sysmac":
@@ -110,13 +111,13 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
                 ctx.diags.error(codes.NON_FORMAL_AFTER_FORMAL,
                                 "a non-formal argument cannot follow formal ones (`Name := value`); "
                                 "name every argument", arg.span)
-                ck.expr(arg.value)
+                _type_skipped(ck, arg.value)
                 continue
             if pos >= len(positional):
                 ctx.diags.error(codes.ARGUMENT_COUNT, f"too many arguments: {pt.name} takes {len(positional)} "
                                 f"{'inputs and outputs' if kind == 'fb' and ctx.dialect == 'sysmac' else 'input(s)'}",
                                 arg.span)
-                ck.expr(arg.value)
+                _type_skipped(ck, arg.value)
                 continue
             p = positional[pos]
             pos += 1
@@ -132,13 +133,12 @@ def bind_pou(ck, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
                 ctx.diags.error(codes.WRONG_DIRECTION,
                                 f"`{p.name}` is {DIR_TEXT[p.direction]} of {pt.name}; use `:=` to pass it",
                                 arg.span)
-                if arg.value is not None:
-                    ck.expr(arg.value)
+                _type_skipped(ck, arg.value)
                 continue
             if not arg.output and p.direction == "out":
                 ctx.diags.error(codes.WRONG_DIRECTION,
                                 f"`{p.name}` is an output of {pt.name}; use `=>` to read it", arg.span)
-                ck.expr(arg.value)
+                _type_skipped(ck, arg.value)
                 continue
         if p.index in bound:
             ctx.diags.error(codes.PARAMETER_TWICE, f"parameter `{p.name}` of {pt.name} is given twice", arg.span)
@@ -161,17 +161,23 @@ def _iec_alias(pt: T.PouType, name: str):
     return pt.param(sysmac) if sysmac and pt.namespace in (None, "") else None
 
 
-def _unknown_param(ck, arg: A.Arg, pt: T.PouType) -> None:
+def _type_skipped(ck: ExprHost, value: A.Expr | None) -> None:
+    """Type the value of an argument that was reported and is not bound: its names are still resolved (and
+    reported if undeclared) and its variables count as used."""
+    if value is not None:
+        ck.expr(value)
+
+
+def _unknown_param(ck: ExprHost, arg: A.Arg, pt: T.PouType) -> None:
     names = [p.name for p in pt.params]
     close = difflib.get_close_matches((arg.name or "").upper(), [n.upper() for n in names], n=1, cutoff=0.7)
     notes = [f"did you mean `{names[[n.upper() for n in names].index(close[0])]}`?"] if close else []
     notes.append(f"parameters of {pt.name}: " + (", ".join(names) or "none"))
     ck.ctx.diags.error(codes.UNKNOWN_PARAMETER, f"{pt.name} has no parameter `{arg.name}`", arg.span, notes)
-    if arg.value is not None:
-        ck.expr(arg.value)
+    _type_skipped(ck, arg.value)
 
 
-def bind_arg(ck, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
+def bind_arg(ck: ExprHost, arg: A.Arg, p: T.Param, pt: T.PouType) -> BoundArg:
     ctx = ck.ctx
     value = arg.value
     ba = BoundArg(p, value, arg.negated)
@@ -233,7 +239,7 @@ def _inout_compatible(have: T.Type, want: T.Type) -> bool:
     return T.same_type(h, w)
 
 
-def bind_builtin(ck, e: A.Call, b: B.Builtin, expected) -> T.Type:
+def bind_builtin(ck: ExprHost, e: A.Call, b: B.Builtin, expected) -> T.Type:
     ctx = ck.ctx
     values: list[A.Expr] = []
     formal_names = [n.upper() for n in b.formal_names]

@@ -21,17 +21,18 @@ from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from .consteval import const_int
+from .context import ExprHost
 from .symbols import EnumValueSymbol
 
 
-def _value(ck, e: A.Expr):
+def _value(ck: ExprHost, e: A.Expr):
     sym = getattr(e, "sym", None)
     if isinstance(sym, EnumValueSymbol):
         return sym.value
     return const_int(e, ck.ctx, ck.scope)
 
 
-def check(ck, stmt: A.Case, sel_type: T.Type) -> None:
+def check(ck: ExprHost, stmt: A.Case, sel_type: T.Type) -> None:
     ctx = ck.ctx
     sel = T.base_of(sel_type)
     ok_sel = T.is_error(sel) or T.is_int(sel) or isinstance(sel, T.EnumType) or (
@@ -62,7 +63,7 @@ def check(ck, stmt: A.Case, sel_type: T.Type) -> None:
     _report_overlaps(ck, ranges)
 
 
-def _report_overlaps(ck, ranges) -> None:
+def _report_overlaps(ck: ExprHost, ranges) -> None:
     """ST1402 once per label that overlaps an earlier one: sorted by value, so n log n even for 100,000 labels."""
     ranges.sort(key=lambda r: (r[0], r[2]))
     reach = None                                  # the range reaching furthest up among those sorted so far

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 
 MAX_CELLS = 4 * 1024 * 1024
 
@@ -28,7 +29,7 @@ def cells(t: T.Type, memo: dict) -> int:
     return T.value_cells(t, MAX_CELLS, memo)
 
 
-def _report(ctx, what: str, n: int, span) -> None:
+def _report(ctx: Context, what: str, n: int, span) -> None:
     size = f"{n:,} cells" if n <= MAX_CELLS else f"more than {MAX_CELLS:,} cells"
     ctx.diags.error(codes.DATA_TOO_LARGE,
                     f"{what} holds {size} (values plus the arrays, structures and instances that hold "
@@ -38,7 +39,7 @@ def _report(ctx, what: str, n: int, span) -> None:
 class Meter:
     """Measures the declarations of one project as the declaration pass completes them."""
 
-    def __init__(self, ctx) -> None:
+    def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
         self.memo: dict = {}
         self.global_total = 0

@@ -10,26 +10,15 @@ from ..frontend import types as T
 from ..frontend.builtins import default_string
 from . import at_address, data_size, duplicates, undeclared, union_member
 from .consteval import const_int
+from .context import Context, NamespaceView
 from .scope import GENERIC_TYPES, Ambiguous
 from .symbols import VarSymbol
 
 PARAM_DIRECTION = {"VAR_INPUT": "in", "VAR_OUTPUT": "out", "VAR_IN_OUT": "inout"}
 
 
-class NamespaceView:
-    """The items of one NAMESPACE block of a file, seen as a compilation unit of that namespace (names are looked
-    up from it as from a library folder's file)."""
-
-    def __init__(self, unit: A.CompilationUnit, namespace: str) -> None:
-        self.unit = unit
-        self.namespace = namespace
-
-    def __getattr__(self, name):
-        return getattr(self.unit, name)
-
-
 class Declarer:
-    def __init__(self, ctx) -> None:
+    def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
         self.tables = ctx.tables
         self.meter = data_size.Meter(ctx)
@@ -85,10 +74,10 @@ class Declarer:
     # ---- pass 2: bodies of type declarations -------------------------------------------------
     def complete_types(self) -> None:
         for decl, shell, unit in self.ctx.type_decls:
-            if isinstance(shell, T.EnumType):
+            if isinstance(shell, T.EnumType) and isinstance(decl.spec, A.EnumTypeRef):      # see shell_type()
                 self.fill_enum(shell, decl.spec, unit)
         for decl, shell, unit in self.ctx.type_decls:
-            if isinstance(shell, T.StructType):
+            if isinstance(shell, T.StructType) and isinstance(decl.spec, A.StructTypeRef):
                 self.fill_struct(shell, decl.spec, unit)
             elif isinstance(shell, T.AliasType):
                 shell.target = self.resolve(decl.spec, unit, None)

@@ -11,12 +11,13 @@ Failing::
 from __future__ import annotations
 
 from ..frontend import codes
+from .context import Context
 from .symbols import VarSymbol
 
 CODE = codes.DUPLICATE_NAME
 
 
-def report(ctx, what: str, name: str, span, previous) -> None:
+def report(ctx: Context, what: str, name: str, span, previous) -> None:
     notes = []
     prev_span = getattr(getattr(previous, "decl", None), "span", None) or getattr(
         getattr(previous, "pou", None), "name_span", None)
@@ -26,7 +27,7 @@ def report(ctx, what: str, name: str, span, previous) -> None:
     ctx.diags.error(CODE, f"{what} `{name}` is declared more than once; rename or remove one of them", span, notes)
 
 
-def check_locals(ctx, pou) -> dict:
+def check_locals(ctx: Context, pou) -> dict:
     """Build the local scope of a POU (NAME → VarSymbol), reporting duplicates; returns the scope."""
     scope: dict[str, VarSymbol | None] = {}
     for section in pou.sections:

@@ -2,14 +2,15 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 from ..frontend import ast as A
 from ..frontend import builtins as B
 from ..frontend import codes
 from ..frontend import types as T
+from ..frontend.source import Span
 from . import array_bounds, calls, undeclared
 from .compatibility import compatible
+from .context import Context, Flow, Unit
 from .scope import Ambiguous, is_generic
 from .symbols import EnumValueSymbol, PouSymbol, VarSymbol
 
@@ -30,16 +31,6 @@ def lit_string_type(value: str, wide: bool) -> T.StringType:
     return T.StringType(max(1, len(value)), wide, capacity=len(value), explicit=False)
 
 
-@dataclass
-class Flow:
-    """What the statements around an expression tell the rules that check a write (assign_target.py): the
-    variables of the enclosing FOR loops, which must not be written, and the function block instances already
-    called on this path (ST1303). The statement checker (body.py) keeps it; the expression checker reads it
-    when a call writes an output or in-out argument."""
-    for_vars: list[VarSymbol] = field(default_factory=list)
-    called_instances: set[str] = field(default_factory=set)
-
-
 class ExprChecker:
     """Types the expressions of one POU body, or of a unit's initial values and task properties.
 
@@ -50,7 +41,7 @@ class ExprChecker:
     checker. Calls bound here are collected in ``calls_made`` (recursion.py).
     """
 
-    def __init__(self, ctx, ns: str | None, scope: dict[str, VarSymbol | None] | None = None,
+    def __init__(self, ctx: Context, ns: str | None, scope: dict[str, VarSymbol | None] | None = None,
                  result_sym: VarSymbol | None = None, in_pou: bool = False, flow: Flow | None = None) -> None:
         self.ctx = ctx
         self.ns = ns
@@ -59,10 +50,10 @@ class ExprChecker:
         self.in_pou = in_pou
         self.flow = flow if flow is not None else Flow()
         self.implicit_globals: dict[str, VarSymbol] = {}
-        self.calls_made: list = []
+        self.calls_made: list[tuple[T.PouType, Span]] = []
 
     @classmethod
-    def for_unit(cls, ctx, unit: A.CompilationUnit | None) -> ExprChecker:
+    def for_unit(cls, ctx: Context, unit: Unit | None) -> ExprChecker:
         """The checker of the expressions outside any POU in ``unit`` (initial values, task properties)."""
         return cls(ctx, unit.namespace if unit is not None else None)
 

@@ -20,13 +20,14 @@ from __future__ import annotations
 
 from ..frontend import ast as A
 from ..frontend import codes
+from .context import Context
 from .symbols import VarSymbol
 
 SHOWN = 8           # names listed in the message; the rest are counted
 
 
-def _system_globals(ctx) -> frozenset:
-    names = getattr(ctx, "system_global_names", None)
+def _system_globals(ctx: Context) -> frozenset:
+    names = ctx.system_global_names
     if names is None:
         names = frozenset(d.name.upper() for gl, unit in ctx.global_lists if getattr(unit, "in_prelude", False)
                           for section in gl.sections for d in section.vars)
@@ -34,7 +35,7 @@ def _system_globals(ctx) -> frozenset:
     return names
 
 
-def check(ctx, pou: A.Pou, implicit_globals: dict[str, VarSymbol], in_prelude: bool) -> None:
+def check(ctx: Context, pou: A.Pou, implicit_globals: dict[str, VarSymbol], in_prelude: bool) -> None:
     if ctx.dialect != "sysmac" or in_prelude or not implicit_globals:
         return
     system = _system_globals(ctx)

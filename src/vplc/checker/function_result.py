@@ -19,6 +19,7 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 from .symbols import VarSymbol
 
 
@@ -42,7 +43,7 @@ def _assigns(stmts, result) -> bool | None:
     return False
 
 
-def check(ctx, pou: A.Pou, result_sym: VarSymbol | None) -> None:
+def check(ctx: Context, pou: A.Pou, result_sym: VarSymbol | None) -> None:
     if pou.kind != "FUNCTION" or pou.native or result_sym is None or result_sym.type is T.VOID:
         return
     if not _assigns(pou.body, result_sym):

@@ -34,6 +34,7 @@ from . import (
     portable_keywords,
     portable_len_type,
 )
+from .context import Context
 
 RULES = (portable_enum_values, portable_keywords, portable_case_labels, portable_discarded_result,
          portable_enum_order, portable_empty_call, portable_len_type, portable_array_types)
@@ -44,7 +45,7 @@ def exempt(path: str) -> bool:
     return "platform" in parts[:-1]
 
 
-def check_unit(ctx, unit: A.CompilationUnit) -> None:
+def check_unit(ctx: Context, unit: A.CompilationUnit) -> None:
     path = unit.span.file.path
     if getattr(unit, "in_prelude", False) or exempt(path):
         return

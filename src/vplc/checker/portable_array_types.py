@@ -20,20 +20,21 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 
 
 def _anonymous_array(t) -> bool:
     return isinstance(t, T.ArrayType)
 
 
-def _warn(ctx, span, what: str) -> None:
+def _warn(ctx: Context, span, what: str) -> None:
     ctx.diags.warning(codes.PORTABLE_ARRAY_TYPES,
                       f"{what}: two separately written ARRAY types are different types in IEC 61131-3 "
                       "2nd edition; declare the array once as a named type (a STRUCT member for Sysmac Studio) "
                       "and use it on both sides", span)
 
 
-def check_unit(ctx, unit: A.CompilationUnit) -> None:
+def check_unit(ctx: Context, unit: A.CompilationUnit) -> None:
     for node in A.walk(unit):
         if isinstance(node, A.Call) and node.binding is not None and node.binding.kind in ("function", "fb"):
             for ba in node.binding.args:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from ..frontend import ast as A
 from ..frontend import codes
+from .context import Context
 from .symbols import EnumValueSymbol
 
 
@@ -39,7 +40,7 @@ def _label_text(e: A.Expr) -> str:
     return f"`{text}`; write its decimal value (or an enumeration value)"
 
 
-def check_unit(ctx, unit: A.CompilationUnit) -> None:
+def check_unit(ctx: Context, unit: A.CompilationUnit) -> None:
     for node in A.walk(unit):
         if isinstance(node, A.Case):
             for branch in node.branches:

@@ -16,9 +16,10 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 
 
-def check_unit(ctx, unit: A.CompilationUnit) -> None:
+def check_unit(ctx: Context, unit: A.CompilationUnit) -> None:
     for node in A.walk(unit):
         if isinstance(node, A.CallStmt):
             b = node.call.binding

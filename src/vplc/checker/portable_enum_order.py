@@ -16,11 +16,12 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 
 ORDERING = ("<", ">", "<=", ">=")
 
 
-def check_unit(ctx, unit: A.CompilationUnit) -> None:
+def check_unit(ctx: Context, unit: A.CompilationUnit) -> None:
     for node in A.walk(unit):
         if isinstance(node, A.Binary) and node.op in ORDERING:
             enum = next((T.base_of(o.ty) for o in (node.left, node.right)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from ..frontend import ast as A
 from ..frontend import codes
+from .context import Context
 
 SFC = ["STEP", "END_STEP", "INITIAL_STEP", "TRANSITION", "END_TRANSITION", "FROM", "ACTION", "END_ACTION"]
 CONFIG = ["TASK", "ON", "WITH", "READ_ONLY", "READ_WRITE", "SINGLE", "INTERVAL", "PRIORITY", "AT", "VAR_ACCESS"]
@@ -36,7 +37,7 @@ def _names(node):
         yield node.name, node.name_span or node.span
 
 
-def check_unit(ctx, unit: A.CompilationUnit) -> None:
+def check_unit(ctx: Context, unit: A.CompilationUnit) -> None:
     for node in A.walk(unit):
         for name, span in _names(node):
             kind = KIND.get(name.upper())

@@ -19,6 +19,7 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 from .scope import is_generic
 
 ARITH = ("+", "-", "*", "/", "MOD")
@@ -51,7 +52,7 @@ def _is_int_type(e) -> bool:
     return e.ty is not None and T.base_of(e.ty) is T.INT
 
 
-def _report(ctx, e, where: str) -> None:
+def _report(ctx: Context, e, where: str) -> None:
     ctx.diags.warning(codes.PORTABLE_LEN_TYPE,
                       f"LEN and FIND return INT in IEC 61131-3 (UINT only in Sysmac), so this value is "
                       f"INT where {where}; use an INT variable or an INT_TO_... conversion", e.span)
@@ -77,7 +78,7 @@ def _arg_uses(call: A.Call):
             yield ba.expr, ba.param.type, f"`{ba.param.name}` of {b.pou.name} is {ba.param.type.name}"
 
 
-def check_unit(ctx, unit: A.CompilationUnit) -> None:
+def check_unit(ctx: Context, unit: A.CompilationUnit) -> None:
     for node in A.walk(unit):
         if isinstance(node, A.Assign) and _iec_int(node.value) and not _target_ok(node.target.ty):
             _report(ctx, node.value, f"`{node.target.span.file.text[node.target.span.start:node.target.span.end]}` "

@@ -17,9 +17,10 @@ from __future__ import annotations
 
 from ..frontend import codes
 from ..frontend import types as T
+from .context import Context
 
 
-def check(ctx, edges: dict) -> None:
+def check(ctx: Context, edges: dict) -> None:
     """``edges``: PouType → list of (callee PouType, span). Reports each cycle once, at its first call."""
     color: dict[int, int] = {}
     reported: set[frozenset] = set()

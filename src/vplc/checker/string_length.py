@@ -16,9 +16,10 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from .context import ExprHost
 
 
-def check(ck, value, want) -> None:
+def check(ck: ExprHost, value, want) -> None:
     t = T.unalias(want)
     if not isinstance(t, T.StringType) or not t.explicit:
         return

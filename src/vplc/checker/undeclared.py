@@ -18,6 +18,7 @@ from __future__ import annotations
 import difflib
 
 from ..frontend import codes, sysmac_names
+from .context import Context
 
 
 def _suggest(name: str, candidates) -> list[str]:
@@ -29,14 +30,14 @@ def _suggest(name: str, candidates) -> list[str]:
     return [f"did you mean `{by_upper[close[0]]}`?"]
 
 
-def report(ctx, name: str, span, candidates=()) -> None:
+def report(ctx: Context, name: str, span, candidates=()) -> None:
     if _not_modelled(ctx, name, span):
         return
     ctx.diags.error(codes.UNDECLARED, f"`{name}` is not declared; declare it in a VAR section or check the spelling",
                     span, _suggest(name, candidates))
 
 
-def _not_modelled(ctx, name: str, span) -> bool:
+def _not_modelled(ctx: Context, name: str, span) -> bool:
     """ST1007: a real Omron name (frontend/sysmac_names.py) that vplc does not model, in the Sysmac dialect."""
     if ctx.dialect != "sysmac":
         return False
@@ -48,7 +49,7 @@ def _not_modelled(ctx, name: str, span) -> bool:
     return True
 
 
-def report_type(ctx, name: str, span) -> None:
+def report_type(ctx: Context, name: str, span) -> None:
     if _not_modelled(ctx, name, span):
         return
     known = [k[1] for k in ctx.tables.types.entries] + [k[1] for k in ctx.tables.pous.entries]
@@ -61,7 +62,7 @@ def report_type(ctx, name: str, span) -> None:
     ctx.diags.error(codes.UNKNOWN_TYPE, f"unknown data type `{name}`", span, notes)
 
 
-def report_ambiguous(ctx, name: str, candidates: list[str], span) -> None:
+def report_ambiguous(ctx: Context, name: str, candidates: list[str], span) -> None:
     ctx.diags.error(codes.AMBIGUOUS_NAME,
                     f"`{name}` is ambiguous: it is declared in {', '.join(candidates)}; qualify it "
                     f"with its namespace (e.g. `{candidates[0]}`)", span)

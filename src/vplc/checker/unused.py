@@ -14,9 +14,10 @@ from __future__ import annotations
 
 from ..frontend import ast as A
 from ..frontend import codes
+from .context import Context
 
 
-def check(ctx, pou: A.Pou, in_prelude: bool) -> None:
+def check(ctx: Context, pou: A.Pou, in_prelude: bool) -> None:
     if pou.native or in_prelude:
         return
     for section in pou.sections:
