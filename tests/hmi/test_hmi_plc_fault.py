@@ -62,7 +62,8 @@ def test_after_a_major_fault_writes_are_refused_and_nothing_is_written(faulted, 
 def test_a_fault_of_the_real_plc_is_reported(tmp_path):
     """The vplc runtime's own fault, not a stand-in: a division by zero the HMI itself provokes."""
     (tmp_path / "main.st").write_text("VAR_GLOBAL Divisor : INT := 1; Quotient : INT; END_VAR\n"
-                                      "PROGRAM Main\nQuotient := 100 / Divisor;\nEND_PROGRAM\n")
+                                      "PROGRAM Main VAR_EXTERNAL Divisor : INT; Quotient : INT; END_VAR\n"
+                                      "Quotient := 100 / Divisor;\nEND_PROGRAM\n")
     plc = load_plc([str(tmp_path)])
     mapping = Mapping({"types": {}, "variables": {"Divisor": {"type": "INT", "access": "rw"},
                                                   "Quotient": {"type": "INT", "access": "r"}}})
