@@ -115,7 +115,8 @@ SYNTHETIC = {
                        "END_VAR\nVAR_IN_OUT\n    Buf : ARRAY[*] OF BYTE;\nEND_VAR\n"
                        "VAR_OUTPUT\n    Last : DINT;\nEND_VAR\n"
                        "IF Go THEN Last := Count; END_IF;\nEND_FUNCTION_BLOCK\n",
-    "Main.st": "PROGRAM Main\nVAR\n    K : DemoLib\\Keep;\n    B : ARRAY[0..3] OF BYTE;\n    M : DemoLib\\eMode;\n"
+    "Main.st": "PROGRAM Main\nVAR_EXTERNAL\n    gRun : BOOL;\n    gSpeed : REAL;\nEND_VAR\n"
+               "VAR\n    K : DemoLib\\Keep;\n    B : ARRAY[0..3] OF BYTE;\n    M : DemoLib\\eMode;\n"
                "    Y : REAL;\nEND_VAR\nK(Go := gRun, Count := 3, Buf := B);\nY := DemoLib\\Scale(X := gSpeed);\n"
                "gSpeed := gSpeed + DemoLib\\Now();\nEND_PROGRAM\n",
     "globals.st": "VAR_GLOBAL\n    gRun : BOOL;\n    gSpeed : REAL := 3.0;\nEND_VAR\nVAR_GLOBAL CONSTANT\n"
