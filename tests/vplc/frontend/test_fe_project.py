@@ -26,7 +26,7 @@ def test_names_resolve_to_symbols_including_globals_and_enum_values(tmp_path):
     (tmp_path / "gvl.st").write_text("VAR_GLOBAL Cobot : INT; END_VAR\n")
     check_text(tmp_path, "TYPE eStep : (Idle, Run := 10); END_TYPE\n"
                + program("Cobot := 1; s := Run; IF s = eStep#Idle THEN ; END_IF;", "s : eStep;"))
-    proj = load_project([str(tmp_path)])
+    proj = load_project([str(tmp_path)], dialect="iec")     # a global read without VAR_EXTERNAL: IEC allows it
     assert not proj.has_errors, proj.render_diagnostics()
     a, b, c = stmts(proj)
     assert isinstance(a.target.sym, VarSymbol) and a.target.sym.section == "VAR_GLOBAL"
