@@ -87,16 +87,19 @@ def _type(t):
     return f'<derived name="{t}"/>'
 
 
-def document(variables: dict, body: list[str], name="Main", pou_type="program") -> str:
+def document(variables: dict, body: list[str], name="Main", pou_type="program", externals: dict | None = None) -> str:
+    """``externals``: the globals the program uses, declared as external variables (Sysmac requires them)."""
     vars_xml = "".join(f'<variable name="{n}"><type>{_type(t)}</type></variable>' for n, t in variables.items())
+    ext_xml = "".join(f'<variable name="{n}"><type>{_type(t)}</type></variable>' for n, t in (externals or {}).items())
+    ext = f"<externalVars>{ext_xml}</externalVars>" if externals else ""
     return (HEAD + f'<types><dataTypes/><pous><pou name="{name}" pouType="{pou_type}"><interface>'
-            f'<localVars>{vars_xml}</localVars></interface><body><LD>\n' + "\n".join(body) +
+            f'{ext}<localVars>{vars_xml}</localVars></interface><body><LD>\n' + "\n".join(body) +
             '\n</LD></body></pou></pous></types><instances><configurations/></instances></project>\n')
 
 
-def program(tmp_path, variables: dict, body: list[str], name="Main", file="main.xml"):
+def program(tmp_path, variables: dict, body: list[str], name="Main", file="main.xml", externals: dict | None = None):
     path = tmp_path / file
-    path.write_text(document(variables, body, name), encoding="utf-8")
+    path.write_text(document(variables, body, name, externals=externals), encoding="utf-8")
     return path
 
 

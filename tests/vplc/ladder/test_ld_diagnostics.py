@@ -145,7 +145,7 @@ def test_ladder_and_st_files_mix_in_one_project(tmp_path):
                                         "END_FUNCTION\n", encoding="utf-8")
     body = [rail(1), invar(2, "Start"), invar(3, "TRUE", y=10), block(4, "Both", {"a": 2, "b": 3}, ["Both"]),
             outvar(5, "Lamp", (4, "Both"))]
-    program(tmp_path, {}, body)
+    program(tmp_path, {}, body, externals={"Start": "BOOL", "Lamp": "BOOL"})
     from vplc.api import load_plc
     plc = load_plc([str(tmp_path)], task="Main@1ms")
     plc.write("Start", True)
@@ -251,17 +251,14 @@ def test_check_summary_counts_one_exported_project_file_as_one_file(tmp_path, ca
                                               "END_FUNCTION\n", encoding="utf-8")
     (src / "Globals.st").write_text("VAR_GLOBAL\n    Start : BOOL;\n    Lamp : BOOL;\nEND_VAR\n", encoding="utf-8")
     program(src, {}, [rail(1), invar(2, "Start"), invar(3, "TRUE", y=10), block(4, "Both", {"a": 2, "b": 3}, ["Both"]),
-                      outvar(5, "Lamp", (4, "Both"))])
+                      outvar(5, "Lamp", (4, "Both"))], externals={"Start": "BOOL", "Lamp": "BOOL"})
     assert main(["check", str(src)]) == 0
-    # the ladder program reads the globals without declaring them external (ST1009, Sysmac refuses it); the
-    # IEC 61131-10 export declares them (ExternalVars), the PLCopen export does not
-    assert capsys.readouterr().out.splitlines()[-1] == "3 file(s) checked: 0 error(s), 1 warning(s)"
+    assert capsys.readouterr().out.splitlines()[-1] == "3 file(s) checked: 0 error(s), 0 warning(s)"
     out = tmp_path / "project.xml"
     assert main(["export", str(src), "--format", fmt, "-o", str(out)]) == 0
     capsys.readouterr()
-    assert main(["check", str(out)]) == 0
-    warnings = 0 if fmt == "iec61131-10" else 1
-    assert capsys.readouterr().out.splitlines()[-1] == f"1 file(s) checked: 0 error(s), {warnings} warning(s)"
+    assert main(["check", str(out)]) == 0          # both formats write the program's external variables
+    assert capsys.readouterr().out.splitlines()[-1] == "1 file(s) checked: 0 error(s), 0 warning(s)"
 
 
 def test_independent_wiring_problems_are_all_reported_with_the_st_rules_of_the_broken_rung(tmp_path):
