@@ -136,6 +136,7 @@ def test_a_named_axis_is_the_same_axis_as_its_mc_ax_element(tmp_path):
     named in the axis configuration is the same variable as _MC_AX[n]."""
     (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    MC_Shuttle : _sAXIS_REF;\nEND_VAR\n")
     (tmp_path / "Main.st").write_text("""PROGRAM Main
+VAR_EXTERNAL MC_Shuttle : _sAXIS_REF; END_VAR
 VAR pwr : MC_Power; mv : MC_MoveAbsolute; END_VAR
 pwr(Axis := MC_Shuttle, Enable := TRUE);
 mv(Axis := MC_Shuttle, Execute := pwr.Status, Position := 3.0, Velocity := 100.0);
