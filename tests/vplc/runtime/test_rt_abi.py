@@ -31,6 +31,7 @@ VAR_INPUT k : INT; END_VAR
 x := x + k; Bump := x / k MOD 7;
 END_FUNCTION
 PROGRAM Main
+VAR_EXTERNAL Lamp : BOOL; Word480 : WORD; Count : DINT; END_VAR
 VAR u : uWord; p, q : sPair; i, n : INT := 1; r : REAL; arr : ARRAY[1..10] OF INT; s : STRING[20]; END_VAR
 u.W := Word480; Lamp := NOT Lamp; q := p; p.b[2] := r / 3.0;
 FOR i := 1 TO n DO arr[i] := Bump(x := n, k := i); END_FOR;
