@@ -100,8 +100,12 @@ CUT_TEXTS = """
         continue;
       const s = getComputedStyle(el);
       if (s.overflowX === 'visible' && s.overflowY === 'visible' && s.textOverflow !== 'ellipsis') continue;
-      if (el.scrollWidth > el.clientWidth + 1 || (s.overflowY !== 'visible' && s.overflowY !== 'auto' &&
-          el.scrollHeight > el.clientHeight + 1)) out.push([el.id || el.dataset.status || el.className || el.tagName,
+      const range = document.createRange();        // the text's own width, to the sub-pixel (scrollWidth is rounded)
+      range.selectNodeContents(el);
+      const box = el.getBoundingClientRect().width - parseFloat(s.paddingLeft) - parseFloat(s.paddingRight) -
+        parseFloat(s.borderLeftWidth) - parseFloat(s.borderRightWidth);
+      if (range.getBoundingClientRect().width > box + 0.01 || el.scrollWidth > el.clientWidth + 1 ||
+          (s.overflowY !== 'visible' && s.overflowY !== 'auto' && el.scrollHeight > el.clientHeight + 1)) out.push([el.id || el.dataset.status || el.className || el.tagName,
         t.textContent.trim().slice(0, 40)]);
     }
     return out;"""

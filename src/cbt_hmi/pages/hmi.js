@@ -148,11 +148,28 @@ function makeField(path, spec, label) {
 }
 
 /* A field whose label does not fit its grid cell ("Motion Command" at 800x480) takes two cells: a label the
-   operator needs is never cut with "…". Run once the page is laid out. */
+   operator needs is never cut with "…". Checked again whenever the fields' area changes size (its scroll bar
+   appears once the fields are filled, the panel is drawn larger from 1280x800). */
 function uncutLabels(root) {
-  for (const label of root.querySelectorAll(".field > label")) {
-    if (label.scrollWidth > label.clientWidth + 1) label.parentElement.classList.add("span2");
+  const check = () => {
+    for (const label of root.querySelectorAll(".field > label")) {
+      if (textWiderThanBox(label)) label.parentElement.classList.add("span2");
+    }
+  };
+  check();
+  if (!root.dataset.uncut) {
+    root.dataset.uncut = "watched";
+    new ResizeObserver(check).observe(root);
   }
+}
+/* the text's laid-out width against the element's content box, to the sub-pixel: scrollWidth is rounded, and a label
+   0.2 px too wide is already cut with "…" */
+function textWiderThanBox(el) {
+  const range = document.createRange();
+  range.selectNodeContents(el);
+  const s = getComputedStyle(el), box = el.getBoundingClientRect().width - parseFloat(s.paddingLeft) -
+    parseFloat(s.paddingRight) - parseFloat(s.borderLeftWidth) - parseFloat(s.borderRightWidth);
+  return range.getBoundingClientRect().width > box + 0.01;
 }
 
 /* builds fieldsets for a struct variable (or array element) rooted at `path` */
