@@ -1,8 +1,8 @@
 """The simulator's three ports through their protocol objects' byte interface, with no socket (issue 22 step 2,
-pymodbus discipline): the Listen node (ListenSession), the Ethernet Slave (SvrSession) and the control channel
-(tmsim.protocol.control) each get the same byte stream whole, split in two at every position, byte by byte and
-glued into one piece, and answer the same in every case. A port's answers may not depend on how TCP cut its
-input."""
+pymodbus discipline): the Listen node (ListenSession and its ListenProtocol), the Ethernet Slave (SvrSession) and
+the control channel (tmsim.protocol.control) each get the same byte stream whole, split in two at every position,
+byte by byte and glued into one piece, and answer the same in every case. A port's answers may not depend on how
+TCP cut its input."""
 import json
 
 import pytest
@@ -10,6 +10,8 @@ from sim_harness import Harness
 
 from tmsim.protocol import codec
 from tmsim.protocol.control import RequestError, decode_request, next_line
+from tmsim.protocol.listen_protocol import ListenProtocol
+from tmsim.tmscript.work import WorkMeter
 
 
 def feeds(stream: bytes, frames: list[bytes]):
@@ -52,6 +54,39 @@ def test_the_listen_node_answers_the_same_however_its_input_is_cut(h):
     assert [item.header for item in codec.decode_all(bytearray(whole))] == ["TMSTA", "CPERR", "TMSTA", "CPERR"]
     assert b"CPERR,2,02" in whole and b"CPERR,2,03" in whole
     assert {name: answer for name, answer in answers.items() if answer != whole} == {}
+
+
+class _Node:
+    """A stand-in Listen node: it keeps what the protocol hands it and answers every frame with its header."""
+
+    def __init__(self, protocol_events):
+        self.now, self.meter, self.items, self.waiting_scripts = 0.0, WorkMeter(), [], 0
+        self.protocol = ListenProtocol(self, lambda kind, **fields: protocol_events.append(kind))
+
+    def handle(self, conn, item):
+        self.items.append(item)
+        if type(item) is codec.Frame:
+            self.protocol.send(conn, "TMSTA", item.header)
+
+
+def test_the_listen_protocol_decodes_for_any_node_the_same_however_its_input_is_cut():
+    """The Listen node's bytes are its protocol's (issue 22 step 2): ListenProtocol decodes, limits the CPERR
+    answers and logs the frames for any node it serves - here one that is no Listen node at all."""
+    stream = b"".join(LISTEN)
+    seen = {}
+    for name, chunks in feeds(stream, LISTEN):
+        events = []
+        node = _Node(events)
+        node.protocol.connect(1)
+        for chunk in chunks:
+            node.protocol.receive_data(1, chunk)
+        items = [type(item).__name__ for item in node.items if type(item) is not codec.Garbage]   # (noise: per chunk)
+        seen[name] = (items, b"".join(node.protocol.data_to_send(1)))
+        assert node.protocol.input_bytes(1) == 0 and events.count("frame_in") == 2, name
+        assert events.count("frame_out") == 2 and events[0] == "connect", name
+    assert seen["whole"][0] == ["Frame", "BadFrame", "Frame", "BadFrame"]
+    assert seen["whole"][1] == codec.encode("TMSTA", "TMSTA") * 2
+    assert {name: got for name, got in seen.items() if got != seen["whole"]} == {}
 
 
 # ---- Ethernet Slave ($TMSVR) ------------------------------------------------------------------------------

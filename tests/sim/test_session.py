@@ -6,17 +6,8 @@ from session_rig import PTP_LONG, S, sct, sta
 
 from tmsim.limits import CPERR_BURST, CPERR_PER_S, TurnBudget
 from tmsim.protocol import codec
-from tmsim.protocol.listen_session import (
-    EXITING,
-    FRAME_LIMIT,
-    IDLE,
-    IN_NODE,
-    INPUT_DONE,
-    INPUT_LEFT,
-    STOPPED,
-    TRANSITIONS,
-    TransitionError,
-)
+from tmsim.protocol.listen_protocol import FRAME_LIMIT, INPUT_DONE, INPUT_LEFT
+from tmsim.protocol.listen_session import EXITING, IDLE, IN_NODE, STOPPED, TRANSITIONS, TransitionError
 
 
 def budget(items, decoded, **bounds):

@@ -20,7 +20,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Protocol
 
 from tmsim.limits import FRAME_DATA_MAX, IO_SLICE_S, PENDING_SCRIPTS_MAX, POLL_BUDGET_S, SERVE_TURN
-from tmsim.protocol.listen_session import FRAME_LIMIT, INPUT_DONE
+from tmsim.protocol.listen_protocol import FRAME_LIMIT, INPUT_DONE
 
 if TYPE_CHECKING:
     from tmsim.net.server import Conn, Robot

@@ -1,34 +1,25 @@
-"""Listen Node session of one robot: a sans-I/O state machine (bytes and time in, frames out).
+"""Listen node of one robot: a sans-I/O state machine (frames and time in, frames out).
 
-A server calls ``connect``/``receive_data(conn, bytes)``/``disconnect``/``advance(now)`` and takes
-``data_to_send(conn)`` (one bytes object per frame, so each goes out in one send); the control channel
-uses the control methods (``enter_node``, ``stop_project`` ...). A server that shares its input fairly
-between clients (tmsim/net/fairness.py) calls ``buffer_data`` and then ``turn(conn, budget)`` in bounded turns
-(a ``TurnBudget`` of tmsim/limits.py) instead of ``receive_data``; the session decodes, limits its CPERR
-answers to bad packets (CPERR_BURST, CPERR_PER_S in tmsim/limits.py) and logs ``frame_in`` either way. The
-node state follows an explicit transition table; the scripts of all clients are run strictly in arrival order,
-one at a time.
+The node follows an explicit transition table (project stopped / not in the node / in the node / exiting);
+the scripts of all clients are checked and run strictly in arrival order, one at a time, on the robot model
+(TMscript 2.24 §15: TMSCT scripts, TMSTA status queries, priority commands). Its bytes are its protocol's
+(``ListenProtocol``, tmsim/protocol/listen_protocol.py: receive buffers, decoding, the CPERR limit on bad
+packets, outboxes, the frame events); the node hands a server the protocol's port interface unchanged:
+``connect`` / ``receive_data(conn, bytes)`` or ``buffer_data`` + ``turn(conn, budget)`` / ``disconnect`` /
+``data_to_send(conn)``. A server also calls ``advance(now)``; the control channel uses the control methods
+(``enter_node``, ``stop_project`` ...) and the queries (``node_state()``, ``snapshot()`` ...).
 """
 from __future__ import annotations
 
 import re
 from collections import deque
 from collections.abc import Callable, Generator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
-from tmsim.limits import (
-    CPERR_BURST,
-    CPERR_PER_S,
-    RECEIVE_TURN,
-    WORK_CHAR,
-    WORK_LINE,
-    WORK_LOG_BYTES,
-    WORK_TOKEN,
-    TurnBudget,
-)
+from tmsim.limits import WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN, TurnBudget
 from tmsim.protocol import codec
-from tmsim.robot.eventlog import text as _text
+from tmsim.protocol.listen_protocol import Client, ListenProtocol, outgoing
 from tmsim.robot.model import RobotModel
 from tmsim.tmscript.interp import Context, ScriptRuntimeError, run_script, variable_memory
 from tmsim.tmscript.parser import iter_lines
@@ -53,24 +44,11 @@ TRANSITIONS = {
     (EXITING, "robot_fault"): STOPPED,
 }
 
-# outcome of one turn of a connection's input (``turn``)
-INPUT_DONE = "done"                 # no complete item is left in the receive buffer
-INPUT_LEFT = "left"                 # a bound of the turn ended it: input may be left for the next turn
-FRAME_LIMIT = "frame_limit"         # the connection's received frames reached ``frame_limit``
-
 # TMscript 2.24 §15.8: a priority command is a line that is literally ScriptExit(0|1) or StopAndClearBuffer(0|1|2)
 # ("not the use with variables and functions"); StopAndClearBuffer with any other argument goes to the checker,
 # which refuses it (tmscript.py: §13.4 defines no parameter)
 _PRIORITY = re.compile(r"^\s*(ScriptExit|StopAndClearBuffer)\s*\(\s*(\d)\s*\)\s*$")
 _PRIORITY_ARGS = {"ScriptExit": (0, 1), "StopAndClearBuffer": (0, 1, 2)}
-
-
-# a frame queued for a client: (the frame's bytes, its header, its data as given to the codec)
-Outgoing = tuple[bytes, str, bytes | str]
-
-
-def _outgoing(header: str, data: bytes | str) -> Outgoing:
-    return codec.encode(header, data), header, data
 
 
 @dataclass
@@ -86,17 +64,6 @@ class Running:
     gen: Generator[Any, Any, tuple[str, bool]]     # the script checked, then run (``_script``)
     wait: tuple | None = None          # ("tag", tag, deadline or None), ("delay", None, deadline) or
                                        # ("room" | "idle" | "turn", None, None): see _resume_waits
-
-
-@dataclass
-class Client:
-    peer: str
-    cperr_at: float                     # robot clock of the last refill of ``cperr_tokens``
-    cperr_tokens: float = float(CPERR_BURST)        # CPERR answers to bad packets still allowed (a bucket)
-    suppressed: int = 0                 # bad packets not answered since the last ``cperr_suppressed`` event
-    frames_in: int = 0                  # well-formed frames received
-    outbox: list[Outgoing] = field(default_factory=list)    # frames not handed out yet (``data_to_send``)
-    rbuf: bytearray = field(default_factory=bytearray)      # bytes received and not processed yet
 
 
 class TransitionError(Exception):
@@ -116,7 +83,8 @@ class ListenSession:
         self.state = STOPPED
         self.exit_path: str | None = None
         self.now = 0.0
-        self.clients: dict[int, Client] = {}
+        self.protocol = ListenProtocol(self, self.log)    # the node's bytes: buffers, decoding, CPERR limit
+        self.clients: dict[int, Client] = self.protocol.clients     # (the same dict: who is connected)
         self.pending: deque[Packet] = deque()
         self.running: Running | None = None
         self.variables: dict[str, Any] = {}          # the node's variables, while it stays in the node
@@ -181,36 +149,52 @@ class ListenSession:
         else:
             self.pending.clear()
 
-    # ---- connections --------------------------------------------------------------------------
+    # ---- the protocol's port interface (ListenProtocol) ---------------------------------------
     def connect(self, conn: int, peer: str = "127.0.0.1") -> None:
-        self.clients[conn] = Client(peer, self.now)
-        self.log("connect", conn=conn, peer=peer)
+        self.protocol.connect(conn, peer)
 
     def disconnect(self, conn: int) -> None:
-        client = self.clients.pop(conn, None)
-        if client is not None:
-            if client.suppressed:
-                self.log("cperr_suppressed", conn=conn, count=client.suppressed)
-            self.log("disconnect", conn=conn)
+        self.protocol.disconnect(conn)
+
+    def receive_data(self, conn: int, data: bytes) -> int:
+        """Bytes received from connection ``conn``, processed at once (ListenProtocol.receive_data)."""
+        return self.protocol.receive_data(conn, data)
+
+    def buffer_data(self, conn: int, data: bytes) -> None:
+        """Bytes received from connection ``conn``, kept for ``turn``."""
+        self.protocol.buffer_data(conn, data)
+
+    def turn(self, conn: int, budget: TurnBudget) -> tuple[int, str]:
+        """One bounded turn of ``conn``'s buffered input (ListenProtocol.turn)."""
+        return self.protocol.turn(conn, budget)
+
+    def data_to_send(self, conn: int) -> list[bytes]:
+        """The frames for connection ``conn`` produced so far (ListenProtocol.data_to_send)."""
+        return self.protocol.data_to_send(conn)
+
+    def input_bytes(self, conn: int) -> int:
+        """Bytes of connection ``conn`` received and not processed yet."""
+        return self.protocol.input_bytes(conn)
+
+    def unanswered_bad(self, conn: int) -> int:
+        """Bad packets of connection ``conn`` not answered (CPERR limit) and not logged yet."""
+        return self.protocol.unanswered_bad(conn)
+
+    def has_output(self) -> bool:
+        """True when a frame for some client is waiting in data_to_send."""
+        return self.protocol.has_output()
+
+    def is_connected(self, conn: int) -> bool:
+        return self.protocol.is_connected(conn)
 
     def send(self, conn: int, header: str, data: bytes | str) -> None:
         """Queue the frame ``header``/``data`` for connection ``conn`` (unknown connection: nothing)."""
-        client = self.clients.get(conn)
-        if client is not None:
-            client.outbox.append(_outgoing(header, data))
+        self.protocol.send(conn, header, data)
 
     def push(self, header: str, data: bytes | str, ip_filter: str | None = None) -> int:
         """Queue the frame ``header``/``data`` for every client (of address ``ip_filter``); returns how many get
         it."""
-        return self._push(_outgoing(header, data), ip_filter)
-
-    def _push(self, out: Outgoing, ip_filter: str | None) -> int:
-        count = 0
-        for client in self.clients.values():
-            if ip_filter is None or client.peer == ip_filter:
-                client.outbox.append(out)
-                count += 1
-        return count
+        return self.protocol.push(outgoing(header, data), ip_filter)
 
     # ---- input --------------------------------------------------------------------------------
     def handle(self, conn: int, item: codec.Frame | codec.BadFrame | codec.Garbage) -> None:
@@ -410,8 +394,8 @@ class ListenSession:
             self._step(result)
 
     def _listen_send(self, ip_filter, sub, payload):
-        out = _outgoing("TMSTA", f"{sub},".encode() + payload)
-        recipients = self._push(out, ip_filter)
+        out = outgoing("TMSTA", f"{sub},".encode() + payload)
+        recipients = self.protocol.push(out, ip_filter)
         self.meter.add(len(out[0]) * recipients // WORK_LOG_BYTES)     # sending it and its event, per client
 
     # ---- time ---------------------------------------------------------------------------------
@@ -444,109 +428,7 @@ class ListenSession:
         if self.state == EXITING and self.robot.idle and self.running is None:
             self.fire("drain_done")
 
-    # ---- sans-I/O byte interface (h11 pattern): bytes in, bytes out; nobody else touches the state -------
-    def receive_data(self, conn: int, data: bytes) -> int:
-        """Bytes received from connection ``conn``: every complete item in them (and in what an earlier call
-        left incomplete) is processed at once; returns the number of items handled (bad packets beyond the
-        CPERR limit are not). A partial frame waits in the session's buffer of that connection for the next
-        call."""
-        if conn not in self.clients:
-            return 0
-        self.buffer_data(conn, data)
-        total = 0
-        while True:
-            handled, outcome = self.turn(conn, RECEIVE_TURN)
-            total += handled
-            if outcome != INPUT_LEFT:
-                return total
-
-    def buffer_data(self, conn: int, data: bytes) -> None:
-        """Bytes received from connection ``conn``, kept for ``turn`` (unknown connection: ignored)."""
-        client = self.clients.get(conn)
-        if client is not None:
-            client.rbuf += data
-
-    def input_bytes(self, conn: int) -> int:
-        """Bytes of connection ``conn`` received and not processed yet."""
-        client = self.clients.get(conn)
-        return 0 if client is None else len(client.rbuf)
-
-    def unanswered_bad(self, conn: int) -> int:
-        """Bad packets of connection ``conn`` not answered (CPERR limit) and not logged yet."""
-        client = self.clients.get(conn)
-        return 0 if client is None else client.suppressed
-
-    def turn(self, conn: int, budget: TurnBudget) -> tuple[int, str]:
-        """One turn of connection ``conn``'s buffered input within ``budget`` (tmsim/limits.py TurnBudget): at
-        most ``budget.decoded`` items decoded and ``budget.items`` of them handled; the turn also ends once
-        ``budget.waiting`` scripts wait to start, when the turn's work is spent, or right after the item that
-        brings the connection's received frames to ``budget.frame_limit``. Returns (items handled, INPUT_DONE |
-        INPUT_LEFT | FRAME_LIMIT). Bad packets are answered with CPERR at most CPERR_BURST at once, then
-        CPERR_PER_S per second of robot clock; the others are counted (event ``cperr_suppressed`` before the
-        next item handled, or at ``disconnect``)."""
-        if budget.work is not None:
-            self.meter.begin(budget.work)
-        client = self.clients.get(conn)
-        if client is None:
-            return 0, INPUT_DONE
-        max_items, max_waiting, frame_limit = budget.items, budget.waiting, budget.frame_limit
-        rbuf, handled = client.rbuf, 0
-        for _ in range(budget.decoded):
-            if rbuf[:2] == b"$$" and self._cperr_tokens(client) < 1.0:
-                # a '$' followed by another '$' is always a bad packet (header missing, CPERR 01): a run of
-                # them that gets no answer anyway is skipped at once
-                run = len(rbuf) - len(rbuf.lstrip(b"$")) - 1
-                del rbuf[:run]
-                client.suppressed += run
-                continue
-            item, used = codec.decode(rbuf)
-            if item is None:                    # need more bytes (decode consumed none)
-                return handled, INPUT_DONE
-            del rbuf[:used]
-            if type(item) is codec.BadFrame and not self._may_answer_bad(client):
-                client.suppressed += 1
-                continue
-            if client.suppressed:
-                self.log("cperr_suppressed", conn=conn, count=client.suppressed)
-                client.suppressed = 0
-            if type(item) is codec.Frame:
-                client.frames_in += 1
-                self.log("frame_in", conn=conn, raw=_text(item.raw), header=item.header, data=_text(item.data))
-            self.handle(conn, item)
-            handled += 1
-            if frame_limit is not None and client.frames_in >= frame_limit:
-                return handled, FRAME_LIMIT
-            if handled >= max_items or (max_waiting is not None and len(self.pending) >= max_waiting) or \
-                    self.meter.spent:
-                return handled, INPUT_LEFT
-        return handled, INPUT_LEFT
-
-    def _cperr_tokens(self, client) -> float:
-        """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""
-        client.cperr_tokens = min(CPERR_BURST, client.cperr_tokens + (self.now - client.cperr_at) * CPERR_PER_S)
-        client.cperr_at = self.now
-        return client.cperr_tokens
-
-    def _may_answer_bad(self, client) -> bool:
-        if self._cperr_tokens(client) < 1.0:
-            return False
-        client.cperr_tokens -= 1.0
-        return True
-
-    def data_to_send(self, conn: int) -> list[bytes]:
-        """The frames for connection ``conn`` produced so far (one bytes object per frame, so each can go out
-        in one send); the session forgets them and logs each as event ``frame_out`` (its header and data as it
-        built them: nobody parses the frames it sends)."""
-        client = self.clients.get(conn)
-        if client is None or not client.outbox:
-            return []
-        queued, client.outbox = client.outbox, []
-        log = self.log
-        for frame, header, data in queued:
-            log("frame_out", conn=conn, raw=_text(frame), header=header,
-                data=data if isinstance(data, str) else _text(data))
-        return [out[0] for out in queued]
-
+    # ---- queries ------------------------------------------------------------------------------
     def has_work_for(self, conn: int) -> bool:
         """True while a script of ``conn`` runs or waits (its replies are still to come)."""
         if self.running is not None and self.running.packet.conn == conn:
@@ -575,13 +457,6 @@ class ListenSession:
 
     def waiting_script_bytes(self) -> int:
         return sum(len(p.script) for p in self.pending)
-
-    def has_output(self) -> bool:
-        """True when a frame for some client is waiting in data_to_send."""
-        return any(client.outbox for client in self.clients.values())
-
-    def is_connected(self, conn: int) -> bool:
-        return conn in self.clients
 
     def node_state(self) -> str:
         """The node's state: STOPPED ("project_stopped"), IDLE ("not_in_node"), IN_NODE or EXITING."""
