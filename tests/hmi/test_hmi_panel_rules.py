@@ -177,3 +177,17 @@ def test_the_ladder_drawing_reads_at_the_panels_body_text_size(ladder_stack, siz
     found = page_metrics(browser)
     assert found == {"small": [], "text": [], "contrast": []}, found
     assert cut_texts(browser) == []                   # the title beside "Robot not connected" too
+
+
+@pytest.mark.parametrize("size", SIZES, ids=["800x480", "1280x800"])
+def test_the_pnp_segment_dialog_cuts_no_label(stack, size):
+    """The segment dialog (a CBT_MoveAbsolute parameter structure, laid out only when it opens) keeps its labels whole
+    and its controls at panel size."""
+    browser = open_sized(stack, "pnp", "engineer", size)
+    browser.wait_for(lambda d: d.execute_script("return document.getElementById('edit-0') !== null"), "the drawing")
+    browser.driver.execute_script("document.getElementById('edit-0').onclick()")
+    browser.wait_for(lambda d: d.execute_script("return document.getElementById('seg-dialog').open"), "the dialog")
+    browser.wait_for(lambda d: cut_texts(browser) == [], f"every text whole: {cut_texts(browser)}")
+    browser.screenshot(f"panel_pnp_segment_{size[0]}x{size[1]}")
+    found = page_metrics(browser)
+    assert found == {"small": [], "text": [], "contrast": []}, found
