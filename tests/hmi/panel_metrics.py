@@ -105,8 +105,8 @@ CUT_TEXTS = """
       const box = el.getBoundingClientRect().width - parseFloat(s.paddingLeft) - parseFloat(s.paddingRight) -
         parseFloat(s.borderLeftWidth) - parseFloat(s.borderRightWidth);
       if (range.getBoundingClientRect().width > box + 0.01 || el.scrollWidth > el.clientWidth + 1 ||
-          (s.overflowY !== 'visible' && s.overflowY !== 'auto' && el.scrollHeight > el.clientHeight + 1)) out.push([el.id || el.dataset.status || el.className || el.tagName,
-        t.textContent.trim().slice(0, 40)]);
+          (s.overflowY !== 'visible' && s.overflowY !== 'auto' && el.scrollHeight > el.clientHeight + 1))
+        out.push([el.id || el.dataset.status || el.className || el.tagName, t.textContent.trim().slice(0, 40)]);
     }
     return out;"""
 
