@@ -4,6 +4,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
+from collections.abc import Iterable
 
 from .checker import calls, recursion
 from .checker import portable as portable_rule
@@ -19,6 +20,8 @@ from .frontend.diagnostics import Diagnostic, DiagnosticBag, render_all, sort_ke
 from .frontend.parser import parse
 from .frontend.source import SourceFile, Span
 from .ladder.load import attach_ladders, check_operands, is_project_xml, is_xml, read_xml
+
+Paths = str | os.PathLike[str] | Iterable[str | os.PathLike[str]]    # one file or folder, or several
 
 PRELUDE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prelude")
 VENDOR_PRELUDE = ("sysmac_types.st", "sysmac_decl.st", "sysmac_sysvars.st", "sysmac_motion.st", "sysmac_control.st")
@@ -72,7 +75,7 @@ def namespace_of(path: str) -> str | None:
     return None
 
 
-def collect_files(paths, diags: DiagnosticBag) -> list[str]:
+def collect_files(paths: Iterable[str | os.PathLike[str]], diags: DiagnosticBag) -> list[str]:
     files: list[str] = []
     for p in paths:
         p = str(p)
@@ -127,7 +130,8 @@ def read_source(path: str, diags: DiagnosticBag) -> SourceFile | None:
 
 # ---- loading -------------------------------------------------------------------------------------
 
-def load_project(paths, *, dialect: str = "sysmac", include_prelude: bool = True, portable: bool = False) -> Project:
+def load_project(paths: Paths, *, dialect: str = "sysmac", include_prelude: bool = True,
+                 portable: bool = False) -> Project:
     """Read, parse and check ``paths`` (files or folders, recursively ``*.st`` and ``*.xml``: PLCopen XML and
     IEC 61131-10 projects, see :mod:`vplc.ladder`) plus the prelude."""
     # The front end allocates many small long-lived objects and frees almost nothing: the cyclic garbage
@@ -141,13 +145,11 @@ def load_project(paths, *, dialect: str = "sysmac", include_prelude: bool = True
             gc.enable()
 
 
-def _load(paths, dialect: str, include_prelude: bool, portable: bool) -> Project:
+def _load(paths: Paths, dialect: str, include_prelude: bool, portable: bool) -> Project:
     diags = DiagnosticBag()
     ctx = Context(dialect, diags)
     proj = Project(dialect)
-    if isinstance(paths, (str, os.PathLike)):
-        paths = [paths]
-    user_files = collect_files(paths, diags)
+    user_files = collect_files([paths] if isinstance(paths, (str, os.PathLike)) else paths, diags)
     prelude_files = sorted(os.path.join(PRELUDE_DIR, n) for n in os.listdir(PRELUDE_DIR) if n.endswith(".st")) \
         if include_prelude and os.path.isdir(PRELUDE_DIR) else []
     prelude_abs = {os.path.abspath(f) for f in prelude_files}
@@ -237,7 +239,7 @@ def check_units(ctx: Context, proj: Project) -> None:
     proj.globals = dict(ctx.tables.globals)
 
 
-def check_configuration(ctx: Context, cfg: A.Configuration, unit) -> None:
+def check_configuration(ctx: Context, cfg: A.Configuration, unit: Unit) -> None:
     ck = ExprChecker.for_unit(ctx, unit)
     for res in cfg.resources:
         tasks = {}

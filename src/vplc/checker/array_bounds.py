@@ -12,14 +12,16 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import ast as A
 from ..frontend import codes
+from ..frontend import types as T
 from .consteval import const_int
 from .context import ExprHost
 
 
-def check(ck: ExprHost, e, array_type) -> None:
+def check(ck: ExprHost, e: A.Index, array_type: T.ArrayType) -> None:
     for ix, (lo, hi) in zip(e.indices, array_type.dims, strict=False):
-        if lo is None:
+        if lo is None or hi is None:        # an open dimension
             continue
         value = const_int(ix, ck.ctx, ck.scope)
         if value is not None and not lo <= value <= hi:
@@ -27,9 +29,8 @@ def check(ck: ExprHost, e, array_type) -> None:
                                f"`{ck.text(e.base)}`", ix.span)
 
 
-def check_slice(ck: ExprHost, element, param_type, param_name: str) -> None:
+def check_slice(ck: ExprHost, element: A.Index, param_type: T.ArrayType, param_name: str) -> None:
     """Sysmac "array element passed to an array parameter": enough elements must remain from that element."""
-    from ..frontend import types as T
     base = T.unalias(element.base.ty) if element.base.ty is not None else None
     if param_type.open or not isinstance(base, T.ArrayType) or base.open or len(base.dims) != 1:
         return

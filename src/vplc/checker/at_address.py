@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import re
 
+from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from .context import Context
@@ -36,10 +37,11 @@ from .context import Context
 # bank 32,768 words; W501)
 AREA_WORDS = {"CIO": 6144, "W": 512, "H": 1536, "D": 32768, "E": 32768}
 EM_BANKS = 25
+Layout = tuple[str, int, int | None]      # how the value lies in the words: types.union_layout()
 _RE = re.compile(r"%(?:(?P<area>[WHDA])|E(?P<bank>[0-9A-F]{1,2})_)?(?P<word>[0-9]+)(?:\.(?P<bit>[0-9]+))?$", re.I)
 
 
-def parse(text: str):
+def parse(text: str) -> tuple[str, int, int, int | None] | None:
     """(area, bank, word, bit or None) of a Sysmac memory-area address, or None for another address."""
     m = _RE.match(text)
     if m is None:
@@ -50,7 +52,7 @@ def parse(text: str):
     return area, bank, int(m.group("word")), bit
 
 
-def check_global(ctx: Context, decl, vt: T.Type):
+def check_global(ctx: Context, decl: A.VarDecl, vt: T.Type) -> tuple[str, int, int, int, Layout, int] | None:
     """The address of a global in a Sysmac area as (area, bank, word, bit, layout, words in the area), or None;
     reports ST1110."""
     if decl.at is None:
@@ -99,7 +101,7 @@ def check_global(ctx: Context, decl, vt: T.Type):
     return area, bank, word, bit or 0, layout, AREA_WORDS[area]
 
 
-def check_local(ctx: Context, decl) -> None:
+def check_local(ctx: Context, decl: A.VarDecl) -> None:
     """vplc places global variables in memory areas; an AT of a Sysmac area on a POU's variable is refused."""
     if decl.at is not None and parse(decl.at) is not None:
         ctx.diags.error(codes.AT_ADDRESS,

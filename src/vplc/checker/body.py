@@ -78,17 +78,17 @@ class BodyChecker:
         for s in stmts:
             getattr(self, "s_" + type(s).__name__)(s)
 
-    def s_Empty(self, s):
+    def s_Empty(self, s: A.Empty) -> None:
         pass
 
-    def s_Assign(self, s: A.Assign):
+    def s_Assign(self, s: A.Assign) -> None:
         exprs = self.exprs
         tt = exprs.expr(s.target)
         vt = exprs.expr(s.value, tt)
         assign_target.check_write(exprs, s.target)
         exprs.coerce(s.value, vt, tt, f"assignment to `{exprs.text(s.target)}`")
 
-    def s_CallStmt(self, s: A.CallStmt):
+    def s_CallStmt(self, s: A.CallStmt) -> None:
         calls.check_call(self.exprs, s.call, None, statement=True)
         if s.call.binding is not None and s.call.binding.kind == "fb":
             self.flow.called_instances.add(self.exprs.text(s.call.callee).upper())
@@ -98,7 +98,7 @@ class BodyChecker:
         if not T.is_error(t) and T.base_of(t) is not T.BOOL:
             self.ctx.diags.error(codes.CONDITION_TYPE, f"the {what} condition must be BOOL, not {t.name}", e.span)
 
-    def branches(self, bodies) -> None:
+    def branches(self, bodies: list[list[A.Stmt]]) -> None:
         """Check alternative statement lists: an FB called in one branch is not 'already called' in a sibling
         branch (ST1303), but may have been called after the whole construct."""
         flow = self.flow
@@ -110,17 +110,17 @@ class BodyChecker:
             after |= flow.called_instances
         flow.called_instances = after
 
-    def s_If(self, s: A.If):
+    def s_If(self, s: A.If) -> None:
         for b in s.branches:
             self.condition(b.cond, "IF")
         self.branches([b.body for b in s.branches] + [s.else_body or []])
 
-    def s_Case(self, s: A.Case):
+    def s_Case(self, s: A.Case) -> None:
         st = self.exprs.expr(s.selector)
         case_labels.check(self.exprs, s, st)
         self.branches([b.body for b in s.branches] + [s.else_body or []])
 
-    def s_For(self, s: A.For):
+    def s_For(self, s: A.For) -> None:
         exprs = self.exprs
         vt = exprs.expr(s.var)
         sym = s.var.sym
@@ -139,26 +139,26 @@ class BodyChecker:
         self.loop_depth -= 1
         self.flow.for_vars.pop()
 
-    def s_While(self, s: A.While):
+    def s_While(self, s: A.While) -> None:
         self.condition(s.cond, "WHILE")
         self.loop_depth += 1
         self.block(s.body)
         self.loop_depth -= 1
 
-    def s_Repeat(self, s: A.Repeat):
+    def s_Repeat(self, s: A.Repeat) -> None:
         self.loop_depth += 1
         self.block(s.body)
         self.loop_depth -= 1
         self.condition(s.cond, "UNTIL")
 
-    def s_Exit(self, s):
+    def s_Exit(self, s: A.Exit) -> None:
         if self.loop_depth == 0:
             self.ctx.diags.error(codes.EXIT_OUTSIDE_LOOP, "EXIT is only allowed inside FOR, WHILE or REPEAT", s.span)
 
-    def s_Continue(self, s):
+    def s_Continue(self, s: A.Continue) -> None:
         if self.loop_depth == 0:
             self.ctx.diags.error(codes.EXIT_OUTSIDE_LOOP,
                                  "CONTINUE is only allowed inside FOR, WHILE or REPEAT", s.span)
 
-    def s_Return(self, s):
+    def s_Return(self, s: A.Return) -> None:
         pass

@@ -35,7 +35,7 @@ def is_lvalue(e: A.Expr) -> bool:
     return isinstance(e, (A.Member, A.Index, A.BitAccess))
 
 
-def check_call(ck: ExprHost, e: A.Call, expected, statement: bool) -> T.Type:
+def check_call(ck: ExprHost, e: A.Call, expected: T.Type | None, statement: bool) -> T.Type:
     """Resolve the callee of ``e`` and bind its arguments; returns the call's result type."""
     ctx = ck.ctx
     callee = e.callee
@@ -95,7 +95,7 @@ def _skip_args(ck: ExprHost, e: A.Call) -> T.Type:
     return T.ERROR
 
 
-def bind_pou(ck: ExprHost, e: A.Call, pt: T.PouType, kind: str, instance) -> T.Type:
+def bind_pou(ck: ExprHost, e: A.Call, pt: T.PouType, kind: str, instance: A.Expr | None) -> T.Type:
     ctx = ck.ctx
     positional = [p for p in pt.params if p.direction in ("in", "inout")]
     if kind == "fb" and ctx.dialect == "sysmac":
@@ -239,7 +239,7 @@ def _inout_compatible(have: T.Type, want: T.Type) -> bool:
     return T.same_type(h, w)
 
 
-def bind_builtin(ck: ExprHost, e: A.Call, b: B.Builtin, expected) -> T.Type:
+def bind_builtin(ck: ExprHost, e: A.Call, b: B.Builtin, expected: T.Type | None) -> T.Type:
     ctx = ck.ctx
     values: list[A.Expr] = []
     formal_names = [n.upper() for n in b.formal_names]

@@ -1,10 +1,16 @@
 """Constant folding of integer expressions (array bounds, string lengths, enum values, CASE labels)."""
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from ..frontend import ast as A
+from ..frontend import types as T
+from .context import Context
+from .symbols import VarSymbol
 
 
-def const_int(e: A.Expr | None, ctx, scope, _depth: int = 0) -> int | None:
+def const_int(e: A.Expr | None, ctx: Context, scope: Mapping[str, VarSymbol | None] | None,
+              _depth: int = 0) -> int | None:
     """Value of a constant integer expression, or None. ``scope`` maps NAME → VarSymbol (locals) or None."""
     if _depth > 50 or e is None:
         return None
@@ -33,7 +39,7 @@ def const_int(e: A.Expr | None, ctx, scope, _depth: int = 0) -> int | None:
             t = ctx.tables.types.lookup(e.type_name.name, e.type_name.namespace)
         except Exception:
             return None
-        if t is not None and hasattr(t, "values"):
+        if isinstance(t, T.EnumType):
             key = t.lookup(e.value)
             return t.values.get(key) if key else None
         return None

@@ -18,9 +18,11 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from .context import Context
+from .symbols import VarSymbol
 
 MAX_CELLS = 4 * 1024 * 1024
 
@@ -45,7 +47,7 @@ class Meter:
         self.global_total = 0
         self.global_reported = False
 
-    def check_pous(self, pous) -> None:
+    def check_pous(self, pous: list[T.PouType]) -> None:
         """Each variable of each POU (``pous``: PouTypes), then a program's or FB's instance data as a whole."""
         for pt in pous:
             pou = pt.pou
@@ -67,7 +69,7 @@ class Meter:
             if total > MAX_CELLS and not reported and pou.kind != "FUNCTION":
                 _report(self.ctx, f"the instance data of {pou.kind} `{pou.name}`", total, pou.name_span or pou.span)
 
-    def check_global(self, decl, sym) -> None:
+    def check_global(self, decl: A.VarDecl, sym: VarSymbol) -> None:
         """One global variable, and the running total of all global variables."""
         n = cells(sym.type, self.memo)
         if n > MAX_CELLS:

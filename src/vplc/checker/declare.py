@@ -4,13 +4,15 @@ Runs before any body is checked, so declarations may appear in any order and any
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from ..frontend.builtins import default_string
 from . import at_address, data_size, duplicates, undeclared, union_member
 from .consteval import const_int
-from .context import Context, NamespaceView
+from .context import Context, NamespaceView, Unit
 from .scope import GENERIC_TYPES, Ambiguous
 from .symbols import VarSymbol
 
@@ -97,7 +99,7 @@ class Declarer:
                     seen.add(id(t))
                     t = t.target
 
-    def fill_enum(self, enum: T.EnumType, spec: A.EnumTypeRef, unit) -> None:
+    def fill_enum(self, enum: T.EnumType, spec: A.EnumTypeRef, unit: Unit) -> None:
         if spec.base is not None:
             base = self.resolve(spec.base, unit, None)
             if T.is_int(base):
@@ -154,7 +156,7 @@ class Declarer:
                     path.append(inner)
                     stack.append(iter(list(inner.fields.values())))
 
-    def fill_struct(self, st: T.StructType, spec: A.StructTypeRef, unit) -> None:
+    def fill_struct(self, st: T.StructType, spec: A.StructTypeRef, unit: Unit) -> None:
         for f in spec.fields:
             ftype = self.resolve(f.type, unit, None)
             if ftype is st:
@@ -171,7 +173,7 @@ class Declarer:
             self.ctx.note_edition3("UNION (a Sysmac extension)", spec.span)
 
     # ---- type references ----------------------------------------------------------------------
-    def resolve(self, ref: A.TypeRef, unit, scope) -> T.Type:
+    def resolve(self, ref: A.TypeRef, unit: Unit, scope: Mapping[str, VarSymbol | None] | None) -> T.Type:
         """Turn a syntactic type into a semantic type; unknown names are reported (ST1004)."""
         ctx = self.ctx
         if isinstance(ref, A.NamedTypeRef):
@@ -269,7 +271,7 @@ class Declarer:
                         index += 1
         self.meter.check_pous([pou.sym for pou, _unit in self.ctx.pou_units])
 
-    def declare_globals(self, sections, unit, list_name: str | None) -> None:
+    def declare_globals(self, sections: list[A.VarSection], unit: Unit, list_name: str | None) -> None:
         for section in sections:
             if section.kind != "VAR_GLOBAL":
                 self.ctx.diags.error(codes.STRAY_TEXT,

@@ -10,14 +10,16 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import ast as A
 from ..frontend import codes
+from ..frontend.source import Span
 from .context import Context
 from .symbols import VarSymbol
 
 CODE = codes.DUPLICATE_NAME
 
 
-def report(ctx: Context, what: str, name: str, span, previous) -> None:
+def report(ctx: Context, what: str, name: str, span: Span, previous: object) -> None:
     notes = []
     prev_span = getattr(getattr(previous, "decl", None), "span", None) or getattr(
         getattr(previous, "pou", None), "name_span", None)
@@ -27,7 +29,7 @@ def report(ctx: Context, what: str, name: str, span, previous) -> None:
     ctx.diags.error(CODE, f"{what} `{name}` is declared more than once; rename or remove one of them", span, notes)
 
 
-def check_locals(ctx: Context, pou) -> dict:
+def check_locals(ctx: Context, pou: A.Pou) -> dict[str, VarSymbol | None]:
     """Build the local scope of a POU (NAME → VarSymbol), reporting duplicates; returns the scope."""
     scope: dict[str, VarSymbol | None] = {}
     for section in pou.sections:

@@ -72,7 +72,7 @@ class ExprChecker:
             self.implicit_globals.setdefault(up, g)      # used without VAR_EXTERNAL (external_globals.py)
         return g
 
-    def mark_used(self, sym) -> None:
+    def mark_used(self, sym: object) -> None:
         if isinstance(sym, VarSymbol):
             sym.used = True
 
@@ -130,7 +130,7 @@ class ExprChecker:
         e.ty = ty
         return ty
 
-    def x_Literal(self, e: A.Literal, expected):
+    def x_Literal(self, e: A.Literal, expected: T.Type | None) -> T.Type:
         if e.kind in LIT_TYPES:
             return LIT_TYPES[e.kind]
         if e.kind in ("string", "wstring"):
@@ -147,7 +147,7 @@ class ExprChecker:
             return t
         return self.untyped_number(e, e.value, expected)
 
-    def real_fits(self, e, t) -> None:
+    def real_fits(self, e: A.Literal, t: T.Type) -> None:
         """ST1107 for a real literal that overflows its type (REAL ±3.4028235E38, LREAL ±1.7976931E308)."""
         value = e.value
         base = T.base_of(t)
@@ -158,7 +158,7 @@ class ExprChecker:
             self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE,
                                  f"{e.text or value} does not fit in {rt.name} (±{rt.hi:.8g})", e.span)
 
-    def untyped_number(self, e, value, expected):
+    def untyped_number(self, e: A.Expr, value: int | float, expected: T.Type | None) -> T.Type:
         exp = T.unalias(expected) if expected is not None else None
         if isinstance(e, A.Literal) and e.kind == "real" or isinstance(value, float):
             t = T.base_of(exp) if exp is not None and T.is_real(exp) else T.LREAL
@@ -178,10 +178,10 @@ class ExprChecker:
         self.ctx.diags.error(codes.CONSTANT_OUT_OF_RANGE, f"{value} is too large for any integer type", e.span)
         return T.ERROR
 
-    def x_Name(self, e: A.Name, expected):
+    def x_Name(self, e: A.Name, expected: T.Type | None) -> T.Type:
         return self.name(e, expected)
 
-    def x_EnumLiteral(self, e: A.EnumLiteral, expected):
+    def x_EnumLiteral(self, e: A.EnumLiteral, expected: T.Type | None) -> T.Type:
         qn = e.type_name
         try:
             t = self.ctx.tables.types.lookup(qn.name, qn.namespace, self.ns)
@@ -189,7 +189,7 @@ class ExprChecker:
             undeclared.report_ambiguous(self.ctx, qn.text(), amb.candidates, e.span)
             return T.ERROR
         enum = T.unalias(t) if t is not None else None
-        if not isinstance(enum, T.EnumType):
+        if t is None or not isinstance(enum, T.EnumType):
             if t is None:
                 undeclared.report_type(self.ctx, qn.text(), qn.span or e.span)
             else:
@@ -204,7 +204,7 @@ class ExprChecker:
         self.ctx.note_vendor(enum, e.span)
         return t
 
-    def x_Member(self, e: A.Member, expected):
+    def x_Member(self, e: A.Member, expected: T.Type | None) -> T.Type:
         bt = T.unalias(self.expr(e.base))
         if T.is_error(bt):
             return T.ERROR
@@ -241,7 +241,7 @@ class ExprChecker:
                              f"`{self.text(e.base)}` is of type {bt.name}, which has no members", e.span)
         return T.ERROR
 
-    def x_BitAccess(self, e: A.BitAccess, expected):
+    def x_BitAccess(self, e: A.BitAccess, expected: T.Type | None) -> T.Type:
         bt = T.base_of(self.expr(e.base))
         if T.is_error(bt):
             return T.BOOL
@@ -254,7 +254,7 @@ class ExprChecker:
                                  e.span)
         return T.BOOL
 
-    def x_Index(self, e: A.Index, expected):
+    def x_Index(self, e: A.Index, expected: T.Type | None) -> T.Type:
         bt = T.unalias(self.expr(e.base))
         for ix in e.indices:
             it = self.expr(ix, T.DINT)
@@ -281,7 +281,7 @@ class ExprChecker:
                                  f"array variable (`Buf := {self.text(e.base)};`) and index that", e.span)
         return bt.element
 
-    def x_Unary(self, e: A.Unary, expected):
+    def x_Unary(self, e: A.Unary, expected: T.Type | None) -> T.Type:
         if e.op == "NOT":
             t = self.expr(e.operand, expected)
             if not T.is_error(t) and not T.is_bits(t):
@@ -329,7 +329,7 @@ class ExprChecker:
             return True
         return isinstance(e, A.Name) and not e.name.namespace and self.lookup_var(e.name.name) is None
 
-    def x_Binary(self, e: A.Binary, expected):
+    def x_Binary(self, e: A.Binary, expected: T.Type | None) -> T.Type:
         op = e.op
         hint = None if op in COMPARE else expected
         if self.needs_context(e.left) and not self.needs_context(e.right):
@@ -352,7 +352,7 @@ class ExprChecker:
             return self.op_error(e, lt, rt, "BOOL or bit-string operands of the same kind")
         return self.arithmetic(e, lt, rt)
 
-    def comparison(self, e, lt, rt):
+    def comparison(self, e: A.Binary, lt: T.Type, rt: T.Type) -> T.Type:
         a, b = T.base_of(lt), T.base_of(rt)
         if e.op in ("=", "<>") and (self.bool_digit(e.right, a, b) or self.bool_digit(e.left, b, a)):
             return T.BOOL
@@ -370,7 +370,7 @@ class ExprChecker:
         return self.op_error(e, lt, rt, "comparable values of the same type")
 
     @staticmethod
-    def bool_digit(lit, other: T.Type, this: T.Type) -> bool:
+    def bool_digit(lit: A.Expr, other: T.Type, this: T.Type) -> bool:
         """`Flag = 1`, `Flag <> 0`: a plain 0 or 1 compared with a BOOL is a BOOL literal (IEC 61131-3
         boolean_literal; Sysmac accepts it). The literal becomes FALSE / TRUE."""
         if not (isinstance(lit, A.Literal) and lit.kind == "int" and lit.type_prefix is None and lit.value in (0, 1)
@@ -380,7 +380,7 @@ class ExprChecker:
         lit.kind, lit.value = "bool", bool(lit.value)
         return True
 
-    def numeric_common(self, e, a: T.Type, b: T.Type) -> T.Type | None:
+    def numeric_common(self, e: A.Binary, a: T.Type, b: T.Type) -> T.Type | None:
         """Common type of two operands. Sysmac (W501 6-106): the operand of highest rank, unsigned at equal
         rank. Where Sysmac's rank table puts an integer above a floating-point operand (DINT above REAL, LINT
         above LREAL), Sysmac computes the expression in that integer; vplc computes it in LREAL, keeps Sysmac's
@@ -407,7 +407,7 @@ class ExprChecker:
             return T.LREAL
         return s
 
-    def arithmetic(self, e, lt, rt):
+    def arithmetic(self, e: A.Binary, lt: T.Type, rt: T.Type) -> T.Type:
         op = e.op
         a, b = T.base_of(lt), T.base_of(rt)
         ka, kb = getattr(a, "kind", ""), getattr(b, "kind", "")
@@ -439,7 +439,7 @@ class ExprChecker:
                                  "WORD_TO_UINT etc.)")
         return self.op_error(e, lt, rt, "numbers of compatible types")
 
-    def op_error(self, e, lt, rt, needs: str):
+    def op_error(self, e: A.Binary, lt: T.Type, rt: T.Type, needs: str) -> T.Type:
         self.ctx.diags.error(codes.OPERATOR_TYPE,
                              f"operator {e.op} cannot combine {lt.name} and {rt.name}; it needs {needs}",
                              e.span)
@@ -453,15 +453,15 @@ class ExprChecker:
         if not T.is_error(have) and not T.same_type(T.base_of(have), want) and e.conv is None:
             e.conv = want
 
-    def x_Call(self, e: A.Call, expected):
+    def x_Call(self, e: A.Call, expected: T.Type | None) -> T.Type:
         return calls.check_call(self, e, expected, statement=False)
 
-    def x_ArrayInit(self, e, expected):
+    def x_ArrayInit(self, e: A.Expr, expected: T.Type | None) -> T.Type:
         self.ctx.diags.error(codes.UNEXPECTED_TOKEN,
                              "an array initializer `[...]` is only allowed as an initial value", e.span)
         return T.ERROR
 
-    def x_StructInit(self, e, expected):
+    def x_StructInit(self, e: A.Expr, expected: T.Type | None) -> T.Type:
         self.ctx.diags.error(codes.UNEXPECTED_TOKEN,
                              "a structure initializer `(...)` is only allowed as an initial value", e.span)
         return T.ERROR

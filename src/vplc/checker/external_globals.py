@@ -2,8 +2,9 @@
 
 Sysmac Studio refuses it: a program or function block reads or writes a global variable only through an
 external variable of the same name and type (W501, external variables; the IEC 61131-10 export writes them as
-`ExternalVars`). vplc runs the program anyway and warns once per POU, naming the globals; the system-defined
-variables (P_On, _CurrentTime, ... in prelude/sysmac_sysvars.st) need no declaration.
+`ExternalVars`). In the sysmac dialect it is an error, once per POU, naming the globals (the IEC dialect lets a
+POU read a global directly); the system-defined variables (P_On, _CurrentTime, ... in prelude/sysmac_sysvars.st)
+need no declaration.
 
 Passing::
 
@@ -44,8 +45,9 @@ def check(ctx: Context, pou: A.Pou, implicit_globals: dict[str, VarSymbol], in_p
         return
     shown = ", ".join(f"`{n}`" for n in names[:SHOWN]) + (f" and {len(names) - SHOWN} more" if len(names) > SHOWN
                                                           else "")
-    ctx.diags.warning(codes.SYSMAC_MISSING_EXTERNAL,
-                      f"{pou.name} uses the global variable{'s' if len(names) > 1 else ''} {shown} "
-                      "without VAR_EXTERNAL; Sysmac Studio refuses a global that the POU does not declare as an "
-                      "external variable", pou.name_span or pou.span,
-                      ["declare each in `VAR_EXTERNAL ... END_VAR` with the global's type"])
+    ctx.diags.error(codes.SYSMAC_MISSING_EXTERNAL,
+                    f"{pou.name} uses the global variable{'s' if len(names) > 1 else ''} {shown} "
+                    "without VAR_EXTERNAL; Sysmac Studio refuses a global that the POU does not declare as an "
+                    "external variable", pou.name_span or pou.span,
+                    ["declare each in `VAR_EXTERNAL ... END_VAR` with the global's type, or check with "
+                     "`--dialect iec`, which lets a POU read a global directly"])

@@ -15,8 +15,10 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from ..frontend.source import Span
 from .context import Context
 
 
@@ -53,7 +55,7 @@ def check(ctx: Context, edges: dict) -> None:
                 stack.append((callee, iter(edges.get(callee, ()))))
 
 
-def instance_edges(pt: T.PouType, decls) -> list:
+def instance_edges(pt: T.PouType, decls: list[A.VarDecl]) -> list[tuple[T.PouType, Span]]:
     """Edges from FB/program instances declared inside ``pt`` (an FB containing itself recurses)."""
     out = []
     for d in decls:

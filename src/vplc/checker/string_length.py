@@ -19,7 +19,7 @@ from ..frontend import types as T
 from .context import ExprHost
 
 
-def check(ck: ExprHost, value, want) -> None:
+def check(ck: ExprHost, value: A.Expr, want: T.Type) -> None:
     t = T.unalias(want)
     if not isinstance(t, T.StringType) or not t.explicit:
         return

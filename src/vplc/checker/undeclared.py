@@ -16,12 +16,14 @@ Failing::
 from __future__ import annotations
 
 import difflib
+from collections.abc import Iterable
 
 from ..frontend import codes, sysmac_names
+from ..frontend.source import Span
 from .context import Context
 
 
-def _suggest(name: str, candidates) -> list[str]:
+def _suggest(name: str, candidates: Iterable[str]) -> list[str]:
     names = {c for c in candidates if c}
     close = difflib.get_close_matches(name.upper(), [n.upper() for n in names], n=1, cutoff=0.75)
     if not close:
@@ -30,14 +32,14 @@ def _suggest(name: str, candidates) -> list[str]:
     return [f"did you mean `{by_upper[close[0]]}`?"]
 
 
-def report(ctx: Context, name: str, span, candidates=()) -> None:
+def report(ctx: Context, name: str, span: Span, candidates: Iterable[str] = ()) -> None:
     if _not_modelled(ctx, name, span):
         return
     ctx.diags.error(codes.UNDECLARED, f"`{name}` is not declared; declare it in a VAR section or check the spelling",
                     span, _suggest(name, candidates))
 
 
-def _not_modelled(ctx: Context, name: str, span) -> bool:
+def _not_modelled(ctx: Context, name: str, span: Span) -> bool:
     """ST1007: a real Omron name (frontend/sysmac_names.py) that vplc does not model, in the Sysmac dialect."""
     if ctx.dialect != "sysmac":
         return False
@@ -49,7 +51,7 @@ def _not_modelled(ctx: Context, name: str, span) -> bool:
     return True
 
 
-def report_type(ctx: Context, name: str, span) -> None:
+def report_type(ctx: Context, name: str, span: Span) -> None:
     if _not_modelled(ctx, name, span):
         return
     known = [k[1] for k in ctx.tables.types.entries] + [k[1] for k in ctx.tables.pous.entries]
@@ -62,7 +64,7 @@ def report_type(ctx: Context, name: str, span) -> None:
     ctx.diags.error(codes.UNKNOWN_TYPE, f"unknown data type `{name}`", span, notes)
 
 
-def report_ambiguous(ctx: Context, name: str, candidates: list[str], span) -> None:
+def report_ambiguous(ctx: Context, name: str, candidates: list[str], span: Span) -> None:
     ctx.diags.error(codes.AMBIGUOUS_NAME,
                     f"`{name}` is ambiguous: it is declared in {', '.join(candidates)}; qualify it "
                     f"with its namespace (e.g. `{candidates[0]}`)", span)

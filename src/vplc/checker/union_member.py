@@ -21,12 +21,13 @@ Failing::
 """
 from __future__ import annotations
 
+from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
 from .context import Context
 
 
-def check(ctx: Context, st: T.StructType, f, ftype: T.Type) -> None:
+def check(ctx: Context, st: T.StructType, f: A.VarDecl, ftype: T.Type) -> None:
     if f.init is not None:
         ctx.diags.error(codes.UNION_MEMBER,
                         f"member `{f.name}` of UNION {st.name} has an initial value; a union's members "

@@ -14,6 +14,7 @@ docs/toolchain/frontend_api.md:
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import KW_ONLY, dataclass, field
 from typing import Any
 
@@ -488,7 +489,7 @@ class CompilationUnit(Node, LoadedFrom):
     comments: list = _ann(None)
 
 
-def iter_children(node: Node):
+def iter_children(node: Node) -> Iterator[Node]:
     """Yield the direct child nodes of ``node`` (used by generic walkers)."""
     for name in node.__dataclass_fields__:
         if name in ("span", "ty", "conv", "sym", "binding", "name_span"):
@@ -502,7 +503,7 @@ def iter_children(node: Node):
                     yield v
 
 
-def walk(node: Node):
+def walk(node: Node) -> Iterator[Node]:
     """Depth-first pre-order walk, iterative (safe on very deep trees)."""
     stack = [node]
     while stack:

@@ -22,19 +22,25 @@ class SignatureError(Exception):
         self.arg_index = arg_index
 
 
+# A standard function's signature check: (argument types, dialect) -> (result type, the conversion of each
+# argument or None); raises SignatureError naming the argument that does not fit.
+Resolved = tuple[T.Type, list[T.Type | None]]
+Resolver = Callable[[list[T.Type], str], Resolved]
+
+
 @dataclass(frozen=True)
 class Builtin:
     name: str
     min_args: int
     max_args: int | None          # None: extensible (CONCAT, MAX, ...)
-    resolve: Callable              # (arg_types, dialect) -> (result, [conv or None])
+    resolve: Resolver              # (arg_types, dialect) -> (result, [conv or None])
     formal_names: tuple[str, ...] = ()   # accepted formal parameter names, in order (IN, IN1, ...)
     vendor: bool = False
 
 
 # ---- helpers ----------------------------------------------------------------------------------
 
-def _need(pred, t: T.Type, i: int, what: str) -> None:
+def _need(pred: Callable[[T.Type], bool], t: T.Type, i: int, what: str) -> None:
     if T.is_error(t) or pred(t):
         return
     raise SignatureError(f"argument {i + 1} must be {what}, not {t.name}", i)
@@ -57,7 +63,7 @@ def _common(types_: list[T.Type], first: int = 0) -> T.Type:
     return result
 
 
-def _convs(arg_types, target) -> list:
+def _convs(arg_types: list[T.Type], target: T.Type) -> list[T.Type | None]:
     return [None if (T.is_error(a) or T.same_type(a, target)) else target for a in arg_types]
 
 
@@ -67,84 +73,84 @@ def _real_of(t: T.Type) -> T.Type:
 
 # ---- families -----------------------------------------------------------------------------------
 
-def _numeric_same(args, dialect):
+def _numeric_same(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_num, args[0], 0, "a number")
     return T.base_of(args[0]) if not T.is_error(args[0]) else T.ERROR, [None]
 
 
-def _real_math(args, dialect):
+def _real_math(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_num, args[0], 0, "a number")
     r = _real_of(args[0]) if not T.is_error(args[0]) else T.ERROR
     return r, _convs(args, r)
 
 
-def _atan2(args, dialect):
+def _atan2(args: list[T.Type], dialect: str) -> Resolved:
     for i, a in enumerate(args):
         _need(T.is_num, a, i, "a number")
     r = _common([_real_of(a) if not T.is_error(a) else a for a in args])
     return r, _convs(args, r)
 
 
-def _expt(args, dialect):
+def _expt(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_num, args[0], 0, "a number")
     _need(T.is_num, args[1], 1, "a number")
     r = _real_of(args[0]) if not T.is_error(args[0]) else T.ERROR
     return r, [None if T.same_type(args[0], r) else r, None]
 
 
-def _arith(args, dialect):
+def _arith(args: list[T.Type], dialect: str) -> Resolved:
     for i, a in enumerate(args):
         _need(lambda t: T.is_num(t) or T.is_time(t), a, i, "a number or TIME")
     r = _common(args)
     return r, _convs(args, r)
 
 
-def _mod(args, dialect):
+def _mod(args: list[T.Type], dialect: str) -> Resolved:
     for i, a in enumerate(args):
         _need(T.is_int, a, i, "an integer")
     r = _common(args)
     return r, _convs(args, r)
 
 
-def _sel(args, dialect):
+def _sel(args: list[T.Type], dialect: str) -> Resolved:
     _need(lambda t: T.base_of(t) is T.BOOL, args[0], 0, "BOOL")
     r = _common(args, 1)
-    return r, [None] + _convs(args[1:], r)
+    return r, [None, *_convs(args[1:], r)]
 
 
-def _maxmin(args, dialect):
+def _maxmin(args: list[T.Type], dialect: str) -> Resolved:
     for i, a in enumerate(args):
         _need(T.is_elementary, a, i, "an elementary value")
     r = _common(args)
     return r, _convs(args, r)
 
 
-def _mux(args, dialect):
+def _mux(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_int, args[0], 0, "an integer selector")
     r = _common(args, 1)
-    return r, [None] + _convs(args[1:], r)
+    return r, [None, *_convs(args[1:], r)]
 
 
-def _shift(args, dialect):
+def _shift(args: list[T.Type], dialect: str) -> Resolved:
     _need(lambda t: T.is_bits(t) and T.base_of(t) is not T.BOOL or T.is_int(t), args[0], 0,
           "a bit string (BYTE..LWORD)")
     _need(T.is_int, args[1], 1, "an integer")
     return (T.base_of(args[0]) if not T.is_error(args[0]) else T.ERROR), [None, None]
 
 
-def _bitwise(args, dialect):
+def _bitwise(args: list[T.Type], dialect: str) -> Resolved:
     for i, a in enumerate(args):
         _need(T.is_bits, a, i, "BOOL or a bit string")
     r = _common(args)
     return r, _convs(args, r)
 
 
-def _not(args, dialect):
+def _not(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_bits, args[0], 0, "BOOL or a bit string")
     return T.base_of(args[0]), [None]
 
 
-def _compare(args, dialect):
+def _compare(args: list[T.Type], dialect: str) -> Resolved:
     """LT, LE, GT, GE, EQ, NE as functions (IEC 61131-3 comparison functions; Sysmac accepts them in ST like ADD):
     operands of one comparable type, the result BOOL. LT/LE/GT/GE/EQ are extensible, `LT(a, b, c)` meaning
     `a < b AND b < c`."""
@@ -162,7 +168,7 @@ def _compare(args, dialect):
     return T.BOOL, _convs(args, c)
 
 
-def _move(args, dialect):
+def _move(args: list[T.Type], dialect: str) -> Resolved:
     return args[0], [None]
 
 
@@ -170,9 +176,9 @@ def _str_default(dialect: str) -> T.StringType:
     return default_string(dialect)
 
 
-def _string_fn(pattern: str) -> Callable:
+def _string_fn(pattern: str) -> Resolver:
     """pattern letters: s = STRING arg, i = integer arg; result STRING."""
-    def resolve(args, dialect):
+    def resolve(args: list[T.Type], dialect: str) -> Resolved:
         for i, (a, p) in enumerate(zip(args, pattern, strict=False)):
             if p == "s":
                 _need(T.is_string, a, i, "a STRING")
@@ -183,32 +189,32 @@ def _string_fn(pattern: str) -> Callable:
     return resolve
 
 
-def _concat(args, dialect):
+def _concat(args: list[T.Type], dialect: str) -> Resolved:
     for i, a in enumerate(args):
         _need(T.is_string, a, i, "a STRING")
     wide = any(isinstance(bt := T.base_of(a), T.StringType) and bt.wide for a in args)
     return default_string(dialect, wide), [None] * len(args)
 
 
-def _len(args, dialect):
+def _len(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_string, args[0], 0, "a STRING")
     return (T.UINT if dialect == "sysmac" else T.INT), [None]
 
 
-def _find(args, dialect):
+def _find(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_string, args[0], 0, "a STRING")
     _need(T.is_string, args[1], 1, "a STRING")
     return (T.UINT if dialect == "sysmac" else T.INT), [None, None]
 
 
-def _bound(args, dialect):
+def _bound(args: list[T.Type], dialect: str) -> Resolved:
     _need(lambda t: isinstance(T.unalias(t), T.ArrayType), args[0], 0, "an array")
     _need(T.is_int, args[1], 1, "an integer dimension")
     return T.DINT, [None, None]
 
 
-def _fixed(params: tuple[T.Type, ...], result: T.Type) -> Callable:
-    def resolve(args, dialect):
+def _fixed(params: tuple[T.Type, ...], result: T.Type) -> Resolver:
+    def resolve(args: list[T.Type], dialect: str) -> Resolved:
         convs = []
         for i, (a, p) in enumerate(zip(args, params, strict=False)):
             if not (T.widens_to(a, p) or (dialect == "sysmac" and T.sysmac_assignable(a, p))):
@@ -240,7 +246,7 @@ def _conversion(src_name: str, dst_name: str) -> Builtin | None:
         return None
     src, dst = CONVERTIBLE[src_name], CONVERTIBLE[dst_name]
 
-    def resolve(args, dialect):
+    def resolve(args: list[T.Type], dialect: str) -> Resolved:
         a = args[0]
         if not T.is_error(a):
             ok = (T.is_string(a) if src is None else
@@ -270,7 +276,7 @@ def _bcd(name: str) -> Builtin | None:
     if m and T.is_int(T.ELEMENTARY.get(m.group(2), T.BOOL)):
         bits_name, result = m.group(1), T.ELEMENTARY[m.group(2)]
 
-        def decode(args, dialect):
+        def decode(args: list[T.Type], dialect: str) -> Resolved:
             a = args[0]
             if bits_name is None:
                 _need(lambda t: T.base_of(t).kind == "bit", a, 0, "a bit string (BYTE, WORD, DWORD, LWORD)")
@@ -284,7 +290,7 @@ def _bcd(name: str) -> Builtin | None:
         source = T.ELEMENTARY[m.group(1)]
         result = T.ELEMENTARY[m.group(2) or _BITS_OF_WIDTH[source.bits]]
 
-        def encode(args, dialect):
+        def encode(args: list[T.Type], dialect: str) -> Resolved:
             a = args[0]
             _need(lambda t: T.same_type(T.base_of(t), source) or T.widens_to(t, source), a, 0, f"a {source.name}")
             return result, [None if T.is_error(a) or T.same_type(T.base_of(a), source) else source]
@@ -292,7 +298,7 @@ def _bcd(name: str) -> Builtin | None:
     return None
 
 
-def _trunc(args, dialect):
+def _trunc(args: list[T.Type], dialect: str) -> Resolved:
     _need(T.is_real, args[0], 0, "REAL or LREAL")
     return T.DINT, [None]
 
@@ -381,7 +387,7 @@ def lookup(name: str) -> Builtin | None:
     if up.startswith("TO_") and up[3:] in CONVERTIBLE:      # IEC 3rd edition generic conversion TO_<type>
         dst = CONVERTIBLE[up[3:]]
 
-        def resolve(args, dialect, _dst=dst, _name=up[3:]):
+        def resolve(args: list[T.Type], dialect: str, _dst: T.Type | None = dst, _name: str = up[3:]) -> Resolved:
             _need(lambda t: T.is_elementary(t), args[0], 0, "an elementary value")
             return (default_string(dialect, _name == "WSTRING") if _dst is None else _dst), [None]
         b = Builtin(up, 1, 1, resolve, ("IN",))
@@ -390,7 +396,7 @@ def lookup(name: str) -> Builtin | None:
     if up.startswith("TRUNC_") and up[6:] in T.ELEMENTARY and T.is_int(T.ELEMENTARY[up[6:]]):
         target = T.ELEMENTARY[up[6:]]
 
-        def truncate(args, dialect, _t=target):
+        def truncate(args: list[T.Type], dialect: str, _t: T.Type = target) -> Resolved:
             _need(T.is_real, args[0], 0, "REAL or LREAL")
             return _t, [None]
         b = Builtin(up, 1, 1, truncate, ("IN",))

@@ -5,6 +5,7 @@ The full table of codes (with a failing and a fixed example each) is docs/toolch
 from __future__ import annotations
 
 import json
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from .source import Span
@@ -109,12 +110,12 @@ class DiagnosticBag:
     def note(self, code: str, message: str, span: Span, notes: list[str] | None = None) -> Diagnostic:
         return self.add(code, NOTE, message, span, notes)
 
-    def extend(self, diags) -> None:
+    def extend(self, diags: Iterable[Diagnostic]) -> None:
         for d in diags:
             self.add(d.code, d.severity, d.message, d.span, d.notes)
 
 
-def sort_key(d: Diagnostic):
+def sort_key(d: Diagnostic) -> tuple[str, int, str]:
     return (d.span.file.path, d.span.start, d.code)
 
 

@@ -169,7 +169,7 @@ def statement(s: A.Stmt, level: int) -> list[str]:
     raise TypeError(f"cannot print {type(s).__name__}")
 
 
-def item(it) -> list[str]:
+def item(it: A.Item) -> list[str]:
     if isinstance(it, A.TypeBlock):
         out = ["TYPE"]
         for d in it.decls:
