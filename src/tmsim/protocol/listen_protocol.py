@@ -91,7 +91,7 @@ class ListenProtocol:
         """Queue the frame ``header``/``data`` for connection ``conn`` (unknown connection: nothing)."""
         client = self.clients.get(conn)
         if client is not None:
-            client.outbox.append(outgoing(header, data))
+            client.outbox.append((codec.encode(header, data), header, data))     # (outgoing(), inlined)
 
     def push(self, out: Outgoing, ip_filter: str | None = None) -> int:
         """Queue the frame ``out`` for every client (of address ``ip_filter``); returns how many get it."""

@@ -115,7 +115,7 @@ class ListenSession:
         self.variables, self.types = {}, {}
         self.entered_at = self.last_packet = self.now
         self.exit_path = None
-        self.push("TMSCT", "0," + self.send_message)
+        self.protocol.push(outgoing("TMSCT", "0," + self.send_message))
 
     def _on_stop_project(self, **_):
         self.robot.stop_and_clear()
@@ -187,15 +187,6 @@ class ListenSession:
     def is_connected(self, conn: int) -> bool:
         return self.protocol.is_connected(conn)
 
-    def send(self, conn: int, header: str, data: bytes | str) -> None:
-        """Queue the frame ``header``/``data`` for connection ``conn`` (unknown connection: nothing)."""
-        self.protocol.send(conn, header, data)
-
-    def push(self, header: str, data: bytes | str, ip_filter: str | None = None) -> int:
-        """Queue the frame ``header``/``data`` for every client (of address ``ip_filter``); returns how many get
-        it."""
-        return self.protocol.push(outgoing(header, data), ip_filter)
-
     # ---- input --------------------------------------------------------------------------------
     def handle(self, conn: int, item: codec.Frame | codec.BadFrame | codec.Garbage) -> None:
         """Process one decoded item (codec.Frame / BadFrame / Garbage) from connection ``conn``, as it is
@@ -205,13 +196,13 @@ class ListenSession:
             self.log("garbage", conn=conn, bytes=len(item.raw))
         elif isinstance(item, codec.BadFrame):
             self.log("bad_frame", conn=conn, code=item.code, reason=item.reason)
-            self.send(conn, "CPERR", item.code)
+            self.protocol.send(conn, "CPERR", item.code)
         elif item.header == "TMSTA":
             self._tmsta(conn, item.data)
         elif item.header == "TMSCT":
             self._tmsct(conn, item.data)
         else:
-            self.send(conn, "CPERR", codec.CPERR_HEADER)
+            self.protocol.send(conn, "CPERR", codec.CPERR_HEADER)
 
     def _tmsta(self, conn, data: bytes):
         text = data.decode("utf-8", "replace")
@@ -225,9 +216,9 @@ class ListenSession:
                 tag = None
             reply = f"01,{param},{self.robot.tag_status(tag) if tag is not None else 'none'}"
         else:
-            self.send(conn, "CPERR", codec.CPERR_DATA)
+            self.protocol.send(conn, "CPERR", codec.CPERR_DATA)
             return
-        self.send(conn, "TMSTA", reply)
+        self.protocol.send(conn, "TMSTA", reply)
 
     def _tmsct(self, conn, data: bytes):
         ident, comma, body = data.partition(b",")
@@ -236,7 +227,7 @@ class ListenSession:
         except UnicodeDecodeError:
             ident_text, script = "", ""
         if not comma or not ident_text or not ident_text.isalnum():
-            self.send(conn, "CPERR", codec.CPERR_DATA)
+            self.protocol.send(conn, "CPERR", codec.CPERR_DATA)
             return
         packet = Packet(conn, ident_text, script)
         if self.state not in (IN_NODE, EXITING):
@@ -251,7 +242,7 @@ class ListenSession:
 
     def _not_in_node(self, packet):
         self.log("rejected", conn=packet.conn, id=packet.id, reason="not in the Listen node")
-        self.send(packet.conn, "CPERR", codec.CPERR_NOT_IN_NODE)
+        self.protocol.send(packet.conn, "CPERR", codec.CPERR_NOT_IN_NODE)
 
     # ---- priority commands --------------------------------------------------------------------
     def _priority(self, packet, name, arg):
@@ -280,7 +271,7 @@ class ListenSession:
 
     # ---- script execution ---------------------------------------------------------------------
     def _reply(self, packet, status):
-        self.send(packet.conn, "TMSCT", f"{packet.id},{status}")
+        self.protocol.send(packet.conn, "TMSCT", f"{packet.id},{status}")
 
     def _pump(self):
         """Resume the running script if it may continue, then run buffered scripts in order until
@@ -410,7 +401,7 @@ class ListenSession:
             kind = event.pop("kind")
             self.log(kind, **event)
             if kind == "tag_reached":
-                self.push("TMSTA", f"01,{event['tag']:02d},true")
+                self.protocol.push(outgoing("TMSTA", f"01,{event['tag']:02d},true"))
         if self.robot.fault:
             reason, self.robot.fault = self.robot.fault, None
             self.fire("robot_fault", reason=reason)
