@@ -7,18 +7,26 @@ the real-time drivers (``run_until`` / ``run_realtime`` in vplc.api) call the sa
 from __future__ import annotations
 
 import collections
+import contextlib
 import gc
 import math
 import sys
 import time
 import traceback
 import weakref
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from types import FrameType
+from typing import TYPE_CHECKING, Any
 
 from ..frontend.types import StructType
 from . import abi
 from .faults import GEN_FILE, PlcFault, RuntimeFaultError, WatchdogError
 from .sockets import SocketManager
+
+if TYPE_CHECKING:
+    from .motion import MotionController
+    from .program import Image
 
 
 @dataclass
@@ -34,14 +42,14 @@ class Task:
 _perf_counter = time.perf_counter
 
 
-def gc_pause_callback(deadline: list, probation: list):
+def gc_pause_callback(deadline: list[float], probation: list[float]) -> Callable[[str, dict], None]:
     """A ``gc.callbacks`` entry for one engine. Python's garbage collector is the host's time, not the program's:
     a collection during a scan moves the engine's watchdog deadline (and a probation it started) by its duration,
     so it does not look like an endless loop. The callback holds the engine's two cells, not the engine, so an
     engine nobody uses any more can still be collected; :func:`_forget` then removes the callback."""
     started = [0.0]
 
-    def callback(phase: str, _info) -> None:
+    def callback(phase: str, _info: dict) -> None:
         if phase == "start":
             started[0] = _perf_counter()
         elif started[0]:
@@ -54,15 +62,13 @@ def gc_pause_callback(deadline: list, probation: list):
     return callback
 
 
-def _forget(callback) -> None:
-    try:
+def _forget(callback: Callable[[str, dict], None]) -> None:
+    with contextlib.suppress(ValueError):
         gc.callbacks.remove(callback)
-    except ValueError:
-        pass
 
 
 class Engine:
-    def __init__(self, module, *, watchdog_ns: int = 500_000_000, socket_limit: int = 30,
+    def __init__(self, module: Image, *, watchdog_ns: int = 500_000_000, socket_limit: int = 30,
                  socket_latency_ns: int = 0, clock_base_ns: int | None = None) -> None:
         self.module = module
         self.tasks: list[Task] = []
@@ -82,9 +88,11 @@ class Engine:
         weakref.finalize(self, _forget, pause)
         self.stmt_counter = module.namespace[abi.STATEMENTS]
         self.now_cell = module.namespace[abi.SCAN_TIME]          # what VPLC_ScanTime() returns in generated code
-        self.before_task = None           # hook(task, now_ns) run before every task execution (a dialect's
-                                          # system variables: runtime/sysmac_system.py), or None
+        # hook(task, now_ns) run before every task execution (a dialect's system variables:
+        # runtime/sysmac_system.py), or None
+        self.before_task: Callable[[Task, int], None] | None = None
         self.current_task: Task | None = None     # the task whose programs are running
+        self.motion: MotionController | None = None   # the virtual axes (Plc attaches them), read by MC_* FBs
         self.instruction_errors: collections.deque[str] = collections.deque(maxlen=100)   # the latest, located
         self.instruction_error_count = 0
 
@@ -93,7 +101,7 @@ class Engine:
         recorded with its ST location (``file:line: instruction error in Main.x: message``), never a fault."""
         self.instruction_error_count += 1
         frames = []
-        frame = sys._getframe(1)
+        frame: FrameType | None = sys._getframe(1)
         while frame is not None:
             frames.append((frame, frame.f_lineno))
             frame = frame.f_back
@@ -101,7 +109,7 @@ class Engine:
         where = f"{loc[0]}:{loc[1]}" if loc and loc[0] else "<unknown location>"
         self.instruction_errors.append(f"{where}: instruction error in {inst or '<unknown instance>'}: {message}")
 
-    def st_location(self, frames) -> tuple[tuple | None, str | None]:
+    def st_location(self, frames: Iterable[tuple[FrameType, int]]) -> tuple[tuple | None, str | None]:
         """((file, line), instance path) of the innermost generated-code frame of ``frames`` (outermost first)."""
         loc, inst = None, None
         for frame, lineno in frames:
@@ -112,14 +120,14 @@ class Engine:
         return loc, inst
 
     # ---- services used by native POUs -----------------------------------------------------------
-    def new_struct(self, name: str):
+    def new_struct(self, name: str) -> Any:
         """A fresh value of the structure type ``name`` (used by native FBs for _sSOCKET outputs)."""
         cache = self.__dict__.setdefault("_struct_classes", {})
         cls = cache.get(name.upper())
         if cls is None:
             for c in self.module.namespace.values():
-                if isinstance(c, type) and isinstance(getattr(c, "i__type", None), StructType) and \
-                        c.i__type.name.upper() == name.upper():
+                t = getattr(c, "i__type", None) if isinstance(c, type) else None
+                if isinstance(t, StructType) and t.name.upper() == name.upper():
                     cls = cache[name.upper()] = c
                     break
             else:

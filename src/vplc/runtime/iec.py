@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 import struct
+from collections.abc import Callable, Iterator
+from typing import Any
 
 from .faults import RuntimeFaultError
 
@@ -16,7 +18,8 @@ _F32 = struct.Struct("<f")
 F32_MAX = 3.4028234663852886e38
 
 
-def f32(x: float, _pack=_F32.pack, _unpack=_F32.unpack) -> float:
+def f32(x: float, _pack: Callable[..., bytes] = _F32.pack,
+        _unpack: Callable[[bytes], tuple[Any, ...]] = _F32.unpack) -> float:
     """Round a Python float to IEEE single precision (overflow gives +/-inf like the FPU)."""
     try:
         return _unpack(_pack(x))[0]
@@ -26,7 +29,7 @@ def f32(x: float, _pack=_F32.pack, _unpack=_F32.unpack) -> float:
         return _unpack(_pack(float(x)))[0]
 
 
-def wrapper(bits: int, signed: bool):
+def wrapper(bits: int, signed: bool) -> Callable[[int], int]:
     """Return a function wrapping an int to ``bits`` (two's complement when ``signed``)."""
     mask = (1 << bits) - 1
     if signed:
@@ -116,7 +119,7 @@ def ixn(idx: tuple, dims: tuple, what: str = "array") -> int:
     return off
 
 
-def ixo(i: int, arr, what: str = "array") -> int:
+def ixo(i: int, arr: list | ArrView, what: str = "array") -> int:
     """Index into an open array (``ARRAY[*]``): bounds are those of the actual array (``lo`` of a view),
     or 0..n-1 when an element was passed as the array start."""
     lo = getattr(arr, "lo", 0)
@@ -125,19 +128,23 @@ def ixo(i: int, arr, what: str = "array") -> int:
     raise RuntimeFaultError(f"index {i} out of range {lo}..{lo + len(arr) - 1} of {what}")
 
 
-def lower_bound(arr) -> int:
+def lower_bound(arr: list | ArrView) -> int:
     return getattr(arr, "lo", 0)
 
 
-def upper_bound(arr) -> int:
+def upper_bound(arr: list | ArrView) -> int:
     return getattr(arr, "lo", 0) + len(arr) - 1
 
 
 class ArrView:
     """The array starting at an element (Sysmac rule for array parameters given ``a[i]``)."""
     __slots__ = ("base", "off", "n", "lo")
+    base: Any           # the list (never a view: a view of a view is a view of the list)
+    off: int
+    n: int
+    lo: int
 
-    def __init__(self, base, off: int, lo: int = 0) -> None:
+    def __init__(self, base: list | ArrView, off: int, lo: int = 0) -> None:
         if isinstance(base, ArrView):
             off += base.off
             base = base.base
@@ -146,24 +153,24 @@ class ArrView:
     def __len__(self) -> int:
         return self.n
 
-    def __getitem__(self, i):
+    def __getitem__(self, i: int | slice) -> Any:
         if isinstance(i, slice):
             return [self.base[self.off + k] for k in range(*i.indices(self.n))]
         return self.base[self.off + i]
 
-    def __setitem__(self, i, v) -> None:
+    def __setitem__(self, i: int | slice, v: Any) -> None:
         if isinstance(i, slice):
             for k, x in zip(range(*i.indices(self.n)), v, strict=False):
                 self.base[self.off + k] = x
             return
         self.base[self.off + i] = v
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Any]:
         b, o = self.base, self.off
         return (b[o + k] for k in range(self.n))
 
 
-def bytes_of(arr, n: int) -> bytes:
+def bytes_of(arr: list[int] | ArrView, n: int) -> bytes:
     """The first ``n`` elements of a byte array (a list, or a view starting at an element) as bytes."""
     items = arr.base[arr.off:arr.off + n] if isinstance(arr, ArrView) else arr[:n]
     try:
@@ -172,7 +179,7 @@ def bytes_of(arr, n: int) -> bytes:
         return bytes(x & 0xFF for x in items)
 
 
-def store_bytes(arr, data) -> None:
+def store_bytes(arr: list[int] | ArrView, data: bytes) -> None:
     """Write ``data`` into the first elements of a byte array (a list, or a view starting at an element)."""
     if isinstance(arr, ArrView):
         arr.base[arr.off:arr.off + len(data)] = data
@@ -180,9 +187,9 @@ def store_bytes(arr, data) -> None:
         arr[:len(data)] = data
 
 
-def copy_value(v):
+def copy_value(v: Any) -> Any:
     """Deep copy of a value (structs and arrays are copied; scalars are immutable)."""
-    t = type(v)
+    t: Any = type(v)
     if t is list:
         if v and type(v[0]) in (int, float, bool, str):
             return v[:]
@@ -196,7 +203,7 @@ def copy_value(v):
     return o
 
 
-def assign_into(dst, src) -> None:
+def assign_into(dst: Any, src: Any) -> None:
     """Structure / array assignment: copy ``src`` into the existing ``dst`` object (keeps references)."""
     if isinstance(dst, (list, ArrView)):
         n = min(len(dst), len(src))

@@ -7,6 +7,10 @@ arrives as a (container, key) reference, an array as a list or an array view.
 """
 from __future__ import annotations
 
+import socket
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
 from . import iec
 from . import sockets as S
 from .motion_fbs import NATIVE_FBS as MOTION_FBS
@@ -16,11 +20,14 @@ from .sysmac_errors import NATIVE_FBS as ERROR_FBS
 from .sysmac_fns import FUNCTIONS
 from .testing import FUNCTIONS as TEST_FUNCTIONS
 
+if TYPE_CHECKING:
+    from .engine import Engine
+
 
 class _SocketFB:
     """Execute/Busy/Done/Error handshake shared by the socket instructions."""
 
-    def __init__(self, rt, path: str) -> None:
+    def __init__(self, rt: Engine, path: str) -> None:
         self.i__rt, self.i__path = rt, path
         self.Execute = False
         self.Done = self.Busy = self.Error = False
@@ -68,21 +75,25 @@ class _SocketFB:
     def start(self) -> None:
         self.i__err = 0
 
+    def poll(self) -> int | None:
+        """The instruction's result once it has one: 0 (Done) or its ErrorID; None while it is still busy."""
+        raise NotImplementedError(f"{type(self).__name__} does not say when it is done")
+
     def handle(self) -> int:
         return self.Socket.Handle
 
 
 class SktTCPConnect(_SocketFB):
-    def __init__(self, rt, path):
+    def __init__(self, rt: Engine, path: str) -> None:
         super().__init__(rt, path)
         self.SrcTcpPort = 0
         self.DstAdr = ""
         self.DstTcpPort = 0
 
-    def start(self):
+    def start(self) -> None:
         self.i__handle, self.i__err = self.i__rt.sockets.open(self.DstAdr, self.DstTcpPort, self.SrcTcpPort)
 
-    def poll(self):
+    def poll(self) -> int | None:
         if self.i__err:
             return self.i__err
         mgr = self.i__rt.sockets
@@ -98,21 +109,22 @@ class SktTCPConnect(_SocketFB):
 
 
 class SktTCPSend(_SocketFB):
-    def __init__(self, rt, path):
+    def __init__(self, rt: Engine, path: str) -> None:
         super().__init__(rt, path)
         self.Size = 0
-        self.SendDat = []
+        self.SendDat: list[int] = []
 
-    def start(self):
+    def start(self) -> None:
         self.i__err = 0
         c = self.i__rt.sockets.get(self.Socket.Handle)
         if c is None:
             self.i__err = S.ERR_HANDLE
-        elif self.Size > len(self.SendDat):
+            return
+        if self.Size > len(self.SendDat):
             self.i__err = S.ERR_PARAM
         else:
             c.pump()
-        if c is not None and not self.i__err and (c.eof or c.error):
+        if not self.i__err and (c.eof or c.error):
             self.i__err = S.ERR_CLOSED
         if not self.i__err:
             c.tx += iec.bytes_of(self.SendDat, self.Size)
@@ -123,7 +135,7 @@ class SktTCPSend(_SocketFB):
             except OSError:
                 self.i__err = S.ERR_CLOSED
 
-    def poll(self):
+    def poll(self) -> int | None:
         if self.i__err:
             return self.i__err
         c = self.i__rt.sockets.get(self.Socket.Handle)
@@ -136,20 +148,20 @@ class SktTCPSend(_SocketFB):
 
 
 class SktTCPRcv(_SocketFB):
-    def __init__(self, rt, path):
+    def __init__(self, rt: Engine, path: str) -> None:
         super().__init__(rt, path)
         self.TimeOut = 0
         self.Size = 0
         self.RcvSize = 0
-        self.RcvDat = []
+        self.RcvDat: list[int] = []
 
-    def start(self):
+    def start(self) -> None:
         self.i__err = 0
         self.RcvSize = 0
         if self.Size > len(self.RcvDat):
             self.i__err = S.ERR_PARAM
 
-    def poll(self):
+    def poll(self) -> int | None:
         if self.i__err:
             return self.i__err
         rt = self.i__rt
@@ -173,15 +185,15 @@ class SktTCPRcv(_SocketFB):
 
 
 class SktGetTCPStatus(_SocketFB):
-    def __init__(self, rt, path):
+    def __init__(self, rt: Engine, path: str) -> None:
         super().__init__(rt, path)
         self.TcpStatus = S.CLOSED
         self.DatRcvFlag = False
 
-    def start(self):
+    def start(self) -> None:
         self.i__err = 0
 
-    def poll(self):
+    def poll(self) -> int | None:
         mgr = self.i__rt.sockets
         if mgr.get(self.Socket.Handle) is None:
             self.TcpStatus, self.DatRcvFlag = S.CLOSED, False
@@ -191,7 +203,7 @@ class SktGetTCPStatus(_SocketFB):
 
 
 class SktClearBuf(_SocketFB):
-    def poll(self):
+    def poll(self) -> int | None:
         c = self.i__rt.sockets.get(self.Socket.Handle)
         if c is None:
             return S.ERR_HANDLE
@@ -201,7 +213,7 @@ class SktClearBuf(_SocketFB):
 
 
 class SktClose(_SocketFB):
-    def poll(self):
+    def poll(self) -> int | None:
         return 0 if self.i__rt.sockets.close(self.Socket.Handle) else S.ERR_HANDLE
 
 
@@ -209,27 +221,30 @@ class SktTCPAccept(_SocketFB):
     """Passive open: listens on SrcTcpPort (bound to 127.0.0.1) until a client connects or TimeOut
     (0.1 s units, 0 = wait forever) expires."""
 
-    def __init__(self, rt, path):
+    def __init__(self, rt: Engine, path: str) -> None:
         super().__init__(rt, path)
         self.SrcTcpPort = 0
         self.TimeOut = 0
-        self.i__listener = None
+        self.i__listener: socket.socket | None = None
 
-    def start(self):
+    def start(self) -> None:
         self.i__listener, self.i__err = self.i__rt.sockets.listen(self.SrcTcpPort)
 
-    def poll(self):
+    def poll(self) -> int | None:
         if self.i__err:
             return self.i__err
+        listener = self.i__listener
+        if listener is None:          # never reached: listen() gives a socket exactly when it reports no error
+            return S.ERR_HANDLE
         rt = self.i__rt
         try:
-            conn, _ = self.i__listener.accept()
+            conn, _ = listener.accept()
         except (BlockingIOError, InterruptedError):
             if self.TimeOut and rt.now_ns - self.i__t0 >= self.TimeOut * 100_000_000:
-                self.i__listener.close()
+                listener.close()
                 return S.ERR_TIMEOUT
             return None
-        self.i__listener.close()
+        listener.close()
         handle = rt.sockets.adopt(conn)
         if not handle:
             return S.ERR_RESOURCES
@@ -240,8 +255,8 @@ class SktTCPAccept(_SocketFB):
         return 0
 
 
-NATIVE_FBS = {c.__name__: c for c in (SktTCPConnect, SktTCPSend, SktTCPRcv, SktGetTCPStatus, SktClearBuf,
-                                      SktClose, SktTCPAccept)}
+NATIVE_FBS: dict[str, type] = {c.__name__: c for c in (SktTCPConnect, SktTCPSend, SktTCPRcv, SktGetTCPStatus,
+                                                       SktClearBuf, SktClose, SktTCPAccept)}
 NATIVE_FBS.update(MOTION_FBS)           # W508 single-axis motion instructions on virtual axes
 NATIVE_FBS.update(CONTROL_FBS, **ERROR_FBS)     # W502 control and system control instructions
-NATIVE_FUNCTIONS = {**FUNCTIONS, **ERROR_FUNCTIONS, **TEST_FUNCTIONS}
+NATIVE_FUNCTIONS: dict[str, Callable[..., Any]] = {**FUNCTIONS, **ERROR_FUNCTIONS, **TEST_FUNCTIONS}

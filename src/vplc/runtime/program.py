@@ -13,9 +13,13 @@ import math
 import time
 from dataclasses import dataclass, field
 from types import CodeType
+from typing import TYPE_CHECKING, Any
 
 from . import abi, iec, natives, stdlib, sysmac_fns
 from .faults import GEN_FILE, RuntimeFaultError, WatchdogError
+
+if TYPE_CHECKING:
+    from .engine import Engine
 
 __all__ = ["GEN_FILE", "HELPERS", "Image", "InstanceSpec", "PouClass", "Program", "TaskSpec", "program_key"]
 
@@ -84,7 +88,7 @@ def program_key(text: str) -> str:
 
 @dataclass
 class Program:
-    project: object                                     # the checked project it was compiled from
+    project: Any            # the checked vplc.project.Project it was compiled from (a layer above the runtime)
     source: str
     code: CodeType
     linemap: dict                                       # python line -> (st file, st line)
@@ -108,6 +112,7 @@ class Program:
         ns[abi.WATCHDOG] = make_watchdog(ns[abi.DEADLINE], ns[abi.PROBATION], ns[abi.WATCHDOG_LIMIT])
         exec(self.code, ns)
         image = Image(self, ns)
+        cls: Any        # a native FB's class or a generated one: both get their variables and POU type
         for key, info in self.pous.items():
             if info.native:
                 cls = natives.NATIVE_FBS.get(info.pou.name)
@@ -123,8 +128,8 @@ class Program:
                 image.bodies[key] = ns[info.body_name]
         for name, fields, t in self.structs:
             ns[name].i__vars, ns[name].i__type = fields, t
-        image.globals_cls = ns[abi.GLOBALS_CLASS]
-        image.globals_cls.i__vars = self.globals_vars
+        image.globals_cls = globals_cls = ns[abi.GLOBALS_CLASS]
+        globals_cls.i__vars = self.globals_vars
         return image
 
 
@@ -135,7 +140,7 @@ class Image:
     namespace: dict
     classes: dict = field(default_factory=dict)          # upper POU qualified name -> class
     bodies: dict = field(default_factory=dict)           # upper POU qualified name -> body function
-    globals_cls: type | None = None
+    globals_cls: Any = None         # the generated class of the global variables (set by Program.load)
 
     @property
     def source(self) -> str:
@@ -145,7 +150,7 @@ class Image:
     def linemap(self) -> dict:
         return self.program.linemap
 
-    def bind_natives(self, rt) -> None:
+    def bind_natives(self, rt: Engine) -> None:
         """Make the native POUs of this image use the controller ``rt`` (sockets, clock)."""
         ns = self.namespace
         for name, cls in natives.NATIVE_FBS.items():

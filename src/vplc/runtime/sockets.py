@@ -8,6 +8,7 @@ ErrorIDs are listed in ``ERRORS`` and docs/toolchain/runtime_sysmac.md.
 """
 from __future__ import annotations
 
+import contextlib
 import errno
 import ipaddress
 import select
@@ -23,7 +24,8 @@ ERR_CLOSED = 0x2007           # connection closed or reset by the remote node
 ERR_REFUSED = 0x2008          # connection refused / remote node unreachable
 ERRORS = {ERR_PARAM: "input value out of range", ERR_ADDRESS: "invalid destination IP address",
           ERR_HANDLE: "socket does not exist", ERR_RESOURCES: "too many sockets open",
-          ERR_PORT_IN_USE: "local port already in use", ERR_TIMEOUT: "timeout", ERR_CLOSED: "connection closed by the remote node",
+          ERR_PORT_IN_USE: "local port already in use", ERR_TIMEOUT: "timeout",
+          ERR_CLOSED: "connection closed by the remote node",
           ERR_REFUSED: "connection refused or remote node unreachable"}
 
 # _eCONNECTION_STATE values (declaration order in prelude/sysmac_types.st)
@@ -130,7 +132,7 @@ class SocketManager:
         self.close(handle)
         return ERR_REFUSED
 
-    def listen(self, port: int, host: str = "127.0.0.1"):
+    def listen(self, port: int, host: str = "127.0.0.1") -> tuple[socket.socket | None, int]:
         """Open a non-blocking listening socket for a passive open; returns (socket, 0) or (None, ErrorID)."""
         if len(self.conns) >= self.limit:
             return None, ERR_RESOURCES
@@ -163,8 +165,10 @@ class SocketManager:
     def get(self, handle: int) -> _Conn | None:
         return self.conns.get(handle)
 
-    def addresses(self, handle: int):
+    def addresses(self, handle: int) -> tuple[tuple[str, int], tuple[str, int]]:
         c = self.conns.get(handle)
+        if c is None:
+            return ("", 0), ("", 0)
         try:
             return c.sock.getsockname(), c.sock.getpeername()
         except (OSError, AttributeError):
@@ -187,10 +191,8 @@ class SocketManager:
         c = self.conns.pop(handle, None)
         if c is None:
             return False
-        try:
+        with contextlib.suppress(OSError):
             c.sock.close()
-        except OSError:
-            pass
         return True
 
     def close_all(self) -> None:

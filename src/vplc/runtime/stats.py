@@ -1,8 +1,10 @@
 """Scan statistics for ``vplc run --stats`` and the real-time driver: scan time, lateness, overruns."""
 from __future__ import annotations
 
+from collections.abc import Sequence
 
-def percentile(values: list, q: float):
+
+def percentile(values: Sequence[float], q: float) -> float:
     if not values:
         return 0
     s = sorted(values)

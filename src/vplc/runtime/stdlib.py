@@ -6,6 +6,8 @@ in the namespace of the generated module (``NAMESPACE``).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 from ..frontend import builtins as B
 from ..frontend import types as T
@@ -113,7 +115,8 @@ NAMESPACE = {
     "_left": _left, "_right": _right, "_mid": _mid, "_insert": _insert,
     "_delete": _delete, "_replace": _replace, "_find": _find, "_sinit": _sinit, "_fill": _fill,
     "_round": iec.round_half_even, "_trunc": iec.trunc, "_shl": iec.shl, "_shr": iec.shr, "_rol": iec.rol,
-    "_ror": iec.ror, "_lbound": iec.lower_bound, "_ubound": iec.upper_bound, "_atan2": _nan_on_domain(lambda yx: math.atan2(*yx)),
+    "_ror": iec.ror, "_lbound": iec.lower_bound, "_ubound": iec.upper_bound,
+    "_atan2": _nan_on_domain(lambda yx: math.atan2(*yx)),
     **{"_m" + k: v for k, v in MATH.items()},
 }
 
@@ -132,7 +135,7 @@ def _kind(t):
     return "other", t
 
 
-def to_string(v, t, dialect: str = "sysmac") -> str:
+def to_string(v: Any, t: T.Type, dialect: str = "sysmac") -> str:
     """Text of a value as the *_TO_STRING conversions produce it (Sysmac formats, docs/toolchain/runtime.md)."""
     k, bt = _kind(t)
     if k == "bool":
@@ -160,7 +163,7 @@ def to_string(v, t, dialect: str = "sysmac") -> str:
     return str(v)
 
 
-def string_converter(t, dialect: str = "sysmac"):
+def string_converter(t: T.Type, dialect: str = "sysmac") -> Callable[[Any], str]:
     """``to_string`` specialised to the source type ``t`` once, at compile time (no type dispatch per call)."""
     k, bt = _kind(t)
     if k == "bool":
@@ -185,7 +188,7 @@ def _parse_number(s: str, real: bool):
         return 0.0 if real else 0
 
 
-def conversion(src, dst, dialect: str = "sysmac"):
+def conversion(src: T.Type, dst: T.Type, dialect: str = "sysmac") -> Callable[[Any], Any]:
     """Python function converting a value of type ``src`` to ``dst`` (IEC *_TO_* semantics)."""
     sk, st = _kind(src)
     dk, dt = _kind(dst)
@@ -228,7 +231,7 @@ def conversion(src, dst, dialect: str = "sysmac"):
 COMPARE_FUNCTIONS = {"LT": " < ", "LE": " <= ", "GT": " > ", "GE": " >= ", "EQ": " == ", "NE": " != "}
 
 
-def gen_builtin(gen, b) -> str:
+def gen_builtin(gen: Any, b: Any) -> str:      # the compiler's ExprGen, the checker's call binding
     name = b.builtin.name.upper()
     args = [gen.expr(ba.expr) for ba in b.args]
     tys = [ba.expr.conv or ba.expr.ty for ba in b.args]
@@ -246,6 +249,8 @@ def gen_builtin(gen, b) -> str:
 
     bcd = B.bcd_kind(name)
     if bcd == "decode":
+        if not isinstance(rt, T.ElementaryType):
+            raise NotImplementedError(f"{name} without an integer result")
         return f"_bcd_decode({args[0]}, {name!r}, {rt.hi})"
     if bcd == "encode":
         return f"_bcd_encode({args[0]}, {bits}, {name!r})"

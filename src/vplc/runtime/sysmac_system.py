@@ -16,8 +16,13 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from . import abi
+
+if TYPE_CHECKING:
+    from .engine import Engine, Task
 
 FIRST_RUN = ("P_FIRST_RUN", "P_FIRST_RUNMODE")
 CLOCK_PULSES = (("P_0_02S", 20_000_000), ("P_0_1S", 100_000_000), ("P_0_2S", 200_000_000),
@@ -32,9 +37,9 @@ class SystemVariables:
         self.values = values              # the globals object's __dict__
         self.first = first                # attributes of the first-run flags
         self.clocks = clocks              # (attribute, period ns) of the clock pulses
-        self.next_ns = 0                  # scan time at which a clock pulse changes next
+        self.next_ns: float = 0           # scan time at which a clock pulse changes next
 
-    def update(self, task, now_ns: int) -> None:
+    def update(self, task: Task, now_ns: int) -> None:
         """First-run flags for the task's first cycle; clock pulses (half period on, half off). The next call is
         due when the next pulse changes (the scan skips the work until then)."""
         values = self.values
@@ -48,7 +53,7 @@ class SystemVariables:
         self.next_ns = nxt
 
 
-def task_hook(engine, globals_obj):
+def task_hook(engine: Engine, globals_obj: Any) -> Callable[[Task, int], None] | None:
     """The hook updating the system-defined variables of ``globals_obj`` before every task execution of
     ``engine``, or None when the program's globals have none of them. It runs in every scan, so it is a
     closure over what it needs (no attribute look-ups on the way to the common case)."""
@@ -62,15 +67,15 @@ def task_hook(engine, globals_obj):
     if state is None and current is None:
         return None
     if state is None:
-        def before_task(task, now_ns: int) -> None:
+        def before_task(task: Task, now_ns: int) -> None:
             base = engine.clock_base_ns                     # as Engine.clock_dt_ns()
             values[current] = time_ns() if base is None else base + now_ns
     elif current is None:
-        def before_task(task, now_ns: int) -> None:
+        def before_task(task: Task, now_ns: int) -> None:
             if task.cycles < 2 or now_ns >= state.next_ns:
                 state.update(task, now_ns)
     else:
-        def before_task(task, now_ns: int) -> None:
+        def before_task(task: Task, now_ns: int) -> None:
             if task.cycles < 2 or now_ns >= state.next_ns:
                 state.update(task, now_ns)
             base = engine.clock_base_ns                     # as Engine.clock_dt_ns()

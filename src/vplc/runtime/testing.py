@@ -8,10 +8,16 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from types import FrameType
+from typing import TYPE_CHECKING
 
 from ..frontend import types as T
 from .faults import GEN_FILE
+
+if TYPE_CHECKING:
+    from .engine import Engine
 
 
 @dataclass
@@ -41,7 +47,7 @@ class Collector:
 
 
 def _where(rt):
-    f = sys._getframe(2)
+    f: FrameType | None = sys._getframe(2)
     while f is not None and f.f_code.co_filename != GEN_FILE:
         f = f.f_back
     if f is None:
@@ -58,7 +64,7 @@ def _collector(rt) -> Collector:
     return c
 
 
-def TEST(rt, Name) -> bool:
+def TEST(rt: Engine, Name: str) -> bool:
     _file, _line, suite = _where(rt)
     col = _collector(rt)
     tc = col.tests.get((suite, Name))
@@ -69,7 +75,7 @@ def TEST(rt, Name) -> bool:
     return not tc.finished
 
 
-def TEST_FINISHED(rt) -> bool:
+def TEST_FINISHED(rt: Engine) -> bool:
     _file, _line, suite = _where(rt)
     tc = _collector(rt).current.get(suite)
     if tc is not None:
@@ -77,7 +83,7 @@ def TEST_FINISHED(rt) -> bool:
     return True
 
 
-def IS_TEST_FINISHED(rt, Name) -> bool:
+def IS_TEST_FINISHED(rt: Engine, Name: str) -> bool:
     _file, _line, suite = _where(rt)
     tc = _collector(rt).tests.get((suite, Name))
     return bool(tc and tc.finished)
@@ -100,11 +106,11 @@ def _msg(message: str, detail: str) -> str:
     return f"{message}: {detail}" if message else detail
 
 
-def AssertTrue(rt, Condition, Message) -> bool:
+def AssertTrue(rt: Engine, Condition: bool, Message: str) -> bool:
     return _record(rt, bool(Condition), _msg(Message or "", "expected TRUE, got FALSE"))
 
 
-def AssertFalse(rt, Condition, Message) -> bool:
+def AssertFalse(rt: Engine, Condition: bool, Message: str) -> bool:
     return _record(rt, not Condition, _msg(Message or "", "expected FALSE, got TRUE"))
 
 
@@ -120,7 +126,7 @@ def _equals(rt, Expected, Actual, Message) -> bool:
     return _record(rt, Expected == Actual, _msg(Message or "", f"expected {_fmt(Expected)}, got {_fmt(Actual)}"))
 
 
-def _equals_bits(bits: int):
+def _equals_bits(bits: int) -> Callable[[Engine, int, int, str], bool]:
     """AssertEquals_BYTE .. _LWORD: the values in the notation the controller shows them, 16#4006 (not 16390)."""
     def equals(rt, Expected, Actual, Message) -> bool:
         return _record(rt, Expected == Actual, _msg(Message or "", f"expected {T.bits_literal(Expected, bits)}, "
@@ -137,8 +143,9 @@ _BITS = {"BYTE": 8, "WORD": 16, "DWORD": 32, "LWORD": 64}
 _TYPES = ("BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT",
           "TIME", "LTIME", "DATE", "TIME_OF_DAY", "DATE_AND_TIME", "STRING")
 
-FUNCTIONS = {"TEST": TEST, "TEST_FINISHED": TEST_FINISHED, "IS_TEST_FINISHED": IS_TEST_FINISHED,
-             "AssertTrue": AssertTrue, "AssertFalse": AssertFalse,
-             "AssertEquals_REAL": _equals_real, "AssertEquals_LREAL": _equals_real,
-             **{f"AssertEquals_{t}": _equals for t in _TYPES},
-             **{f"AssertEquals_{t}": _equals_bits(bits) for t, bits in _BITS.items()}}
+FUNCTIONS: dict[str, Callable[..., bool]] = {
+    "TEST": TEST, "TEST_FINISHED": TEST_FINISHED, "IS_TEST_FINISHED": IS_TEST_FINISHED,
+    "AssertTrue": AssertTrue, "AssertFalse": AssertFalse,
+    "AssertEquals_REAL": _equals_real, "AssertEquals_LREAL": _equals_real,
+    **{f"AssertEquals_{t}": _equals for t in _TYPES},
+    **{f"AssertEquals_{t}": _equals_bits(bits) for t, bits in _BITS.items()}}

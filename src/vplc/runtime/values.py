@@ -4,6 +4,8 @@ enumeration values as their name. Writes are type-checked."""
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
+from typing import Any
 
 from ..frontend import types as T
 from . import iec
@@ -32,7 +34,7 @@ def parse_duration(text: str) -> int | None:
 _SEG = re.compile(r"([A-Za-z_]\w*)((?:\[[^\]]*\])*)")
 
 
-def type_text(t) -> str:
+def type_text(t: T.Type) -> str:
     u = T.unalias(t) if not isinstance(t, T.AliasType) else t
     ns = getattr(u, "namespace", None)
     name = getattr(u, "qualified_name", None) or u.name
@@ -43,7 +45,7 @@ class Resolver:
     """Reads and writes variables by path. A path is parsed once (names upper-cased, indexes read) and then only
     walked, and each type gets its value converter once: traces and the HMI read the same paths every scan."""
 
-    def __init__(self, plc) -> None:
+    def __init__(self, plc: Any) -> None:          # a vplc.api.Plc (the API sits above the runtime)
         self.plc = plc
         gl = plc.project.global_lists
         self.list_names = {g.name.upper() for g in gl if g.name}
@@ -125,14 +127,14 @@ class Resolver:
             raise PathError(f"{path!r} names a program instance, not a variable")
         return container, key, cur_t
 
-    def read(self, path: str):
+    def read(self, path: str) -> Any:
         c, k, t = self._locate(path)
         return converter(t)(c[k])
 
     def type_text(self, path: str) -> str:
         return type_text(self._locate(path)[2])
 
-    def write(self, path: str, value, raw: bool = False) -> None:
+    def write(self, path: str, value: Any, raw: bool = False) -> None:
         c, k, t = self._locate(path)
         c[k] = from_python(value, t, path, raw)
 
@@ -140,32 +142,39 @@ class Resolver:
 _CONVERTERS: dict[int, tuple] = {}
 
 
-def converter(t):
+def _same(v: Any) -> Any:
+    return v
+
+
+def converter(t: T.Type) -> Callable[[Any], Any]:
     """The function turning a runtime value of type ``t`` into its API value (built once per type)."""
     entry = _CONVERTERS.get(id(t))
     if entry is not None and entry[0] is t:
         return entry[1]
     u = T.base_of(t)
+    conv: Callable[[Any], Any]
     if isinstance(u, T.EnumType):
-        names = {}
+        names: dict[int, str] = {}
         for name, val in u.values.items():
             names.setdefault(val, name)              # the first name declared for a value, as before
 
-        def conv(v, names=names):
+        def enum_name(v, names=names):
             return names.get(v, v)
+        conv = enum_name
     elif isinstance(u, T.ArrayType):
         element = u.element
 
-        def conv(v, element=element):
+        def elements(v, element=element):
             each = converter(element)
             return [each(x) for x in v]
+        conv = elements
     elif isinstance(u, (T.StructType, T.PouType)):
-        def conv(v):
+        def members(v):
             info = getattr(type(v), "i__vars", {})
             return {attr: converter(ft)(getattr(v, attr)) for attr, ft in info.values() if hasattr(v, attr)}
+        conv = members
     else:
-        def conv(v):
-            return v
+        conv = _same
     if len(_CONVERTERS) > 20_000:                # many programs loaded in one process (tests): start again
         _CONVERTERS.clear()
     _CONVERTERS[id(t)] = (t, conv)               # the type is kept, so its id cannot be reused
@@ -175,7 +184,7 @@ def converter(t):
 WATCH_ELEMENTS = 32          # array elements written out in PLC notation; the rest is counted
 
 
-def plc_text(t):
+def plc_text(t: T.Type) -> Callable[[Any], str]:
     """The function writing an API value of type ``t`` (what ``read`` returns) in PLC notation: TRUE/FALSE, bit
     strings in 16#, enumerations by name, durations as T#..., arrays as [a, b, ...] and structures and instances
     as (Member := value, ...). Strings are written as they are at the top level and quoted inside a value."""
@@ -228,7 +237,7 @@ def _text(t, top: bool = False):
 INSTANCE_VISIBLE = ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT", "VAR")
 
 
-def real_literal(v) -> str:
+def real_literal(v: Any) -> str:
     """A REAL / LREAL with six significant digits that still reads as a real: 0.0, 1.5, 1e+10, -2.5e-07."""
     if not isinstance(v, float):
         return str(v)
@@ -247,7 +256,7 @@ def duration_literal(ns: int) -> str:
     return f"T#{sign}{a}ns"
 
 
-def from_python(value, t, path: str, raw: bool = False):
+def from_python(value: Any, t: T.Type, path: str, raw: bool = False) -> Any:
     """Checked conversion of an API value; ``raw`` lets an enumeration take any integer of its storage
     type, declared or not (what an HMI or a memory copy can put there on the controller)."""
     u = T.base_of(t)
@@ -284,8 +293,9 @@ def from_python(value, t, path: str, raw: bool = False):
         if isinstance(value, bool) or not isinstance(value, int):
             raise bad
         lo, hi = (u.lo, u.hi) if u.lo is not None else (-(1 << 63), (1 << 63) - 1)
-        if isinstance(T.unalias(t), T.SubrangeType):
-            lo, hi = T.unalias(t).lo, T.unalias(t).hi
+        sub = T.unalias(t)
+        if isinstance(sub, T.SubrangeType):
+            lo, hi = sub.lo, sub.hi
         if not lo <= value <= hi:
             raise PathError(f"{value} is outside the range {lo}..{hi} of {path} ({tn})")
         return value
