@@ -12,15 +12,28 @@ import re
 import threading
 import time
 from collections import OrderedDict
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from .compiler.codegen import CodeGen
 from .frontend import types as T
+from .ladder.model import LadderBody
 from .runtime import abi, sysmac_system
 from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
-from .runtime.program import program_key
+from .runtime.program import Program, program_key
+from .runtime.stats import OverrunCount, ScanStats
 from .runtime.values import PathError, Resolver, parse_duration
+
+if TYPE_CHECKING:
+    from .runtime.motion import MotionController
+    from .runtime.motion_config import AxisConfig
+
+# what load_plc and compile_program take: a file or folder, or several (``.st``, PLCopen / IEC 61131-10 ``.xml``)
+SourcePaths = str | Iterable[str | os.PathLike[str]]
+# a virtual axis configuration: its file (TOML), or the axes runtime.motion_config.load_axes read from one
+Axes = str | os.PathLike[str] | Iterable["AxisConfig"]
 
 __all__ = ["load_plc", "compile_program", "LoadError", "PlcFault", "Plc", "LadderProgram", "integer_ranges"]
 
@@ -33,7 +46,8 @@ def integer_ranges() -> dict[str, tuple[int, int]]:
     """(lowest, highest) value of every IEC 61131-3 integer and bit-string type by name (SINT .. ULINT,
     BYTE .. LWORD): the type model the checker, compiler and runtime use, for a tool that judges a value before
     it writes it (the HMI's value checks)."""
-    return {name: (t.lo, t.hi) for name, t in T.ELEMENTARY.items() if t.kind in ("int", "uint", "bit")}
+    return {name: (t.lo, t.hi) for name, t in T.ELEMENTARY.items()
+            if t.kind in ("int", "uint", "bit") and isinstance(t.lo, int) and isinstance(t.hi, int)}
 
 
 @dataclass(frozen=True)
@@ -42,7 +56,7 @@ class LadderProgram:
 
     name: str                   # as declared
     instance: str               # the instance its own variables are read under (Plc.read("<instance>.<name>"))
-    ladder: object              # the LD model (vplc.ladder): rungs of elements (id, kind, var ...) and wires
+    ladder: LadderBody          # the LD model (vplc.ladder): rungs of elements (id, kind, var ...) and wires
     own_names: frozenset[str]   # upper-case names it declares itself; a VAR_EXTERNAL is read as the global
 
     def svg(self) -> str:
@@ -51,7 +65,7 @@ class LadderProgram:
         return svg_document(self.ladder)
 
 
-def parse_task(task: str) -> tuple[str, int]:
+def parse_task(task: str | None) -> tuple[str, int]:
     """``"Main@1ms"`` -> ("Main", 1_000_000); LoadError with the reason for anything else."""
     m = re.fullmatch(r"\s*([A-Za-z_]\w*)\s*@\s*(.+)", task or "")
     if not m:
@@ -64,9 +78,9 @@ def parse_task(task: str) -> tuple[str, int]:
     return m.group(1), period
 
 
-def load_plc(paths, task: str = "Main@1ms", programs=None, *, dialect: str = "sysmac",
-             watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
-             count_statements: bool = False, clock_base_ns: int | None = None, axes=None) -> Plc:
+def load_plc(paths: SourcePaths, task: str | None = "Main@1ms", programs: Iterable[str] | None = None, *,
+             dialect: str = "sysmac", watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
+             count_statements: bool = False, clock_base_ns: int | None = None, axes: Axes | None = None) -> Plc:
     """A new PLC instance (its own variables, tasks and sockets) running the compiled ``paths``; ``axes``: the
     axis configuration file of its virtual servo axes (docs/toolchain/runtime_sysmac.md section 5)."""
     program = compile_program(paths, dialect=dialect, count_statements=count_statements)
@@ -79,7 +93,7 @@ _COMPILED_MAX = 8
 _COMPILE_LOCK = threading.Lock()
 
 
-def compile_program(paths, *, dialect: str = "sysmac", count_statements: bool = False):
+def compile_program(paths: SourcePaths, *, dialect: str = "sysmac", count_statements: bool = False) -> Program:
     """Parse, check and compile ``paths`` once: the result serves any number of PLC instances.
 
     Programs are kept by a fingerprint of every source file's name and bytes (prelude included), so loading
@@ -139,9 +153,9 @@ _HEAP_FROZEN: list = []      # once per process: see Plc.run_realtime
 class Plc:
     """One virtual controller: its own copy of a compiled program's variables, its tasks and its sockets."""
 
-    def __init__(self, program, task="Main@1ms", programs=None, *, watchdog_ms: float = 500.0,
-                 socket_limit: int = 30, socket_latency_ns: int = 0, clock_base_ns: int | None = None,
-                 axes=None) -> None:
+    def __init__(self, program: Program, task: str | None = "Main@1ms", programs: Iterable[str] | None = None, *,
+                 watchdog_ms: float = 500.0, socket_limit: int = 30, socket_latency_ns: int = 0,
+                 clock_base_ns: int | None = None, axes: Axes | None = None) -> None:
         self.program = program
         self.project = program.project
         self.module = module = program.load()
@@ -154,7 +168,7 @@ class Plc:
             self.globals = module.globals_cls()
             ns[abi.GLOBALS] = self.globals
             self.engine.before_task = sysmac_system.task_hook(self.engine, self.globals)
-            self.instances: dict[str, object] = ns[abi.PROGRAMS]
+            self.instances: dict[str, Any] = ns[abi.PROGRAMS]     # instances of generated classes
             self.type_named_instances: dict[str, list[str]] = {}   # see _setup_tasks
             self._setup_tasks(task, programs)
         except LoadError:
@@ -167,7 +181,7 @@ class Plc:
         self.motion = self._attach_axes(axes) if axes is not None else None
         self._resolver = Resolver(self)
 
-    def _attach_axes(self, axes):
+    def _attach_axes(self, axes: Axes) -> MotionController:
         """Virtual servo axes behind _MC_AX: ``axes`` is the path of an axis configuration file (or the tuple
         ``runtime.motion_config.load_axes`` returns). Their motion processing runs after the programs of the
         highest-priority task, in each of its periods (the NJ/NX primary periodic task)."""
@@ -199,7 +213,7 @@ class Plc:
         self.instances[inst_name.upper()] = inst
         return inst, self.module.bodies[key]
 
-    def _setup_tasks(self, task, programs) -> None:
+    def _setup_tasks(self, task: str | None, programs: Iterable[str] | None) -> None:
         program = self.program
         if program.configured:
             wanted = {p.upper() for p in programs or ()}      # --program: instance or PROGRAM type names
@@ -215,14 +229,14 @@ class Plc:
                     if programs and not names & wanted:
                         continue
                     found.update(names & wanted)
-                    t = by_name.get(pi.task)
-                    if t is None:
+                    runs_it = by_name.get(pi.task)
+                    if runs_it is None:
                         if not self.engine.tasks:
                             self.engine.tasks.append(Task("Default", 10_000_000, 0))
-                        t = self.engine.tasks[0]
+                        runs_it = self.engine.tasks[0]
                     if pi.key is None:
                         raise LoadError(f"error: no PROGRAM named `{pi.type_text}` in the loaded sources")
-                    t.programs.append(self._instance(pi.name, pi.key))
+                    runs_it.programs.append(self._instance(pi.name, pi.key))
             missing = [p for p in programs or () if p.upper() not in found]
             if missing:
                 raise LoadError(f"error: the CONFIGURATION runs no PROGRAM named `{missing[0]}` (give a program "
@@ -237,8 +251,8 @@ class Plc:
             self.engine.tasks.append(t)
         self.engine.tasks.sort(key=lambda t: t.priority)
         scheduled: dict[str, list[str]] = {}        # PROGRAM type -> names of its instances in the tasks
-        for task in self.engine.tasks:
-            for inst, _body in task.programs:
+        for each in self.engine.tasks:
+            for inst, _body in each.programs:
                 scheduled.setdefault(inst.i__type.name.upper(), []).append(inst.i__path)
         for key in program.programs:                # programs called from other programs need an instance
             name = program.pous[key].pou.name
@@ -296,11 +310,11 @@ class Plc:
         with self.lock:
             self.engine.scan(now_ns if type(now_ns) is int else int(now_ns))
 
-    def read(self, path: str):
+    def read(self, path: str) -> Any:
         with self.lock:
             return self._resolver.read(path)
 
-    def write(self, path: str, value, raw: bool = False) -> None:
+    def write(self, path: str, value: Any, raw: bool = False) -> None:
         """Type-checked write of one elementary variable; ``raw=True`` also lets an enumeration variable
         take an integer that is not one of its values (fault tests: an HMI or memory copy writing a number)."""
         with self.lock:
@@ -309,7 +323,8 @@ class Plc:
     def var_type(self, path: str) -> str:
         return self._resolver.type_text(path)
 
-    def run_until(self, pred, timeout_ns: int, on_scan=None) -> bool:
+    def run_until(self, pred: Callable[[], object], timeout_ns: int,
+                  on_scan: Callable[[int], object] | None = None) -> bool:
         eng = self.engine
         t = eng.now_ns + self.period_ns if eng.started else eng.now_ns
         end = t + max(int(timeout_ns), 1)
@@ -322,7 +337,8 @@ class Plc:
             t += self.period_ns
         return False
 
-    def run_realtime(self, stop_event, on_scan=None, stats=None, spin_ns: int = 300_000) -> None:
+    def run_realtime(self, stop_event: threading.Event, on_scan: Callable[[int], object] | None = None,
+                     stats: ScanStats | OverrunCount | None = None, spin_ns: int = 300_000) -> None:
         """Scan at the task period on the monotonic wall clock until ``stop_event`` is set.
 
         The driver sleeps until ``spin_ns`` before the due time, then spins: a longer spin lowers the
@@ -361,10 +377,10 @@ class Plc:
     def close(self) -> None:
         self.engine.sockets.close_all()
 
-    def __enter__(self):
+    def __enter__(self) -> Plc:
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
 
