@@ -14,6 +14,7 @@ Documentation: docs/toolchain/export.md.
 """
 from __future__ import annotations
 
+import argparse
 import errno
 import os
 import sys
@@ -22,7 +23,7 @@ import tempfile
 FORMATS = ("iec61131-10", "plcopen", "paste")
 
 
-def register(subparsers) -> None:
+def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "export", help="export ST sources for Sysmac Studio (IEC 61131-10 XML or paste kit)",
         description="Check the sources, then write them as one IEC 61131-10 XML file (Sysmac Studio: "
@@ -51,7 +52,7 @@ def _usage(msg: str) -> int:
     return 2
 
 
-def run_export(args) -> int:
+def run_export(args: argparse.Namespace) -> int:
     from ..frontend.diagnostics import ERROR, NOTE
     from ..ladder.model import WriteError
     from ..project import load_project
@@ -93,9 +94,9 @@ def run_export(args) -> int:
     export = collect(proj)
     if args.only:
         wanted = {n.strip().upper() for n in args.only.split(",") if n.strip()}
-        missing = wanted - {i.name.upper() for i in export.items}
-        if missing:
-            return _usage(f"--only: no data type or POU named {', '.join(sorted(missing))} in the sources")
+        unknown = wanted - {i.name.upper() for i in export.items}
+        if unknown:
+            return _usage(f"--only: no data type or POU named {', '.join(sorted(unknown))} in the sources")
         export.types = [t for t in export.types if t.name.upper() in wanted]
         export.pous = [p for p in export.pous if p.name.upper() in wanted]
         export.globals = []

@@ -34,6 +34,7 @@ import xml.etree.ElementTree as ET
 from .. import __version__
 from ..frontend import ast as A
 from ..ladder.iec10_write import ld_body
+from ..project import Project
 from .model import ExportError, ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 
 IEC_NS = "www.iec.ch/public/TC65SC65BWG7TF10"
@@ -94,7 +95,7 @@ def _array_spec(el: ET.Element, ref: A.ArrayTypeRef) -> None:
     _type_into(_sub(el, "BaseType"), ref.element)
     for n, dim in enumerate(ref.dims, start=1):
         ds = _sub(el, "DimensionSpec", {"dimensionNumber": str(n)})
-        if dim.lo is None:                          # ARRAY[*]: the schema's VariableLength (fixed "true")
+        if dim.lo is None or dim.hi is None:        # ARRAY[*]: the schema's VariableLength (fixed "true")
             _sub(ds, "VariableLength", text="true")
         else:
             _sub(ds, "IndexRange", {"lower": _bound(dim.lo), "upper": _bound(dim.hi)})
@@ -146,7 +147,7 @@ def _variable(parent: ET.Element, tag: str, d: A.VarDecl, comment: str, order: i
         _sub(v, "Address", {"address": d.at})
 
 
-def _data_type(parent: ET.Element, item: TypeItem, project) -> None:
+def _data_type(parent: ET.Element, item: TypeItem, project: Project) -> None:
     decl = item.decl
     if decl.init is not None:
         raise ExportError(f"{item.path}: data type `{decl.name}` has an initial value of its own; IEC 61131-10 "
@@ -160,8 +161,9 @@ def _data_type(parent: ET.Element, item: TypeItem, project) -> None:
                                                                                else {})})
         for f in spec.fields:
             _variable(ts, "Member", f, item.member_comments.get(id(f), ""))
-        if getattr(decl, "offset_type", None) in ("CJ", "User"):       # kept from the file it was read from
-            _add_data(ts, "StructTypeSpecAdditionalProperties", {"offsetType": decl.offset_type})
+        offset_type = getattr(decl, "offset_type", None)      # kept from the file it was read from (ladder/load)
+        if offset_type in ("CJ", "User"):
+            _add_data(ts, "StructTypeSpecAdditionalProperties", {"offsetType": offset_type})
     elif isinstance(spec, A.EnumTypeRef):
         ts = _sub(el, "UserDefinedTypeSpec", {"xsi:type": "EnumTypeWithNamedValueSpec"})
         values = enum_values(project, item)
@@ -331,7 +333,8 @@ def _namespace_decl(containers: dict, ns: str) -> ET.Element:
     return containers[ns]
 
 
-def build(export: ExportSet, project, *, flat: bool = False, device: tuple[str, str] | None = None) -> ET.Element:
+def build(export: ExportSet, project: Project, *, flat: bool = False,
+          device: tuple[str, str] | None = None) -> ET.Element:
     """The ``Project`` element of the export; ``device`` (model, version) names the controller."""
     root = ET.Element("Project", {
         "xmlns": IEC_NS,
@@ -379,5 +382,5 @@ def to_bytes(root: ET.Element) -> bytes:
     return ('<?xml version="1.0" encoding="utf-8"?>\n' + body + "\n").encode("utf-8")
 
 
-def render(export: ExportSet, project, *, flat: bool = False, device: tuple[str, str] | None = None) -> bytes:
+def render(export: ExportSet, project: Project, *, flat: bool = False, device: tuple[str, str] | None = None) -> bytes:
     return to_bytes(build(export, project, flat=flat, device=device))

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 from ..frontend import ast as A
 from ..frontend import printer
+from ..project import Project
 from .order import dependency_order
 
 
@@ -132,14 +133,13 @@ def body_text(pou: A.Pou) -> str:
     space are dropped.
     """
     text = pou.span.file.text
+    ret_span = getattr(pou.return_type, "span", None)         # every type specification has one
     header_end = max([pou.name_span.end]
-                     + ([pou.return_type.span.end] if pou.return_type is not None and pou.return_type.span else [])
+                     + ([ret_span.end] if ret_span else [])
                      + [s.span.end for s in pou.sections if s.span is not None])
     tail = text[header_end:pou.span.end]
-    m = None
-    for m in re.finditer(r"(?i)\bEND_" + pou.kind + r"\b", tail):
-        pass
-    stop = header_end + (m.start() if m else len(tail))
+    ends = list(re.finditer(r"(?i)\bEND_" + pou.kind + r"\b", tail))
+    stop = header_end + (ends[-1].start() if ends else len(tail))
     raw = text[header_end:stop].replace("\r\n", "\n").replace("\r", "\n")
     first_nl = raw.find("\n")
     if first_nl >= 0 and not raw[:first_nl].strip():
@@ -152,7 +152,7 @@ def body_text(pou: A.Pou) -> str:
 
 # ---- collection ----------------------------------------------------------------------------------
 
-def collect(project) -> ExportSet:
+def collect(project: Project) -> ExportSet:
     """The exportable content of ``project`` (which must have no errors), prelude excluded."""
     types: list[TypeItem] = []
     pous: list[PouItem] = []
@@ -200,21 +200,21 @@ def _named_refs(ref: A.TypeRef):
         yield ref.name.text()
     elif isinstance(ref, A.ArrayTypeRef):
         yield from _named_refs(ref.element)
-    elif isinstance(ref, A.SubrangeTypeRef) or isinstance(ref, A.EnumTypeRef) and ref.base is not None:
+    elif isinstance(ref, (A.SubrangeTypeRef, A.EnumTypeRef)) and ref.base is not None:
         yield from _named_refs(ref.base)
     elif isinstance(ref, A.StructTypeRef):
         for f in ref.fields:
             yield from _named_refs(f.type)
 
 
-def _type_deps(project, item: TypeItem):
+def _type_deps(project: Project, item: TypeItem):
     for name in _named_refs(item.decl.spec):
         t = project.lookup_type(name, item.namespace)
         if t is not None:
             yield getattr(t, "namespace", None), t.name.upper()
 
 
-def _pou_deps(project, item: PouItem):
+def _pou_deps(project: Project, item: PouItem):
     pou = item.pou
     for section in pou.sections:
         for d in section.vars:
@@ -229,12 +229,15 @@ def _pou_deps(project, item: PouItem):
                 yield callee.namespace, callee.name.upper()
 
 
-def enum_values(project, item: TypeItem) -> dict[str, int]:
+def enum_values(project: Project, item: TypeItem) -> dict[str, int]:
     """Value of every enumerator (implicit values counted on from the previous one, as the checker does)."""
     t = project.lookup_type(item.decl.name, item.namespace)
     known = {k.upper(): v for k, v in getattr(t, "values", {}).items()}
+    spec = item.decl.spec
+    if not isinstance(spec, A.EnumTypeRef):
+        raise TypeError(f"enum_values: {item.decl.name} is not an enumeration")
     out, nxt = {}, 0
-    for v in item.decl.spec.values:
+    for v in spec.values:
         value = known.get(v.name.upper(), nxt)
         out[v.name.upper()] = value
         nxt = value + 1

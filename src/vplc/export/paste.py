@@ -22,6 +22,7 @@ import shutil
 
 from .. import __version__
 from ..frontend import ast as A
+from ..project import Project
 from .model import ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 
 VAR_COLUMNS = ("Name", "Data Type", "Initial Value", "AT", "Retain", "Constant", "Comment")
@@ -108,7 +109,7 @@ def order_text(export: ExportSet, folders: dict[int, str], flat: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write(export: ExportSet, project, out_dir: str, *, flat: bool = False) -> int:
+def write(export: ExportSet, project: Project, out_dir: str, *, flat: bool = False) -> int:
     """Write the kit into ``out_dir``; returns the number of objects. A folder that holds anything other
     than an earlier kit (recognised by its ORDER.txt) is never touched."""
     if os.path.exists(out_dir):

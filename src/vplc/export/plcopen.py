@@ -22,6 +22,7 @@ import xml.etree.ElementTree as ET
 from .. import __version__
 from ..frontend import ast as A
 from ..ladder.plcopen_write import XHTML_NS, formatted, ld_body
+from ..project import Project
 from .iec61131_10 import COMPANY, PRODUCT, creation_time, to_bytes
 from .model import ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 
@@ -53,13 +54,15 @@ def _type(parent: ET.Element, ref: A.TypeRef) -> None:
     if isinstance(ref, A.StringTypeRef):
         attrs = {"length": expr_text(ref.length)} if ref.length is not None else {}
         _sub(parent, "wstring" if ref.wide else "string", attrs)
-    elif isinstance(ref, A.ArrayTypeRef) and any(dim.lo is None for dim in ref.dims):
-        _sub(parent, "derived", {"name": type_text(ref)})     # ARRAY[*]: TC6 has no open dimension
     elif isinstance(ref, A.ArrayTypeRef):
-        arr = _sub(parent, "array")
-        for dim in ref.dims:
-            _sub(arr, "dimension", {"lower": expr_text(dim.lo), "upper": expr_text(dim.hi)})
-        _type(_sub(arr, "baseType"), ref.element)
+        bounds = [(dim.lo, dim.hi) for dim in ref.dims if dim.lo is not None and dim.hi is not None]
+        if len(bounds) < len(ref.dims):
+            _sub(parent, "derived", {"name": type_text(ref)})     # ARRAY[*]: TC6 has no open dimension
+        else:
+            arr = _sub(parent, "array")
+            for lo, hi in bounds:
+                _sub(arr, "dimension", {"lower": expr_text(lo), "upper": expr_text(hi)})
+            _type(_sub(arr, "baseType"), ref.element)
     elif isinstance(ref, A.EnumTypeRef):
         en = _sub(parent, "enum")
         values = _sub(en, "values")
@@ -126,7 +129,7 @@ def _list_attrs(section: A.VarSection) -> dict:
     return attrs
 
 
-def _data_type(parent: ET.Element, item: TypeItem, project) -> None:
+def _data_type(parent: ET.Element, item: TypeItem, project: Project) -> None:
     decl = item.decl
     dt = _sub(parent, "dataType", {"name": decl.name})
     spec = decl.spec
@@ -147,7 +150,7 @@ def _pou(parent: ET.Element, item: PouItem) -> None:
     pou = item.pou
     el = _sub(parent, "pou", {"name": pou.name, "pouType": POU_TYPE[pou.kind]})
     iface = _sub(el, "interface")
-    if pou.kind == "FUNCTION":
+    if pou.kind == "FUNCTION" and pou.return_type is not None:     # (the checker requires one)
         _type(_sub(iface, "returnType"), pou.return_type)
     ladder = getattr(pou, "ladder", None)
     helpers = {h.upper() for h in (ladder.helpers if ladder is not None else [])}
@@ -171,7 +174,7 @@ def _pou(parent: ET.Element, item: PouItem) -> None:
         formatted(el, "documentation", item.comment)
 
 
-def build(export: ExportSet, project) -> ET.Element:
+def build(export: ExportSet, project: Project) -> ET.Element:
     root = ET.Element("project", {"xmlns": PLCOPEN_NS, "xmlns:xhtml": XHTML_NS})
     stamp = creation_time()
     _sub(root, "fileHeader", {"companyName": COMPANY, "productName": PRODUCT, "productVersion": __version__,
@@ -198,5 +201,5 @@ def build(export: ExportSet, project) -> ET.Element:
     return root
 
 
-def render(export: ExportSet, project) -> bytes:
+def render(export: ExportSet, project: Project) -> bytes:
     return to_bytes(build(export, project))
