@@ -5,11 +5,12 @@ The sources are loaded and checked first (a ladder with errors is not drawn). Ex
 """
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 
 
-def register(subparsers) -> None:
+def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "draw", help="draw a ladder (LD) POU as SVG",
         description="Check the sources, then draw the ladder body of one POU as an SVG file: rails, contacts, "
@@ -22,7 +23,7 @@ def register(subparsers) -> None:
     p.set_defaults(handler=run_draw)
 
 
-def run_draw(args) -> int:
+def run_draw(args: argparse.Namespace) -> int:
     from ..frontend.diagnostics import ERROR
     from ..ladder.svg import svg_document
     from ..project import load_project

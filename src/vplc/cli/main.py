@@ -24,7 +24,7 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
-def register_check(subparsers) -> None:
+def register_check(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "check", help="parse and check Structured Text files",
         description="Check ST files (or folders, searched recursively for *.st) and print every diagnostic as "
@@ -41,7 +41,7 @@ def register_check(subparsers) -> None:
     p.set_defaults(handler=run_check)
 
 
-def run_check(args) -> int:
+def run_check(args: argparse.Namespace) -> int:
     from ..project import load_project
     proj = load_project(args.paths, dialect=args.dialect, portable=args.portable)
     diags = [d for d in proj.diagnostics if not (args.no_notes and d.severity == NOTE)]
@@ -111,6 +111,6 @@ _WRITE_ERRORS = {errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG, errno.EROFS
 def _drop_stdout() -> None:
     """Forget what could not be written, so the interpreter's exit does not try (and fail) again."""
     try:
-        sys.stdout = open(os.devnull, "w", encoding="utf-8")
+        sys.stdout = open(os.devnull, "w", encoding="utf-8")    # noqa: SIM115 - stdout until the process ends
     except OSError:
         sys.stdout = None

@@ -11,19 +11,25 @@ overruns than --max-overruns; 2 on usage or load errors.
 """
 from __future__ import annotations
 
+import argparse
 import os
 import signal
 import sys
 import threading
 import time
+from typing import TYPE_CHECKING, Any
 
 from ..runtime.values import parse_duration
 from . import scenario as scn
 from . import simlink
 from .scenario_run import Runner
 
+if TYPE_CHECKING:
+    from ..api import Plc
+    from ..trace import Recorder
 
-def register(subparsers) -> None:
+
+def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("run", help="run ST programs on the virtual PLC",
                               description="Load, compile and run ST programs cyclically like an NJ/NX controller.")
     p.add_argument("paths", nargs="+", metavar="PATH",
@@ -56,7 +62,8 @@ def register(subparsers) -> None:
                    help="SVG: draw only this part of the run, e.g. 2s..2.5s (the VCD keeps everything)")
     p.add_argument("--spin-us", type=int, default=300, metavar="US",
                    help="real time: busy-wait this long before each scan for lower jitter (default 300)")
-    p.add_argument("--watchdog", default="500ms", metavar="T", help="major fault when one scan runs longer (default 500ms)")
+    p.add_argument("--watchdog", default="500ms", metavar="T",
+                   help="major fault when one scan runs longer (default 500ms)")
     p.add_argument("--max-overruns", type=int, metavar="N",
                    help="real time: fail the run (exit 1) on more than N overruns (task periods missed because a "
                         "scan was still running when the next one was due)")
@@ -74,7 +81,7 @@ MAX_WATCHDOG_NS = 60 * 10**9
 MAX_SPIN_US = 10_000
 
 
-def run_cmd(args) -> int:
+def run_cmd(args: argparse.Namespace) -> int:
     if bool(args.trace) != bool(args.trace_out):
         return _err("--trace and --trace-out go together")
     for option, text in (("--trace", args.trace), ("--watch", args.watch)):
@@ -165,7 +172,7 @@ def _load_and_run(args, scenario, link, duration, wd, window) -> int:
         plc.close()
         return _err(str(exc))
     runner = Runner(plc, scenario, link, wait=args.virtual_time)
-    stats = ScanStats() if args.stats else None
+    stats: ScanStats | OverrunCount | None = ScanStats() if args.stats else None
     if stats is None and not args.virtual_time:
         stats = OverrunCount()                 # every real-time run reports its overruns in its final line
     reason = None
@@ -192,8 +199,8 @@ def _load_and_run(args, scenario, link, duration, wd, window) -> int:
         link.drain()                           # the answers to the last requests decide the run too
     if reason is None:
         reason = runner.end_check(hooks.last_ns)
-    overruns = None if args.virtual_time else stats.overruns
-    if reason is None and args.max_overruns is not None and overruns > args.max_overruns:
+    overruns = None if args.virtual_time or stats is None else stats.overruns     # real time always counts them
+    if reason is None and args.max_overruns is not None and overruns is not None and overruns > args.max_overruns:
         reason = (f"{overruns} overrun(s), more than --max-overruns {args.max_overruns} (task periods missed "
                   "because a scan was still running when the next one was due)")
     count, latest = plc.instruction_errors
@@ -204,7 +211,7 @@ def _load_and_run(args, scenario, link, duration, wd, window) -> int:
             print(f"  {message}", file=sys.stderr)
     if watch is not None:
         print(watch.final(hooks.last_ns))
-    if args.stats:
+    if isinstance(stats, ScanStats):             # --stats
         print(stats.summary())
     if rec is not None:
         try:
@@ -266,7 +273,7 @@ def _paths(text: str) -> list[str]:
     return [p.strip() for p in text.split(",") if p.strip()]
 
 
-def start_line(plc, args, scenario, duration) -> str:
+def start_line(plc: Plc, args: argparse.Namespace, scenario: scn.Scenario, duration: int | None) -> str:
     tasks = "; ".join(f"task {t.name} every {_period(t.period_ns)}: "
                       f"{', '.join(inst.i__path for inst, _ in t.programs)}" for t in plc.engine.tasks)
     clock = "virtual time" if args.virtual_time else "real time"
@@ -294,7 +301,7 @@ _SOCKET_KINDS = {"SKTTCPCONNECT": "TCP client connections", "SKTTCPACCEPT": "TCP
                  "SKTUDPCREATE": "UDP sockets"}
 
 
-def socket_use(plc) -> str:
+def socket_use(plc: Plc) -> str:
     """Which kinds of socket the loaded program can open (the Skt* instruction instances it declares)."""
     from ..frontend import ast as A
     kinds = []
@@ -313,7 +320,7 @@ def socket_use(plc) -> str:
 class Watch:
     """Prints each change of the watched variables as `time  VAR = value` in PLC notation, and a table at the end."""
 
-    def __init__(self, plc, paths: list[str]) -> None:
+    def __init__(self, plc: Plc, paths: list[str]) -> None:
         from ..runtime.values import plc_text
         self.plc, self.paths = plc, paths
         plc.var_type(paths[0])                                                   # PathError first
@@ -334,7 +341,7 @@ class Watch:
             lines.append(f"  {p:<{self.width}} = {self.show(p, self.plc.read(p))}")
         return "\n".join(lines)
 
-    def show(self, path: str, v) -> str:
+    def show(self, path: str, v: Any) -> str:
         """16#4006 for a WORD, Idle for an enumeration, T#1.5s, (X := 1, Y := 16#00) ... (issue 27)."""
         return self.text[path](v)
 
@@ -342,7 +349,8 @@ class Watch:
 class Hooks:
     """What happens around every scan: scenario writes before it; watch, trace and expectations after it."""
 
-    def __init__(self, plc, runner, rec, watch, cycles, duration) -> None:
+    def __init__(self, plc: Plc, runner: Runner, rec: Recorder | None, watch: Watch | None, cycles: int | None,
+                 duration: int | None) -> None:
         self.plc, self.runner, self.rec, self.watch = plc, runner, rec, watch
         self.cycles, self.duration = cycles, duration
         self.scans = 0
@@ -383,7 +391,7 @@ def _run_virtual(plc, hooks, stats) -> None:
 
 def _run_realtime(plc, hooks, stats, spin_ns) -> None:
     stop = threading.Event()
-    pending = []
+    pending: list[int] = []                # the scan time of a scan whose results are not judged yet
 
     def on_scan(now_ns):
         if pending:                        # the previous scan is complete: judge it

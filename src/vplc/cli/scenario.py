@@ -23,15 +23,26 @@ from __future__ import annotations
 
 import operator
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 from ..frontend import types as T
 from ..runtime.values import PathError, parse_duration
 from . import simlink
 
+if TYPE_CHECKING:
+    from ..api import Plc
+    from .scenario_run import Signal
+
 
 class ScenarioError(ValueError):
     """A scenario line that cannot be understood; str() names the file and line."""
+
+
+def _not_built(_value: object) -> bool:
+    """The comparison of a condition or an expectation before a Runner (scenario_run) built it."""
+    raise RuntimeError("the scenario runner has not built this comparison yet")
 
 
 @dataclass
@@ -59,8 +70,8 @@ class Expect:
     last: object = None
     since_ns: int = 0             # when ``last`` became the variable's value
     decided_ns: int | None = None
-    sig: object = None            # the watched Signal and the comparator, built by Runner
-    test: object = None
+    sig: Signal | None = None     # the watched Signal and the comparator, built by Runner
+    test: Callable[[Any], bool] = _not_built
 
 
 @dataclass
@@ -70,8 +81,8 @@ class Term:
     op: str
     text: str
     value: object = None
-    sig: object = None            # the watched Signal and the comparator, built by Runner
-    test: object = None
+    sig: Signal | None = None     # the watched Signal and the comparator, built by Runner
+    test: Callable[[Any], bool] = _not_built
 
 
 @dataclass
@@ -240,7 +251,7 @@ def _when(text: str, where: str) -> Reaction:
 def _robot(text: str, where: str) -> Action:
     m = _ROBOT.match(text)
     number = m.group(1) if m else ""
-    if not number.isdigit() or int(number) < 1:
+    if m is None or not number.isdigit() or int(number) < 1:
         raise ScenarioError(f"{where}: `robot {number}`: robots are numbered from 1, as the simulator's "
                             f"start-up lines count them")
     try:
@@ -276,13 +287,13 @@ def add_set_option(text: str, sc: Scenario) -> None:
 def check_robots(sc: Scenario, count: int, where: str) -> None:
     """Every `robot N` line names one of the ``count`` robots of the simulator at ``where``."""
     for r in sc.robots:
-        if r.action.robot > count:
+        if r.action.robot is not None and r.action.robot > count:
             raise ScenarioError(f"{r.where}: robot {r.action.robot} does not exist: the simulator at {where} "
                                 f"has {count} robot{'s' if count != 1 else ''} (robot 1 to {count})")
 
 
 # ---- values -------------------------------------------------------------------------------------
-def parse_value(plc, path: str, text: str):
+def parse_value(plc: Plc, path: str, text: str) -> Any:
     """An ST literal for the variable at ``path`` -> the API value (bool/int/float/str); PathError if it
     does not fit the variable's type."""
     t = plc._resolver._locate(path)[2]
@@ -300,10 +311,8 @@ def parse_value(plc, path: str, text: str):
         raise PathError(f"{path} is a {tn}; set its elementary members one by one")
     if "#" in s and u.kind not in ("time", "ltime"):
         prefix, _, rest = s.partition("#")
-        if prefix.isdigit():
-            s = str(_int(rest, int(prefix), bad))
-        else:
-            s = rest                               # typed literal: INT#5, BOOL#TRUE
+        # based literal (16#FF) or typed literal (INT#5, BOOL#TRUE)
+        s = str(_int(rest, int(prefix), bad)) if prefix.isdigit() else rest
     if u.kind == "bool":
         if s.upper() in ("TRUE", "1"):
             return True
@@ -332,7 +341,7 @@ def _int(s: str, base: int, bad: Exception) -> int:
         raise bad from None
 
 
-def compare(a, op: str, b) -> bool:
+def compare(a: Any, op: str, b: Any) -> bool:
     if isinstance(a, str) and isinstance(b, str):
         a, b = a.upper(), b.upper()
     if op == "=":
@@ -345,7 +354,7 @@ def compare(a, op: str, b) -> bool:
         return False
 
 
-def resolve(plc, sc: Scenario) -> None:
+def resolve(plc: Plc, sc: Scenario) -> None:
     """Check every path and value against the loaded program before the first scan."""
     for w in sc.writes:
         try:
@@ -383,7 +392,7 @@ def seconds(t_ns: int) -> str:
     return f"{t_ns / 1e9:.3f} s"
 
 
-def fmt(v) -> str:
+def fmt(v: Any) -> str:
     if isinstance(v, bool):
         return "TRUE" if v else "FALSE"
     if isinstance(v, float):

@@ -9,9 +9,15 @@ lines wait for something that does not change (docs/toolchain/runtime.md section
 from __future__ import annotations
 
 import operator
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from ..runtime.values import PathError
 from .scenario import _ORDER, Expect, Reaction, Scenario, compare, fmt, seconds
+
+if TYPE_CHECKING:
+    from ..api import Plc
+    from .simlink import SimControl
 
 _UNSEEN = object()
 
@@ -25,7 +31,7 @@ class Signal:
     __slots__ = ("container", "conv", "expects", "key", "path", "raw", "reactions", "read", "since_ns", "stamp",
                  "value")
 
-    def __init__(self, plc, path: str) -> None:
+    def __init__(self, plc: Plc, path: str) -> None:
         from ..runtime.values import converter
         res = plc._resolver
         container, key, t = res._locate(path)
@@ -50,7 +56,7 @@ def _one(key):
     return lambda container: (container[key],)
 
 
-def comparator(op: str, b):
+def comparator(op: str, b: Any) -> Callable[[Any], bool]:
     """``v -> v OP b`` for the value ``b`` of a condition or an expectation (what ``compare`` does, built once)."""
     if isinstance(b, str):
         b = b.upper()
@@ -69,7 +75,8 @@ class Runner:
     simulator's control channel (``simlink.SimControl``) for `robot` lines; ``wait`` sends each request and waits
     for its answer (virtual time), otherwise requests leave from a sender thread and the scan never waits."""
 
-    def __init__(self, plc, sc: Scenario, link=None, wait: bool = False, say=print) -> None:
+    def __init__(self, plc: Plc, sc: Scenario, link: SimControl | None = None, wait: bool = False,
+                 say: Callable[..., None] = print) -> None:
         self.plc, self.sc, self.link, self.wait, self.say = plc, sc, link, wait, say
         self.failure: str | None = None
         self.first: Expect | None = None
@@ -204,7 +211,7 @@ class Runner:
         simulator's log then lines up both clocks from the start, before the first action."""
         if self.link is None:
             return
-        for robot in sorted({r.action.robot for r in self.sc.robots}):
+        for robot in sorted({r.action.robot for r in self.sc.robots if r.action.robot is not None}):
             request = {"cmd": "ping", "robot": robot - 1, "plc_time": round(t_ns / 1e9, 6)}
             if self.wait:
                 self.link.send_now(request, "start of the run")
@@ -216,6 +223,10 @@ class Runner:
         if a.path is not None:
             self._write(a.path, a.value, r.where)
             return
+        if a.robot is None or a.request is None:      # an action is a `set` line or a `robot` line
+            raise RuntimeError(f"{r.where}: an action neither writes a variable nor commands a robot")
+        if self.link is None:                         # run.py connects the control channel for `robot` lines
+            raise RuntimeError(f"{r.where}: a `robot` line without the simulator's control channel")
         request = {**a.request, "robot": a.robot - 1, "plc_time": round(t_ns / 1e9, 6)}
         self.say(f"{t_ns / 1e9:10.3f} s  robot {a.robot}: {a.words} ({r.where})", flush=True)
         if self.wait:
@@ -257,8 +268,11 @@ class Runner:
                 self._check(e, t_ns)
 
     def _check(self, e: Expect, t_ns: int) -> None:
-        v = e.sig.value
-        e.last, e.since_ns = v, e.sig.since_ns
+        sig = e.sig
+        if sig is None:
+            raise RuntimeError(f"{e.where}: expectation judged before the runner watched {e.path}")
+        v = sig.value
+        e.last, e.since_ns = v, sig.since_ns
         ok = e.test(v)
         if ok and not e.always:
             e.state, e.decided_ns = "held", t_ns
@@ -302,7 +316,7 @@ class Runner:
         for e in self.sc.expects:
             if e.state == "failed":
                 mark = " (first)" if e is self.first else ""
-                head = f"failed at {seconds(e.decided_ns)}{mark}"
+                head = f"failed at {seconds(e.decided_ns or 0)}{mark}"
             elif e.state == "open" and not (e.always and e.from_ns <= t_ns):
                 head = "not decided"
             else:

@@ -64,8 +64,9 @@ COMMANDS = {
     "vision_remove": Command({}, positional="job"),
 }
 # Words of the commissioning engineer for the commonest actions, each one request of the table above.
-ALIASES = {"cut_link": ("inject", {"fault": "disconnect"}),        # every client connection closed now
-           "release_estop": ("estop", {"pressed": False})}
+ALIASES: dict[str, tuple[str, dict[str, object]]] = {
+    "cut_link": ("inject", {"fault": "disconnect"}),        # every client connection closed now
+    "release_estop": ("estop", {"pressed": False})}
 QUERIES = ("ping", "robots", "state", "events", "vision")                    # answers, not actions
 
 
@@ -286,7 +287,10 @@ class SimControl:
         if self._thread is None:
             return
         done = threading.Event()
-        waiter = threading.Thread(target=lambda: (self._queue.join(), done.set()), daemon=True)
+        def answered() -> None:
+            self._queue.join()
+            done.set()
+        waiter = threading.Thread(target=answered, daemon=True)
         waiter.start()
         done.wait(timeout)
 

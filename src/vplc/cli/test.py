@@ -7,21 +7,29 @@ then ``N passed, N failed``. Exit 0 when nothing failed, 1 otherwise, 2 for usag
 """
 from __future__ import annotations
 
+import argparse
+import functools
 import os
 import sys
 import tempfile
 import time
+from typing import TYPE_CHECKING
 from xml.sax.saxutils import escape, quoteattr
 
 from ..frontend import ast as A
 from ..runtime.values import parse_duration
+
+if TYPE_CHECKING:
+    from ..project import Project
+    from ..runtime.faults import PlcFault
+    from ..runtime.testing import TestCase
 
 RUNNER = "VPLC_TestRunner"
 
 MAX_TIMEOUT_NS = 86_400 * 10**9          # one day of virtual time
 
 
-def register(subparsers) -> None:
+def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("test", help="run ST unit-test suites (TcUnit style)",
                               description="Run every test-suite FB (a FUNCTION_BLOCK calling TEST('name')) found in "
                                           "PATHS on virtual time and report the results.")
@@ -35,7 +43,7 @@ def register(subparsers) -> None:
     p.set_defaults(handler=run_tests)
 
 
-def find_suites(proj) -> list[str]:
+def find_suites(proj: Project) -> list[str]:
     suites = []
     for unit in proj.units:
         if getattr(unit, "in_prelude", False):
@@ -64,7 +72,7 @@ def _inst(suite: str) -> str:
     return suite.rsplit("\\", 1)[-1]
 
 
-def run_tests(args) -> int:
+def run_tests(args: argparse.Namespace) -> int:
     from ..api import LoadError, PlcFault, load_plc
     from ..project import load_project
     timeout = parse_duration(args.timeout)
@@ -88,7 +96,8 @@ def run_tests(args) -> int:
         print("0 passed, 0 failed")
         return 1
     t0 = time.perf_counter()
-    results, errors = [], []
+    results: list[TestCase] = []
+    errors: list[tuple[str | None, PlcFault]] = []
     remaining = list(suites)
     while remaining:
         with tempfile.TemporaryDirectory() as tmp:
@@ -102,7 +111,7 @@ def run_tests(args) -> int:
                 return 2
         faulted = None
         try:
-            plc.run_until(lambda: _all_finished(plc), timeout)
+            plc.run_until(functools.partial(_all_finished, plc), timeout)
         except PlcFault as exc:
             faulted = exc
         finally:
@@ -115,7 +124,7 @@ def run_tests(args) -> int:
         bad = _inst_of(faulted.instance)
         for c in cases:
             if c.suite.split(".")[1:2] == [bad]:
-                if c is col.current.get(c.suite) and not c.finished:
+                if col is not None and c is col.current.get(c.suite) and not c.finished:
                     c.failures.append(_fault_failure(faulted))
                     c.finished = True
                 results.append(c)
@@ -140,11 +149,14 @@ def _fault_failure(fault):
 
 
 def _all_finished(plc) -> bool:
-    col = getattr(plc.engine, "tests", None)
-    return bool(col and col.tests) and all(t.finished for t in col.tests.values())
+    col = getattr(plc.engine, "tests", None)          # the TEST() collector, once a suite has run (runtime/testing)
+    if col is None or not col.tests:
+        return False
+    return all(t.finished for t in col.tests.values())
 
 
-def report(results, errors, args, elapsed: float) -> int:
+def report(results: list[TestCase], errors: list[tuple[str | None, PlcFault]], args: argparse.Namespace,
+           elapsed: float) -> int:
     passed = failed = 0
     for tc in results:
         label = f"{tc.suite.split('.', 1)[-1]}.{tc.name}"
@@ -178,7 +190,7 @@ def _unfinished(tc):
     return Failure("<runner>", 0, "test did not call TEST_FINISHED() before the timeout")
 
 
-def write_junit(path: str, results, elapsed: float) -> None:
+def write_junit(path: str, results: list[TestCase], elapsed: float) -> None:
     by_suite: dict[str, list] = {}
     for tc in results:
         by_suite.setdefault(tc.suite.split(".", 1)[-1], []).append(tc)
@@ -191,10 +203,10 @@ def write_junit(path: str, results, elapsed: float) -> None:
         for tc in cases:
             lines.append(f'    <testcase classname={quoteattr(suite)} name={quoteattr(tc.name)}>')
             for f in tc.failures:
-                lines.append(f'      <failure message={quoteattr(f.message)}>{escape(f"{f.file}:{f.line}: {f.message}")}'
-                             '</failure>')
+                text = escape(f"{f.file}:{f.line}: {f.message}")
+                lines.append(f'      <failure message={quoteattr(f.message)}>{text}</failure>')
             lines.append("    </testcase>")
         lines.append("  </testsuite>")
     lines.append("</testsuites>")
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("\n".join(lines) + "\n")
+    with open(path, "w", encoding="utf-8") as out:
+        out.write("\n".join(lines) + "\n")
