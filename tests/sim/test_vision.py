@@ -117,7 +117,7 @@ def test_a_bad_job_definition_is_refused_with_its_reason(kwargs, words):
 
 def test_the_control_channel_sets_and_removes_jobs_and_shows_the_camera():
     class Robot:
-        model = object.__new__(type("M", (), {}))
+        model = type("M", (), {"camera": Camera()})()
 
         def camera(self):
             return camera_of(self.model)

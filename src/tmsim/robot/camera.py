@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import re
+from typing import Protocol
 
 from tmsim.limits import VISION_JOBS_MAX, VISION_OBJECTS_MAX, VISION_POSE_MAX, VISION_SECONDS_MAX
 from tmsim.tmscript.floats import float_text  # the texts GetString prints
@@ -157,10 +158,10 @@ def parse_option(text: str) -> dict:
     return dict(name=head.strip(), objects=poses, passed=passed, seconds=seconds)
 
 
-def camera_of(model) -> Camera:
-    """The camera of a robot model (tmsim/robot/model.py), made when first asked; it lives as long as the model."""
-    camera = getattr(model, "vision_camera", None)
-    if camera is None:
-        camera = Camera()
-        model.vision_camera = camera
-    return camera
+class _HasCamera(Protocol):
+    camera: Camera
+
+
+def camera_of(model: _HasCamera) -> Camera:
+    """The camera of a robot model (tmsim/robot/model.py declares it; it lives as long as the model)."""
+    return model.camera

@@ -12,6 +12,7 @@ from typing import Any
 
 from tmsim.limits import FIFO_ITEMS_MAX, WORK_PLAN, WORK_PVT_CARTESIAN
 from tmsim.robot import kinematics as kin
+from tmsim.robot.camera import Camera
 from tmsim.robot.errors import classify
 from tmsim.robot.motion import MotionError, MotionRequest, Plan, Planner, PvtPlan
 from tmsim.tmscript.work import WorkMeter
@@ -35,6 +36,7 @@ class RobotModel:
         self.io = {}
         self.fifo: deque[tuple[str, Any]] = deque()
         self.active = None
+        self.camera = Camera()     # the project's vision jobs (tmsim/robot/camera.py)
         self.meter = WorkMeter()   # the robot's turn budget, shared with its session (tmsim/tmscript/work.py)
         self.owed = 0.0            # seconds of robot clock not run yet: the turn's budget ended the tick
         self.active_t = 0.0
