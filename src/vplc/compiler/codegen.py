@@ -8,10 +8,14 @@ runtime reports a fault at the ST source line and never shows Python. Expression
 """
 from __future__ import annotations
 
+import contextlib
 import re
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 from ..frontend import ast as A
 from ..frontend import types as T
+from ..frontend.source import Span
 from ..runtime import abi
 from ..runtime.program import GEN_FILE, InstanceSpec, PouClass, Program, TaskSpec, program_key
 from ..runtime.sysmac_fns import KEEPS_OUT_ON_ERROR
@@ -20,6 +24,9 @@ from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop
 
 BULK_CELLS = 1024         # a statement copying a structured value this large checks the watchdog after it
 CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)
+
+Branch = TypeVar("Branch", A.IfBranch, A.CaseBranch)
+Binding = Any              # the checker's call binding (checker/symbols.py), read without importing it
 
 
 _LITERAL = re.compile(r"-?\d+(\.\d*)?(e[-+]?\d+)?|True|False|'[^'\\]*'")
@@ -94,10 +101,11 @@ class CodeGen:
                 resources.append((tasks, insts))
         prog.resources = tuple(resources)
 
-    def all_struct_types(self):
-        seen = {}
+    def all_struct_types(self) -> list[T.StructType]:
+        """Every structure and union type of the project, each after the structures its fields hold."""
+        seen: dict[int, T.StructType] = {}
 
-        def visit(t):
+        def visit(t: T.Type) -> None:
             t = T.unalias(t)
             if isinstance(t, T.StructType) and id(t) not in seen:
                 seen[id(t)] = t
@@ -108,9 +116,10 @@ class CodeGen:
         for t in self.proj.types.values():
             visit(t)
         # nested structs first so defaults can construct them
-        ordered, done = [], set()
+        ordered: list[T.StructType] = []
+        done: set[int] = set()
 
-        def place(t):
+        def place(t: T.StructType) -> None:
             if id(t) in done:
                 return
             done.add(id(t))
@@ -125,7 +134,7 @@ class CodeGen:
             place(t)
         return ordered
 
-    def pou_vars(self, pt) -> dict:
+    def pou_vars(self, pt: T.PouType) -> dict[str, tuple[str, T.Type]]:
         out = {}
         if pt.native:
             for p in pt.params:
@@ -200,13 +209,13 @@ class CodeGen:
         self.out.emit("o.i__m[0] = v.i__m[0]")
         self.out.ind -= 1
 
-    def assign_code(self, dst: str, src: str, t) -> str:
+    def assign_code(self, dst: str, src: str, t: T.Type) -> str:
         """Statement copying the structure or array value ``src`` into the existing ``dst`` of type ``t``."""
         u = T.unalias(t)
         entry = self.ex.struct_names.get(id(u)) if isinstance(u, T.StructType) else None
         return f"A{entry[1][1:]}({dst}, {src})" if entry is not None else f"{abi.ASSIGN}({dst}, {src})"
 
-    def field_assign(self, dst: str, src: str, t) -> str:
+    def field_assign(self, dst: str, src: str, t: T.Type) -> str:
         u = T.unalias(t)
         if is_scalar(u):
             return f"{dst} = {src}"
@@ -214,7 +223,7 @@ class CodeGen:
             return f"{dst}[:] = {src}"
         return self.assign_code(dst, src, u)
 
-    def field_copy(self, code: str, t) -> str:
+    def field_copy(self, code: str, t: T.Type) -> str:
         u = T.unalias(t)
         if is_scalar(u):
             return code
@@ -342,7 +351,7 @@ class CodeGen:
         self.out.ind -= 1
 
     # ---- statements ---------------------------------------------------------------------------
-    def block(self, stmts) -> None:
+    def block(self, stmts: list[A.Stmt]) -> None:
         start = len(self.out.lines)
         outer = dict(self.ex.scope.inst_temps)       # instances fetched inside this block are not known after it
         for st in stmts:
@@ -351,7 +360,7 @@ class CodeGen:
         if len(self.out.lines) == start:
             self.out.emit("pass")
 
-    def stmt(self, st) -> None:
+    def stmt(self, st: A.Stmt) -> None:
         self.out.at(st.span)
         if self.count:
             self.out.emit(f"{abi.STATEMENTS}[0] += 1")
@@ -364,7 +373,7 @@ class CodeGen:
             self.out.emit(f"if {abi.PERF_COUNTER}() > {abi.DEADLINE}[0]: "
                           f"{abi.WATCHDOG}('still copying large arrays or structures')")
 
-    def moves_bulk(self, st) -> bool:
+    def moves_bulk(self, st: A.Stmt) -> bool:
         """Whether a statement reads, writes or passes a structured value of at least BULK_CELLS cells (a copy
         of it takes long enough to matter to the watchdog)."""
         memo = self._cells_memo
@@ -375,23 +384,24 @@ class CodeGen:
                 return True
         return False
 
-    def st_Empty(self, st) -> None:
+    def st_Empty(self, st: A.Empty) -> None:
         self.out.emit("pass")
 
-    def st_Exit(self, st) -> None:
+    def st_Exit(self, st: A.Exit) -> None:
         self.out.emit("break")
 
-    def st_Continue(self, st) -> None:
+    def st_Continue(self, st: A.Continue) -> None:
         self.out.emit("continue")
 
-    def st_Return(self, st) -> None:
+    def st_Return(self, st: A.Return) -> None:
         self.out.emit("return")
 
     def st_Assign(self, st: A.Assign) -> None:
         v = st.value
         pt = v.binding.pou if isinstance(v, A.Call) and v.binding is not None and v.binding.kind != "builtin" else None
         tt = T.base_of(st.target.ty) if st.target.ty is not None else None
-        if pt is not None and pt.native and pt.name in KEEPS_OUT_ON_ERROR and isinstance(tt, T.StringType):
+        if pt is not None and isinstance(v, A.Call) and pt.native and pt.name in KEEPS_OUT_ON_ERROR \
+                and isinstance(tt, T.StringType):
             # W502 2-269: on an error the instruction's Out, the variable assigned here, does not change
             self.out.emit(f"_k = {self.ex.call_expr(v)}")            # whole, unconverted: a longer text is an error too
             self.out.emit(f"if {abi.STORES_OUT}(_k, {tt.capacity}, {pt.name!r}):")
@@ -401,7 +411,7 @@ class CodeGen:
             return
         self.store(st.target, self.ex.expr(v), v)
 
-    def store(self, target: A.Expr, code: str, value: A.Expr | None, src_type=None) -> None:
+    def store(self, target: A.Expr, code: str, value: A.Expr | None, src_type: T.Type | None = None) -> None:
         tt = T.base_of(target.ty) if target.ty is not None else None
         st_ty = src_type if src_type is not None else (value.conv or value.ty if value is not None else None)
         if isinstance(target, A.BitAccess):
@@ -429,7 +439,8 @@ class CodeGen:
             return
         self.chains(st.branches, lambda part, pending: self.if_chain(part, st.span, None, pending), st.else_body)
 
-    def chains(self, branches, chain, else_body) -> None:
+    def chains(self, branches: list[Branch], chain: Callable[[list[Branch], str], None],
+               else_body: list[A.Stmt] | None) -> None:
         """Python nests each elif one level deeper when it compiles, so thousands of branches in one chain (CASE
         labels, ELSIF) exceed its recursion limit: they become consecutive chains of CASE_CHAIN branches, written
         by ``chain(part, pending)``, the next one tried only while no branch has matched (``pending`` is set when
@@ -450,7 +461,8 @@ class CodeGen:
             self.block(else_body)
             self.out.ind -= 1
 
-    def if_chain(self, branches, span, else_body, pending: str | None = None) -> None:
+    def if_chain(self, branches: list[A.IfBranch], span: Span | None, else_body: list[A.Stmt] | None,
+                 pending: str | None = None) -> None:
         """One if/elif chain; then the ELSE part, or (``pending``) a flag set when no condition held."""
         extra = 0
         for i, br in enumerate(branches):
@@ -497,12 +509,12 @@ class CodeGen:
             return
         self.chains(st.branches, lambda part, pending: self.case_else(part, sel, st.span, pending), st.else_body)
 
-    def case_else(self, branches, sel: str, span, pending: str) -> None:
+    def case_else(self, branches: list[A.CaseBranch], sel: str, span: Span | None, pending: str) -> None:
         self.case_chain(branches, sel, span)
         self.out.emit("else:")
         self.out.emit(f"    {pending} = True")
 
-    def case_chain(self, branches, sel: str, span) -> None:
+    def case_chain(self, branches: list[A.CaseBranch], sel: str, span: Span | None) -> None:
         """One if/elif chain over the CASE branches given (no else part)."""
         for index, br in enumerate(branches):
             tests = []
@@ -600,7 +612,7 @@ class CodeGen:
         else:
             self.out.emit(self.ex.call_expr(call))
 
-    def inline_body(self, pt, inst: str, forward: dict) -> None:
+    def inline_body(self, pt: T.PouType, inst: str, forward: dict[int, str]) -> None:
         """The callee's statements in place of the call, reading and writing the instance ``inst``; the inputs
         in ``forward`` (variable id -> code) are read from the value just stored instead of the instance."""
         saved = self.ex.scope, self.out.loc
@@ -610,7 +622,7 @@ class CodeGen:
         finally:
             self.ex.scope, self.out.loc = saved
 
-    def fb_call(self, b, inst_code: str | None = None) -> None:
+    def fb_call(self, b: Binding, inst_code: str | None = None) -> None:
         pt = b.pou
         code = inst_code or self.ex.expr_raw(b.instance)
         inst = self.ex.scope.inst_temps.get(code)
@@ -664,12 +676,12 @@ class CodeGen:
             self.store(ba.expr, code, None, src_type=ba.param.type)
 
 
-def _task_number(td, prop: str, default: int) -> int:
+def _task_number(td: A.TaskDecl, prop: str, default: int) -> int:
     """INTERVAL (ns) or PRIORITY of a TASK declaration: a literal, or ``default`` when it is not given."""
     expr = {p.name.upper(): p.value for p in td.props}.get(prop)      # the last one given counts
     if expr is None:
         return default
-    try:
-        return int(expr.value)
-    except (AttributeError, TypeError, ValueError):
-        raise NotImplementedError(f"TASK {td.name}: {prop} must be a literal") from None
+    if isinstance(expr, A.Literal):
+        with contextlib.suppress(TypeError, ValueError):
+            return int(expr.value)
+    raise NotImplementedError(f"TASK {td.name}: {prop} must be a literal")

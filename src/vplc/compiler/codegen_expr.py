@@ -8,7 +8,7 @@ from __future__ import annotations
 import keyword
 import re
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 from ..frontend import ast as A
 from ..frontend import types as T
@@ -20,18 +20,24 @@ _PY_RESERVED = set(keyword.kwlist) | {"None", "True", "False", abi.SELF, abi.GLO
 
 _G_MEMBERS = f"{abi.GLOBALS}.{abi.MEMBERS}"      # the container of memory-area globals
 
+# the checker's symbols and call bindings (checker/symbols.py: VarSymbol, BoundArg, Binding) reach the compiler on
+# the typed tree; the compiler sits beside the checker, not above it, and reads them without importing it
+BoundArg = Any
+
 
 def attr(name: str) -> str:
     """Python attribute name of an ST variable (declared spelling; ST names never contain ``__``)."""
     return name + "_" if name in _PY_RESERVED else name
 
 
-def is_scalar(t) -> bool:
+def is_scalar(t: T.Type) -> bool:
     t = T.base_of(t)
     return not isinstance(t, (T.StructType, T.ArrayType, T.PouType))
 
 
-def _width(t):
+def _width(t: T.Type | None) -> T.ElementaryType | None:
+    if t is None:
+        return None
     t = T.base_of(t)
     if isinstance(t, T.EnumType):
         t = T.base_of(t.base)
@@ -110,14 +116,14 @@ class ExprGen:
         self.spill_ok = False      # set by the statement generator where a value may be computed beforehand
 
     # ---- names of generated things ----------------------------------------------------------
-    def struct_name(self, t) -> str:
+    def struct_name(self, t: T.StructType) -> str:
         entry = self.struct_names.get(id(t))
         if entry is None:
             entry = (t, f"S{len(self.struct_names)}_{''.join(c for c in t.name if c.isalnum() or c == '_')}")
             self.struct_names[id(t)] = entry
         return entry[1]
 
-    def cls_name(self, pt) -> str:
+    def cls_name(self, pt: T.PouType) -> str:
         name = self.pou_names.get(id(pt))
         if name is None:
             clean = "".join(c for c in pt.name if c.isalnum() or c == "_")
@@ -125,13 +131,13 @@ class ExprGen:
             self.pou_names[id(pt)] = name
         return name
 
-    def const(self, value, prefix: str = "_k") -> str:
+    def const(self, value: object, prefix: str = "_k") -> str:
         name = f"{prefix}{len(self.consts)}"
         self.consts[name] = value
         return name
 
     # ---- default values ---------------------------------------------------------------------
-    def default(self, t, init, path: str) -> str:
+    def default(self, t: T.Type, init: A.Expr | None, path: str) -> str:
         """Python expression creating a fresh value of type ``t`` (initialised by ``init`` if given)."""
         if init is not None and not isinstance(init, (A.ArrayInit, A.StructInit)):
             return self.store_conv(self.expr(init), init, t)
@@ -183,7 +189,7 @@ class ExprGen:
         return "None"
 
     # ---- expressions --------------------------------------------------------------------------
-    def expr(self, e) -> str:
+    def expr(self, e: A.Expr) -> str:
         code = getattr(self, "ex_" + type(e).__name__)(e)
         if e.conv is not None:
             code = self.apply_conv(code, e.ty, e.conv)
@@ -200,10 +206,10 @@ class ExprGen:
         self.out.emit(f"{tmp} = {code}")
         return tmp
 
-    def cond(self, e) -> str:
+    def cond(self, e: A.Expr) -> str:
         return self.expr(e)
 
-    def apply_conv(self, code: str, src, dst) -> str:
+    def apply_conv(self, code: str, src: T.Type | None, dst: T.Type) -> str:
         s, d = T.base_of(src) if src is not None else None, T.base_of(dst)
         if isinstance(d, T.StringType):
             if isinstance(s, T.StringType) and s.capacity <= d.capacity:
@@ -221,7 +227,7 @@ class ExprGen:
             return iec.wrap_expr(f"_round({code})", d.bits, d.kind == "int")   # an LREAL Sysmac types as integer
         return _sign_cast(code, s, d)
 
-    def store_conv(self, code: str, e, t) -> str:
+    def store_conv(self, code: str, e: A.Expr | None, t: T.Type) -> str:
         """Value ``code`` of expression ``e`` converted for storing into type ``t``."""
         tt = T.base_of(t)
         et = T.base_of(e.conv or e.ty) if e is not None and (e.conv or e.ty) is not None else None
@@ -238,13 +244,13 @@ class ExprGen:
             return self.copy_code(code, tt)
         return _sign_cast(code, et, tt)
 
-    def copy_code(self, code: str, t) -> str:
+    def copy_code(self, code: str, t: T.Type) -> str:
         """A fresh copy of the structure or array value ``code`` of type ``t``: a structure through the copier
         generated for its type (CodeGen.gen_struct), anything else through the generic deep copy."""
         entry = self.struct_names.get(id(t)) if isinstance(t, T.StructType) else None
         return f"C{entry[1][1:]}({code})" if entry is not None else f"{abi.COPY}({code})"
 
-    def ex_Literal(self, e) -> str:
+    def ex_Literal(self, e: A.Literal) -> str:
         t = T.base_of(e.ty) if e.ty is not None else None
         v = e.value
         if e.kind == "bool":
@@ -262,10 +268,10 @@ class ExprGen:
             return repr(v)
         return str(int(v))
 
-    def ex_EnumLiteral(self, e) -> str:
+    def ex_EnumLiteral(self, e: A.EnumLiteral) -> str:
         return str(e.sym.value)
 
-    def ex_Name(self, e) -> str:
+    def ex_Name(self, e: A.Name) -> str:
         sym = e.sym
         kind = type(sym).__name__
         if kind == "EnumValueSymbol":
@@ -284,7 +290,7 @@ class ExprGen:
             return f"{abi.PROGRAMS}[{sym.type.name.upper()!r}]"
         raise NotImplementedError(f"name {e.name.text()}")
 
-    def ex_Member(self, e) -> str:
+    def ex_Member(self, e: A.Member) -> str:
         base = self.expr_raw(e.base)
         base = self.scope.inst_temps.get(base, base)
         sym = e.sym
@@ -295,13 +301,13 @@ class ExprGen:
             return f"{base}.{attr(name)}__r[{base}.{attr(name)}__k]"
         return f"{base}.{attr(name)}"
 
-    def expr_raw(self, e) -> str:
+    def expr_raw(self, e: A.Expr) -> str:
         return getattr(self, "ex_" + type(e).__name__)(e)
 
-    def ex_BitAccess(self, e) -> str:
+    def ex_BitAccess(self, e: A.BitAccess) -> str:
         return f"((({self.expr_raw(e.base)}) >> {e.bit}) & 1 == 1)"
 
-    def ex_Index(self, e) -> str:
+    def ex_Index(self, e: A.Index) -> str:
         base = self.expr_raw(e.base)
         at = T.unalias(e.base.ty)
         what = self.const(_describe(e.base), "_w")
@@ -326,7 +332,7 @@ class ExprGen:
         dims = self.const(tuple(at.dims), "_d")
         return f"{base}[{abi.IXN}(({', '.join(idx)},), {dims}, {what})]"
 
-    def ex_Unary(self, e) -> str:
+    def ex_Unary(self, e: A.Unary) -> str:
         x = self.expr(e.operand)
         t = _width(e.ty)
         if e.op == "+":
@@ -344,7 +350,7 @@ class ExprGen:
             return iec.wrap_expr(f"~{x}", t.bits, True)
         return f"({x} ^ {(1 << t.bits) - 1})"
 
-    def ex_Binary(self, e) -> str:
+    def ex_Binary(self, e: A.Binary) -> str:
         op = e.op
         a, b = self.expr(e.left), self.expr(e.right)
         if op in ("=", "<>", "<", ">", "<=", ">="):
@@ -376,7 +382,7 @@ class ExprGen:
             py = "//" if op == "/" else "%"
             return f"({a} {py} {k})" if not signed else f"({a} {py} {k} if {a} >= 0 else -(-{a} {py} {k}))"
         if op == "/":
-            if t.kind == "time" and _width(e.right.ty) is not None and _width(e.right.ty).kind == "real":
+            if t.kind == "time" and (rw := _width(e.right.ty)) is not None and rw.kind == "real":
                 return f"int({abi.RDIV}({a}, {b}))"
             r = f"{abi.IDIV}({a}, {b})"
         elif op == "MOD":
@@ -393,20 +399,20 @@ class ExprGen:
             return f"({z} if {-half} <= ({z} := {r}) <= {half - 1} else {iec.wrap_expr(z, 64, True)})"
         return iec.wrap_expr(r, bits, signed)
 
-    def ex_Call(self, e) -> str:
+    def ex_Call(self, e: A.Call) -> str:
         return self.call_expr(e)
 
-    def ex_ArrayInit(self, e) -> str:
+    def ex_ArrayInit(self, e: A.ArrayInit) -> str:
         return self.default(e.ty, e, "''")
 
-    def ex_StructInit(self, e) -> str:
+    def ex_StructInit(self, e: A.StructInit) -> str:
         return self.default(e.ty, e, "''")
 
     # ---- references (VAR_IN_OUT, outputs of functions) ---------------------------------------
-    def lvalue(self, e) -> str:
+    def lvalue(self, e: A.Expr) -> str:
         return self.expr_raw(e)
 
-    def ref(self, e) -> str:
+    def ref(self, e: A.Expr) -> str:
         """(container, key) tuple addressing the lvalue ``e``."""
         if isinstance(e, A.Name):
             container, key = _cell(e.sym, self.scope.self_name)
@@ -431,7 +437,7 @@ class ExprGen:
                         return f"({code[:i]}, {code[i + 1:-1]})"
         return f"([{self.expr(e)}], 0)"
 
-    def aggregate_arg(self, ba) -> str:
+    def aggregate_arg(self, ba: BoundArg) -> str:
         if ba.from_element:
             ref = self.ref(ba.expr)
             if self.optimise and ref.endswith(", 0)"):
@@ -443,7 +449,7 @@ class ExprGen:
             return f"{abi.VIEW}({self.expr_raw(ba.expr)}, 0, {at.dims[0][0]})"
         return self.expr_raw(ba.expr)
 
-    def input_value(self, ba, p) -> str:
+    def input_value(self, ba: BoundArg, p: T.Param) -> str:
         """Value stored into input ``p``; an array element given to an array input copies the array
         starting at that element (Sysmac rule), as many elements as the parameter holds."""
         pt = T.unalias(p.type)
@@ -455,13 +461,13 @@ class ExprGen:
             return f"_fill({abi.COPY}({view}), {n}, lambda: {self.default(pt.element, None, repr(p.name))})"
         return self.store_conv(self.expr(ba.expr), ba.expr, p.type)
 
-    def by_reference(self, pt, p, ba) -> bool:
+    def by_reference(self, pt: T.PouType, p: T.Param, ba: BoundArg) -> bool:
         """A structure or array the function only reads is handed over as it is, not copied."""
         return self.optimise and not pt.native and not is_scalar(p.type) and \
             not ba.from_element and ba.expr.conv is None and p.name.upper() in readonly_inputs(pt, self.inline_cache)
 
     # ---- calls -------------------------------------------------------------------------------
-    def call_expr(self, e) -> str:
+    def call_expr(self, e: A.Call) -> str:
         b = e.binding
         if b.kind == "builtin":
             from ..runtime.stdlib import gen_builtin
@@ -500,7 +506,7 @@ class ExprGen:
         return f"{fn}({', '.join(args)})"
 
 
-def _sign_cast(code: str, src, dst) -> str:
+def _sign_cast(code: str, src: T.Type | None, dst: T.Type) -> str:
     """Sysmac implicit cast between integers of other signedness (W501 6-107: INT -1 -> UINT 16#FFFF): the
     bits are kept, so the value is wrapped to the destination; widenings need no code."""
     if isinstance(src, T.ElementaryType) and isinstance(dst, T.ElementaryType) and src.kind in ("int", "uint") \
@@ -509,7 +515,7 @@ def _sign_cast(code: str, src, dst) -> str:
     return code
 
 
-def _cell(sym, s: str = "s") -> tuple[str, str]:
+def _cell(sym: Any, s: str = "s") -> tuple[str, str]:
     """(container, key) code of a variable: globals live in ``G``, POU variables in the instance ``s``; a scalar
     VAR_IN_OUT holds a reference cell (``s.X__r``, ``s.X__k``)."""
     if sym.section == "VAR_EXTERNAL" and sym.target is not None:
@@ -592,7 +598,7 @@ def _depth(code: str) -> int:
     return best
 
 
-def _describe(e) -> str:
+def _describe(e: A.Expr) -> str:
     if isinstance(e, A.Name):
         return e.name.text()
     if isinstance(e, A.Member):

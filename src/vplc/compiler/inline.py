@@ -10,7 +10,9 @@
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import fields
+from typing import Any
 
 from ..frontend import ast as A
 from ..frontend import types as T
@@ -21,7 +23,7 @@ _SAFE_OPS = {"OR", "XOR", "AND", "=", "<>", "<", ">", "<=", ">=", "+", "-", "*",
 _INLINE_NATIVES = {"VPLC_ScanTime"}
 
 
-def _children(node):
+def _children(node: A.Node) -> Iterator[A.Node]:
     for f in fields(node):
         value = getattr(node, f.name)
         if isinstance(value, A.Node):
@@ -30,7 +32,7 @@ def _children(node):
             yield from (v for v in value if isinstance(v, A.Node))
 
 
-def _safe_expr(e) -> bool:
+def _safe_expr(e: A.Node) -> bool:
     if isinstance(e, (A.Literal, A.EnumLiteral, A.Name)):
         return True
     if isinstance(e, A.Member):
@@ -45,7 +47,7 @@ def _safe_expr(e) -> bool:
     return False
 
 
-def _count(stmts, budget: list, cache: dict) -> bool:
+def _count(stmts: list[A.Stmt], budget: list[int], cache: dict) -> bool:
     """False when a statement cannot be copied inline; ``budget[0]`` counts down the statements."""
     for st in stmts:
         budget[0] -= 1
@@ -80,7 +82,7 @@ def _count(stmts, budget: list, cache: dict) -> bool:
     return True
 
 
-def inlinable(pt, cache: dict) -> bool:
+def inlinable(pt: T.PouType, cache: dict) -> bool:
     """Whether calls of the function block ``pt`` may be compiled as a copy of its body (``cache``: one dict
     per compilation, id(pt) -> answer)."""
     known = cache.get(id(pt))
@@ -94,7 +96,7 @@ def inlinable(pt, cache: dict) -> bool:
     return ok
 
 
-def _written(pt) -> set:
+def _written(pt: T.PouType) -> set[int]:
     """Ids of the variables ``pt``'s body writes: assignment targets and what it passes to calls as an output
     or in-out (a member or element written counts as its whole variable)."""
     written = set()
@@ -109,7 +111,7 @@ def _written(pt) -> set:
     return written
 
 
-def readonly_inputs(pt, cache: dict) -> set:
+def readonly_inputs(pt: T.PouType, cache: dict) -> set[str]:
     """Upper names of the structure and array inputs of FUNCTION ``pt`` that its body only reads, when the body
     writes no global variable either (so nothing can change the caller's value during the call): the caller
     may hand over its value itself instead of a copy."""
@@ -126,7 +128,7 @@ def readonly_inputs(pt, cache: dict) -> set:
     return out
 
 
-def kept_inputs(pt) -> dict:
+def kept_inputs(pt: T.PouType) -> dict[str, Any]:
     """Scalar inputs of ``pt`` (upper name -> variable symbol) that its body never writes: inside an inlined
     body they still hold the value the call just stored."""
     written = _written(pt)
@@ -140,23 +142,23 @@ def kept_inputs(pt) -> dict:
     return out
 
 
-def _scalar(t) -> bool:
+def _scalar(t: T.Type) -> bool:
     return isinstance(T.base_of(t), (T.ElementaryType, T.EnumType, T.StringType))
 
 
-def _root(e):
+def _root(e: A.Expr) -> Any:
     while isinstance(e, (A.Member, A.Index, A.BitAccess)):
         e = e.base
     return getattr(e, "sym", None)
 
 
-def _walk(node):
+def _walk(node: A.Node) -> Iterator[A.Node]:
     yield node
     for c in _children(node):
         yield from _walk(c)
 
 
-def _int_literal(e):
+def _int_literal(e: A.Expr) -> int | None:
     if isinstance(e, A.Literal) and isinstance(e.value, int) and not isinstance(e.value, bool):
         return e.value
     if isinstance(e, A.Unary) and e.op == "-" and isinstance(e.operand, A.Literal) \
@@ -165,13 +167,13 @@ def _int_literal(e):
     return None
 
 
-def _mentions(node, sym) -> bool:
+def _mentions(node: A.Node, sym: Any) -> bool:
     if isinstance(node, A.Name) and node.sym is sym:
         return True
     return any(_mentions(c, sym) for c in _children(node))
 
 
-def constant_bounds(st: A.For):
+def constant_bounds(st: A.For) -> tuple[int, int, int] | None:
     """(start, end, step) of a FOR loop whose bounds and step are literals (step not 0), else None."""
     start, end = _int_literal(st.start), _int_literal(st.end)
     step = 1 if st.step is None else _int_literal(st.step)
@@ -180,7 +182,7 @@ def constant_bounds(st: A.For):
     return start, end, step
 
 
-def constant_step(st: A.For):
+def constant_step(st: A.For) -> int | None:
     """The literal step of a FOR loop (1 when omitted), or None."""
     return 1 if st.step is None else _int_literal(st.step)
 
@@ -196,11 +198,11 @@ def unguarded(st: A.For) -> bool:
         not any(_has_loop(node) for node in st.body)
 
 
-def _has_loop(node) -> bool:
+def _has_loop(node: A.Node) -> bool:
     return isinstance(node, (A.For, A.While, A.Repeat)) or any(_has_loop(c) for c in _children(node))
 
 
-def loop_range(st: A.For):
+def loop_range(st: A.For) -> tuple[int, int] | None:
     """(lowest, highest) value of the FOR variable inside the loop, or None when not known at compile time.
 
     Known means: literal bounds and step, and a local variable of the POU (VAR / VAR_TEMP) that the body
@@ -219,7 +221,7 @@ def loop_range(st: A.For):
     return (lo, hi) if step > 0 else (hi, lo)
 
 
-def _calls(node):
+def _calls(node: A.Node) -> Iterator[A.Call]:
     if isinstance(node, A.CallStmt):
         node = node.call
     if isinstance(node, A.Call):
