@@ -14,6 +14,7 @@ consumed == 0 means "need more bytes", item is a ``Frame``, a ``Garbage`` (bytes
 """
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass
 
 from tmsim.limits import FRAME_DATA_MAX
@@ -86,7 +87,7 @@ def parse_length(field: bytes) -> int | None:
     return value if value >= 0 else None
 
 
-def decode(buf: bytes | bytearray, headers=HEADERS) -> tuple[Frame | Garbage | BadFrame | None, int]:
+def decode(buf: bytes | bytearray, headers: Collection[str] = HEADERS) -> tuple[Frame | Garbage | BadFrame | None, int]:
     """Decode the packet at the front of ``buf``; ``headers`` are the ones this port serves (the Ethernet
     Slave passes {"TMSVR"}, TMscript 2.24 §17.3); any other is a header error (CPERR 03).
 
@@ -133,7 +134,7 @@ def decode(buf: bytes | bytearray, headers=HEADERS) -> tuple[Frame | Garbage | B
     return Frame(header, raw[comma2 + 1:data_end], raw), total
 
 
-def decode_all(buf: bytearray, headers=HEADERS) -> list[Frame | Garbage | BadFrame]:
+def decode_all(buf: bytearray, headers: Collection[str] = HEADERS) -> list[Frame | Garbage | BadFrame]:
     """Decode every complete item at the front of ``buf`` and remove it from the buffer."""
     items: list[Frame | Garbage | BadFrame] = []
     while buf:

@@ -58,7 +58,7 @@ def decode_request(line: bytes) -> dict:
     return request
 
 
-def plc_time(request) -> float:
+def plc_time(request: dict) -> float:
     """The controller's time (s) a client such as ``vplc run --scenario`` sends with its request, logged next to
     the robot clock's ``t`` so that both logs line up."""
     value = request["plc_time"]
@@ -77,21 +77,21 @@ def _no_constant(name):
     raise RequestError(f"{name} is not a number a request may carry")
 
 
-def text_field(request, name) -> str:
+def text_field(request: dict, name: str) -> str:
     value = request.get(name)
     if not isinstance(value, str):
         raise RequestError(f"'{name}' must be a text, got {show(value)}")
     return value
 
 
-def bool_field(request, name, default) -> bool:
+def bool_field(request: dict, name: str, default: bool) -> bool:
     value = request.get(name, default)
     if not isinstance(value, bool):
         raise RequestError(f"'{name}' must be true or false, got {show(value)}")
     return value
 
 
-def int_field(request, name, default, low, high, message) -> int:
+def int_field(request: dict, name: str, default: int, low: int, high: int | None, message: str) -> int:
     value = request.get(name, default)
     if type(value) is not int:
         raise RequestError(f"'{name}' must be an integer, got {show(value)}")
@@ -100,7 +100,7 @@ def int_field(request, name, default, low, high, message) -> int:
     return value
 
 
-def fault_params(request) -> dict:
+def fault_params(request: dict) -> dict:
     params = request.get("params", {})
     if params is None:
         return {}
@@ -121,14 +121,14 @@ def operation_mode(text: object) -> bool:
     return text == "auto"
 
 
-def show(value) -> str:
+def show(value: object) -> str:
     text = json.dumps(value) if isinstance(value, (dict, list, str)) else repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def error_answer(text) -> dict:
+def error_answer(text: str) -> dict:
     return {"ok": False, "error": text}
 
 
-def encode_answer(answer) -> bytes:
+def encode_answer(answer: dict) -> bytes:
     return (json.dumps(answer, allow_nan=False, ensure_ascii=False) + "\n").encode("utf-8")

@@ -22,7 +22,7 @@ from tmsim.protocol import codec
 from tmsim.protocol.listen_protocol import Client, ListenProtocol, outgoing
 from tmsim.robot.model import RobotModel
 from tmsim.tmscript.interp import Context, ScriptRuntimeError, run_script, variable_memory
-from tmsim.tmscript.parser import iter_lines
+from tmsim.tmscript.parser import Line, iter_lines
 from tmsim.tmscript.profiles import Profile
 from tmsim.tmscript.static_check import ScriptChecker
 
@@ -305,11 +305,12 @@ class ListenSession:
         (wait "turn"): a 64 KiB script, or one line of 10,000 tokens, never holds the other robots."""
         meter = self.meter
         checker = ScriptChecker(self.types, self.profile.tmflow)
-        lines, sliced = [], 0
+        lines: list[Line] = []
+        sliced = 0
         for line in iter_lines(packet.script):
             if meter.spent:
                 yield ("turn", None, None)
-            if type(line) is int:               # PARSE_SLICE more tokens of a long line parsed
+            if isinstance(line, int):           # PARSE_SLICE more tokens of a long line parsed
                 meter.add(line * WORK_TOKEN)
                 sliced += line * WORK_TOKEN
                 continue

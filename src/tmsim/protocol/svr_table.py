@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import math
 import struct
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -98,7 +99,7 @@ _PACKERS = {item.name: (_U16.pack(len(item.name.encode())) + item.name.encode(),
 
 
 # ---- checking a value against its item ------------------------------------------------------------
-def check_value(item: Item, value):
+def check_value(item: Item, value: Any) -> Any:
     """The value coerced to the item's type (lists for arrays); raises SvrValueError when it does not fit."""
     if item.size > 1:
         if not isinstance(value, (list, tuple)) or len(value) != item.size:
@@ -147,7 +148,7 @@ def _packer(item: Item):
             None if item.type == "string" else struct.Struct(f"<{item.size}{_PACK[item.type]}"))
 
 
-def binary_value(item: Item, value) -> bytes:
+def binary_value(item: Item, value: Any) -> bytes:
     if item.type == "string":
         if item.size > 1:                      # §17.4.2: "two bytes, 0x00 0x00, are inserted between the elements"
             return b"\x00\x00".join(v.encode("utf-8") for v in value)
@@ -158,7 +159,7 @@ def binary_value(item: Item, value) -> bytes:
     return packer.pack(value)
 
 
-def encode_binary(pairs) -> bytes:
+def encode_binary(pairs: Iterable[tuple[Item, Any]]) -> bytes:
     """``pairs``: (Item, value) -> mode 1 content: u16 name length, name, u16 value length, value."""
     out = []
     for item, value in pairs:
@@ -197,7 +198,7 @@ def _chunk(content, pos):
     return content[pos + 2:end], end
 
 
-def decode_binary_value(item: Item, data: bytes):
+def decode_binary_value(item: Item, data: bytes) -> Any:
     if item.type == "string":
         try:
             if item.size > 1:
@@ -215,7 +216,7 @@ def decode_binary_value(item: Item, data: bytes):
 
 
 # ---- string (mode 2 / 12) --------------------------------------------------------------------------
-def string_value(item: Item, value) -> str:
+def string_value(item: Item, value: Any) -> str:
     if item.size > 1:
         return "{" + ",".join(_string_scalar(item, v) for v in value) + "}"
     return _string_scalar(item, value)
@@ -238,7 +239,7 @@ def _float_text(value) -> str:
     return "0" if text in ("-0", "0") else text
 
 
-def encode_string(pairs) -> str:
+def encode_string(pairs: Iterable[tuple[Item, Any]]) -> str:
     return "\r\n".join(f"{item.name}={string_value(item, value)}" for item, value in pairs)
 
 
@@ -258,7 +259,7 @@ def split_string(content: str, with_values: bool) -> list[tuple[str, str | None]
     return out
 
 
-def parse_string_value(item: Item, text: str):
+def parse_string_value(item: Item, text: str) -> Any:
     """``Value`` text of mode 2 -> Python value (not yet range-checked); SvrValueError when unreadable."""
     if item.size > 1:
         if not (text.startswith("{") and text.endswith("}")):
@@ -303,7 +304,7 @@ def _parse_scalar(item, text):
 
 
 # ---- JSON (mode 3 / 13) ----------------------------------------------------------------------------
-def json_value(item: Item, value):
+def json_value(item: Item, value: Any) -> Any:
     if item.type == "bool":
         return [bool(v) for v in value] if item.size > 1 else bool(value)
     if item.type == "float":
@@ -311,7 +312,7 @@ def json_value(item: Item, value):
     return value
 
 
-def encode_json(pairs) -> str:
+def encode_json(pairs: Iterable[tuple[Item, Any]]) -> str:
     return json.dumps([{"Item": item.name, "Value": json_value(item, value)} for item, value in pairs],
                       separators=(",", ":"), ensure_ascii=False)
 
@@ -362,7 +363,7 @@ def variable_item(name: str, kind: str, size: int = 1, access: str = "rw") -> It
     return Item(name, kind, size, VARIABLE_ACCESS[access])
 
 
-def default_value(item: Item):
+def default_value(item: Item) -> Any:
     zero = "" if item.type == "string" else 0.0 if item.type == "float" else 0
     return [zero] * item.size if item.size > 1 else zero
 

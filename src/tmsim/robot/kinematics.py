@@ -44,7 +44,7 @@ class KinematicsError(Exception):
     """Target out of reach or beyond the joint limits."""
 
 
-def matmul(m, n):
+def matmul(m: Sequence[Sequence[float]], n: Sequence[Sequence[float]]) -> list[list[float]]:
     """4x4 product, unrolled (the planner's hot spot); same operation order as the textbook loop."""
     (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3) = n
     return [[r0 * a0 + r1 * b0 + r2 * c0 + r3 * d0, r0 * a1 + r1 * b1 + r2 * c1 + r3 * d1,
@@ -52,13 +52,13 @@ def matmul(m, n):
             for r0, r1, r2, r3 in m]
 
 
-def inverse(m):
+def inverse(m: Sequence[Sequence[float]]) -> list[list[float]]:
     r = [[m[j][i] for j in range(3)] for i in range(3)]
     t = [-(r[i][0] * m[0][3] + r[i][1] * m[1][3] + r[i][2] * m[2][3]) for i in range(3)]
     return [r[0] + [t[0]], r[1] + [t[1]], r[2] + [t[2]], [0.0, 0.0, 0.0, 1.0]]
 
 
-def pose_to_matrix(pose):
+def pose_to_matrix(pose: Sequence[float]) -> list[list[float]]:
     x, y, z, rx, ry, rz = pose
     a, b, c = math.radians(rx), math.radians(ry), math.radians(rz)
     ca, sa, cb, sb, cc, sc = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c)
@@ -68,7 +68,7 @@ def pose_to_matrix(pose):
             [0.0, 0.0, 0.0, 1.0]]
 
 
-def matrix_to_pose(m):
+def matrix_to_pose(m: Sequence[Sequence[float]]) -> list[float]:
     sb = -m[2][0]
     cb = math.hypot(m[0][0], m[1][0])
     ry = math.atan2(sb, cb)
@@ -97,7 +97,7 @@ def _frames(joints):
     return frames
 
 
-def forward(joints, tool=None):
+def forward(joints: Sequence[float], tool: Sequence[Sequence[float]] | None = None) -> list[list[float]]:
     """Flange (or TCP when ``tool`` matrix given) pose matrix in the robot base frame.
 
     The loop of ``_frames`` without keeping the intermediate frames (same arithmetic)."""
@@ -254,7 +254,7 @@ def _wrap(q, reference):
     return [a - 360.0 * round((a - r) / 360.0) for a, r in zip(q, reference, strict=False)]
 
 
-def configuration(joints):
+def configuration(joints: Sequence[float]) -> tuple[int, int, int]:
     """Arm configuration (shoulder, elbow, wrist) as (0|1, 2|3, 4|5)."""
     m = forward(joints)
     wx = m[0][3] - D[5] * m[0][2]
@@ -288,11 +288,13 @@ def _matches(q, target):
     return math.sqrt(sum(e * e for e in err[:3])) < REACH_TOLERANCE_MM and max(abs(e) for e in err[3:]) < 1e-6
 
 
-def within_limits(joints):
+def within_limits(joints: Sequence[float]) -> bool:
     return all(abs(q) <= lim + 1e-6 for q, lim in zip(joints, LIMITS, strict=False))
 
 
-def inverse_kinematics(target, tool=None, reference=(0.0, 0.0, 90.0, 0.0, 90.0, 0.0), config=None):
+def inverse_kinematics(target: Sequence[Sequence[float]], tool: Sequence[Sequence[float]] | None = None,
+                       reference: Sequence[float] = (0.0, 0.0, 90.0, 0.0, 90.0, 0.0),
+                       config: Sequence[int] | None = None) -> list[float]:
     """Joint angles reaching the pose matrix ``target``; raises KinematicsError.
 
     Without ``config`` the solution nearest to ``reference`` is kept (the arm keeps its

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Sequence
 from typing import Any
 
 from tmsim.limits import FIFO_ITEMS_MAX, WORK_PLAN, WORK_PVT_CARTESIAN
@@ -25,7 +26,8 @@ IDENTITY_POSE = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 class RobotModel:
     """One arm. ``tick(dt)`` returns the list of events (dicts) that happened during dt."""
 
-    def __init__(self, tag_history=4, bases=None, tools=None, stop_tags="forget"):
+    def __init__(self, tag_history: int = 4, bases: dict | None = None, tools: dict | None = None,
+                 stop_tags: str = "forget"):
         self.joints = list(HOME_JOINTS)
         self.bases = {"RobotBase": IDENTITY_POSE, **(bases or {})}
         self.tools = {"NOTOOL": IDENTITY_POSE, **(tools or {})}
@@ -33,9 +35,9 @@ class RobotModel:
         self.tool_name, self.tool_pose = "NOTOOL", list(IDENTITY_POSE)
         self.tool_mass = 0.0
         self.load = 0.0
-        self.io = {}
+        self.io: dict[str, Any] = {}
         self.fifo: deque[tuple[str, Any]] = deque()
-        self.active = None
+        self.active: Plan | None = None
         self.camera = Camera()     # the project's vision jobs (tmsim/robot/camera.py)
         self.meter = WorkMeter()   # the robot's turn budget, shared with its session (tmsim/tmscript/work.py)
         self.owed = 0.0            # seconds of robot clock not run yet: the turn's budget ended the tick
@@ -43,24 +45,27 @@ class RobotModel:
         self.paused = False
         self.tag_history = tag_history
         self.stop_tags = stop_tags     # tmsim.tmscript.profiles.STOP_TAGS: what a stop does to the tags it drops
-        self.tags = {}             # tag -> "true" | "false", the last tag_history tags in the order they were queued
-        self.tag_gen = {}          # tag -> generation of its latest QueueTag (a reused tag's older item stays mute)
+        # tag -> "true" | "false", the last tag_history tags in the order they were queued
+        self.tags: dict[int, str] = {}
+        # tag -> generation of its latest QueueTag (a reused tag's older item stays mute)
+        self.tag_gen: dict[int, int] = {}
         self._gen = 0
-        self.fault = None
+        self.fault: str | None = None
         self.pvt_mode = None       # None outside PVTEnter .. PVTExit, else 0 (joint) / 1 (Cartesian)
         self.pvt_velocity = (0.0,) * 6   # end velocity of the last PVTPoint (start velocity of the next)
         # status read over the Ethernet Slave (TMflow 2.24 software manual, Appendix D)
         self.error_active = False        # Robot_Error: set by a robot error, cleared by Play or Stop
-        self.error_code, self.error_text, self.error_time = 0, "", None    # the last error, kept
+        self.error_code, self.error_text = 0, ""                         # the last error, kept ...
+        self.error_time: float | None = None                             # ... and its robot clock
         self.estop = False               # ESTOP: pressed stops the project; Play is refused while pressed
         self.auto_mode = True            # Operation_Mode: True auto, False manual
         self.project_speed = 100         # Project_Speed in %: motions advance at this share of time (motion_rate)
 
     # ---- queue --------------------------------------------------------------------------------
-    def enqueue_motion(self, request: MotionRequest):
+    def enqueue_motion(self, request: MotionRequest) -> None:
         self.fifo.append(("motion", request))
 
-    def enqueue_tag(self, tag: int):
+    def enqueue_tag(self, tag: int) -> None:
         """QueueTag(tag): the robot keeps the status of the last four tags only (TMscript 2.24 §13.2, §13.3:
         "retain the status of the final four tags ... if the tag number did not occur or exceeds them, it
         returns not existed"); a tag queued earlier than the last ``tag_history`` ones is forgotten, even
@@ -73,11 +78,11 @@ class RobotModel:
             del self.tags[next(iter(self.tags))]
         self.fifo.append(("tag", (tag, self._gen)))
 
-    def enqueue_setting(self, kind: str, value):
+    def enqueue_setting(self, kind: str, value: Any) -> None:
         self.fifo.append((kind, value))
 
     @property
-    def queue_length(self):
+    def queue_length(self) -> int:
         return len(self.fifo) + (1 if self.active else 0)
 
     @property
@@ -86,7 +91,7 @@ class RobotModel:
         return len(self.fifo) < FIFO_ITEMS_MAX
 
     @property
-    def idle(self):
+    def idle(self) -> bool:
         return not self.fifo and self.active is None
 
     def tag_status(self, tag: int) -> str:
@@ -99,13 +104,13 @@ class RobotModel:
         return {"true": 1, "false": 0}.get(status, -1)
 
     # ---- immediate commands -------------------------------------------------------------------
-    def pause(self):
+    def pause(self) -> None:
         self.paused = True
 
-    def resume(self):
+    def resume(self) -> None:
         self.paused = False
 
-    def stop_and_clear(self):
+    def stop_and_clear(self) -> list:
         """Stop where the arm is now and drop the FIFO; returns the queue tags that were dropped.
         The manual (TMscript 2.24 §13.1-13.4) does not say what becomes of them; our choice (profile
         option, docs/simulator.md): 'forget' - they answer "not existed" (TMSTA 01 none, WaitQueueTag -1);
@@ -125,12 +130,12 @@ class RobotModel:
         self.pvt_mode, self.pvt_velocity = None, (0.0,) * 6       # a stop also ends PVT mode
         return dropped
 
-    def latch_error(self, text: str, now: float):
+    def latch_error(self, text: str, now: float) -> None:
         """A robot error (its project stops): shown in Robot_Error, Error_Code, Error_Content."""
         self.error_active = True
         self.error_code, self.error_text, self.error_time = classify(text)[0], text, now
 
-    def motion_rate(self, request) -> float:
+    def motion_rate(self, request: MotionRequest) -> float:
         """Share of time a motion advances at: Project_Speed, except the D formats (absolute mm/s, not scaled
         by the project speed, TMscript 2.24 §13.10-13.12) and PVT points (their durations; the
         syncToProjectSpeed flag of §13.19 is not modelled)."""
@@ -139,7 +144,7 @@ class RobotModel:
         return self.project_speed / 100.0
 
     # ---- time ---------------------------------------------------------------------------------
-    def pvt_mode_queued(self):
+    def pvt_mode_queued(self) -> int | None:
         """The PVT mode once every queued item has run (None = not in PVT mode)."""
         for kind, value in reversed(self.fifo):
             if kind == "pvt":
@@ -275,19 +280,19 @@ class RobotModel:
         return matrix
 
     # ---- reading ------------------------------------------------------------------------------
-    def current_joints(self):
+    def current_joints(self) -> list[float]:
         if self.active is None:
             return list(self.joints)
         return self.active.joints_at(self.active_t, self.joints)
 
-    def tcp_pose(self, joints=None):
+    def tcp_pose(self, joints: Sequence[float] | None = None) -> list[float]:
         """TCP pose (X, Y, Z, Rx, Ry, Rz) in the current base."""
         joints = self.current_joints() if joints is None else joints
         m = kin.matmul(kin.inverse(self._matrix(self.base_pose)),
                        kin.forward(joints, self._matrix(self.tool_pose)))
         return kin.matrix_to_pose(m)
 
-    def tcp_speed(self, dt=0.01) -> float:
+    def tcp_speed(self, dt: float = 0.01) -> float:
         """TCP speed in mm/s (Robot[0].TCPSpeed3D), from the position now and ``dt`` s before."""
         if self.active is None or self.paused or self.active_t <= 0:
             return 0.0
@@ -297,7 +302,7 @@ class RobotModel:
         p1 = kin.forward(self.active.joints_at(self.active_t, self.joints), tool)
         return math.dist([p0[i][3] for i in range(3)], [p1[i][3] for i in range(3)]) / (self.active_t - before)
 
-    def tcp_pose_robot(self):
+    def tcp_pose_robot(self) -> list[float]:
         return kin.matrix_to_pose(kin.forward(self.current_joints(), self._matrix(self.tool_pose)))
 
     def state(self) -> dict:

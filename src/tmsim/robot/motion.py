@@ -25,7 +25,7 @@ Duration of one motion (trapezoidal speed profile):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -96,7 +96,7 @@ class Plan:
     total: float               # time until the next FIFO item starts
     cartesian: Callable[[float], list] | None = None   # s -> TCP matrix in robot coordinates; None: joint motion
     end_pose: list = field(default_factory=list)
-    tool: object = None
+    tool: Sequence[Sequence[float]] | None = None
     start_pose: list = field(default_factory=list)
 
     def joints_at(self, t, reference=None):

@@ -11,7 +11,7 @@ channel).
 from __future__ import annotations
 
 import datetime
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any, Protocol
 
 from tmsim.protocol.svr_table import ITEMS
@@ -79,7 +79,7 @@ class RobotDataSource:
         return self.model.auto_mode
 
     # ---- reading ------------------------------------------------------------------------------
-    def values(self, names) -> dict:
+    def values(self, names: Iterable[str]) -> dict:
         """{name: value} of one consistent moment (joints and poses computed once)."""
         session, model = self.robot.session, self.model
         running = session.project_running()
@@ -151,7 +151,7 @@ class RobotDataSource:
                 model.io["CameraLight"] = int(value)
             else:
                 key = io_key(name)
-                model.io[key] = value
+                model.io[key] = value    # type: ignore[index]  # the other writable items are IO points: a key
                 self.log("io", point=key, value=value, source="ethernet_slave")
 
     def _stick(self, button):

@@ -101,7 +101,7 @@ IO_SIZES = {"ControlBox": {"DI": 16, "DO": 16, "AI": 2, "AO": 2}, "EndModule": {
 IO_EXT_SIZES = {"DI": 16, "DO": 16, "AI": 0, "AO": 0}
 
 
-def overloads(name: str, version: str):
+def overloads(name: str, version: str) -> list[tuple[tuple[str, ...], str]] | None:
     """[(parameter types, return type)] of function ``name`` in ``version``; None when it does not exist."""
     entry = FUNCTIONS.get(name)
     if entry is None:
@@ -128,7 +128,7 @@ INT_ARGUMENTS: dict[tuple[str, int], tuple[tuple[int, bool], ...]] = {
     key: min(kinds) for key, kinds in int_parameter_kinds().items() if any(kinds)}
 
 
-def formats(name: str, version: str):
+def formats(name: str, version: str) -> tuple[str, ...] | None:
     table = FORMATS.get(name)
     return None if table is None else tuple(f for f, versions in table.items() if version in versions)
 

@@ -26,7 +26,7 @@ can parse a long line in pieces between its other robots' turns (``iter_lines``)
 from __future__ import annotations
 
 import re
-from collections.abc import Generator
+from collections.abc import Generator, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -518,7 +518,7 @@ def split_lines(script: str) -> list[Line]:
     return [line for line in iter_lines(script) if type(line) is Line]
 
 
-def iter_lines(script: str):
+def iter_lines(script: str) -> Iterator[Line | int]:
     """``split_lines`` as a generator, so that a caller can spread the parsing of a long script over
     several turns of the simulator's scheduler: it yields each Line, and while it parses a line longer
     than the cache keeps (_CACHE_LINE), the number PARSE_SLICE after every PARSE_SLICE tokens."""

@@ -42,7 +42,7 @@ class ScriptChecker:
         self.scope = dict(variables)
         self.declared: dict[str, str] = {}
 
-    def check(self, line: ast.Line):
+    def check(self, line: ast.Line) -> None:
         if line.error:
             return
         checker = _LineChecker(self.scope, line.warnings, self.version)
