@@ -13,6 +13,8 @@ Done := Execute AND CBT > Speed;
 END_FUNCTION_BLOCK
 """
 
+TON_X = "FUNCTION_BLOCK TON_X VAR_INPUT IN : BOOL; END_VAR END_FUNCTION_BLOCK\n"
+
 # (code, failing source, fixed source)
 CASES = [
     ("ST1001", program("Cuont := 1;", "Count : INT;"), program("Count := 1;", "Count : INT;")),
@@ -48,8 +50,7 @@ CASES = [
     ("ST1207", FB + program("m(CBT := c, Speed := 1, Speed := 2);", "m : Mover; c : INT;"),
      FB + program("m(CBT := c, Speed := 1);", "m : Mover; c : INT;")),
     ("ST1208", program("EXIT;", ""), program("WHILE TRUE DO EXIT; END_WHILE;", "")),
-    ("ST1006", program("TON_X(IN := TRUE);", "") + "FUNCTION_BLOCK TON_X VAR_INPUT IN : BOOL; END_VAR END_FUNCTION_BLOCK\n",
-     program("t(IN := TRUE);", "t : TON_X;") + "FUNCTION_BLOCK TON_X VAR_INPUT IN : BOOL; END_VAR END_FUNCTION_BLOCK\n"),
+    ("ST1006", program("TON_X(IN := TRUE);", "") + TON_X, program("t(IN := TRUE);", "t : TON_X;") + TON_X),
     ("ST1301", program("Max := 5;", "END_VAR VAR CONSTANT Max : INT := 10;"),
      program("i := Max;", "i : INT; END_VAR VAR CONSTANT Max : INT := 10;")),
     ("ST1302", FB + program("m.Done := FALSE;", "m : Mover;"), FB + program("d := m.Done;", "m : Mover; d : BOOL;")),
@@ -57,7 +58,8 @@ CASES = [
      FB + program("m.Execute := TRUE; m(CBT := c);", "m : Mover; c : INT;")),
     ("ST1304", program("FOR i := 0 TO 9 DO i := i + 1; END_FOR;", "i : INT;"),
      program("FOR i := 0 TO 9 DO j := i + 1; END_FOR;", "i, j : INT;")),
-    ("ST1401", program("CASE i OF 'a': i := 1; END_CASE;", "i : INT;"), program("CASE i OF 1: i := 1; END_CASE;", "i : INT;")),
+    ("ST1401", program("CASE i OF 'a': i := 1; END_CASE;", "i : INT;"),
+     program("CASE i OF 1: i := 1; END_CASE;", "i : INT;")),
     ("ST1402", program("CASE i OF 1..5: i := 1; 3: i := 2; END_CASE;", "i : INT;"),
      program("CASE i OF 1..5: i := 1; 6: i := 2; END_CASE;", "i : INT;")),
     ("ST1501", program("a[10] := 1;", "a : ARRAY[0..9] OF INT;"), program("a[9] := 1;", "a : ARRAY[0..9] OF INT;")),

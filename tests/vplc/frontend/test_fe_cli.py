@@ -17,7 +17,8 @@ def test_clean_file_exits_0_and_error_file_exits_1_with_rendered_caret(tmp_path,
     r = run_cli("check", str(bad))
     assert r.returncode == 1
     lines = r.stdout.splitlines()
-    assert lines[0] == f"{bad}:5:6: error[ST1001]: `y` is not declared; declare it in a VAR section or check the spelling"
+    assert lines[0] == (f"{bad}:5:6: error[ST1001]: `y` is not declared; declare it in a VAR section or check the "
+                        "spelling")
     assert lines[1].endswith("| x := y;") and lines[2].strip() == "^"
     assert lines[2].index("^") == lines[1].index("y;")
 

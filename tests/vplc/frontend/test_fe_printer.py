@@ -34,7 +34,7 @@ def test_printer_parenthesises_only_where_precedence_requires():
 
 def _snippets():
     from rule_cases import CASES
-    for code, failing, fixed in CASES:
+    for _code, failing, fixed in CASES:
         yield failing
         yield fixed
 
