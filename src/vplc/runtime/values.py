@@ -113,6 +113,10 @@ class Resolver:
             container, key = getattr(value, "i__members", None) or value.__dict__, attr
             if key + "__r" in container:                 # scalar VAR_IN_OUT: follow the reference
                 container, key = container[key + "__r"], container[key + "__k"]
+            elif type(container) is dict and key not in container:     # (a union's view holds all members)
+                external = self._external(value, name, shown, path)
+                if external is not None:
+                    container, key, cur_t = external
             for idx in indexes:
                 at = T.unalias(cur_t)
                 if not isinstance(at, T.ArrayType):
@@ -127,9 +131,26 @@ class Resolver:
             raise PathError(f"{path!r} names a program instance, not a variable")
         return container, key, cur_t
 
+    def _external(self, value: Any, name: str, shown: str, path: str) -> tuple[Any, str, T.Type] | None:
+        """A VAR_EXTERNAL of a program or FB instance is the global it names (W501, external variables:
+        the POU uses the global itself, it holds no copy), so its path reaches that global: (container, key,
+        type) of the global, None when ``name`` is not an external variable of ``value``'s POU."""
+        if _section_of(getattr(value, "i__type", None), name) != "VAR_EXTERNAL":
+            return None
+        g = self.plc.globals
+        ent = getattr(type(g), "i__vars", {}).get(name)
+        if ent is None or not hasattr(g, ent[0]):
+            where = getattr(value, "i__path", None) or "its instance"
+            raise PathError(f"`{shown}` is a VAR_EXTERNAL of {where}, but no global variable `{shown}` exists "
+                            f"(in {path!r})")
+        return getattr(g, "i__members", None) or g.__dict__, ent[0], ent[1]
+
     def read(self, path: str) -> Any:
         c, k, t = self._locate(path)
-        return converter(t)(c[k])
+        try:
+            return converter(t)(c[k])
+        except KeyError:              # declared, but its instance holds no value: an error naming it, no traceback
+            raise PathError(f"{path!r} holds no value the controller can read") from None
 
     def type_text(self, path: str) -> str:
         return type_text(self._locate(path)[2])
@@ -137,6 +158,15 @@ class Resolver:
     def write(self, path: str, value: Any, raw: bool = False) -> None:
         c, k, t = self._locate(path)
         c[k] = from_python(value, t, path, raw)
+
+
+def _section_of(pou_type: Any, name: str) -> str | None:
+    """The section (VAR_EXTERNAL, VAR_TEMP, ...) declaring the upper-case ``name`` in a POU type, or None."""
+    pou = getattr(pou_type, "pou", None)
+    for sec in getattr(pou, "sections", ()):
+        if any(d.name.upper() == name for d in sec.vars):
+            return str(sec.kind)
+    return None
 
 
 _CONVERTERS: dict[int, tuple] = {}

@@ -1,0 +1,104 @@
+"""Defects a new user met writing a whole cell from the docs (issue 27, bad input): `vplc run`, its scenarios and
+the paths they name. Each is a usage error with file and line before the first scan, or it works as documented
+(docs/toolchain/runtime.md sections 2 and 6)."""
+from __future__ import annotations
+
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+
+GLOBALS = """
+TYPE eFormat : (Joint, Cartesian); END_TYPE
+TYPE stStatus : STRUCT EStop : BOOL; Code : WORD; END_STRUCT; END_TYPE
+VAR_GLOBAL
+    Count : INT;
+    Status : stStatus;
+END_VAR
+"""
+PROGRAM = """
+PROGRAM M
+VAR_EXTERNAL
+    Count : INT;
+    Status : stStatus;
+END_VAR
+VAR
+    Seg : INT;
+    Format : eFormat;
+    Reset : BOOL;
+    Busy : BOOL;
+    Move : TON;
+END_VAR
+Count := Count + 1;
+Busy := Count > 2;
+END_PROGRAM
+"""
+
+
+def vplc(*args) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    return subprocess.run([sys.executable, "-m", "vplc", *map(str, args)], capture_output=True, text=True, env=env,
+                          timeout=120)
+
+
+@pytest.fixture
+def cell(tmp_path):
+    (tmp_path / "G.st").write_text(GLOBALS, encoding="utf-8")
+    (tmp_path / "M.st").write_text(PROGRAM, encoding="utf-8")
+    return tmp_path
+
+
+def scenario(cell, text: str) -> pathlib.Path:
+    path = cell / "cell.scn"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def run(cell, *args) -> subprocess.CompletedProcess:
+    return vplc("run", cell / "G.st", cell / "M.st", "--virtual-time", *args)
+
+
+def usage_error(r: subprocess.CompletedProcess) -> str:
+    """The one-line message of a usage error (exit 2, no traceback, nothing scanned)."""
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert "Traceback" not in r.stderr and "vplc run: OK" not in r.stdout
+    return r.stderr.strip()
+
+
+# ---- D1: a program's VAR_EXTERNAL is the global ---------------------------------------------------------------
+def test_watch_and_set_reach_the_global_behind_an_external_variable(cell):
+    r = run(cell, "--cycles", "3", "--watch", "M.Count,M.Status.EStop", "--set", "M.Count=5@1ms")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert "     0.000 s  M.Count        = 1" in lines
+    assert "     0.001 s  M.Count        = 6" in lines          # written before the scan at 1 ms, then counted
+    assert "  M.Count        = 7" in lines
+
+
+def test_a_trace_records_the_global_behind_an_external_variable(cell, tmp_path):
+    out = tmp_path / "t.vcd"
+    r = run(cell, "--cycles", "3", "--trace", "M.Count", "--trace-out", out)
+    assert r.returncode == 0, r.stderr
+    vcd = out.read_text(encoding="utf-8")
+    assert "M.Count" in vcd and "b11 " in vcd                  # 3 after the third scan
+
+
+def test_a_scenario_expects_and_sets_through_an_external_variable(cell):
+    sc = scenario(cell, "at 2ms set M.Count 40\nexpect M.Count = 42 within 1s\nexpect M.Count >= 1 within 1s\n")
+    r = run(cell, "--scenario", sc)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[-1] == "vplc run: OK: 4 scan(s), 0.003 s of controller time; 2 of 2 " \
+                                        "expectation(s) held"
+
+
+@pytest.mark.parametrize("option", [["--watch", "M.Counts"], ["--trace", "M.Status.Stop", "--trace-out", "x.vcd"],
+                                    ["--set", "M.Nope=1"]])
+def test_a_path_that_names_nothing_is_a_usage_error_naming_it(cell, option):
+    if "--trace-out" in option:
+        option[-1] = str(cell / option[-1])
+    message = usage_error(run(cell, "--cycles", "1", *option))
+    assert message.startswith("vplc run: error: ") and option[1].split("=")[0] in message
