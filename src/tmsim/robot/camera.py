@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Protocol
+from typing import Any, Protocol
 
 from tmsim.limits import VISION_JOBS_MAX, VISION_OBJECTS_MAX, VISION_POSE_MAX, VISION_SECONDS_MAX
 from tmsim.tmscript.floats import float_text  # the texts GetString prints
@@ -35,7 +35,8 @@ _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,47}\Z")
 class VisionJob:
     __slots__ = ("name", "objects", "passed", "seconds", "capture", "variable")
 
-    def __init__(self, name, objects, passed, seconds, capture, variable):
+    def __init__(self, name: str, objects: list[tuple], passed: bool, seconds: float, capture: tuple | None,
+                 variable: str):
         self.name, self.objects, self.passed = name, objects, passed
         self.seconds, self.capture, self.variable = seconds, capture, variable
 
@@ -53,7 +54,10 @@ class Camera:
         self.outputs: dict[str, list[list[str]]] = {}
         self.runs = 0
 
-    def define(self, name, objects=(), passed=True, seconds=0.2, capture=None, variable=None) -> dict:
+    def define(self, name: Any, objects: Any = (), passed: Any = True, seconds: Any = 0.2, capture: Any = None,
+               variable: Any = None) -> dict:
+        """Define (or redefine) a job from unchecked values (the control channel's, the command line's);
+        ValueError names the first bad one."""
         name = _name(name, "job name")
         if name not in self.jobs and len(self.jobs) >= VISION_JOBS_MAX:
             raise ValueError(f"at most {VISION_JOBS_MAX} vision jobs per robot")
@@ -69,13 +73,13 @@ class Camera:
         self.jobs[name] = VisionJob(name, poses, passed, float(seconds), joints, variable)
         return self.jobs[name].describe()
 
-    def remove(self, name) -> bool:
+    def remove(self, name: str) -> bool:
         job = self.jobs.pop(name, None)
         if job is not None:
             self.outputs.pop(job.variable, None)
         return job is not None
 
-    def available(self, name) -> bool:
+    def available(self, name: str) -> bool:
         """§14.1: the job is in the project."""
         return name in self.jobs
 
@@ -89,14 +93,14 @@ class Camera:
     def _rows(self, variable):
         return self.outputs.get(variable, [])             # a name no job has filled: no rows (our choice)
 
-    def array_size(self, variable, row=None) -> int:
+    def array_size(self, variable: str, row: Any = None) -> int:
         """§14.2.1 syntax 1: the object count; syntax 2: the length of the object's result array."""
         rows = self._rows(variable)
         if row is None:
             return len(rows)
         return len(rows[_index(row, len(rows), "object")])
 
-    def array_value(self, variable, row, column=None):
+    def array_value(self, variable: str, row: Any, column: Any = None) -> Any:
         """§14.2.2 syntax 1: the object's result array; syntax 2: one value of it. Outside the rows or
         columns: an error, "exceeding the access range" (the manual's example)."""
         rows = self._rows(variable)

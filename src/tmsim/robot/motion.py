@@ -41,7 +41,7 @@ class MotionError(Exception):
     """A motion that cannot be executed (bad value, unreachable target, joint limit)."""
 
 
-def trapezoid_time(distance, speed, ta):
+def trapezoid_time(distance: float, speed: float, ta: float) -> float:
     if distance <= 0:
         return 0.0
     if ta <= 0 or distance >= speed * ta:
@@ -49,7 +49,7 @@ def trapezoid_time(distance, speed, ta):
     return 2.0 * math.sqrt(distance * ta / speed)
 
 
-def trapezoid_fraction(t, total, ta):
+def trapezoid_fraction(t: float, total: float, ta: float) -> float:
     """Fraction of the path covered at time t of a symmetric trapezoidal profile of length total."""
     if total <= 0 or t >= total:
         return 1.0
@@ -99,7 +99,7 @@ class Plan:
     tool: Sequence[Sequence[float]] | None = None
     start_pose: list = field(default_factory=list)
 
-    def joints_at(self, t, reference=None):
+    def joints_at(self, t: float, reference: Sequence[float] | None = None) -> list[float]:
         s = trapezoid_fraction(t, self.duration, self.ta)
         if s >= 1.0:
             return list(self.end_joints)
@@ -111,7 +111,8 @@ class Plan:
             return [a + (b - a) * s for a, b in zip(self.start_joints, self.end_joints, strict=False)]
 
 
-def hermite(p0, v0, p1, v1, T, t):
+def hermite(p0: Sequence[float], v0: Sequence[float], p1: Sequence[float], v1: Sequence[float], T: float,
+            t: float) -> tuple[list[float], list[float]]:
     """Position and velocity at time t of the cubic Hermite curve p0,v0 (t=0) -> p1,v1 (t=T), per coordinate."""
     s = min(max(t / T, 0.0), 1.0)
     s2, s3 = s * s, s * s * s
@@ -129,9 +130,10 @@ class PvtPlan(Plan):
     v0: tuple = ()
     p1: tuple = ()
     v1: tuple = ()
-    to_joints: Callable[[list, list], list] | None = None   # Cartesian mode: (pose, reference joints) -> joints
+    # Cartesian mode: (pose, reference joints) -> joints
+    to_joints: Callable[[list, Sequence[float]], list] | None = None
 
-    def joints_at(self, t, reference=None):
+    def joints_at(self, t: float, reference: Sequence[float] | None = None) -> list[float]:
         if t >= self.duration:
             return list(self.end_joints)
         pos, _vel = hermite(self.p0, self.v0, self.p1, self.v1, self.duration, t)
@@ -171,7 +173,7 @@ def _slerp_matrix(m0, m1, s):
     return [rs[0] + [p[0]], rs[1] + [p[1]], rs[2] + [p[2]], [0.0, 0.0, 0.0, 1.0]]
 
 
-def rotation_angle(m0, m1):
+def rotation_angle(m0: Sequence[Sequence[float]], m1: Sequence[Sequence[float]]) -> float:
     r0, r1 = _rot(m0), _rot(m1)
     trace = sum(sum(r0[k][i] * r1[k][i] for k in range(3)) for i in range(3))
     return math.degrees(math.acos(max(-1.0, min(1.0, (trace - 1) / 2))))
@@ -197,15 +199,15 @@ def _check_common(req):
 class Planner:
     """Turns MotionRequests into Plans for a given robot state (base, tool, joints)."""
 
-    def __init__(self, base, tool):
+    def __init__(self, base: Sequence[Sequence[float]], tool: Sequence[Sequence[float]]):
         self.base = base          # base frame matrix in robot coordinates
         self.tool = tool          # TCP matrix in flange coordinates
         self.base_inverse = kin.inverse(base)
 
-    def tcp_in_base(self, joints):
+    def tcp_in_base(self, joints: Sequence[float]) -> list[list[float]]:
         return kin.matmul(self.base_inverse, kin.forward(joints, self.tool))
 
-    def flange_target(self, pose_in_base):
+    def flange_target(self, pose_in_base: Sequence[float]) -> list[list[float]]:
         """TCP pose in the current base -> TCP matrix in robot coordinates."""
         return kin.matmul(self.base, kin.pose_to_matrix(pose_in_base))
 
@@ -255,7 +257,7 @@ class Planner:
             path = None if frame == "J" else (lambda s, a=start_tcp, b=end_tcp: _slerp_matrix(a, b, s))
         return self._finish(req, joints, end_joints, duration, ta, distance, path)
 
-    def plan_pvt(self, req: MotionRequest, joints: list, mode: int, velocity) -> PvtPlan:
+    def plan_pvt(self, req: MotionRequest, joints: list, mode: int, velocity: Sequence[float]) -> PvtPlan:
         """One PVTPoint from the current joints and velocity (joint mode 0, Cartesian mode 1)."""
         T = req.duration
         if not 0 < T <= 3600:

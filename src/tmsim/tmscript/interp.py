@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import math
 import struct
+from collections.abc import Callable, Generator, Iterable
+from typing import TYPE_CHECKING, Any
 
 from tmsim.limits import (
     ARRAY_MAX,
@@ -48,6 +50,9 @@ from tmsim.tmscript import parser as ast
 from tmsim.tmscript.floats import float_text
 from tmsim.tmscript.work import WorkMeter
 
+if TYPE_CHECKING:
+    from tmsim.robot.model import RobotModel
+
 MOTIONS = ("PTP", "Line", "Circle", "PLine", "Move_PTP", "Move_Line", "Move_PLine")
 _DEFAULTS = {"int": 0, "float": 0.0, "string": "", "bool": False, "byte": 0}
 
@@ -59,7 +64,10 @@ class ScriptRuntimeError(Exception):
 class Context:
     """What a running script may touch; the session fills it in."""
 
-    def __init__(self, robot, variables, types, listen_send, stop_and_clear, log_line, log_event=None, meter=None):
+    def __init__(self, robot: RobotModel, variables: dict[str, Any], types: dict[str, Any],
+                 listen_send: Callable[[str | None, str, bytes], None], stop_and_clear: Callable[[], None],
+                 log_line: Callable[..., None], log_event: Callable[..., None] | None = None,
+                 meter: WorkMeter | None = None):
         self.robot = robot
         self.vars = variables
         self.types = types
@@ -72,7 +80,9 @@ class Context:
         self.meter = meter or WorkMeter()       # the turn's work (tmscript/work.py): a spent turn suspends the script
 
 
-def run_script(lines, ctx: Context):
+def run_script(lines: Iterable[Any], ctx: Context) -> Generator[tuple, Any, str | None]:
+    """Run checked lines (ast.Line) on ``ctx``: a generator that yields each wait (see the session's _resume_waits)
+    and returns "exit" when ScriptExit() ran."""
     for line in lines:
         if isinstance(line.stmt, ast.Empty):
             continue
@@ -631,7 +641,7 @@ def _text_of(value, ctx) -> str:
     return to_text(value)
 
 
-def to_text(value) -> str:
+def to_text(value: Any) -> str:
     """A value as GetString and string concatenation print it."""
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -642,7 +652,7 @@ def to_text(value) -> str:
     return str(value)
 
 
-def encode_value(value, type_name=None) -> bytes:
+def encode_value(value: Any, type_name: str | None = None) -> bytes:
     """ListenSend payload: strings as UTF-8 text, other values as little-endian binary."""
     if isinstance(value, str):
         return value.encode("utf-8")
