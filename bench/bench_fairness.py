@@ -184,8 +184,8 @@ def robot_attacker(stream, port):
 
 def main():
     def ms(values):
-        return "%.2f / %.2f / %.2f ms" % (values[len(values) // 2] * 1e3, values[int(len(values) * 0.99)] * 1e3,
-                                          values[-1] * 1e3)
+        return (f"{values[len(values) // 2] * 1e3:.2f} / {values[int(len(values) * 0.99)] * 1e3:.2f} / "
+                f"{values[-1] * 1e3:.2f} ms")
 
     attacks = {"pvt": pvt_stream, "listen_send": listen_send_stream, "frames_64k": frames_64k_stream,
                "nested": nested_stream, "long_line": long_line_stream, "control": None}

@@ -154,7 +154,7 @@ def scan_cost(rounds: int = 5) -> tuple[float, float, int]:
             without.append(mean_scan_us(plc))
             stop = threading.Event()
 
-            def browser():
+            def browser(stop=stop):
                 while not stop.wait(0.050):
                     get(url)
             clients = [threading.Thread(target=browser, daemon=True) for _ in range(2)]
@@ -343,8 +343,9 @@ def compare_with(directory: str, blocks: int = 16, reads: int = 150, count: int 
 
     def ratio_line(what, figures):
         ratios = sorted(n / b for n, b in zip(figures["now"], figures["before"], strict=False))
-        print(f"{what}: before {statistics.median(figures['before']):.3f} ms, now {statistics.median(figures['now']):.3f}"
-              f" ms (medians of {blocks} blocks); now/before per block median {statistics.median(ratios):.3f}, "
+        print(f"{what}: before {statistics.median(figures['before']):.3f} ms, "
+              f"now {statistics.median(figures['now']):.3f} ms (medians of {blocks} blocks); "
+              f"now/before per block median {statistics.median(ratios):.3f}, "
               f"{ratios[0]:.3f} .. {ratios[-1]:.3f}")
 
     def alternate(run):

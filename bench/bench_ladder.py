@@ -75,7 +75,8 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         twin = os.path.join(tmp, "st_examples")
         shutil.copytree(EXAMPLES, twin, ignore=shutil.ignore_patterns("*.py", "Commands_Example.xml"))
-        shutil.copy(os.path.join(ROOT, "bench", "st", "Commands_Example_ST.st"), os.path.join(twin, "Commands_Example.st"))
+        shutil.copy(os.path.join(ROOT, "bench", "st", "Commands_Example_ST.st"),
+                    os.path.join(twin, "Commands_Example.st"))
         ld = per_scan_us([LIB, EXAMPLES])
         st = per_scan_us([LIB, twin])
         print("Per-scan cost, examples (PnP_Example + Commands_Example) on virtual time, best of 3 x "

@@ -35,12 +35,14 @@ def latency_table():
         try:
             res[order] = dict(edge=execute_to_socket(r), reply=reply_to_done(r),
                               held1=sustained(r, 1, pulse=False), pulse1=sustained(r, 1, pulse=True),
-                              held4=sustained(r, 4, pulse=False, count=400), pulse4=sustained(r, 4, pulse=True, count=400))
+                              held4=sustained(r, 4, pulse=False, count=400),
+                              pulse4=sustained(r, 4, pulse=True, count=400))
         finally:
             r.close()
     d, t = res["documented"], res["twice"]
     print("CBT_Commands_Lib latency in scans (virtual PLC, 1 ms task, simulator on loopback)")
-    print("  orders: documented = FBs, then CBT_Connect; fast = CBT_Connect, FBs, CBT_Connect (same instance); ok = target met")
+    print("  orders: documented = FBs, then CBT_Connect; fast = CBT_Connect, FBs, CBT_Connect (same instance); "
+          "ok = target met")
     print(f"  {'figure':<58}{'target':>10}{'documented':>12}{'fast':>10}")
     rows = [
         ("(1) Execute edge -> frame handed to SktTCPSend (scans)", 0, "edge", "{:.0f}"),
@@ -195,7 +197,8 @@ def main():
         try:
             idle_us, idle_st = cost(r)
             for k in range(1, 5):
-                r.set_struct(f"MParam[{k}]", move_abs(Speed=5, TargetPosition=dict(X=60.0 + k, Y=0, Z=90, RX=0, RY=90, RZ=0)))
+                target = dict(X=60.0 + k, Y=0, Z=90, RX=0, RY=90, RZ=0)
+                r.set_struct(f"MParam[{k}]", move_abs(Speed=5, TargetPosition=target))
                 r.write(f"MExec[{k}]", True)
             r.set_struct("RelParam", dict(MovementCommand=0, DataFormat=1, Speed=5, AccelTime=200,
                                           TargetPosition=dict(X=0, Y=0, Z=-10, RX=0, RY=0, RZ=0)))
@@ -205,8 +208,11 @@ def main():
             r.write("PrgExec", True)
             scan(r)
             busy_us, busy_st = cost(r)
-            print(f"  library cost per scan ({'fast' if order == 'twice' else order:>10}), 7 idle FBs : {idle_us:4.0f} us, {idle_st:4.0f} statements (median)")
-            print(f"  library cost per scan ({'fast' if order == 'twice' else order:>10}), 7 busy FBs : {busy_us:4.0f} us, {busy_st:4.0f} statements (median)")
+            name = "fast" if order == "twice" else order
+            print(f"  library cost per scan ({name:>10}), 7 idle FBs : {idle_us:4.0f} us, {idle_st:4.0f} statements "
+                  "(median)")
+            print(f"  library cost per scan ({name:>10}), 7 busy FBs : {busy_us:4.0f} us, {busy_st:4.0f} statements "
+                  "(median)")
         finally:
             r.close()
 
@@ -223,7 +229,7 @@ def position_traffic(seconds=10.0):
         try:
             r.write("ReadPeriod", period_ms * 1_000_000)
             r.write("ReadEnable", True)
-            r.until(lambda: r.read("rd.Valid"), 2)
+            r.until(lambda r=r: r.read("rd.Valid"), 2)
             before = len([e for e in r.events("frame_in") if e.get("header") == "TMSCT"])
             start = r.plc.now_ns
             r.until(lambda: False, seconds)

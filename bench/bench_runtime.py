@@ -147,8 +147,8 @@ def axes_cost(tmp: str, n: int = AXES_N, scans: int = 5000) -> None:
 def versus_baseline(rev: str) -> None:
     """Issue 15, target 3: this engine against the engine of commit ``rev`` on the same programs, same run."""
     targets = {"100 R_TRIG + 100 TON": 2.5, "300-line CASE sequence": 1.5}
-    rows = engine_compare.compare({"100 R_TRIG + 100 TON": trig_program(), "300-line CASE sequence": sequence_program()},
-                                  rev)
+    rows = engine_compare.compare({"100 R_TRIG + 100 TON": trig_program(),
+                                   "300-line CASE sequence": sequence_program()}, rev)
     print(f"this engine against commit {rev}'s (best of 9 rounds of 1000 scans each, taken in turns):")
     for row in rows:
         target = targets[row["label"]]
@@ -215,7 +215,7 @@ def scenario_cost(when_lines: int = 100, scans: int = 4000) -> None:
 
 
 def main() -> int:
-    print("vplc runtime benchmark (Python %s)" % sys.version.split()[0])
+    print(f"vplc runtime benchmark (Python {sys.version.split()[0]})")
     rev = sys.argv[sys.argv.index("--against") + 1] if "--against" in sys.argv else engine_compare.BASELINE
     versus_baseline(rev)
     with tempfile.TemporaryDirectory() as tmp:
@@ -251,7 +251,8 @@ def main() -> int:
             cpu = (time.process_time() - cpu0) / 3.0 * 100
             timer.cancel()
             print(f"real time, 1 ms task, 3 s, spin {spin // 1000} us: lateness median "
-                  f"{percentile(stats.lateness, .5) / 1000:.1f} us, p99 {percentile(stats.lateness, .99) / 1000:.1f} us, "
+                  f"{percentile(stats.lateness, .5) / 1000:.1f} us, "
+                  f"p99 {percentile(stats.lateness, .99) / 1000:.1f} us, "
                   f"max {max(stats.lateness) / 1000:.1f} us, overruns {stats.overruns} of {len(stats.lateness)} scans, "
                   f"CPU {cpu:.0f} %")
 
@@ -260,9 +261,9 @@ def main() -> int:
         with open(path, "w") as f:
             f.write(big)
         code = ("import resource, time; from vplc.api import load_plc; "
-                "t0 = time.perf_counter(); p = load_plc([%r]); dt = time.perf_counter() - t0; "
+                f"t0 = time.perf_counter(); p = load_plc([{path!r}]); dt = time.perf_counter() - t0; "
                 "[p.scan(k * 1000000) for k in range(100)]; "
-                "print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)") % path
+                "print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)")
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
         dt, rss = (float(x) for x in out.stdout.split())
         print(f"compile (load + check + codegen + instantiate) of {big.count(chr(10))} lines: {dt:.2f} s")

@@ -99,7 +99,7 @@ def bench_streaming(ports, seconds=5.0, look_ahead=3, saturate=False, warm_up=1.
     """
     sel = selectors.DefaultSelector()
     clients = []
-    for index, port in enumerate(ports):
+    for port in ports:
         sock = socket.create_connection(("127.0.0.1", port))
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         sock.setblocking(False)
@@ -214,8 +214,8 @@ def bench_poll_cost(robots=32, iterations=2000):
 def main():
     def ms(values):
         """median / p99 / worst of sorted latencies, in ms."""
-        return "%.2f / %.2f / %.2f ms" % (values[len(values) // 2] * 1e3, values[int(len(values) * 0.99)] * 1e3,
-                                          values[-1] * 1e3)
+        return (f"{values[len(values) // 2] * 1e3:.2f} / {values[int(len(values) * 0.99)] * 1e3:.2f} / "
+                f"{values[-1] * 1e3:.2f} ms")
 
     proc, ports = start_cli(1)
     try:
@@ -241,7 +241,8 @@ def main():
         proc.terminate()
         proc.communicate(timeout=10)
 
-    print("32 robots, one client each, streaming blended Line motions (3 queued per robot, next sent on each tag push):")
+    print("32 robots, one client each, streaming blended Line motions (3 queued per robot, next sent on each tag "
+          "push):")
     print(f"  reply latency median / p99 / worst: {ms(latencies)}   (target worst <= 5 ms; {len(latencies):,d} "
           f"scripts in 5 s; CPU: simulator {server_cpu / wall:.0%}, clients {client_cpu / wall:.0%} of one core)")
     print(f"  same clients flooding (next script on each reply): {sum(1 for s in stamps if s < 1.0):,d} scripts/s "

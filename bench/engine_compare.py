@@ -2,8 +2,9 @@
 
 The earlier engine is taken from git (``git archive <rev> src``) into a temporary folder. Each engine runs in a
 worker process of its own; the parent asks them for rounds of scans in turn, so both see the same machine load,
-and keeps each engine's best round of CPU time (process time: a busy machine's preemption does not count). Before timing, each worker scans the program on virtual time and reports a
-digest of every variable it can read after every scan: the results must be identical.
+and keeps each engine's best round of CPU time (process time: a busy machine's preemption does not count).
+Before timing, each worker scans the program on virtual time and reports a digest of every variable it can read
+after every scan: the results must be identical.
 """
 from __future__ import annotations
 
@@ -77,7 +78,8 @@ def compare(programs: dict[str, str], rev: str = BASELINE, rounds: int = 9, scan
             with open(path, "w") as f:
                 f.write(text)
             workers = [subprocess.Popen([sys.executable, "-c", WORKER, src, path, str(scans)], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, text=True, cwd=tmp, env={**os.environ, "PYTHONPATH": src})
+                                        stdout=subprocess.PIPE, text=True, cwd=tmp,
+                                        env={**os.environ, "PYTHONPATH": src})
                        for src in (old_src, new_src)]
             try:
                 digests = [json.loads(w.stdout.readline())["digest"] for w in workers]

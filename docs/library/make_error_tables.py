@@ -4,11 +4,11 @@
     python3 docs/library/make_error_tables.py --check   # exit 1 and name the files that are out of date
 
 errors.tsv has one row per ErrorID: id (16#XXXX), name (ErrXxx: the name every WORD#16#XXXX literal of the
-library's ST carries in a comment on its line, tests/lib/test_lib_error_table.py), raised_by, text (the ErrorDescrip, <= 79 characters), cause,
-remedy (for the engineer: the FB pages and errors.md), operator (what the operator does at the panel; it names
-screens and buttons, never a function block) and hmi ("alarm": the HMI server raises an alarm when a command
-ends with it, unless a cause it already shows explains it; "message": a refused start, nothing happened, the
-page's message line says it). Generated from it:
+library's ST carries in a comment on its line, tests/lib/test_lib_error_table.py), raised_by, text (the
+ErrorDescrip, <= 79 characters), cause, remedy (for the engineer: the FB pages and errors.md), operator (what the
+operator does at the panel; it names screens and buttons, never a function block) and hmi ("alarm": the HMI server
+raises an alarm when a command ends with it, unless a cause it already shows explains it; "message": a refused
+start, nothing happened, the page's message line says it). Generated from it:
   lib/CBT_Commands_Lib/core/CBTi_ErrorText.st   the ST text function (decimal CASE labels, IEC 61131-3 Ed. 2
                                                has no based-number CASE labels; the hex ID in a comment)
   docs/library/errors.md                       the table between the BEGIN / END markers
@@ -113,7 +113,8 @@ def errors_md(rows: dict, text: str) -> str:
     if BEGIN not in text or END not in text:
         raise TableError(f"errors.md: the markers {BEGIN} and {END} are missing")
     table = ["| ErrorID | Name | Raised by | Description | Cause | Remedy |", "|---|---|---|---|---|---|"]
-    table += [f"| {c} | {r['name']} | {r['raised_by']} | {r['text']} | {r['cause']} | {r['remedy']} |" for c, r in rows.items()]
+    table += [f"| {c} | {r['name']} | {r['raised_by']} | {r['text']} | {r['cause']} | {r['remedy']} |"
+              for c, r in rows.items()]
     head, rest = text.split(BEGIN, 1)
     tail = rest.split(END, 1)[1]
     return head + BEGIN + "\n" + "\n".join(table) + "\n" + END + tail

@@ -73,7 +73,8 @@ def page_trace(page: str, out: Path) -> None:
             fb = done.rpartition(".")[0] or "fbConnect"
             if trigger:
                 plc.write(f"{program}.{trigger}", True)
-            plc.run_until(lambda: sample() or read(done) or read(f"{fb}.Error"), 20 * SEC, on_scan=pump)
+            plc.run_until(lambda done=done, fb=fb: sample() or read(done) or read(f"{fb}.Error"), 20 * SEC,
+                          on_scan=pump)
             plc.run_until(sample, int(HOLD_PAGE_S.get(page, HOLD_S) * SEC), on_scan=pump)
             if trigger:
                 plc.write(f"{program}.{trigger}", False)
