@@ -281,7 +281,7 @@ def start_line(plc: Plc, args: argparse.Namespace, scenario: scn.Scenario, durat
         until = f"{args.cycles} scan(s)"
     elif duration is not None:
         until = scn.seconds(duration)
-    elif scenario.stop_ns is not None or scenario.expects:
+    elif scenario.ends:
         until = "the scenario is decided"
     else:
         until = "Ctrl-C" if not args.virtual_time else "Ctrl-C (virtual time never ends by itself)"

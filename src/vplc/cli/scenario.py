@@ -6,7 +6,8 @@
     at 5s expect Main.Busy = FALSE         must hold at the first scan at or after 5 s
     at 5s expect Main.Error = FALSE within 1s
     expect Main.Error = FALSE always       must hold at every scan from its time to the end of the run
-    at 90s stop                            end the run (without it: when every line has been decided)
+    at 90s stop                            end the run (without it: when every write, `at` robot line and
+                                           `within`/`at` expectation is done; runtime.md section 6)
     at 5s robot 1 cut_link                 a request on the simulator's control channel (--sim-control)
     when Main.Moves >= 80 robot 1 estop    ... when a condition becomes true
     when Main.Alarm = TRUE for 1s then set Main.Reset TRUE after 200ms every time
@@ -121,10 +122,19 @@ class Scenario:
     expects: list[Expect] = field(default_factory=list)
     reactions: list[Reaction] = field(default_factory=list)
     stop_ns: int | None = None
+    files: list[str] = field(default_factory=list)      # the scenario files read (``load``)
 
     @property
     def empty(self) -> bool:
         return not self.writes and not self.expects and not self.reactions and self.stop_ns is None
+
+    @property
+    def ends(self) -> bool:
+        """The scenario ends the run by itself: it has an `at ... stop`, a `within` / `at` expectation, an
+        `at ... robot` line, or a scenario file with writes (``--set`` lines alone leave the run to Ctrl-C,
+        --cycles or --duration). `when` lines and `always` expectations never end a run."""
+        return (self.stop_ns is not None or any(not e.always for e in self.expects)
+                or any(r.timed for r in self.reactions) or bool(self.files and self.writes))
 
     @property
     def robots(self) -> list[Reaction]:
@@ -272,6 +282,7 @@ def load(filename: str, sc: Scenario | None = None) -> Scenario:
         raise ScenarioError(f"scenario {filename} is not UTF-8 text") from None
     for n, line in enumerate(lines, 1):
         parse_line(line, f"{filename}:{n}", sc)
+    sc.files.append(filename)
     return sc
 
 

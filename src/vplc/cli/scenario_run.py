@@ -104,6 +104,7 @@ class Runner:
         self.timed = [r for r in sc.reactions if r.timed]                # `at TIME robot ...` lines
         self.decisive = sum(1 for e in sc.expects if not e.always)        # `within` / `at` expectations
         self.undecided = self.decisive
+        self.ends = sc.ends                                              # see Scenario.ends
         groups: dict[int, list[Signal]] = {}       # direct signals by the instance they live in
         for sig in self.signals.values():
             if sig.read is None:
@@ -286,13 +287,13 @@ class Runner:
                                 f"{e.path} is {fmt(v)}")
 
     def finished(self, t_ns: int) -> bool:
-        """The run ends at a failure, at `stop`, or when every write and timed robot action is done and every
-        expectation decided."""
+        """The run ends at a failure, at `stop`, or, when the scenario ends by itself (``Scenario.ends``), as soon
+        as every write and timed robot action is done and every `within` / `at` expectation decided."""
         if self.failure is not None:
             return True
         if self.sc.stop_ns is not None:
             return t_ns >= self.sc.stop_ns
-        if self.undecided or not self.decisive or self.writes:
+        if self.undecided or not self.ends or self.writes:
             return False                       # (kept as counts and lists: this is asked before every scan)
         return all(r.fired and not r.due for r in self.timed)
 

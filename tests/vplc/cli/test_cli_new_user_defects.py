@@ -102,3 +102,29 @@ def test_a_path_that_names_nothing_is_a_usage_error_naming_it(cell, option):
         option[-1] = str(cell / option[-1])
     message = usage_error(run(cell, "--cycles", "1", *option))
     assert message.startswith("vplc run: error: ") and option[1].split("=")[0] in message
+
+
+# ---- D2: a scenario of writes alone ends after its last write ------------------------------------------------
+def test_a_scenario_of_writes_alone_ends_after_the_scan_that_saw_its_last_write(cell):
+    sc = scenario(cell, "at 2ms set M.Count 5\nat 1ms set M.Reset TRUE\n")
+    r = run(cell, "--scenario", sc, "--watch", "M.Count")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0].endswith("virtual time until the scenario is decided; opens no sockets")
+    assert "     0.002 s  M.Count = 6" in lines                 # written before the scan at 2 ms, then counted
+    assert lines[-1] == "vplc run: OK: 3 scan(s), 0.002 s of controller time"
+
+
+def test_set_options_without_a_scenario_file_leave_the_end_to_the_bounds(cell):
+    r = run(cell, "--set", "M.Count=5@1ms", "--cycles", "6")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[-1] == "vplc run: OK: 6 scan(s), 0.005 s of controller time"
+
+
+def test_reactions_and_always_expectations_alone_do_not_end_the_run(cell):
+    sc = scenario(cell, "when M.Busy = TRUE then set M.Reset TRUE\nexpect M.Count >= 0 always\n")
+    r = run(cell, "--scenario", sc, "--cycles", "8")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[0].endswith("virtual time until 8 scan(s); opens no sockets")
+    assert r.stdout.splitlines()[-1] == "vplc run: OK: 8 scan(s), 0.007 s of controller time; 1 of 1 " \
+                                        "expectation(s) held"
