@@ -69,7 +69,8 @@ from tmsim.protocol.listen_session import TransitionError
 
 if TYPE_CHECKING:
     from tmsim.net.ethernet_slave import EthernetSlave, SlaveService
-    from tmsim.net.server import Robot, SimServer
+    from tmsim.net.robot_ports import Robot
+    from tmsim.net.server import SimServer
 
 
 class _Client:

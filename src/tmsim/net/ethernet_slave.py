@@ -24,7 +24,8 @@ from tmsim.protocol.svr_session import DEFAULT_STREAM, SvrSession
 from tmsim.robot.svr_source import RobotDataSource
 
 if TYPE_CHECKING:
-    from tmsim.net.server import Robot, SimServer
+    from tmsim.net.robot_ports import Robot
+    from tmsim.net.server import SimServer
 
 
 class SvrConn:

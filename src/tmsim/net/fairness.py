@@ -23,7 +23,7 @@ from tmsim.limits import FRAME_DATA_MAX, IO_SLICE_S, PENDING_SCRIPTS_MAX, POLL_B
 from tmsim.protocol.listen_protocol import FRAME_LIMIT, INPUT_DONE
 
 if TYPE_CHECKING:
-    from tmsim.net.server import Conn, Robot
+    from tmsim.net.robot_ports import Conn, Robot
 
 
 class TurnHost(Protocol):

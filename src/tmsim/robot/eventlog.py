@@ -1,6 +1,6 @@
 """Event log of one robot: every event as a dict, bounded in memory by count and by bytes.
 
-``server.Robot`` holds one (``robot.log``) and hands ``robot.log.event`` to its sessions as their log. The
+``net.robot_ports.Robot`` holds one (``robot.log``) and hands ``robot.log.event`` to its sessions as their log. The
 log follows the clock of the robot's Listen-node session (``follow``): each event carries that clock's
 ``t``, and keeping or writing it is billed to the session's work meter. The JSONL file (``LogFile``, rotated
 at LOG_FILE_BYTES_MAX, shared by every robot of a server) gets every event whole; memory keeps the newest

@@ -60,7 +60,7 @@ def io_key(name: str) -> str | None:
 
 
 class RobotDataSource:
-    """``robot`` is a ``tmsim.net.server.Robot`` (its ``session`` is the ListenSession with the RobotModel)."""
+    """``robot`` is a ``tmsim.net.robot_ports.Robot`` (its ``session`` is the ListenSession with the RobotModel)."""
 
     def __init__(self, robot: Controller, log: Callable[..., None], origin: datetime.datetime | None = None):
         self.robot = robot
