@@ -78,7 +78,8 @@ def free_port():
 def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp_path):
     """SIGKILL: no FIN, no RST from a process that is gone — the kernel answers for it. CBT_Connect (Execute held)
     reports the loss and reconnects by itself once the simulator is back; the cycle resumes with an operator
-    start where the part is and completes. The simulator runs as its own process in real time, so this test runs the PLC in real time too."""
+    start where the part is and completes. The simulator runs as its own process in real time, so this test runs the
+    PLC in real time too."""
     port = free_port()
     cmd = [sys.executable, "-m", "tmsim", "--port", str(port), "--no-svr", "--speedup", "4"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

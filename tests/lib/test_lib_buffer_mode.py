@@ -47,8 +47,7 @@ def test_aborting_replaces_the_running_and_the_queued_motion(buf):
     buf.write("MExec[3]", True)
     seen = []
     assert buf.until(lambda: buf.read("movers[3].Done") or buf.read("movers[3].Error"), 20,
-                     on_scan=lambda _: seen.append((frozenset(pins(buf, "movers[1]")), frozenset(pins(buf, "movers[2]")),
-                                                    frozenset(pins(buf, "movers[3]")))))
+                     on_scan=lambda _: seen.append(tuple(frozenset(pins(buf, f"movers[{k}]")) for k in (1, 2, 3))))
     assert buf.read("movers[3].Done"), buf.read("movers[3].ErrorDescrip")
     # one frame: the stop and the motion in one script, so nothing else can run in between
     ident, script = buf.scripts_in()[-1]

@@ -94,7 +94,8 @@ def test_pause_mid_motion_holds_the_move_busy_until_resume(rig):
                                          (2, "StopAndClearBuffer(1)"), (3, "StopAndClearBuffer(2)")])
 def test_stop_aborts_every_waiting_motion(rig, mode, script):
     for k in range(1, 4):
-        rig.set_struct(f"MParam[{k}]", move_abs(Speed=20, TargetPosition=dict(X=20.0 * k, Y=0, Z=90, RX=0, RY=90, RZ=0)))
+        target = dict(X=20.0 * k, Y=0, Z=90, RX=0, RY=90, RZ=0)
+        rig.set_struct(f"MParam[{k}]", move_abs(Speed=20, TargetPosition=target))
         rig.write(f"MExec[{k}]", True)
     assert rig.until(lambda: rig.read("movers[3].Active"), 1)
     sent = run(rig, "stop", "StopExec", "StopParam", dict(Mode=mode))

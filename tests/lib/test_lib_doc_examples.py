@@ -36,7 +36,7 @@ def test_page_example_runs_against_the_simulator(page, tmp_path):
             if trigger:
                 plc.write(f"{program}.{trigger}", True)
             fb = done.rpartition(".")[0] or "fbConnect"
-            ended = plc.run_until(lambda: read(done) or read(f"{fb}.Error"), 20 * SEC, on_scan=pump)
+            ended = plc.run_until(lambda done=done, fb=fb: read(done) or read(f"{fb}.Error"), 20 * SEC, on_scan=pump)
             assert ended and not read(f"{fb}.Error"), f"{page}: {read(f'{fb}.ErrorDescrip')}"
         sent = [e["data"].partition(",")[2] for e in srv.robots[0].events
                 if e["kind"] == "frame_in" and e.get("header") == "TMSCT"]

@@ -1,6 +1,6 @@
 """The one ErrorID table (docs/library/errors.tsv): the files generated from it are up to date, the library raises
-only ErrorIDs of the table and names each literal after its row in a comment on its line, every row has a cause and a remedy, and the ST text function compiled on the virtual
-PLC returns exactly the table's text for every ID."""
+only ErrorIDs of the table and names each literal after its row in a comment on its line, every row has a cause and
+a remedy, and the ST text function compiled on the virtual PLC returns exactly the table's text for every ID."""
 import json
 import re
 import subprocess

@@ -152,7 +152,8 @@ def test_retrigger_while_busy_starts_new_command_and_old_gives_no_feedback(rig):
 
 def test_queue_depth_counts_pending_commands(rig):
     for k in range(1, 4):
-        rig.set_struct(f"MParam[{k}]", move_abs(Speed=30, TargetPosition=dict(X=10.0 * k, Y=0, Z=90, RX=0, RY=90, RZ=0)))
+        target = dict(X=10.0 * k, Y=0, Z=90, RX=0, RY=90, RZ=0)
+        rig.set_struct(f"MParam[{k}]", move_abs(Speed=30, TargetPosition=target))
         rig.write(f"MExec[{k}]", True)
     rig.scans(1)
     assert rig.read("Cobot.QueueDepth") == 3

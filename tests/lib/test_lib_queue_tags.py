@@ -93,7 +93,8 @@ def test_the_last_push_lost_is_recovered_by_a_status_query_after_one_second_of_s
     end = rig.motion_ends(1)[1]
     done = rig.scan_time(rig.read("DoneScan[1]"))
     assert end < done <= end + 1.1 and done >= 1.0
-    queried = [e["data"] for e in rig.srv.robots[0].events if e["kind"] == "frame_in" and e.get("data", "").startswith("01,")]
+    queried = [e["data"] for e in rig.srv.robots[0].events
+               if e["kind"] == "frame_in" and e.get("data", "").startswith("01,")]
     assert queried == ["01,01"]
 
 

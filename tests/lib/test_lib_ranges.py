@@ -1,7 +1,8 @@
 """The one range table, docs/library/ranges.tsv, agrees with what the library's ST checks: every row is run on the
 virtual PLC (no robot connected, so a command whose parameters pass ends with 16#2001 "not connected" and one
 that fails them with the row's ErrorID): both limits accepted, one step outside refused, every allowed
-enumeration value accepted and every other one refused. The generated types.md and cbt_hmi/pages/ranges.json are current."""
+enumeration value accepted and every other one refused. The generated types.md and cbt_hmi/pages/ranges.json are
+current."""
 from __future__ import annotations
 
 import importlib.util

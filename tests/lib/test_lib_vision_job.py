@@ -77,7 +77,8 @@ def test_pick_through_the_vision_base_change_base_and_a_relative_move(rig):
     """As TMflow users do: the vision base becomes the base, the approach point is taught in it, a relative move
     goes down to the part - the TCP ends at the part the camera found."""
     vision(rig, ObjectIndex=1)
-    rig.set_struct("BaseParam.Transformation", dict(zip(("X", "Y", "Z", "RX", "RY", "RZ"), pose(rig, "vis.Object"), strict=False)))
+    rig.set_struct("BaseParam.Transformation",
+                   dict(zip(("X", "Y", "Z", "RX", "RY", "RZ"), pose(rig, "vis.Object"), strict=False)))
     rig.write("BaseExec", True)
     assert rig.until(lambda: rig.read("base.Done"), 1), rig.read("base.ErrorDescrip")
     rig.set_struct("MoveParam", move_abs(MovementCommand="Line", DataFormat="CPP_Abs", Speed=100,

@@ -49,7 +49,8 @@ def control(sim):
 
 # ---- the command table is the documented one ------------------------------------------------------------
 def _doc_section(title):
-    text = open(os.path.join(ROOT, "docs", "simulator.md"), encoding="utf-8").read()
+    with open(os.path.join(ROOT, "docs", "simulator.md"), encoding="utf-8") as f:
+        text = f.read()
     start = text.index(title)
     return text[start:text.index("\n## ", start + 1)] if "\n## " in text[start + 1:] else text[start:]
 

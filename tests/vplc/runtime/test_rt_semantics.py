@@ -111,7 +111,8 @@ def test_bcd_conversions_pack_and_unpack_decimal_digits(tmp_path):
     ("i := BCD_TO_INT(w);", r"BCD_TO_INT: 16#12A4 is not a BCD value \(digit 16#A\)"),
     ("w := INT_TO_BCD(-1);", r"INT_TO_BCD: -1 cannot be written as BCD in 16 bits \(0\.\.9999\)"),
     ("w := UINT_TO_BCD(UINT#10000);", r"UINT_TO_BCD: 10000 cannot be written as BCD"),
-    ("s := BCD_TO_SINT(BYTE#16#99); s := BCD_TO_SINT(WORD#16#0128);", r"= 128 is out of the result's range \(max 127\)"),
+    ("s := BCD_TO_SINT(BYTE#16#99); s := BCD_TO_SINT(WORD#16#0128);",
+     r"= 128 is out of the result's range \(max 127\)"),
 ])
 def test_a_value_that_is_not_bcd_is_a_runtime_fault(tmp_path, body, message):
     plc = plc_from(tmp_path, body, "w : WORD := WORD#16#12A4; i : INT; s : SINT;")

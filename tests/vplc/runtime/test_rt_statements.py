@@ -42,8 +42,8 @@ VAR_IN_OUT Count : INT; P : stPoint; Arr : ARRAY[0..2] OF INT; END_VAR
     Count := Count + 1; P.X := 5.0; Arr[2] := 7;
 END_FUNCTION_BLOCK
 """
-    plc = run1(tmp_path, "b(Count := c, P := pt, Arr := a);", "b : Bump; c : INT := 1; pt : stPoint; a : ARRAY[0..2] OF INT;",
-               extra)
+    plc = run1(tmp_path, "b(Count := c, P := pt, Arr := a);",
+               "b : Bump; c : INT := 1; pt : stPoint; a : ARRAY[0..2] OF INT;", extra)
     assert (plc.read("Main.c"), plc.read("Main.pt"), plc.read("Main.a")) == (2, {"X": 5.0, "Y": 0.0}, [0, 0, 7])
 
 
