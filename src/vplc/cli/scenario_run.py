@@ -52,7 +52,7 @@ def _same(v):
     return v
 
 
-def _one(key):
+def _one(key: Any) -> Callable[[Any], tuple]:
     return lambda container: (container[key],)
 
 
@@ -110,8 +110,11 @@ class Runner:
             if sig.read is None:
                 groups.setdefault(id(sig.container), []).append(sig)
         # one C-level read of all of an instance's watched variables a scan: [container, getter, signals, last]
-        self.direct = [[sigs[0].container, operator.itemgetter(*[x.key for x in sigs]) if len(sigs) > 1 else
-                        _one(sigs[0].key), sigs, None] for sigs in groups.values()]
+        self.direct: list[list[Any]] = []
+        for sigs in groups.values():
+            getter: Callable[[Any], tuple] = operator.itemgetter(*[x.key for x in sigs]) if len(sigs) > 1 \
+                else _one(sigs[0].key)
+            self.direct.append([sigs[0].container, getter, sigs, None])
         self.indirect = [sig for sig in self.signals.values() if sig.read is not None]
         self.stamp = -1
 
