@@ -1,6 +1,8 @@
 """Fixtures for the HMI server tests: a fake PLC scanning in a thread and the HMI server on an ephemeral port."""
 from __future__ import annotations
 
+import contextlib
+
 import pytest
 from browser import Browser
 from fake_plc import FakePlc, command_program, scanning, serving
@@ -53,15 +55,11 @@ def chromium(_chromium_process):
             browser = _chromium_process[0].fresh()
         except WebDriverException:
             broken = _chromium_process.pop()
-            try:
+            with contextlib.suppress(WebDriverException):   # already gone: close() removed its profile all the same
                 broken.close()
-            except WebDriverException:
-                pass                  # already gone; close() removed its profile directory all the same
     if browser is None:
         _chromium_process.append(Browser())
         browser = _chromium_process[0]
     yield browser
-    try:
+    with contextlib.suppress(WebDriverException):   # left unusable: the next module replaces it (above)
         browser.driver.get("about:blank")
-    except WebDriverException:
-        pass                          # left unusable: the next module replaces it (above)
