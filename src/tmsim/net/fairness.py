@@ -86,7 +86,7 @@ class FairScheduler:
         if outcome == INPUT_DONE:
             self._backlog.pop(key, None)
         elif outcome == FRAME_LIMIT:
-            robot.faults.close_after = None
+            robot.faults.close_after_reached()
             self._host.flush(robot)
             self._host.drop(robot, conn, "fault: close_after")
         else:

@@ -154,6 +154,10 @@ class FaultState:
         if self.black_hole:
             out.clear()
 
+    def close_after_reached(self) -> None:
+        """A connection received the ``close_after`` count of frames and is closed: the fault is spent."""
+        self.close_after = None
+
     def adopt(self, other: FaultState) -> None:
         """Take over the frames another (cleared) fault state still holds back."""
         self._queues, self._partial = other._queues, other._partial
