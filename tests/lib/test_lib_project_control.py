@@ -41,7 +41,7 @@ def statuses(rig):
 
 def test_no_write_permission_is_16_4008_and_the_project_keeps_running(svr):
     """§17.4.1 status 02 WritePermission: the robot's Ethernet Slave settings do not let the PLC's address write."""
-    svr.robot.svr.write_permission = False
+    svr.robot.svr.configure(write_permission=False)
     command(svr, "ProjectPause", 3)
     assert_refused(svr, 0x4008)
     assert statuses(svr) == ["02"] and svr.events("stick") == []

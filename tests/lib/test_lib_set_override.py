@@ -112,7 +112,7 @@ def test_every_value_outside_the_range_table_is_refused_at_the_edge_and_nothing_
 
 def test_no_write_permission_is_16_4020_and_the_speed_stays(svr):
     """§17.4.1 status 02 WritePermission (the robot's IP filter does not let the PLC write)."""
-    svr.robot.svr.write_permission = False
+    svr.robot.svr.configure(write_permission=False)
     override(svr, 30)
     assert_refused(svr, 0x4020)
     assert svr.robot.session.robot.project_speed == 100

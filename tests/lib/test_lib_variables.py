@@ -149,13 +149,13 @@ def test_the_robots_refusals_of_a_write_are_their_own_error_ids(var):
     assert run(var, "wr", "WrExec") == (False, 0x4044)                 # 07 ValueError: 1.5 to an int
     variable(var, "WrVar", "g_pos", "VarFloat", 3, FloatValue=[1, 2, 3])
     assert run(var, "wr", "WrExec") == (False, 0x4044)                 # 07: three values to a float[6]
-    var.robot.svr.write_permission = False
+    var.robot.svr.configure(write_permission=False)
     variable(var, "WrVar", "g_count", "VarInt", IntValue=[1])
     assert run(var, "wr", "WrExec") == (False, 0x4041)                 # 02 WritePermission
     variable(var, "RdVar", "g_count", "VarInt")
     assert run(var, "rd", "RdExec") == (True, 0)                       # reading needs no write permission
-    var.robot.svr.write_permission = True
-    var.robot.svr.refuse = 3                                            # fault refuse_writes: 03 InvalidData
+    var.robot.svr.configure(write_permission=True)
+    var.robot.svr.inject("refuse_writes", status=3)                    # 03 InvalidData
     assert run(var, "wr", "WrExec") == (False, 0x4046)
     assert var.robot.svr.variables["g_count"] == 5 and var.robot.svr.variables["g_mode"] == 1
 
@@ -215,7 +215,7 @@ def test_without_the_ethernet_slave_it_is_16_2010():
 
 def test_a_silent_ethernet_slave_is_16_2021_before_and_16_3007_after_sending(var):
     variable(var, "WrVar", "g_count", "VarInt", IntValue=[1])
-    var.robot.svr.stalled = True                                        # fault stall: requests dropped unanswered
+    var.robot.svr.inject("stall")                                       # requests dropped unanswered
     var.write("WrExec", True)
     assert var.until(lambda: var.read("wr.Error"), 3)
     assert var.read("wr.ErrorID") == 0x3007
