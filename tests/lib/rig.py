@@ -14,8 +14,12 @@ SEC = 1_000_000_000
 HOME_JOINTS = dict(X=0, Y=0, Z=90, RX=0, RY=90, RZ=0)
 
 
+MULTI_ROBOT = {"Main_Tags.st"}     # programs of several robots: Ports[r], Robots and conns[r], r = 1..robots
+
+
 class Rig:
-    """One simulator robot + the library program Main_Lib.st, pumped once per PLC scan."""
+    """The simulator's robot(s) + a library test program (Main_Lib.st unless named), pumped once per PLC scan.
+    ``sim_args`` go to the SimServer (``robots=4`` for a program of MULTI_ROBOT)."""
 
     def __init__(self, program="Main_Lib.st", connect=True, load_args=None, **sim_args):
         sim_args.setdefault("auto_enter", True)
@@ -23,12 +27,20 @@ class Rig:
         self.srv.start()
         self.robot = self.srv.robots[0]
         self.plc = load_plc([str(LIB), str(ST / program)], task="Main@1ms", **(load_args or {}))
-        self.plc.write("Main.Port", self.srv.ports[0])
+        if program in MULTI_ROBOT:
+            for r, port in enumerate(self.srv.ports, start=1):
+                self.plc.write(f"Main.Ports[{r}]", port)
+            self.plc.write("Main.Robots", len(self.srv.ports))
+            links = [f"conns[{r}]" for r in range(1, len(self.srv.ports) + 1)]
+        else:
+            self.plc.write("Main.Port", self.srv.ports[0])
+            links = ["conn"]
         if sim_args.get("svr_port") is not None:
             self.plc.write("Main.SvrPort", self.robot.svr_port)
         if connect:
             self.write("ConnExec", True)
-            assert self.until(lambda: self.read("conn.Connected"), 5), self.read("conn.ErrorDescrip")
+            assert self.until(lambda: all(self.read(f"{link}.Connected") for link in links), 5), \
+                "; ".join(self.read(f"{link}.ErrorDescrip") for link in links)
 
     # --- access -------------------------------------------------------------------------------
     def read(self, path):
