@@ -77,6 +77,12 @@ def run_documented_values(line: Line) -> None:
     assert line["DelayDone"] is False and line["DelayElapsed"] == 90 * MS
     line.scan()
     assert line["DelayDone"] is True and line["DelayElapsed"] == 100 * MS
+    # W560 2-728: 25 % of a 200 ms period is 50 ms: HeaterOn in 5 of any 20 scans of 10 ms while RunLamp is on
+    heater = []
+    for _ in range(20):
+        heater.append(line["HeaterOn"])
+        line.scan()
+    assert sum(heater) == 5 and line["HeaterErr"] is False
     # the CJ-area globals share their words: RunLamp is bit 00 of W100, FaultLamp bit 15 (CTD's Q is TRUE: CV 0)
     assert line["StatusWord"] == 0x8001 and line["FaultLamp"] is True
     cycles = line["Cycles"]
@@ -98,6 +104,9 @@ def run_documented_values(line: Line) -> None:
     line.scan(StopButton=False)
     assert line["RunLamp"] is False and line["StatusWord"] & 1 == 0
     assert line["Motor.Starts"] == 1
+    assert line["HeaterOn"] is False                                                    # Enable FALSE resets DOut
+    # the empty batch raised the user-defined error 16#0100 (SetAlarm); GetAlarm reports it
+    assert (line["AlarmActive"], line["AlarmLevel"], line["AlarmCode"]) == (True, 1, 0x0100)
 
 
 def test_the_project_runs_with_the_documented_values():
