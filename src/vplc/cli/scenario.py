@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ..frontend import types as T
-from ..runtime.values import PathError, parse_duration
+from ..runtime.values import PathError, from_python, parse_duration
 from . import simlink
 
 if TYPE_CHECKING:
@@ -304,10 +304,17 @@ def check_robots(sc: Scenario, count: int, where: str) -> None:
 
 
 # ---- values -------------------------------------------------------------------------------------
-def parse_value(plc: Plc, path: str, text: str) -> Any:
+def parse_value(plc: Plc, path: str, text: str, compared: bool = False) -> Any:
     """An ST literal for the variable at ``path`` -> the API value (bool/int/float/str); PathError if it
-    does not fit the variable's type."""
+    does not fit the variable's type (its range, its enumeration values, its STRING capacity: what a write
+    would refuse). ``compared``: the value of a condition or an expectation, not of a write."""
     t = plc._resolver._locate(path)[2]
+    value = _literal(plc, path, t, text, compared)
+    from_python(value, t, path)          # the check the write makes, made before the first scan
+    return value
+
+
+def _literal(plc: Plc, path: str, t: T.Type, text: str, compared: bool) -> Any:
     u = T.base_of(t)
     tn = plc.var_type(path)
     s = text.strip()
@@ -387,13 +394,22 @@ def resolve(plc: Plc, sc: Scenario) -> None:
                 raise ScenarioError(f"{r.where}: {exc}") from None
 
 
-def _resolve_term(plc, term, where: str) -> None:
+def _resolve_term(plc: Plc, term: Term | Expect, where: str) -> None:
+    path = term.path
+    if path is None:                          # `time`: its value was read with the line
+        return
     try:
-        term.value = parse_value(plc, term.path, term.text)
+        t = plc._resolver._locate(path)[2]
+        term.value = _literal(plc, path, t, term.text, compared=True)
     except PathError as exc:
         raise ScenarioError(f"{where}: {exc}") from None
+    try:
+        from_python(term.value, t, path)
+    except PathError as exc:                  # issue 27: a condition that can never be evaluated is a mistake
+        raise ScenarioError(f"{where}: `{path} {term.op} {term.text}` compares {path} with a value it can never "
+                            f"hold: {exc}") from None
     if term.op not in ("=", "<>") and isinstance(term.value, (bool, str)):
-        raise ScenarioError(f"{where}: `{term.op}` compares numbers; {term.path} is a {plc.var_type(term.path)}")
+        raise ScenarioError(f"{where}: `{term.op}` compares numbers; {path} is a {plc.var_type(path)}")
 
 
 _ORDER = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}

@@ -128,3 +128,70 @@ def test_reactions_and_always_expectations_alone_do_not_end_the_run(cell):
     assert r.stdout.splitlines()[0].endswith("virtual time until 8 scan(s); opens no sockets")
     assert r.stdout.splitlines()[-1] == "vplc run: OK: 8 scan(s), 0.007 s of controller time; 1 of 1 " \
                                         "expectation(s) held"
+
+
+# ---- D3 and D5: a value that does not fit its variable is refused before the first scan --------------------
+@pytest.fixture
+def plc(cell):
+    from vplc.api import load_plc
+    with load_plc([str(cell / "G.st"), str(cell / "M.st")]) as p:
+        yield p
+
+
+def scenario_error(plc, cell, text: str) -> str:
+    """The message of a scenario line refused when it is checked against the loaded program."""
+    from vplc.cli import scenario as scn
+    with pytest.raises(scn.ScenarioError) as info:
+        scn.resolve(plc, scn.load(str(scenario(cell, text))))
+    return str(info.value)
+
+
+@pytest.mark.parametrize(("line", "message"), [
+    ("at 2s set M.Seg 99999", "99999 is outside the range -32768..32767 of M.Seg (INT)"),
+    ("at 2s set M.Seg -40000", "-40000 is outside the range -32768..32767 of M.Seg (INT)"),
+    ("at 2s set M.Format Foo", "'Foo' is not a value of eFormat (values: Joint, Cartesian)"),
+    ("when M.Busy = TRUE then set M.Seg 16#10000", "65536 is outside the range -32768..32767 of M.Seg (INT)"),
+])
+def test_a_write_that_does_not_fit_is_refused_with_file_and_line(plc, cell, line, message):
+    assert scenario_error(plc, cell, "# the cell\n" + line + "\n") == f"{cell / 'cell.scn'}:2: {message}"
+
+
+def test_an_out_of_range_write_is_a_usage_error_before_the_first_scan(cell):
+    r = run(cell, "--scenario", scenario(cell, "at 2s set M.Seg 99999\n"))
+    assert usage_error(r) == f"vplc run: error: {cell / 'cell.scn'}:1: 99999 is outside the range -32768..32767 " \
+                             "of M.Seg (INT)"
+    assert r.stdout == ""                                        # nothing ran: no start line
+    r = run(cell, "--set", "M.Seg=99999@2s")
+    assert usage_error(r) == "vplc run: error: --set M.Seg=99999@2s: 99999 is outside the range -32768..32767 " \
+                             "of M.Seg (INT)"
+
+
+@pytest.mark.parametrize(("line", "shown", "reason"), [
+    ("when M.Seg = 99999 then set M.Reset TRUE", "M.Seg = 99999",
+     "99999 is outside the range -32768..32767 of M.Seg (INT)"),
+    ("when M.Busy = TRUE and M.Seg >= 40000 robot 1 estop", "M.Seg >= 40000",
+     "40000 is outside the range -32768..32767 of M.Seg (INT)"),
+    ("expect M.Seg = 99999 within 1s", "M.Seg = 99999", "99999 is outside the range -32768..32767 of M.Seg (INT)"),
+    ("at 1s expect M.Format <> Foo", "M.Format <> Foo", "'Foo' is not a value of eFormat (values: Joint, Cartesian)"),
+])
+def test_a_condition_or_expectation_on_a_value_the_variable_cannot_hold_is_refused(plc, cell, line, shown, reason):
+    assert scenario_error(plc, cell, line + "\n") == \
+        f"{cell / 'cell.scn'}:1: `{shown}` compares {shown.split()[0]} with a value it can never hold: {reason}"
+
+
+def test_values_that_fit_are_still_accepted(plc, cell):
+    from vplc.cli import scenario as scn
+    sc = scn.load(str(scenario(cell, "at 1s set M.Seg -32768\nat 1s set M.Format Cartesian\n"
+                                     "when M.Seg = 32767 then set M.Format eFormat#Joint\n"
+                                     "expect M.Format = cartesian within 2s\n")))
+    scn.resolve(plc, sc)
+    assert [w.value for w in sc.writes] == [-32768, "Cartesian"]
+    assert sc.reactions[0].terms[0].value == 32767 and sc.expects[0].value == "cartesian"
+
+
+def test_a_condition_that_can_never_be_true_is_a_usage_error(cell):
+    r = run(cell, "--scenario", scenario(cell, "at 1ms set M.Reset TRUE\nwhen M.Seg = 99999 then set M.Reset "
+                                               "FALSE\n"))
+    assert usage_error(r).startswith(f"vplc run: error: {cell / 'cell.scn'}:2: `M.Seg = 99999` compares M.Seg "
+                                     "with a value it can never hold")
+
