@@ -13,12 +13,13 @@
     when Main.Alarm = TRUE for 1s then set Main.Reset TRUE after 200ms every time
                                            a reaction: the operator or a machine, without PLC code
 
-Times count from the first scan. A condition is one or more `VAR OP VALUE` joined by `and`; `time` is the
-controller time (`when time >= 5s and Main.Busy = FALSE ...`). A reaction fires on the scan its condition becomes
-true (held for `for T` when given), once, or again each time it becomes true with `every time`; its action runs
-`after T` later (before that scan). Operators: = <> < <= > >=. Values are ST literals of the variable's type
-(TRUE, 12, -3.5, 16#FF, 'text', T#250ms, an enumeration value's name). ``--set VAR=VALUE@TIME`` on the command
-line is the same as ``at TIME set VAR VALUE``.
+Times count from the first scan (written without a blank: 60s). A condition is one or more `VAR OP VALUE` of
+an elementary variable joined by `and` (no `or`); `time` is the controller time (`when time >= 5s and Main.Busy
+= FALSE ...`). A reaction fires on the scan its condition becomes true (held for `for T` when given), once, or
+again each time it becomes true with `every time`; its action runs `after T` later (before that scan).
+Operators: = <> < <= > >=. Values are ST literals of the variable's type (TRUE, 12, -3.5, 16#FF, 'text',
+T#250ms, an enumeration value's name) that the variable can hold. ``--set VAR=VALUE@TIME`` on the command line
+is the same as ``at TIME set VAR VALUE``.
 """
 from __future__ import annotations
 
@@ -174,10 +175,35 @@ def _strip_comment(line: str) -> str:
     return line.strip()
 
 
+_SPACED_TIME = re.compile(r"\b(at|within|for|after)\s+(\d+(?:\.\d+)?)\s+(ns|us|µs|ms|s|m|h)\b", re.IGNORECASE)
+_OR = re.compile(r"\s(or|xor)\s", re.IGNORECASE)
+_JUDGED = re.compile(r"^(?:at\s+\S+\s+)?(?:when|expect)\s", re.IGNORECASE)    # lines with conditions
+
+
+def _unquoted(text: str) -> str:
+    """``text`` with its quoted strings emptied: what is left is keywords, names and numbers."""
+    return re.sub(r"'[^']*'|\"[^\"]*\"", "''", text)
+
+
+def _check_words(text: str, where: str) -> None:
+    """Mistakes that would otherwise surface as a value that does not fit: a time written with a blank
+    (`within 60 s`) and conditions joined by `or`."""
+    bare = _unquoted(text)
+    m = _SPACED_TIME.search(bare)
+    if m:
+        raise ScenarioError(f"{where}: `{m.group(0)}`: write the time without a blank between number and unit, "
+                            f"like `{m.group(1)} {m.group(2)}{m.group(3)}` (2s, 250ms, 1.5s)")
+    m = _OR.search(bare)
+    if m and _JUDGED.match(bare):
+        raise ScenarioError(f"{where}: `{m.group(1)}` cannot join conditions: only `and` does (`when A = TRUE and "
+                            f"B = FALSE ...`); for either of two conditions write one line for each")
+
+
 def parse_line(line: str, where: str, sc: Scenario) -> None:
     text = _strip_comment(line)
     if not text:
         return
+    _check_words(text, where)
     at_ns, rest, timed = 0, text, False
     m = _AT.match(text)
     if m:
@@ -326,6 +352,11 @@ def _literal(plc: Plc, path: str, t: T.Type, text: str, compared: bool) -> Any:
             return s[1:-1]
         raise PathError(f"`{s}`: write a text for {path} ({tn}) in quotes, e.g. '{s}'")
     if not isinstance(u, T.ElementaryType):
+        if compared:
+            members = _members(u)
+            example = f", e.g. `{path}.{members[0]}`" if members else ""
+            raise PathError(f"{path} is a {tn}: a condition or an expectation compares one elementary "
+                            f"variable; name one of its members{example}")
         raise PathError(f"{path} is a {tn}; set its elementary members one by one")
     if "#" in s and u.kind not in ("time", "ltime"):
         prefix, _, rest = s.partition("#")
@@ -350,6 +381,15 @@ def _literal(plc: Plc, path: str, t: T.Type, text: str, compared: bool) -> Any:
     if u.kind in ("int", "uint", "bit"):
         return _int(s, 10, bad)
     raise PathError(f"{path} ({tn}) cannot be set from a scenario")
+
+
+def _members(u: T.Type) -> list[str]:
+    """Member names of a structure or a function block instance (its outputs first), for a message."""
+    if isinstance(u, T.StructType):
+        return [f.name for f in u.fields.values()]
+    if isinstance(u, T.PouType):
+        return [p.name for p in sorted(u.params, key=lambda p: p.direction != "out")]
+    return []
 
 
 def _int(s: str, base: int, bad: Exception) -> int:

@@ -195,3 +195,46 @@ def test_a_condition_that_can_never_be_true_is_a_usage_error(cell):
     assert usage_error(r).startswith(f"vplc run: error: {cell / 'cell.scn'}:2: `M.Seg = 99999` compares M.Seg "
                                      "with a value it can never hold")
 
+
+# ---- D4: messages that point at the mistake -------------------------------------------------------------------
+@pytest.mark.parametrize(("line", "message"), [
+    ("when M.Reset = TRUE or M.Busy = TRUE then set M.Seg 1",
+     "`or` cannot join conditions: only `and` does (`when A = TRUE and B = FALSE ...`); for either of two "
+     "conditions write one line for each"),
+    ("expect M.Reset = TRUE OR M.Busy = TRUE within 1s", "`OR` cannot join conditions: only `and` does"),
+    ("when M.Move = TRUE then set M.Seg 1",
+     "M.Move is a TON: a condition or an expectation compares one elementary variable; name one of its members, "
+     "e.g. `M.Move.Q`"),
+    ("expect M.Status = TRUE within 1s", "M.Status is a stStatus: a condition or an expectation compares one "
+                                         "elementary variable; name one of its members, e.g. `M.Status.EStop`"),
+    ("expect M.Busy = TRUE within 60 s",
+     "`within 60 s`: write the time without a blank between number and unit, like `within 60s` (2s, 250ms, 1.5s)"),
+    ("when M.Busy = TRUE for 1 s then set M.Seg 1", "`for 1 s`: write the time without a blank"),
+    ("when M.Busy = TRUE then set M.Seg 1 after 200 ms", "`after 200 ms`: write the time without a blank"),
+    ("at 2 s set M.Seg 1", "`at 2 s`: write the time without a blank between number and unit, like `at 2s`"),
+])
+def test_messages_point_at_the_mistake(cell, line, message):
+    from vplc.cli import scenario as scn
+    path = scenario(cell, line + "\n")
+    try:
+        sc = scn.load(str(path))
+    except scn.ScenarioError as exc:
+        text = str(exc)
+    else:
+        from vplc.api import load_plc
+        with load_plc([str(cell / "G.st"), str(cell / "M.st")]) as p, pytest.raises(scn.ScenarioError) as info:
+            scn.resolve(p, sc)
+        text = str(info.value)
+    assert text.startswith(f"{path}:1: {message}")
+    assert "is not a value" not in text
+
+
+def test_set_still_takes_an_aggregate_member_by_member(plc, cell):
+    assert scenario_error(plc, cell, "at 1s set M.Move TRUE\n").endswith(
+        "M.Move is a TON; set its elementary members one by one")
+
+
+def test_or_inside_a_quoted_text_is_a_value(cell):
+    from vplc.cli import scenario as scn
+    sc = scn.load(str(scenario(cell, "at 1s set M.Name 'a or'\nexpect M.Name = 'x or y' within 1s\n")))
+    assert sc.writes[0].text == "'a or'" and sc.expects[0].text == "'x or y'"
