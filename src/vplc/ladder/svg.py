@@ -59,7 +59,7 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
     if lay.number % 2 == 0:
         out.append(f'<rect class="band" x="0" y="-4" width="{width:.0f}" height="{h:.0f}"/>')
     out.append(_t(4, 15, str(lay.number), "num"))
-    x = 40
+    x: float = 40
     if lay.rung.label:                                 # a jump target, written first as Sysmac shows labels
         out.append(_t(x, 15, lay.rung.label + ":", "type"))
         x += 12 + text_width(lay.rung.label, 1.1)
@@ -112,7 +112,8 @@ def _rung(lay: RungLayout, top: float, width: float) -> str:
     for p in lay.placed.values():                      # a coil's right side always reaches the right rail
         if p.element.kind == "coil" and p.element.id not in read:
             pt = out_point(p.element.id, None)
-            out.append(_line(pt[0], pt[1], right, pt[1], "wire", p.element.id))
+            if pt is not None:                         # a placed coil always has its point
+                out.append(_line(pt[0], pt[1], right, pt[1], "wire", p.element.id))
     out.append("</g>")
     return "".join(out)
 
@@ -127,11 +128,13 @@ def _element(p, y: float, lay: RungLayout) -> str:
         g.append(_line(x, cy, cx - 10, cy, "sym"))
         g.append(_line(cx + 10, cy, x + w, cy, "sym"))
         if e.kind == "contact":
-            g.append(f'<path class="sym" d="M{cx - 10:.0f} {cy - 12:.0f}V{cy + 12:.0f}M{cx + 10:.0f} {cy - 12:.0f}V{cy + 12:.0f}"/>')
+            g.append(f'<path class="sym" d="M{cx - 10:.0f} {cy - 12:.0f}V{cy + 12:.0f}'
+                     f'M{cx + 10:.0f} {cy - 12:.0f}V{cy + 12:.0f}"/>')
             if e.negated:
                 g.append(f'<path class="sym" d="M{cx - 12:.0f} {cy + 12:.0f}L{cx + 12:.0f} {cy - 12:.0f}"/>')
         else:
-            g.append(f'<path class="sym" d="M{cx - 6:.0f} {cy - 12:.0f}Q{cx - 14:.0f} {cy:.0f} {cx - 6:.0f} {cy + 12:.0f}'
+            g.append(f'<path class="sym" d="M{cx - 6:.0f} {cy - 12:.0f}'
+                     f'Q{cx - 14:.0f} {cy:.0f} {cx - 6:.0f} {cy + 12:.0f}'
                      f'M{cx + 6:.0f} {cy - 12:.0f}Q{cx + 14:.0f} {cy:.0f} {cx + 6:.0f} {cy + 12:.0f}"/>')
             if e.negated:
                 g.append(f'<path class="sym" d="M{cx - 6:.0f} {cy + 10:.0f}L{cx + 6:.0f} {cy - 10:.0f}"/>')

@@ -43,6 +43,7 @@ class ElementView:
     """A live view of the elements of an array stored in a memory image (a union's image, a memory area): the
     list behaviour both share; a subclass reads and writes one element at a checked index."""
     __slots__ = ("n",)
+    n: int                                  # the number of elements, set by the subclass
 
     def _get(self, i: int):
         raise NotImplementedError

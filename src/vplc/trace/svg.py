@@ -3,7 +3,8 @@
 BOOL is a square wave whose high pulses stay at least ``MIN_PULSE`` pixels wide, however long the trace (a
 pulse that had to be widened also gets a marker above it); REAL/LREAL are analog curves scaled to their range
 in the window, with the range written at the left; other values are a bus with the value written where it
-fits (bit strings BYTE .. LWORD in 16# notation, as the controller shows them), and changes too dense to draw one by one become a hatched band. ``window`` (FROM, TO) in ns draws only
+fits (bit strings BYTE .. LWORD in 16# notation, as the controller shows them), and changes too dense to draw
+one by one become a hatched band. ``window`` (FROM, TO) in ns draws only
 that part of the run."""
 from __future__ import annotations
 
