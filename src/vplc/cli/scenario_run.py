@@ -25,8 +25,9 @@ _UNSEEN = object()
 class Signal:
     """One variable a scenario watches: sampled once after every scan; the reactions and expectations on it are
     judged again only when it changed (what keeps 100 `when` lines cheap). A variable declared directly in a
-    program instance or a global list is read straight from its instance, which lives as long as the controller;
-    anything deeper (members, array elements, whose containers an assignment may replace) through ``plc.read``."""
+    program instance or a global list (a program's VAR_EXTERNAL too: it is the global) is read straight from its
+    instance, which lives as long as the controller; anything deeper (members, array elements, whose containers
+    an assignment may replace) through ``plc.read``."""
 
     __slots__ = ("container", "conv", "expects", "key", "path", "raw", "reactions", "read", "since_ns", "stamp",
                  "value")
@@ -38,7 +39,8 @@ class Signal:
         root, steps = res._parse(path)
         owner = plc.instances[root] if root is not None else plc.globals
         self.path, self.read = path, None
-        if len(steps) == 1 and not steps[0][3] and container is getattr(owner, "__dict__", None):
+        lasting = (getattr(owner, "__dict__", None), plc.globals.__dict__)     # a VAR_EXTERNAL lands in the globals
+        if len(steps) == 1 and not steps[0][3] and any(container is d for d in lasting):
             self.container, self.key, self.conv = container, key, converter(t)
         else:
             self.container, self.key, self.conv = None, None, _same

@@ -238,3 +238,21 @@ def test_or_inside_a_quoted_text_is_a_value(cell):
     from vplc.cli import scenario as scn
     sc = scn.load(str(scenario(cell, "at 1s set M.Name 'a or'\nexpect M.Name = 'x or y' within 1s\n")))
     assert sc.writes[0].text == "'a or'" and sc.expects[0].text == "'x or y'"
+
+
+def test_a_scenario_watches_an_external_variable_without_a_path_lookup_per_scan(plc, cell):
+    """The global behind `M.Count` lives as long as the controller: it is sampled straight from the globals, like
+    `Count`, not through plc.read every scan (what keeps `when` lines cheap, runtime.md section 7)."""
+    from vplc.cli import scenario as scn
+    from vplc.cli.scenario_run import Runner
+    sc = scn.load(str(scenario(cell, "when M.Count >= 3 then set M.Seg 7\nexpect M.Seg = 7 within 10ms\n")))
+    scn.resolve(plc, sc)
+    runner = Runner(plc, sc)
+    assert runner.signals["M.Count"].read is None and runner.signals["M.Count"].container is plc.globals.__dict__
+    t = 0
+    while not runner.finished(t):
+        runner.before_scan(t)
+        plc.scan(t)
+        runner.after_scan(t)
+        t += plc.period_ns
+    assert runner.end_check(t) is None and plc.read("M.Seg") == 7
