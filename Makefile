@@ -34,10 +34,13 @@ bench: install
 traces: install
 	PYTHONPATH=tests/lib $(VPY) docs/library/make_traces.py
 
-## check: toolchain diagnostics over the library and the examples
-check: install
+## check: toolchain diagnostics over the library and the examples, then ruff (lint, pyproject [tool.ruff]) over
+## the Python code and mypy (types, pyproject [tool.mypy]) over src/
+check: test-deps
 	$(VPY) -m vplc check lib/ examples/
 	$(VPY) -m vplc check --portable --warnings-as-errors lib/CBT_Commands_Lib
+	$(VENV)/bin/ruff check .
+	$(VPY) -m mypy
 
 ## package: the library for Sysmac Studio: build/CBT_Commands_Lib.xml (IEC 61131-10 import) and build/paste/
 package: install
