@@ -147,7 +147,9 @@ def test_a_run_stopped_by_a_signal_still_writes_its_trace(program, tmp_path, sig
     assert f"vplc run: stopped by {who}" in err and "Traceback" not in err
     assert f"trace written to {svg}" in out and "vplc run: OK: " in out
     texts = [t.text for t in ET.parse(svg).iter("{http://www.w3.org/2000/svg}text")]
-    assert "Main.Status" in texts and "16#4006" in texts
+    # Status is 16#4006 in the first scan and 16#200B from the second to the signal; a value is written where it
+    # fits, so which of the two gets its text depends on how long the run lasted before the signal (the load)
+    assert "Main.Status" in texts and {"16#4006", "16#200B"} & set(texts)
 
 
 def test_a_failed_bit_string_assert_shows_both_values_in_16_notation(tmp_path):
