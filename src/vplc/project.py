@@ -5,6 +5,7 @@ import contextlib
 import gc
 import os
 from collections.abc import Iterable
+from typing import Any
 
 from .checker import calls, recursion
 from .checker import portable as portable_rule
@@ -48,7 +49,7 @@ class Project:
     def render_diagnostics(self, context: bool = True) -> str:
         return render_all(self.diagnostics, context)
 
-    def _lookup(self, table, text: str, from_ns: str | None):
+    def _lookup(self, table: str, text: str, from_ns: str | None) -> Any:
         parts = [p for p in text.replace("\\\\", "\\").split("\\") if p]
         if not parts or self._tables is None:
             return None

@@ -105,6 +105,7 @@ def bind_pou(ck: ExprHost, e: A.Call, pt: T.PouType, kind: str, instance: A.Expr
     bound: dict[int, BoundArg] = {}
     pos = 0
     formal_seen = False
+    p: T.Param | None
     for arg in e.args:
         if arg.name is None:
             if formal_seen:
@@ -156,7 +157,7 @@ def bind_pou(ck: ExprHost, e: A.Call, pt: T.PouType, kind: str, instance: A.Expr
 IEC_PARAM_NAMES = {("CTD", "LD"): "Load"}
 
 
-def _iec_alias(pt: T.PouType, name: str):
+def _iec_alias(pt: T.PouType, name: str) -> T.Param | None:
     sysmac = IEC_PARAM_NAMES.get((pt.name.upper(), name.upper()))
     return pt.param(sysmac) if sysmac and pt.namespace in (None, "") else None
 

@@ -25,7 +25,7 @@ from .context import ExprHost
 from .symbols import EnumValueSymbol
 
 
-def _value(ck: ExprHost, e: A.Expr):
+def _value(ck: ExprHost, e: A.Expr) -> int | None:
     sym = getattr(e, "sym", None)
     if isinstance(sym, EnumValueSymbol):
         return sym.value
@@ -41,7 +41,7 @@ def check(ck: ExprHost, stmt: A.Case, sel_type: T.Type) -> None:
         ctx.diags.error(codes.CASE_LABEL_TYPE,
                         f"the CASE selector must be an integer or enumeration, not {sel_type.name}",
                         stmt.selector.span)
-    ranges: list[tuple[int, int, int, A.Node]] = []      # lo, hi, position in the source, label
+    ranges: list[tuple[int, int, int, A.Expr | A.CaseRange]] = []      # lo, hi, position in the source, label
     for branch in stmt.branches:
         for label in branch.labels:
             parts = [label.lo, label.hi] if isinstance(label, A.CaseRange) else [label]
@@ -58,12 +58,13 @@ def check(ck: ExprHost, stmt: A.Case, sel_type: T.Type) -> None:
                 if v is None and not T.is_error(lt):
                     ctx.diags.error(codes.CASE_LABEL_TYPE, "CASE labels must be constants", p.span)
                 values.append(v)
-            if all(v is not None for v in values):
-                ranges.append((values[0], values[-1], len(ranges), label))
+            lo, hi = values[0], values[-1]
+            if lo is not None and hi is not None:
+                ranges.append((lo, hi, len(ranges), label))
     _report_overlaps(ck, ranges)
 
 
-def _report_overlaps(ck: ExprHost, ranges) -> None:
+def _report_overlaps(ck: ExprHost, ranges: list[tuple[int, int, int, A.Expr | A.CaseRange]]) -> None:
     """ST1402 once per label that overlaps an earlier one: sorted by value, so n log n even for 100,000 labels."""
     ranges.sort(key=lambda r: (r[0], r[2]))
     reach = None                                  # the range reaching furthest up among those sorted so far

@@ -21,6 +21,7 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from ..frontend.source import Span
 from .context import Context
 from .symbols import VarSymbol
 
@@ -31,7 +32,7 @@ def cells(t: T.Type, memo: dict) -> int:
     return T.value_cells(t, MAX_CELLS, memo)
 
 
-def _report(ctx: Context, what: str, n: int, span) -> None:
+def _report(ctx: Context, what: str, n: int, span: Span) -> None:
     size = f"{n:,} cells" if n <= MAX_CELLS else f"more than {MAX_CELLS:,} cells"
     ctx.diags.error(codes.DATA_TOO_LARGE,
                     f"{what} holds {size} (values plus the arrays, structures and instances that hold "

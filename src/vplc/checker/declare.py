@@ -123,7 +123,7 @@ class Declarer:
     def struct_cycles(self) -> None:
         """ST1004 for structures that contain themselves through other structures or arrays (A has a B, B has an
         A): such a value would be infinitely large. Reported once per cycle, at the member that closes it."""
-        def contained(t):
+        def contained(t: T.Type) -> T.StructType | None:
             t = T.unalias(t)
             while isinstance(t, T.ArrayType):
                 t = T.unalias(t.element)

@@ -466,7 +466,7 @@ class ExprChecker:
                              "a structure initializer `(...)` is only allowed as an initial value", e.span)
         return T.ERROR
 
-    def text(self, e: A.Expr) -> str:
+    def text(self, e: A.Expr | A.CaseRange) -> str:
         return e.span.file.text[e.span.start:e.span.end] if e.span is not None else "?"
 
     # ---- assignment compatibility ---------------------------------------------------------------

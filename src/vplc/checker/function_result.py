@@ -23,7 +23,7 @@ from .context import Context
 from .symbols import VarSymbol
 
 
-def _assigns(stmts, result) -> bool | None:
+def _assigns(stmts: list[A.Stmt], result: VarSymbol) -> bool | None:
     """True: every path assigns; False: some path may end without assigning; None: a path RETURNs first."""
     for s in stmts:
         if isinstance(s, A.Assign) and isinstance(s.target, A.Name) and s.target.sym is result:

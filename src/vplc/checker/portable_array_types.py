@@ -20,14 +20,15 @@ from __future__ import annotations
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
+from ..frontend.source import Span
 from .context import Context
 
 
-def _anonymous_array(t) -> bool:
+def _anonymous_array(t: T.Type) -> bool:
     return isinstance(t, T.ArrayType)
 
 
-def _warn(ctx: Context, span, what: str) -> None:
+def _warn(ctx: Context, span: Span, what: str) -> None:
     ctx.diags.warning(codes.PORTABLE_ARRAY_TYPES,
                       f"{what}: two separately written ARRAY types are different types in IEC 61131-3 "
                       "2nd edition; declare the array once as a named type (a STRUCT member for Sysmac Studio) "

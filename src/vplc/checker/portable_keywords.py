@@ -15,8 +15,11 @@ Failing (portable)::
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 from ..frontend import ast as A
 from ..frontend import codes
+from ..frontend.source import Span
 from .context import Context
 
 SFC = ["STEP", "END_STEP", "INITIAL_STEP", "TRANSITION", "END_TRANSITION", "FROM", "ACTION", "END_ACTION"]
@@ -30,7 +33,7 @@ KIND = {**{w: "a keyword of the sequential function chart (SFC)" for w in SFC},
         **{w: "an elementary data type name" for w in TYPES}}
 
 
-def _names(node):
+def _names(node: A.Node) -> Iterator[tuple[str, Span]]:
     if isinstance(node, (A.VarDecl, A.TypeDecl, A.EnumValueDecl)):
         yield node.name, node.name_span
     elif isinstance(node, A.Pou):

@@ -16,6 +16,8 @@ Failing (portable)::
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 from ..frontend import ast as A
 from ..frontend import codes
 from ..frontend import types as T
@@ -26,16 +28,16 @@ ARITH = ("+", "-", "*", "/", "MOD")
 INT_FUNCTIONS = ("LEN", "FIND")
 
 
-def _builtin(e) -> str | None:
+def _builtin(e: A.Expr) -> str | None:
     b = getattr(e, "binding", None) if isinstance(e, A.Call) else None
     return b.builtin.name if b is not None and b.kind == "builtin" else None
 
 
-def _int_literal(e) -> bool:
+def _int_literal(e: A.Expr) -> bool:
     return isinstance(e, A.Literal) and e.kind == "int" and e.type_prefix is None
 
 
-def _iec_int(e) -> bool:
+def _iec_int(e: A.Expr) -> bool:
     """True when ``e`` is INT under IEC typing because of a LEN / FIND result (LEN(s) - 1, ...)."""
     if _builtin(e) in INT_FUNCTIONS:
         return True
@@ -48,21 +50,21 @@ def _iec_int(e) -> bool:
     return False
 
 
-def _is_int_type(e) -> bool:
+def _is_int_type(e: A.Expr) -> bool:
     return e.ty is not None and T.base_of(e.ty) is T.INT
 
 
-def _report(ctx: Context, e, where: str) -> None:
+def _report(ctx: Context, e: A.Expr, where: str) -> None:
     ctx.diags.warning(codes.PORTABLE_LEN_TYPE,
                       f"LEN and FIND return INT in IEC 61131-3 (UINT only in Sysmac), so this value is "
                       f"INT where {where}; use an INT variable or an INT_TO_... conversion", e.span)
 
 
-def _target_ok(t) -> bool:
+def _target_ok(t: T.Type | None) -> bool:
     return t is None or T.is_error(t) or T.base_of(t) is T.INT or is_generic(t)
 
 
-def _arg_uses(call: A.Call):
+def _arg_uses(call: A.Call) -> Iterator[tuple[A.Expr, T.Type | None, str]]:
     """(argument expression, parameter type or None for generic) of every input argument."""
     b = call.binding
     if b is None:

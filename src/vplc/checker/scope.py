@@ -5,6 +5,7 @@ library namespace where it is unique (else ST1003 ambiguous). ``Ns\\Name`` looks
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Generic, TypeGuard, TypeVar
 
@@ -14,7 +15,7 @@ from .symbols import EnumValueSymbol, VarSymbol
 GENERIC_TYPES: dict[str, T.SpecialType] = {}
 
 
-def _generic(name: str, pred, shown: str | None = None) -> None:
+def _generic(name: str, pred: Callable[[T.Type], bool], shown: str | None = None) -> None:
     t = T.SpecialType(shown or name, "generic", pred)
     GENERIC_TYPES[name] = t
 

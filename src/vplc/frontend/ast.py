@@ -21,7 +21,7 @@ from typing import Any
 from .source import Span
 
 
-def _ann(default=None):
+def _ann(default: Any = None) -> Any:
     return field(default=default, compare=False, repr=False)
 
 

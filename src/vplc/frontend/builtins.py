@@ -10,7 +10,7 @@ Sysmac dialect: LEN and FIND return UINT (IEC: INT).
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from . import types as T
@@ -305,7 +305,7 @@ def _trunc(args: list[T.Type], dialect: str) -> Resolved:
 
 # ---- table ----------------------------------------------------------------------------------
 
-def _b(name, lo, hi, fn, formal=()):
+def _b(name: str, lo: int, hi: int | None, fn: Resolver, formal: Iterable[str] = ()) -> Builtin:
     return Builtin(name, lo, hi, fn, tuple(formal))
 
 
