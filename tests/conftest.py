@@ -1,9 +1,10 @@
 """Fixtures every test package shares.
 
 `run_cli` starts one of the project's command lines (`vplc`, `tmsim`, `cbtdemo`) as a child process, the way a
-user starts it. The packages are installed editable into .venv by the Makefile; from a plain checkout
-(`python3 -m pytest`, nothing installed) the child finds them through PYTHONPATH, set here once for every child
-process a test starts.
+user starts it: for tests of the process (start-up, signals, exit). A test of what `vplc` prints and returns runs it
+in the test process instead (tests/cli_main.py: no interpreter start, no compile of the same program again).
+The packages are installed editable into .venv by the Makefile; from a plain checkout (`python3 -m pytest`, nothing
+installed) the child finds them through PYTHONPATH, set here once for every child process a test starts.
 """
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""`vplc run` and `vplc test` command lines."""
+"""`vplc run` and `vplc test` command lines (run in this process: what they print and return)."""
+from cli_main import run_in_process
 
 PROG = """PROGRAM Main
 VAR t : TON; q : BOOL; n : INT; END_VAR
@@ -7,48 +8,49 @@ END_PROGRAM
 """
 
 
-def test_run_virtual_time_with_stats_and_traces(tmp_path, run_cli):
+def test_run_virtual_time_with_stats_and_traces(tmp_path):
     src = tmp_path / "m.st"
     src.write_text(PROG)
     vcd, svg = tmp_path / "t.vcd", tmp_path / "t.svg"
-    r = run_cli("run", str(src), "--virtual-time", "--cycles", "20", "--stats", "--trace", "Main.q,Main.n",
+    r = run_in_process("run", str(src), "--virtual-time", "--cycles", "20", "--stats", "--trace", "Main.q,Main.n",
              "--trace-out", str(vcd))
     assert r.returncode == 0, r.stderr
     assert "scan time: median" in r.stdout and "statements per scan: median 9" in r.stdout
     text = vcd.read_text()
     assert "$var wire 1 ! Main.q $end" in text and "#5000000\n1!" in text
-    r = run_cli("run", str(src), "--virtual-time", "--duration", "10ms", "--trace", "Main.q", "--trace-out", str(svg))
+    r = run_in_process("run", str(src), "--virtual-time", "--duration", "10ms", "--trace", "Main.q",
+                       "--trace-out", str(svg))
     assert r.returncode == 0 and svg.read_text().startswith("<svg")
 
 
-def test_run_reports_a_fault_without_traceback(tmp_path, run_cli):
+def test_run_reports_a_fault_without_traceback(tmp_path):
     src = tmp_path / "m.st"
     src.write_text("PROGRAM Main\nVAR a : INT; END_VAR\na := 1 / a;\nEND_PROGRAM\n")
-    r = run_cli("run", str(src), "--virtual-time", "--cycles", "3")
+    r = run_in_process("run", str(src), "--virtual-time", "--cycles", "3")
     assert r.returncode == 1
     assert "m.st:3: major fault in Main: integer division by zero" in r.stderr
     assert "Traceback" not in r.stderr
 
 
-def test_run_usage_errors_exit_2(tmp_path, run_cli):
+def test_run_usage_errors_exit_2(tmp_path):
     src = tmp_path / "m.st"
     src.write_text(PROG)
-    assert run_cli("run", str(src), "--trace", "Main.q").returncode == 2
-    r = run_cli("run", str(src), "--virtual-time", "--cycles", "1", "--trace", "Main.zz", "--trace-out", "x.vcd")
+    assert run_in_process("run", str(src), "--trace", "Main.q").returncode == 2
+    r = run_in_process("run", str(src), "--virtual-time", "--cycles", "1", "--trace", "Main.zz", "--trace-out", "x.vcd")
     assert r.returncode == 2 and "zz" in r.stderr
 
 
-def test_run_refuses_a_malformed_task_option_cleanly(tmp_path, run_cli):
+def test_run_refuses_a_malformed_task_option_cleanly(tmp_path):
     src = tmp_path / "m.st"
     src.write_text(PROG)
-    r = run_cli("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main")
+    r = run_in_process("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main")
     assert r.returncode == 2 and "task `Main` is not of the form Name@period" in r.stderr
-    r = run_cli("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main@0ms")
+    r = run_in_process("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Main@0ms")
     assert r.returncode == 2 and "task period `0ms` must be greater than zero" in r.stderr
     assert "Traceback" not in r.stderr and "internal" not in r.stderr
 
 
-def test_run_says_when_the_task_option_gives_way_to_a_configuration(tmp_path, run_cli):
+def test_run_says_when_the_task_option_gives_way_to_a_configuration(tmp_path):
     src = tmp_path / "m.st"
     src.write_text(PROG + """CONFIGURATION Cfg
 RESOURCE Res ON PLC
@@ -57,12 +59,12 @@ PROGRAM Inst WITH Fast : Main;
 END_RESOURCE
 END_CONFIGURATION
 """)
-    r = run_cli("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Other@5ms")
+    r = run_in_process("run", str(src), "--virtual-time", "--cycles", "1", "--task", "Other@5ms")
     assert r.returncode == 0, r.stderr
     assert "--task Other@5ms is not used: the sources define their own CONFIGURATION" in r.stderr
 
 
-def test_test_command_reports_failures_with_location_and_writes_junit(tmp_path, run_cli):
+def test_test_command_reports_failures_with_location_and_writes_junit(tmp_path):
     (tmp_path / "suite.st").write_text("""FUNCTION_BLOCK Demo_Test
 VAR n : INT; END_VAR
 n := n + 1;
@@ -77,7 +79,7 @@ END_IF;
 END_FUNCTION_BLOCK
 """)
     junit = tmp_path / "r.xml"
-    r = run_cli("test", str(tmp_path), "--junit", str(junit))
+    r = run_in_process("test", str(tmp_path), "--junit", str(junit))
     assert r.returncode == 1
     assert "suite.st:9: FAIL Demo_Test.fails_after_two_scans: text: expected 'abc', got 'abd'" in r.stdout
     assert r.stdout.strip().splitlines()[-1] == "1 passed, 1 failed"
@@ -85,7 +87,7 @@ END_FUNCTION_BLOCK
     assert 'name="passes"' in xml and "<failure" in xml
 
 
-def test_a_faulting_suite_fails_its_test_and_the_other_suites_still_run(tmp_path, run_cli):
+def test_a_faulting_suite_fails_its_test_and_the_other_suites_still_run(tmp_path):
     (tmp_path / "s.st").write_text("""FUNCTION_BLOCK Faulty_Test
 VAR z : INT; END_VAR
 TEST('divides');
@@ -98,7 +100,7 @@ AssertTrue(TRUE, '');
 TEST_FINISHED();
 END_FUNCTION_BLOCK
 """)
-    r = run_cli("test", str(tmp_path))
+    r = run_in_process("test", str(tmp_path))
     assert r.returncode == 1
     assert "s.st:4: FAIL Faulty_Test.divides: major fault in VPLC_TestRunner.Faulty_Test: integer division by zero" \
         in r.stdout

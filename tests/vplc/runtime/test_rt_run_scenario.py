@@ -1,9 +1,8 @@
 """`vplc run` for commissioning: start line, --watch, --set, scenario files and the exit status."""
 import os
-import subprocess
-import sys
 
 import pytest
+from cli_main import run_in_process
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 
@@ -17,7 +16,8 @@ END_PROGRAM
 
 
 def vplc(*args):
-    return subprocess.run([sys.executable, "-m", "vplc", *args], capture_output=True, text=True, timeout=60)
+    """`vplc args...` in this process (these tests are about what a run says and returns, not the process)."""
+    return run_in_process(*args)
 
 
 def run(tmp_path, *args, scenario=None):

@@ -2,10 +2,9 @@
 reactions (`when ... then set ...`) and the list of unmet expectations."""
 import os
 import re
-import subprocess
-import sys
 
 import pytest
+from cli_main import run_in_process
 
 from tmsim.net.server import SimServer
 from vplc.cli import simlink
@@ -26,7 +25,8 @@ END_PROGRAM
 
 
 def vplc(*args):
-    return subprocess.run([sys.executable, "-m", "vplc", *args], capture_output=True, text=True, timeout=120)
+    """`vplc args...` in this process (these tests are about what a run says and returns, not the process)."""
+    return run_in_process(*args)
 
 
 def run(tmp_path, scenario, *args):
