@@ -2,9 +2,11 @@
 real time, the robot simulator over loopback, the HMI server, and a Chromium page on it."""
 from __future__ import annotations
 
+import contextlib
 import pathlib
 import threading
 import time
+from collections.abc import Iterator
 
 from browser import Browser
 
@@ -18,6 +20,24 @@ SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
 MOVE_WAIT_S = 30
 SIM_SPEEDUP = 4.0     # the robot model runs 4x faster than the wall clock; PLC timers stay real time
 DWELL_NS = 250_000_000  # PnP_DwellTime for the cycle tests (T#250ms)
+
+
+@contextlib.contextmanager
+def serving(plc, mapping: Mapping) -> Iterator[HmiServer]:
+    """``plc`` scanning in real time on a thread of its own and an HMI server on it with ``mapping``; afterwards the
+    server stopped, the scans ended and the PLC closed."""
+    stop = threading.Event()
+    thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
+    thread.start()
+    server = HmiServer(plc, mapping, port=0)
+    server.start()
+    try:
+        yield server
+    finally:
+        server.stop()
+        stop.set()
+        thread.join(timeout=5)
+        plc.close()
 
 
 class System:

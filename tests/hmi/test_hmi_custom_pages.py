@@ -7,12 +7,12 @@ from __future__ import annotations
 import json
 import pathlib
 import shutil
-import threading
 import urllib.error
 import urllib.request
 
 import pytest
 from browser import chromium_paths
+from hmi_system import serving
 from panel_metrics import page_metrics
 
 from cbt_hmi.web.mapping import Mapping
@@ -34,16 +34,8 @@ def cell():
     assert errors == []
     mapping = Mapping(program_table(plc, pages), "generated from Conveyor.st")
     mapping.check_against_plc(plc)
-    stop = threading.Event()
-    thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
-    thread.start()
-    server = HmiServer(plc, mapping, port=0)
-    server.start()
-    yield plc, server
-    server.stop()
-    stop.set()
-    thread.join(timeout=5)
-    plc.close()
+    with serving(plc, mapping) as server:
+        yield plc, server
 
 
 def test_the_variable_table_is_generated_from_the_programs_global_variables(cell):

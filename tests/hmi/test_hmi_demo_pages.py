@@ -4,14 +4,13 @@ PLC, no robot needed). Screenshots: artifacts/screenshots/demo_pages_*.png."""
 from __future__ import annotations
 
 import pathlib
-import threading
 
 import pytest
+from hmi_system import serving
 from selenium.webdriver.common.by import By
 
 from cbt_hmi.demo import with_user_pages
 from cbt_hmi.web.mapping import Mapping
-from cbt_hmi.web.server import HmiServer
 from vplc.api import load_plc
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -33,16 +32,8 @@ def served(chromium, tmp_path_factory):
     mapping, errors = with_user_pages(Mapping.load(), plc, str(folder))
     assert errors == []
     mapping.check_against_plc(plc)
-    stop = threading.Event()
-    thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
-    thread.start()
-    server = HmiServer(plc, mapping, port=0)
-    server.start()
-    yield server, chromium
-    server.stop()
-    stop.set()
-    thread.join(timeout=5)
-    plc.close()
+    with serving(plc, mapping) as server:
+        yield server, chromium
 
 
 def test_the_users_page_shows_beside_the_shipped_pages_and_opens_from_main(served):

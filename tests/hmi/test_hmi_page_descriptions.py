@@ -7,16 +7,15 @@ from __future__ import annotations
 
 import json
 import pathlib
-import threading
 
 import pytest
 from browser import chromium_paths
+from hmi_system import serving
 from panel_metrics import page_metrics
 
 from cbt_hmi import PAGES
 from cbt_hmi.web.mapping import DEFAULT_MAPPING, Mapping
 from cbt_hmi.web.pagedesc import DESC_DIR, load_pages, program_table
-from cbt_hmi.web.server import HmiServer
 from cbt_hmi.web.shipped import render, shipped_table
 from vplc.api import load_plc
 
@@ -95,16 +94,8 @@ def gripper():
     assert errors == []
     mapping = Mapping(program_table(plc, pages), "generated from Gripper.st")
     mapping.check_against_plc(plc)
-    stop = threading.Event()
-    thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
-    thread.start()
-    server = HmiServer(plc, mapping, port=0)
-    server.start()
-    yield plc, server
-    server.stop()
-    stop.set()
-    thread.join(timeout=5)
-    plc.close()
+    with serving(plc, mapping) as server:
+        yield plc, server
 
 
 def test_a_users_fb_instance_page_gets_its_table_from_the_description(gripper):

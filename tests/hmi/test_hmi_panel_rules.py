@@ -101,22 +101,14 @@ def test_normal_states_are_grey(stack, name):
 def ladder_stack(chromium):
     """The Program page needs the real ladder example: the examples on the virtual PLC (no robot needed)."""
     import pathlib
-    import threading
 
-    from cbt_hmi.web.server import HmiServer
+    from hmi_system import serving
+
     from vplc.api import load_plc
     root = pathlib.Path(__file__).resolve().parents[2]
     plc = load_plc([str(root / "lib" / "CBT_Commands_Lib"), str(root / "examples")])
-    stop = threading.Event()
-    thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
-    thread.start()
-    server = HmiServer(plc, Mapping.load(), port=0)
-    server.start()
-    yield plc, server, chromium
-    server.stop()
-    stop.set()
-    thread.join(timeout=5)
-    plc.close()
+    with serving(plc, Mapping.load()) as server:
+        yield plc, server, chromium
     chromium._fit()
 
 

@@ -4,17 +4,16 @@ list and jump, zoom, whole comments, 16# values, no text over another, boxes apa
 from __future__ import annotations
 
 import pathlib
-import threading
 
 import pytest
 from browser import chromium_paths
 from hmi_http import Client
+from hmi_system import serving
 from panel_metrics import check_controls
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
 from cbt_hmi.web.mapping import Mapping
-from cbt_hmi.web.server import HmiServer
 from tmsim.net.server import SimServer
 from vplc.api import load_plc
 
@@ -32,16 +31,8 @@ def system(chromium):
     with plc.lock:
         plc.write("Connect_AddressIP", "127.0.0.1")
         plc.write("Connect_Dest_PortIP", sim.ports[0])
-    stop = threading.Event()
-    thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
-    thread.start()
-    hmi = HmiServer(plc, Mapping.load(), port=0)
-    hmi.start()
-    yield plc, hmi, chromium
-    hmi.stop()
-    stop.set()
-    thread.join(timeout=5)
-    plc.close()
+    with serving(plc, Mapping.load()) as hmi:
+        yield plc, hmi, chromium
     sim.close()
 
 
