@@ -69,6 +69,8 @@ def check_call(ck: ExprHost, e: A.Call, expected: T.Type | None, statement: bool
             if builtin is not None:
                 if B.is_edition3(builtin):
                     ctx.note_edition3(f"the function {builtin.name}", callee.span)
+                if builtin.vendor:
+                    ctx.vendor_uses.append((callee.span, builtin.name, "instruction or type"))
                 callee.sym = BuiltinSymbol(builtin)
                 callee.ty = T.VOID
                 return bind_builtin(ck, e, builtin, expected)

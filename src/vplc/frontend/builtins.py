@@ -356,6 +356,14 @@ BUILTINS: dict[str, Builtin] = {b.name: b for b in [
 ]}
 
 
+# Omron instructions with a generic signature ST cannot declare (W560 2-209, Math Instructions: Out :=
+# DegToRad(In); / RadToDeg(In);, In REAL or LREAL, Out of the type of In). Vendor names: `--portable` flags them
+# (ST2001) as it flags the prelude's instructions.
+for _vendor in (Builtin("DegToRad", 1, 1, _real_math, ("In",), vendor=True),
+                Builtin("RadToDeg", 1, 1, _real_math, ("In",), vendor=True)):
+    BUILTINS[_vendor.name.upper()] = _vendor
+
+
 # Not in IEC 61131-3 2nd edition (3rd edition or common extensions): reported by `--portable`.
 EDITION3 = frozenset({"LOWER_BOUND", "UPPER_BOUND", "ATAN2"})
 

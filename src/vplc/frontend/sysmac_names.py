@@ -28,7 +28,7 @@ _W502_SECTIONS: dict[str, tuple[str, ...]] = {
     "NX Unit Instructions": ("NX_WriteObj", "NX_ReadObj"),
 }
 
-_W508_MOTION = ("MC_Power", "MC_Home", "MC_HomeWithParameter", "MC_MoveAbsolute", "MC_MoveRelative",
+_W508_MOTION = ("MC_Power", "MC_Home", "MC_HomeWithParameter", "MC_Move", "MC_MoveAbsolute", "MC_MoveRelative",
                 "MC_MoveVelocity", "MC_MoveFeed", "MC_MoveZeroPosition", "MC_MoveJog", "MC_Stop",
                 "MC_ImmediateStop", "MC_Reset", "MC_ReadAxisError", "MC_SetPosition", "MC_SetOverride",
                 "MC_ChangeAxisUse", "MC_TorqueControl", "MC_SetTorqueLimit", "MC_ZoneSwitch", "MC_TouchProbe",

@@ -108,7 +108,8 @@ def _fill(items: list, n: int, make):
 
 MATH = {name: _nan_on_domain(fn) for name, fn in {
     "SQRT": math.sqrt, "LN": math.log, "LOG": math.log10, "EXP": math.exp, "SIN": math.sin, "COS": math.cos,
-    "TAN": math.tan, "ASIN": math.asin, "ACOS": math.acos, "ATAN": math.atan}.items()}
+    "TAN": math.tan, "ASIN": math.asin, "ACOS": math.acos, "ATAN": math.atan,
+    "DEGTORAD": math.radians, "RADTODEG": math.degrees}.items()}       # W560 2-209 (Omron, builtins.py)
 
 NAMESPACE = {
     "_fmod": _fmod, "_mux": _mux, "_bcd_decode": _bcd_decode, "_bcd_encode": _bcd_encode,

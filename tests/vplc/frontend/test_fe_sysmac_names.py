@@ -98,3 +98,22 @@ def test_the_printer_keeps_namespaces_and_unions():
     assert diags == diags2 == [] and again == unit
     assert [i.declared_namespace for i in again.items] == ["nsMachine", "nsMachine\\Io"]
     assert "END_UNION" in print_unit(unit)
+
+
+def test_mc_move_is_a_real_motion_instruction_not_an_unknown_type(tmp_path):
+    """MC_Move (W508: positioning with a move mode) is used in published Sysmac programs; vplc does not model it."""
+    proj = check_text(tmp_path, program("Mv(Axis := _MC_AX[0], Execute := TRUE);", "Mv : MC_Move;"))
+    errors = [d for d in proj.diagnostics if d.severity == "error"]
+    assert errors and errors[0].code == "ST1007" and "`MC_Move` (W508)" in errors[0].message
+
+
+def test_deg_to_rad_is_an_omron_instruction_for_portable_and_checks_its_argument(tmp_path):
+    """DegToRad / RadToDeg (W560 2-209) check in both dialects, take REAL or LREAL and give the same type back;
+    --portable reports them as Omron instructions (ST2001)."""
+    src = program("r := DegToRad(In := x); l := RadToDeg(y);", "x, r : REAL; y, l : LREAL;")
+    assert codes(check_text(tmp_path, src), "error") == []
+    assert codes(check_text(tmp_path, src, "p.st", portable=True)) == ["ST2001", "ST2001"]
+    narrowing = program("r := DegToRad(y);", "r : REAL; y : LREAL;")
+    assert codes(check_text(tmp_path, narrowing, "n.st"), "error") != []
+    wrong = program("r := DegToRad('a');", "r : REAL;")
+    assert codes(check_text(tmp_path, wrong, "w.st"), "error") != []

@@ -105,3 +105,13 @@ def test_current_time_is_the_controller_clock_and_ethernet_ip_is_online(tmp_path
     plc.scan(3_000_000_000)
     assert plc.read("Main.Now") == (1_700_000_003) * 10**9
     assert plc.read("Main.On") is True and plc.read("Main.Err") == 0
+
+
+def test_deg_to_rad_and_rad_to_deg_keep_the_type_of_in(tmp_path):
+    """W560 2-209 (Math Instructions): Out := DegToRad(In); / RadToDeg(In);, Out of the type of In (REAL or
+    LREAL), called with In formal or not, nested in COS as engineers write it."""
+    plc = run1(tmp_path, "r := DegToRad(REAL#180.0); l := RadToDeg(In := LREAL#3.141592653589793); "
+               "c := COS(In := DegToRad(In := LREAL#60.0)); back := RadToDeg(DegToRad(REAL#90.0));",
+               "r, back : REAL; l, c : LREAL;")
+    assert abs(plc.read("Main.r") - 3.1415927) < 1e-6 and plc.read("Main.l") == 180.0
+    assert abs(plc.read("Main.c") - 0.5) < 1e-12 and abs(plc.read("Main.back") - 90.0) < 1e-5
