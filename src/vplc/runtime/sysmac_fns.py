@@ -293,9 +293,17 @@ def Get100msClk(rt) -> bool:
     return rt.now_ns % 100_000_000 < 50_000_000
 
 
+def Get1usCnt(rt) -> int:
+    return rt.now_ns // 1_000                    # W560 2-1465; counted from the start of the run
+
+
+def Get1msCnt(rt) -> int:
+    return rt.now_ns // 1_000_000
+
+
 FUNCTIONS = {f.__name__: f for f in (ToAryByte, AryByteTo, StringToAry, AryToString, RealToFormatString,
                                      LrealToFormatString, GetTime, SecToDt, DtToSec, NanoSecToTime,
                                      TimeToNanoSec, VPLC_ScanTime, SecToTime, TimeToSec, CopyDwordToReal,
                                      CopyRealToDword, CopyLwordToLreal, CopyLrealToLword, EnumToNum, ModReal,
                                      Inc, Dec, AryMove, SizeOfAry, ClearString, GetMyTaskInterval, Get1sClk,
-                                     Get100msClk)}
+                                     Get100msClk, Get1usCnt, Get1msCnt)}

@@ -117,3 +117,14 @@ def test_deg_to_rad_is_an_omron_instruction_for_portable_and_checks_its_argument
     assert codes(check_text(tmp_path, narrowing, "n.st"), "error") != []
     wrong = program("r := DegToRad('a');", "r : REAL;")
     assert codes(check_text(tmp_path, wrong, "w.st"), "error") != []
+
+
+def test_w560_indexed_instructions_are_st1007_with_their_page(tmp_path):
+    """DtToString (W560 2-481) is called in published Sysmac programs (DtToString(GetTime())); the instructions of
+    the W560 index that vplc does not model name their page."""
+    proj = check_text(tmp_path, program("s := DtToString(GetTime()); ok := ChkRange(x);", "s : STRING[40]; "
+                                        "ok : BOOL; x : INT;"))
+    errors = [d for d in proj.diagnostics if d.severity == "error"]
+    assert [d.code for d in errors] == ["ST1007", "ST1007"]
+    assert "Sysmac instruction `DtToString` (W560 2-481, the same instruction as W502's) is not modelled" \
+        in errors[0].message

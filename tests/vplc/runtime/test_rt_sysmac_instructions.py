@@ -115,3 +115,12 @@ def test_deg_to_rad_and_rad_to_deg_keep_the_type_of_in(tmp_path):
                "r, back : REAL; l, c : LREAL;")
     assert abs(plc.read("Main.r") - 3.1415927) < 1e-6 and plc.read("Main.l") == 180.0
     assert abs(plc.read("Main.c") - 0.5) < 1e-12 and abs(plc.read("Main.back") - 90.0) < 1e-5
+
+
+def test_free_running_counters_count_microseconds_and_milliseconds_as_ulint(tmp_path):
+    """W560 2-1465 (Get**Cnt): Get1usCnt / Get1msCnt, ULINT as ULINT_TO_STRING(Get1usCnt()) in Sysmac code shows;
+    vplc counts from the start of the run and reads the scan's time."""
+    plc = plc_from(tmp_path, "us := Get1usCnt(); ms := Get1msCnt(); s := ULINT_TO_STRING(Get1usCnt());",
+                   "us, ms : ULINT; s : STRING[24];")
+    plc.scan(2_500_000_000)
+    assert plc.read("Main.us") == 2_500_000 and plc.read("Main.ms") == 2_500 and plc.read("Main.s") == "2500000"
