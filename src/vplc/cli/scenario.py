@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ..frontend import types as T
+from ..frontend.parser_exprs import parse_duration as parse_time_literal
 from ..runtime.values import PathError, from_python, parse_duration
 from . import simlink
 
@@ -374,7 +375,10 @@ def _literal(plc: Plc, path: str, t: T.Type, text: str, compared: bool) -> Any:
         except ValueError:
             raise bad from None
     if u.kind in ("time", "ltime"):
-        ns = parse_duration(s)
+        prefix, sep, body = s.partition("#")
+        # an ST TIME literal with several units or a sign (T#1s500ms, TIME#-2s) is read as the compiler reads it
+        ns = parse_time_literal(body) if sep and prefix.upper() in ("T", "TIME", "LT", "LTIME") \
+            else parse_duration(s)
         if ns is None:
             raise bad
         return ns

@@ -135,3 +135,15 @@ def test_watch_shows_a_negative_time_with_its_sign(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "     0.000 s  Main.Late = T#-5ms" in r.stdout.splitlines()
     assert "  Main.Late = T#-5ms" in r.stdout.splitlines() and "  Main.Zero = T#0s" in r.stdout.splitlines()
+
+
+def test_set_takes_a_time_literal_with_several_units_as_st_writes_it(tmp_path):
+    """`T#1s500ms` and `TIME#-2s` are ST TIME literals (IEC 61131-3, W501 time literals): --set read only one unit
+    and refused them. Single units and bare durations keep working."""
+    for literal, shown in (("T#1s500ms", "T#1.5s"), ("TIME#1m_30s", "T#90s"), ("T#-2s", "T#-2s"),
+                           ("250ms", "T#250ms")):
+        r = run(tmp_path, "--cycles", "1", "--set", f"Main.Wait={literal}", "--watch", "Main.Wait")
+        assert r.returncode == 0, r.stderr
+        assert f"Main.Wait = {shown}" in r.stdout.splitlines()[-2]
+    r = run(tmp_path, "--cycles", "1", "--set", "Main.Wait=T#1s5")
+    assert r.returncode == 2 and "`T#1s5` is not a value for Main.Wait (TIME)" in r.stderr
