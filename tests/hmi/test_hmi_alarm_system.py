@@ -247,12 +247,12 @@ def test_a_sample_never_waits_for_the_disk(plant, monkeypatch):
     held = threading.Event()
     writing = threading.Event()
 
-    def stuck(self):
+    def stuck(self, path):
         writing.set()
         held.wait(30)
     monkeypatch.setattr(alarm_module.History, "_write", stuck)
     system.history.start()
-    writing.wait(5)
+    assert writing.wait(5), "the history writer did not start"
 
     def work():
         for n in range(200):
