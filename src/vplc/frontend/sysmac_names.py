@@ -15,7 +15,7 @@ _W502_SECTIONS: dict[str, tuple[str, ...]] = {
                                 "AryCmpGE", "AryMax", "AryMin", "AryMean", "ArySD", "AryAdd", "ArySub",
                                 "AryExchg"),
     "Control Instructions": ("PIDAT_HeatCool",),
-    "System Control Instructions": ("ResetCJBError", "GetCJBError", "GetEIPError", "ResetEIPError",
+    "System Control Instructions": ("ResetCJBError", "GetCJBError", "GetEIPError", "ResetEIPError", "GetNXBError",
                                     "GetMyTaskStatus", "Task_IsActive", "ActEventTask", "TraceSamp", "TraceTrig",
                                     "Lock", "Unlock"),
     "EtherCAT Communications Instructions": ("EC_CoESDOWrite", "EC_CoESDORead", "EC_StartMon", "EC_StopMon",
@@ -25,7 +25,7 @@ _W502_SECTIONS: dict[str, tuple[str, ...]] = {
     "SD Memory Card Instructions": ("FileWriteVar", "FileReadVar", "FileOpen", "FileClose", "FileRead",
                                     "FileWrite", "FileRemove", "FileRename", "FileCopy", "DirCreate", "DirRemove"),
     "Serial Communications Instructions": ("SerialSend", "SerialRcv", "SendCmd", "ExecPMCR"),
-    "NX Unit Instructions": ("NX_WriteObj", "NX_ReadObj"),
+    "NX Unit Instructions": ("NX_WriteObj", "NX_ReadObj", "NX_ChangeWriteMode"),
 }
 
 _W508_MOTION = ("MC_Power", "MC_Home", "MC_HomeWithParameter", "MC_Move", "MC_MoveAbsolute", "MC_MoveRelative",
@@ -76,6 +76,12 @@ _W560_PAGES_TEXT = (
     "FileSeek 2-1335, FileGets 2-1354, FilePuts 2-1362, ChkRange 2-1440"
 )
 
+# System-defined data types of instructions vplc does not model (the manual describing the instruction that takes
+# each): declaring a variable of one is ST1007, not "unknown data type".
+_SYSTEM_TYPES = {"_sTimer": "W560 2-152, Timer", "_sSDO_ACCESS": "W502, EtherCAT Communications Instructions",
+                 "_sNXUNIT_ID": "W502, NX Unit Instructions", "_eMC_COORD_SYSTEM": "W508, axes group instructions",
+                 "_eMC_TRANSITION_MODE": "W508, axes group instructions"}
+
 SYSMAC_NAMES: dict[str, tuple[str, str]] = {}
 for _section, _names in _W502_SECTIONS.items():
     for _n in _names:
@@ -85,6 +91,8 @@ for _entry in _W560_PAGES_TEXT.split(","):
     SYSMAC_NAMES.setdefault(_n.upper(), ("instruction", f"W560 {_page}, the same instruction as W502's"))
 for _n in _W508_MOTION:
     SYSMAC_NAMES.setdefault(_n.upper(), ("motion instruction", "W508"))
+for _n, _where in _SYSTEM_TYPES.items():
+    SYSMAC_NAMES.setdefault(_n.upper(), ("system-defined data type", _where))
 for _n in _W501_SYSVARS:
     SYSMAC_NAMES.setdefault(_n.upper(), ("system-defined variable", "W501, system-defined variables"))
 

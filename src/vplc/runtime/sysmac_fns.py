@@ -293,6 +293,18 @@ def Get100msClk(rt) -> bool:
     return rt.now_ns % 100_000_000 < 50_000_000
 
 
+def Get1msClk(rt) -> bool:
+    return rt.now_ns % 1_000_000 < 500_000
+
+
+def Get10msClk(rt) -> bool:
+    return rt.now_ns % 10_000_000 < 5_000_000
+
+
+def Get1minClk(rt) -> bool:
+    return rt.now_ns % 60_000_000_000 < 30_000_000_000
+
+
 def Get1usCnt(rt) -> int:
     return rt.now_ns // 1_000                    # W560 2-1465; counted from the start of the run
 
@@ -306,4 +318,5 @@ FUNCTIONS = {f.__name__: f for f in (ToAryByte, AryByteTo, StringToAry, AryToStr
                                      TimeToNanoSec, VPLC_ScanTime, SecToTime, TimeToSec, CopyDwordToReal,
                                      CopyRealToDword, CopyLwordToLreal, CopyLrealToLword, EnumToNum, ModReal,
                                      Inc, Dec, AryMove, SizeOfAry, ClearString, GetMyTaskInterval, Get1sClk,
-                                     Get100msClk, Get1usCnt, Get1msCnt)}
+                                     Get100msClk, Get1msClk, Get10msClk, Get1minClk, Get1usCnt,
+                                     Get1msCnt)}

@@ -128,3 +128,12 @@ def test_w560_indexed_instructions_are_st1007_with_their_page(tmp_path):
     assert [d.code for d in errors] == ["ST1007", "ST1007"]
     assert "Sysmac instruction `DtToString` (W560 2-481, the same instruction as W502's) is not modelled" \
         in errors[0].message
+
+
+def test_system_data_types_of_unmodelled_instructions_are_st1007(tmp_path):
+    """_sTimer, _sSDO_ACCESS, _eMC_COORD_SYSTEM ... appear in the variable tables of Sysmac projects."""
+    proj = check_text(tmp_path, program("", "t : _sTimer; s : _sSDO_ACCESS; c : _eMC_COORD_SYSTEM;"))
+    errors = [d for d in proj.diagnostics if d.severity == "error"]
+    assert [d.code for d in errors] == ["ST1007"] * 3
+    assert "Sysmac system-defined data type `_sTimer` (W560 2-152, Timer) is not modelled by vplc" \
+        in errors[0].message

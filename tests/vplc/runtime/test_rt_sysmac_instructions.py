@@ -124,3 +124,15 @@ def test_free_running_counters_count_microseconds_and_milliseconds_as_ulint(tmp_
                    "us, ms : ULINT; s : STRING[24];")
     plc.scan(2_500_000_000)
     assert plc.read("Main.us") == 2_500_000 and plc.read("Main.ms") == 2_500 and plc.read("Main.s") == "2500000"
+
+
+def test_more_clock_pulses_are_true_in_the_first_half_of_their_period(tmp_path):
+    """W560 2-1463 (Get**Clk): Get1msClk, Get10msClk and Get1minClk, as Sysmac projects call them."""
+    plc = plc_from(tmp_path, "a := Get10msClk(); b := Get1minClk(); c := Get1msClk();", "a, b, c : BOOL;")
+    seen = []
+    for t_ms in (0, 4, 5, 9, 10, 30_000, 59_999, 60_000):
+        plc.scan(t_ms * 1_000_000)
+        seen.append((plc.read("Main.a"), plc.read("Main.b"), plc.read("Main.c")))
+    assert [s[0] for s in seen] == [True, True, False, False, True, True, False, True]
+    assert [s[1] for s in seen] == [True, True, True, True, True, False, False, True]
+    assert all(s[2] for s in seen)          # read at whole milliseconds: always in the first half of its period
