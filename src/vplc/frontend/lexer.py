@@ -63,8 +63,9 @@ class Token:
         return f"{self.kind}({self.text!r}@{self.start})"
 
 
-def _skip_comment(text: str, pos: int) -> int:
-    """Return the offset after the comment that starts at ``pos`` (``(*`` nests, ``/*`` nests), or -1.
+def comment_end(text: str, pos: int) -> int:
+    """Return the offset after the comment that starts at ``pos`` (``(*`` nests, ``/*`` nests), or -1 when it is
+    not closed (an editor or a formatter can skip a comment the way the lexer does).
 
     Linear in the comment's length: the next opener and the next closer are each searched again only once the
     scan has passed them (100,000 nested openers followed by their closers are read once, not once per level)."""
@@ -130,7 +131,7 @@ def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None
             pos = end
             continue
         if kind == "COMMENT":
-            stop = _skip_comment(text, pos)
+            stop = comment_end(text, pos)
             if stop < 0:
                 diags.error(codes.UNCLOSED_COMMENT, "comment is never closed; add `*)` at its end",
                             Span(src, pos, pos + 2))

@@ -81,7 +81,7 @@ class _CountingText(str):
 
 def _scanned(text: str) -> tuple[int, int]:
     _CountingText.scanned = 0
-    stop = lexer._skip_comment(_CountingText(text), 0)
+    stop = lexer.comment_end(_CountingText(text), 0)
     return stop, _CountingText.scanned
 
 
@@ -118,7 +118,7 @@ def test_the_linear_comment_scan_ends_every_comment_where_the_nesting_rules_end_
         body = "".join(rng.choice(["(", "*", ")", "/", "a", "(*", "*)", "/*", "*/"]) for _ in range(rng.randint(0, 14)))
         for opener in ("(*", "/*"):
             text = opener + body
-            assert lexer._skip_comment(text, 0) == _reference_skip(text, 0), text
+            assert lexer.comment_end(text, 0) == _reference_skip(text, 0), text
 
 
 @pytest.mark.slow
