@@ -27,7 +27,7 @@ import operator
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from ..frontend import types as T
 from ..frontend.parser_exprs import parse_duration as parse_time_literal
@@ -36,7 +36,15 @@ from . import simlink
 
 if TYPE_CHECKING:
     from ..api import Plc
-    from .scenario_run import Signal
+
+
+class Watched(Protocol):
+    """What the runner's watch of one variable offers the lines that read it (scenario_run.Signal): its value after
+    the last scan, since when it has it, and the reactions and expectations to judge again when it changes."""
+    value: Any
+    since_ns: int
+    reactions: list[Reaction]
+    expects: list[Expect]
 
 
 class ScenarioError(ValueError):
@@ -73,7 +81,7 @@ class Expect:
     last: object = None
     since_ns: int = 0             # when ``last`` became the variable's value
     decided_ns: int | None = None
-    sig: Signal | None = None     # the watched Signal and the comparator, built by Runner
+    sig: Watched | None = None    # the watched variable and the comparator, built by Runner
     test: Callable[[Any], bool] = _not_built
 
 
@@ -84,7 +92,7 @@ class Term:
     op: str
     text: str
     value: object = None
-    sig: Signal | None = None     # the watched Signal and the comparator, built by Runner
+    sig: Watched | None = None    # the watched variable and the comparator, built by Runner
     test: Callable[[Any], bool] = _not_built
 
 
