@@ -3,13 +3,13 @@
 False = failed or could not run, a capture point refused by Vision_DoJob), Vision_GetOutputArraySize /
 Vision_GetOutputArrayValue (§14.2: one row per object, an index outside the rows is an error); jobs set through
 the control channel and --vision-job."""
-import threading
+import json
 
 import pytest
 from session_rig import PTP_LONG, sct
 
 from tmsim.cli import build_parser, check_vision_jobs
-from tmsim.net.control import ControlChannel
+from tmsim.net.server import SimServer
 from tmsim.protocol import codec
 from tmsim.robot.camera import Camera, camera_of, parse_option
 
@@ -116,20 +116,18 @@ def test_a_bad_job_definition_is_refused_with_its_reason(kwargs, words):
 
 
 def test_the_control_channel_sets_and_removes_jobs_and_shows_the_camera():
-    class Robot:
-        model = type("M", (), {"camera": Camera()})()
-
-        def camera(self):
-            return camera_of(self.model)
-    channel = ControlChannel.__new__(ControlChannel)
-    channel.server = type("Server", (), {"lock": threading.Lock()})()
-    robot = Robot()
-    answer = channel._vision_job(robot, {"job": "job1", "objects": PARTS, "pass": True, "seconds": 0.3})
-    assert answer["objects"][1] == [300, 60, 5, 0, 0, 90] and answer["variable"] == "job1_Base_TM"
-    assert channel._vision(robot, {})["jobs"][0]["job"] == "job1"
-    assert channel._vision_remove(robot, {"job": "job1"}) is True
-    with pytest.raises(ValueError, match="'objects'"):
-        channel._vision_job(robot, {"job": "job1", "objects": "x"})
+    srv = SimServer(port=0, control_port=0).start()
+    try:
+        def ask(request):
+            return srv.control.execute(json.dumps(request).encode())
+        answer = ask({"cmd": "vision_job", "job": "job1", "objects": PARTS, "pass": True, "seconds": 0.3})["result"]
+        assert answer["objects"][1] == [300, 60, 5, 0, 0, 90] and answer["variable"] == "job1_Base_TM"
+        assert ask({"cmd": "vision"})["result"]["jobs"][0]["job"] == "job1"
+        assert ask({"cmd": "vision_remove", "job": "job1"}) == {"ok": True, "result": True}
+        refused = ask({"cmd": "vision_job", "job": "job1", "objects": "x"})
+        assert refused["ok"] is False and "'objects'" in refused["error"], refused
+    finally:
+        srv.close()
 
 
 def test_the_start_up_option_defines_jobs_and_names_a_bad_one():
