@@ -16,6 +16,7 @@ Reserved shapes (ST identifiers can take none of them, so generated names never 
 from __future__ import annotations
 
 import re
+from typing import Any, Protocol
 
 # ---- cells the runtime creates in each image's namespace (one-element lists: shared, mutable) ---------------
 DEADLINE = "_DL"               # [perf_counter() deadline of the running scan]; math.inf between scans
@@ -98,3 +99,12 @@ def is_declared(name: str) -> bool:
     if m is not None:
         return m["prefix"] in TEMP_PREFIXES or m["prefix"] in CONST_PREFIXES
     return not name.startswith("_")
+
+
+class LoadedCode(Protocol):
+    """What the engine needs of one loaded copy of generated code (``program.Image``): the namespace it runs in
+    (the cells above live there) and the map from generated line numbers to ST ``(file, line)``."""
+    namespace: dict[str, Any]
+
+    @property
+    def linemap(self) -> dict: ...

@@ -26,7 +26,6 @@ from .sockets import SocketManager
 
 if TYPE_CHECKING:
     from .motion import MotionController
-    from .program import Image
 
 
 @dataclass
@@ -68,7 +67,7 @@ def _forget(callback: Callable[[str, dict], None]) -> None:
 
 
 class Engine:
-    def __init__(self, module: Image, *, watchdog_ns: int = 500_000_000, socket_limit: int = 30,
+    def __init__(self, module: abi.LoadedCode, *, watchdog_ns: int = 500_000_000, socket_limit: int = 30,
                  socket_latency_ns: int = 0, clock_base_ns: int | None = None) -> None:
         self.module = module
         self.tasks: list[Task] = []
