@@ -197,7 +197,7 @@ def test_fixed_scale_zoom_buttons_labelled_grid_and_the_arm(page, size):
     assert grid in (100, 200, 500)
     arm = json.loads(b.driver.find_element(By.ID, "view-side").get_attribute("data-arm"))
     assert len(arm) == 8, "base, six joint frames and the TCP"
-    frames = kinematics._frames(JOINTS)
+    frames = kinematics.link_frames(JOINTS)
     side = b.driver.find_element(By.ID, "view-side")
     s, w, h = scale(), side.get_attribute("width"), side.get_attribute("height")
     for (px, py), f in zip(arm[1:7], frames[1:], strict=False):   # drawn where the simulator puts the joints (Y-Z)

@@ -81,8 +81,9 @@ def matrix_to_pose(m: Sequence[Sequence[float]]) -> list[float]:
     return [m[0][3], m[1][3], m[2][3], math.degrees(rx), math.degrees(ry), math.degrees(rz)]
 
 
-def _frames(joints):
-    """Base-to-link transforms T0 (identity) .. T6 (flange); each step is T(i-1) * DH(i), unrolled."""
+def link_frames(joints: Sequence[float]) -> list[list[list[float]]]:
+    """Base-to-link transforms T0 (identity) .. T6 (flange) of ``joints`` (degrees), 4x4 matrices in mm: where
+    each joint of the arm is (a view draws the arm from them). Each step is T(i-1) * DH(i), unrolled."""
     rows: Sequence[tuple[float, float, float, float]] = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0),
                                                          (0.0, 0.0, 1.0, 0.0))
     frames = [[list(r) for r in rows] + [[0.0, 0.0, 0.0, 1.0]]]
@@ -100,7 +101,7 @@ def _frames(joints):
 def forward(joints: Sequence[float], tool: Sequence[Sequence[float]] | None = None) -> list[list[float]]:
     """Flange (or TCP when ``tool`` matrix given) pose matrix in the robot base frame.
 
-    The loop of ``_frames`` without keeping the intermediate frames (same arithmetic)."""
+    The loop of ``link_frames`` without keeping the intermediate frames (same arithmetic)."""
     rows: Sequence[tuple[float, float, float, float]] = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0),
                                                          (0.0, 0.0, 1.0, 0.0))
     for i in range(6):
@@ -176,7 +177,7 @@ def _solve(jac, err, damping):
 def _ik_from(seed, target, iterations=60):
     q = list(seed)
     for _ in range(iterations):
-        frames = _frames(q)
+        frames = link_frames(q)
         err = _error(frames[6], target)
         if math.sqrt(sum(e * e for e in err[:3])) < REACH_TOLERANCE_MM and max(abs(e) for e in err[3:]) < 1e-6:
             return q
