@@ -228,7 +228,7 @@ def test_a_client_leaving_mid_request_is_one_debug_line_not_a_traceback(server, 
     try:
         raise gone
     except OSError:
-        server._httpd.handle_error(None, ("127.0.0.1", 50123))
+        server.front.handle_error(None, ("127.0.0.1", 50123))
     assert capsys.readouterr().err == ""
     assert [r.getMessage() for r in caplog.records] == [
         f"HMI client 127.0.0.1:50123 left before the answer was sent ({type(gone).__name__})"]
@@ -236,4 +236,4 @@ def test_a_client_leaving_mid_request_is_one_debug_line_not_a_traceback(server, 
 
 def test_the_server_binds_with_address_reuse_so_a_restart_works_at_once(server):
     import socket
-    assert server._httpd.socket.getsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR)
+    assert server.front.socket.getsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR)

@@ -147,8 +147,8 @@ def test_600_idle_connections_do_not_lock_the_operator_out(mapping):
         while attack.connects < 600:
             threading.Event().wait(0.01)
         operator_is_served(server)
-        front = server._httpd
-        assert len(front._connections) <= SHORT.connections and front.evicted >= 600 - SHORT.per_client
+        front = server.front
+        assert front.open_connections <= SHORT.connections and front.evicted >= 600 - SHORT.per_client
 
 
 def test_a_client_address_holds_at_most_its_share_of_connections(mapping):
@@ -160,10 +160,10 @@ def test_a_client_address_holds_at_most_its_share_of_connections(mapping):
                   for _ in range(20)]
         try:
             closed = [sock for sock in others[:12] if sock.recv(1) == b""]      # the oldest 12 were closed
-            front = server._httpd
+            front = server.front
             client_counts = {}
             for _ in range(200):                            # the front end has taken every connection
-                client_counts = {client: len(held) for client, held in front._by_client.items()}
+                client_counts = front.connections_by_client()
                 if sum(client_counts.values()) == 9:
                     break
                 threading.Event().wait(0.01)
@@ -213,10 +213,10 @@ def test_a_client_that_does_not_take_its_answer_is_closed_at_the_send_deadline(m
         try:
             with socket.create_connection(("127.0.0.1", server.port), timeout=5) as sock:
                 sock.sendall(f"GET /large.js HTTP/1.0\r\nHost: 127.0.0.1:{server.port}\r\n\r\n".encode())
-                front = server._httpd
+                front = server.front
                 for held in (True, False):                  # until the front end has taken it, then given it up
                     for _ in range(500):
-                        if bool(front._connections) == held:
+                        if bool(front.open_connections) == held:
                             break
                         threading.Event().wait(0.01)
                 received = 0
@@ -226,4 +226,4 @@ def test_a_client_that_does_not_take_its_answer_is_closed_at_the_send_deadline(m
             status, _ = Client(f"http://127.0.0.1:{server.port}").json("/api/read?names=Stop_Busy")
         finally:
             server.stop()
-    assert not front._connections and 0 < received < size and status == 200
+    assert not front.open_connections and 0 < received < size and status == 200

@@ -143,6 +143,16 @@ class HttpFront:
         self._next_due = math.inf                # no deadline of a waiting connection is earlier than this
         self.evicted = self.refused = 0          # connections closed to make room / refused with 503 (counters)
 
+    # --- what is open (for monitoring: read from any thread, a snapshot of a moment) ---------------------------
+    @property
+    def open_connections(self) -> int:
+        """Connections open now: waiting for their request, being answered or sending their answer."""
+        return len(self._connections)
+
+    def connections_by_client(self) -> dict[str, int]:
+        """Open connections per client address (addresses with none are absent)."""
+        return {client: len(held) for client, held in list(self._by_client.items())}
+
     # --- the front-end thread ------------------------------------------------------------------------------
     def serve_forever(self) -> None:
         try:

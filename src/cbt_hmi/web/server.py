@@ -115,6 +115,12 @@ class HmiServer:
         self.alarms = AlarmSystem(plc, self.mapping, alarm_log, clock=clock)
 
     @property
+    def front(self) -> HttpFront | None:
+        """The HTTP front end while the server runs (None before start() and after stop()): its listening
+        ``socket``, ``open_connections``, ``connections_by_client()`` and the counters ``evicted`` / ``refused``."""
+        return self._httpd
+
+    @property
     def port(self) -> int:
         return self._httpd.server_address[1] if self._httpd else self.requested_port
 
