@@ -41,6 +41,9 @@ class FakePlc:
         self.task_every = 1               # the task runs in every n-th scan only
         self.program = program
         self.writes: list[tuple[str, object]] = []
+        # command_program's memory: the Execute each group's fake FB saw in the last scan (a group set TRUE here
+        # with its Execute TRUE is "held": no rising edge, the fake FB does nothing)
+        self.executes_seen: dict[str, bool] = {}
         types = mapping.document["types"]
         self.vars = {}
         self.types = {}
@@ -101,7 +104,7 @@ class FakePlc:
 
 def command_program(plc: FakePlc) -> None:
     """Every <Group>_Execute rising edge turns into Done on the next scan, like a quick FB."""
-    state = plc.__dict__.setdefault("_edges", {})
+    state = plc.executes_seen
     for name in [n for n in plc.vars if n.endswith("_Execute") and n != "PnP_Example_Execute"]:
         group = name[: -len("_Execute")]
         execute = plc.vars[name]

@@ -37,7 +37,7 @@ class Stack:
         self.plc.vars.update(Connect_Execute=True, Connect_Connected=True, Robot_InListenNode=True,
                              RobotStatus_Valid=True)
         self.plc.vars["RobotStatus"].update(ProjectRunning=True, AutoMode=True, ProjectSpeed=100)
-        self.plc._edges = {"Connect": True}
+        self.plc.executes_seen = {"Connect": True}
         self.log_path = log_path
         self.stop_scanning = threading.Event()
         self.thread = threading.Thread(target=self._scan, daemon=True)

@@ -179,7 +179,7 @@ def test_a_first_connect_retried_is_not_called_a_lost_link(plant):
     plc, _, _ = plant
     plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=1, Connect_Error=True,
                     Connect_ErrorID=0x2004, Connect_ErrorDescrip="Robot not reachable")
-    plant[1]._was_connected = False
+    plant[1].forget_connection()
     alarm = step(plant, times=int(ON_DELAY_S / 0.1) + 2)["alarms"][0]
     assert alarm["text"] == "Not connected to the robot, retrying (attempt 1) — Robot not reachable"
 

@@ -196,8 +196,8 @@ def test_a_first_connect_retried_is_not_called_a_lost_connection(page, stack):
         plc.vars.update(Connect_Execute=True, Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=1,
                         Connect_Error=True, Connect_ErrorID=0x2004, Connect_ErrorDescrip="Robot not reachable",
                         Robot_InListenNode=True)
-        plc._edges = {"Connect": True}                # the fake program must not connect it: Execute is "held"
-    stack[1].alarms._was_connected = False            # as after a start: the tests before connected
+        plc.executes_seen = {"Connect": True}          # the fake program must not connect it: Execute is "held"
+    stack[1].alarms.forget_connection()                # as after a start: the tests before connected
     browser = open_page("index")
     try:
         browser.wait_for(lambda d: any("Not connected to the robot, retrying (attempt 1)" in r

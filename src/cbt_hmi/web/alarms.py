@@ -232,6 +232,12 @@ class AlarmSystem:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
+    def forget_connection(self) -> None:
+        """From now on, until the robot is connected again, a connect that fails is "Not connected to the robot"
+        (retrying), not "Connection to the robot lost": for a PLC whose program was restarted (a new first
+        connect) while the HMI kept running."""
+        self._was_connected = False
+
     # --- sampling ------------------------------------------------------------------------------
     def start(self) -> None:
         self.history.start()
