@@ -226,12 +226,7 @@ def test_a_silent_ethernet_slave_is_16_2021_before_and_16_3007_after_sending(var
 
 
 def test_an_answer_that_is_not_the_variable_asked_for_is_16_3008(var):
-    session = var.robot.svr
-    real = session._content
-
-    def other_item(mode, names):
-        return real(mode, ["g_ratio" if n == "g_count" else n for n in names])
-    session._content = other_item
+    var.robot.svr.inject("answer_other_item", item="g_count", instead="g_ratio")
     variable(var, "RdVar", "g_count", "VarInt")
     assert run(var, "rd", "RdExec") == (False, 0x3008)
 

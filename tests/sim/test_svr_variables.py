@@ -82,6 +82,30 @@ def test_a_variable_may_be_streamed_in_the_data_table(h):
     assert peer.frames[0].data.endswith(b",2,Robot_Link=1\r\ng_count=5\r\nProject_Speed=100")
 
 
+def test_fault_answer_other_item_answers_a_read_with_another_item_until_cleared(h):
+    """A robot that answers another item than the one asked for (the library's 16#3008): the other item's name and
+    value stand in the answer; clear_faults() ends it; what names no item is refused with the parameter named."""
+    peer = h.connect_svr()
+    h.srv.svr.inject(h.robot, "answer_other_item", item="g_count", instead="g_ratio")
+    assert ask(h, peer, "Q1,12,g_count\r\ng_ok") == b"Q1,12,g_ratio=0.5\r\ng_ok=true"
+    h.srv.svr.clear_faults(h.robot)
+    assert ask(h, peer, "Q2,12,g_count\r\ng_ok") == b"Q2,12,g_count=5\r\ng_ok=true"
+    for params, words in [({"item": "g_none", "instead": "g_ratio"}, "'item' of fault 'answer_other_item'"),
+                          ({"item": "g_count"}, "'instead' of fault 'answer_other_item'"),
+                          ({"item": "g_count", "instead": ["g_ratio"]}, "'instead' of fault"),
+                          ({"item": "g_count", "instead": "g_ratio", "count": 1}, "has no parameter count")]:
+        with pytest.raises(ValueError, match=words):
+            h.srv.svr.inject(h.robot, "answer_other_item", **params)
+
+
+def test_fault_answer_other_item_also_stands_in_the_data_table(h):
+    h.robot.svr.configure(items=["g_count", "Project_Speed"], mode=2, period=0.1)
+    h.srv.svr.inject(h.robot, "answer_other_item", item="g_count", instead="g_ratio")
+    peer = h.connect_svr()
+    assert h.until(lambda: peer.frames, timeout=1)
+    assert peer.frames[0].data.endswith(b",2,Robot_Link=1\r\ng_ratio=0.5\r\nProject_Speed=100")
+
+
 @pytest.mark.parametrize("spec,message", [
     ("g_x", "expected NAME:TYPE[:ACCESS][=VALUE]"),
     ("g x:int", "1..64 letters, digits or '_'"),

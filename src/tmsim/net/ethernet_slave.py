@@ -172,7 +172,8 @@ class EthernetSlave:
         ``corrupt_checksum`` (count=1): the next frames leave with a wrong checksum;
         ``disconnect``: every Ethernet Slave client of the robot is closed now;
         ``refuse_writes`` (status=6): every well-formed write is answered with that status code (1..7), nothing is
-        written. ValueError when unknown."""
+        written; ``answer_other_item`` (item, instead): ``instead`` is sent wherever ``item`` would be.
+        ValueError when unknown."""
         service = _service(robot)
         service.session.inject(fault, **params)   # checks the fault and its parameters; arms the protocol's
         if fault == "disconnect":                 # ... the sockets are this adapter's

@@ -51,7 +51,7 @@ DEFAULT_STREAM = (
 
 
 # fault injection (docs/simulator.md); clear_faults() ends them
-FAULTS = ("stall", "corrupt_checksum", "disconnect", "refuse_writes")
+FAULTS = ("stall", "corrupt_checksum", "disconnect", "refuse_writes", "answer_other_item")
 
 
 class SvrConfigError(ValueError):
@@ -87,6 +87,7 @@ class SvrSession:
         self.stalled = False      # fault "stall": no data table, requests read and dropped unanswered
         self.corrupt = 0          # fault "corrupt_checksum": this many more frames leave with a wrong checksum
         self.refuse = 0           # fault "refuse_writes": every well-formed write is answered with this status
+        self.swap: tuple[str, str] | None = None   # fault "answer_other_item": (item, the item sent in its place)
 
     def configure(self, items: Iterable[str] | None = None, mode: int | None = None, period: float | None = None,
                   write_permission: bool | None = None) -> None:
@@ -164,12 +165,14 @@ class SvrSession:
     def inject(self, fault: str, **params: Any) -> None:
         """``stall`` (enabled=True): no data table and no answers, connections stay open; ``corrupt_checksum``
         (count=1): the next frames leave with a wrong checksum; ``refuse_writes`` (status=6): every well-formed
-        write is answered with that status code (1..7), nothing is written. (``disconnect`` closes sockets: the
-        TCP adapter's.) ValueError naming what is unknown or out of range."""
+        write is answered with that status code (1..7), nothing is written; ``answer_other_item`` (item, instead):
+        every frame that would carry ``item`` (a read's answer, the data table) carries ``instead``, its name and
+        value, in its place. (``disconnect`` closes sockets: the TCP adapter's.) ValueError naming what is unknown
+        or out of range."""
         if fault not in FAULTS:
             raise ValueError(f"unknown Ethernet Slave fault '{fault}'; known: {', '.join(FAULTS)}")
         unknown = set(params) - {"stall": {"enabled"}, "corrupt_checksum": {"count"}, "disconnect": set(),
-                                 "refuse_writes": {"status"}}[fault]
+                                 "refuse_writes": {"status"}, "answer_other_item": {"item", "instead"}}[fault]
         if unknown:
             raise ValueError(f"Ethernet Slave fault '{fault}' has no parameter {', '.join(sorted(unknown))}")
         if fault == "stall":
@@ -184,9 +187,16 @@ class SvrSession:
             if type(status) is not int or not 1 <= status <= 7:
                 raise ValueError(f"'status' of fault 'refuse_writes' must be 1..7 (a §17.4.1 code), got {status!r}")
             self.refuse = status
+        elif fault == "answer_other_item":
+            for key in ("item", "instead"):
+                name = params.get(key)
+                if not isinstance(name, str) or name not in self.items:
+                    raise ValueError(f"'{key}' of fault 'answer_other_item' must name an item or a declared "
+                                     f"variable, got {params.get(key)!r}")
+            self.swap = (params["item"], params["instead"])
 
     def clear_faults(self) -> None:
-        self.stalled, self.corrupt, self.refuse = False, 0, 0
+        self.stalled, self.corrupt, self.refuse, self.swap = False, 0, 0, None
 
     def _send(self, conn, data):
         self._out(conn, codec.encode("TMSVR", data))
@@ -224,6 +234,9 @@ class SvrSession:
             self._out(conn, frame)
 
     def _content(self, mode, names) -> bytes:
+        if self.swap is not None:
+            asked, instead = self.swap
+            names = [instead if name == asked else name for name in names]
         variables = self.variables
         values = self.source.values([name for name in names if name not in variables]) if variables else \
             self.source.values(names)
