@@ -224,6 +224,7 @@ def delay_data_tables(rig, hold):
     """The robot's Ethernet Slave output is held back while hold(now) is TRUE, then delivered one frame per
     simulator poll: tables that left the robot before an event arrive after the Listen-node close."""
     slave = rig.srv.svr
+    # no seam fits: the hold ends on an event of the other port and the release interleaves the two ports poll by poll
     original = slave._flush
 
     def flush(robot):
