@@ -186,8 +186,9 @@ INT_CASES = [(name, params, position) for name, (_queued, entries) in sorted(tms
 @pytest.mark.parametrize("name,params,position", INT_CASES)
 def test_manual_2_2_a_value_outside_int_in_any_int_parameter_is_an_error_of_its_line(name, params, position, bad):
     """docs/simulator.md "Limits": a float outside int converted to int is ERROR;n - for variables and, in one
-    place (tmsim.tmscript.interp._arguments), for every int parameter of every function: Sleep(1e30) once waited 10^27 s
-    and the robot served no script after it. A decimal constant beyond int is a float constant [MAN 2.24 §2.2]."""
+    place (the interpreter's argument conversion), for every int parameter of every function: Sleep(1e30) once
+    waited 10^27 s and the robot served no script after it. A decimal constant beyond int is a float constant
+    [MAN 2.24 §2.2]."""
     node = node_of("2.24")
     script = _call_with(name, params, position, bad)
     assert reply(node, script) == ok("ERROR;1"), script
