@@ -7,7 +7,7 @@ import os
 from collections.abc import Iterable
 from typing import Any
 
-from .checker import calls, recursion
+from .checker import calls, recursion, sysmac_identifiers
 from .checker import portable as portable_rule
 from .checker.body import BodyChecker
 from .checker.context import Context, Unit
@@ -230,6 +230,7 @@ def check_units(ctx: Context, proj: Project) -> None:
         if pou.kind == "PROGRAM" and not getattr(unit, "in_prelude", False):
             proj.programs.append(pt)
     recursion.check(ctx, edges)
+    sysmac_identifiers.check(ctx)
     for cfg, unit in ctx.configurations:
         check_configuration(ctx, cfg, unit)
     proj._tables = ctx.tables

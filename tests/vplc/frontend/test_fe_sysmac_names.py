@@ -137,3 +137,20 @@ def test_system_data_types_of_unmodelled_instructions_are_st1007(tmp_path):
     assert [d.code for d in errors] == ["ST1007"] * 3
     assert "Sysmac system-defined data type `_sTimer` (W560 2-152, Timer) is not modelled by vplc" \
         in errors[0].message
+
+
+def test_names_sysmac_studio_does_not_accept_are_st1011_in_sysmac_only(tmp_path):
+    """W501 6-3-12: no name may start with P_ (Studio silently renamed a PROGRAM P_SIM_ROBOT to PR_SIM_ROBOT in a
+    published project) or an underline, end with an underline or hold two underlines in a row. Names with single
+    underlines inside (TCP_Status_Inst) are fine; the prelude's own names are not checked."""
+    src = ("TYPE eMode_ : (Idle, _Run); stP : STRUCT P_X : INT; END_STRUCT; END_TYPE\n"
+           "VAR_GLOBAL Part__Count : INT; END_VAR\n"
+           "PROGRAM P_Main\nVAR_EXTERNAL Part__Count : INT; END_VAR\n"
+           "VAR TCP_Status_Inst : INT; _x : INT; y_ : INT; s : _sSOCKET; END_VAR\n"
+           "TCP_Status_Inst := _x + y_ + Part__Count; IF P_First_Run THEN s.Handle := 0; END_IF;\nEND_PROGRAM\n")
+    proj = check_text(tmp_path, src)
+    found = sorted(d.message.split("`")[1] for d in proj.diagnostics if d.code == "ST1011")
+    assert found == ["P_Main", "P_X", "Part__Count", "_Run", "_x", "eMode_", "y_"]
+    assert codes(proj, "error") == ["ST1011"] * 7
+    assert "program `P_Main` starts with `P_`" in next(d.message for d in proj.diagnostics if "P_Main" in d.message)
+    assert "ST1011" not in codes(check_text(tmp_path, src, "iec.st", dialect="iec"))
