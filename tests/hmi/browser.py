@@ -39,9 +39,10 @@ class Browser:
             options.add_argument(flag)
         self.driver = webdriver.Chrome(options=options, service=Service(paths[1]))
         self.driver.set_window_size(800, 480)
-        self._fit()
+        self.fit()
 
-    def _fit(self):
+    def fit(self) -> None:
+        """Size the window so that the page itself is 800 x 480 (the 9-inch panel), whatever the frame takes."""
         dw, dh = self.driver.execute_script(
             "return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
         self.driver.set_window_size(800 + dw, 480 + dh)
@@ -55,7 +56,7 @@ class Browser:
         self.driver.switch_to.window(old)
         self.driver.close()
         self.driver.switch_to.window(new)
-        self._fit()
+        self.fit()
         return self
 
     def close(self):

@@ -169,7 +169,7 @@ def test_alarm_rows_are_touch_targets_and_main_cuts_no_text_while_alarms_stand(b
     finally:
         stack.set(MoveAbs_Error=False, MoveAbs_ErrorID=0, RS_EStop=False, RS_RobotError=False, RS_ErrorText="",
                   Robot_InListenNode=True)
-        browser._fit()
+        browser.fit()
 
 
 def test_acknowledge_is_shared_by_two_browser_sessions(browser, stack):

@@ -55,7 +55,7 @@ needs_chromium = pytest.mark.skipif(chromium_paths() is None, reason="chromium/c
 @pytest.fixture
 def browser(chromium):
     yield chromium
-    chromium._fit()
+    chromium.fit()
 
 
 def sized(browser, size):

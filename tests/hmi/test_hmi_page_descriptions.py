@@ -121,7 +121,7 @@ def sized(browser, size):
 @pytest.fixture
 def browser(chromium):
     yield chromium
-    chromium._fit()
+    chromium.fit()
 
 
 @needs_chromium

@@ -44,7 +44,7 @@ def stack(chromium):
             plc.vars["RobotStatus_Valid"] = True
             plc.vars["RobotStatus"]["ProjectRunning"] = True
         yield plc, server, chromium
-    chromium._fit()
+    chromium.fit()
 
 
 def open_sized(stack, name: str, role: str, size):
@@ -109,7 +109,7 @@ def ladder_stack(chromium):
     plc = load_plc([str(root / "lib" / "CBT_Commands_Lib"), str(root / "examples")])
     with serving(plc, Mapping.load()) as server:
         yield plc, server, chromium
-    chromium._fit()
+    chromium.fit()
 
 
 @pytest.mark.parametrize("size", SIZES, ids=["800x480", "1280x800"])

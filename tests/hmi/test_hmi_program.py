@@ -151,7 +151,7 @@ def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(
     finally:
         with plc.lock:
             plc.write("Connect_Execute", False)
-        browser._fit()
+        browser.fit()
 
 
 def test_the_coils_stand_in_one_column_at_the_right_rail_in_every_rung(system):

@@ -40,7 +40,7 @@ def stack(chromium):
     mapping = Mapping.load()
     with scanning(FakePlc(mapping, command_program)) as plc, serving(plc, mapping) as server:
         yield plc, server, chromium
-    chromium._fit()
+    chromium.fit()
 
 
 @pytest.fixture
@@ -61,7 +61,7 @@ def page(stack):
         browser.wait_for(lambda _d: _d.execute_script("return ARM.data !== null"), "the arm data")
         return browser
     yield plc, server, open_page
-    browser._fit()
+    browser.fit()
 
 
 def js(b, script, *args):
