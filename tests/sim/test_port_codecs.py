@@ -1,15 +1,25 @@
 """The simulator's three ports through their protocol objects' byte interface, with no socket (issue 22 step 2,
 pymodbus discipline): the Listen node (ListenSession and its ListenProtocol), the Ethernet Slave (SvrSession) and
-the control channel (tmsim.protocol.control) each get the same byte stream whole, split in two at every position,
-byte by byte and glued into one piece, and answer the same in every case. A port's answers may not depend on how
-TCP cut its input."""
+the control channel (ControlProtocol, answering through the channel's command table) each get the same byte
+stream whole, split in two at every position, byte by byte and glued into one piece, and answer the same in
+every case. A port's answers may not depend on how TCP cut its input."""
 import json
 
 import pytest
 from sim_harness import Harness
 
+from tmsim.limits import CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_PIECES, CONTROL_TURN_REQUESTS
 from tmsim.protocol import codec
-from tmsim.protocol.control import RequestError, decode_request, next_line
+from tmsim.protocol.control import (
+    CLOSED,
+    INPUT_DONE,
+    INPUT_LEFT,
+    ControlProtocol,
+    RequestError,
+    Streamed,
+    decode_request,
+    next_line,
+)
 from tmsim.protocol.listen_protocol import ListenProtocol
 from tmsim.tmscript.work import WorkMeter
 
@@ -25,7 +35,7 @@ def feeds(stream: bytes, frames: list[bytes]):
 
 @pytest.fixture(scope="module")
 def h():
-    harness = Harness(svr_port=0, svr_options={"period": 0})
+    harness = Harness(svr_port=0, svr_options={"period": 0}, control_port=0)
     yield harness
     harness.close()
 
@@ -115,8 +125,100 @@ def test_the_ethernet_slave_answers_the_same_however_its_input_is_cut(h):
 
 
 # ---- control channel (JSON lines) -------------------------------------------------------------------------
-CONTROL = [b'{"cmd": "ping"}\n', b'{"cmd": "state", "robot": 0}\n', b'{"cmd": "ping", "robt": 0}\n',
-           b'not json\n', b'{"cmd": "set_input", "name": "End_DI0", "value": 1}\n']
+CONTROL = [b'{"cmd": "ping"}\n', b'{"cmd": "vision", "robot": 0}\n', b'{"cmd": "ping", "robt": 0}\n',
+           b'not json\n', b'{"cmd": "set_input", "name": "End_DI0", "value": 0}\n']
+
+
+def _keep(_conn):
+    """A ``flush`` whose socket takes nothing: every answer stays in the protocol until data_to_send."""
+    return True
+
+
+def _serve(protocol, conn, chunks, execute):
+    """Feed ``chunks`` to connection ``conn`` as a server would (each read, then turns until none is left)
+    and return the answer bytes; the connection is left connected."""
+    for chunk in chunks:
+        protocol.receive_data(conn, chunk)
+        while protocol.turn(conn, execute, _keep) == INPUT_LEFT:
+            pass
+    assert protocol.input_bytes(conn) == 0
+    return bytes(protocol.data_to_send(conn))
+
+
+def test_the_control_channel_answers_the_same_however_its_input_is_cut(h):
+    """ControlProtocol fed through the channel's command table: the five requests (more than one turn
+    takes) get the same five answers whether they come whole, split anywhere, byte by byte or glued."""
+    stream = b"".join(CONTROL)
+    protocol, answers = ControlProtocol(lambda kind, **fields: None), {}
+    for conn, (name, chunks) in enumerate(feeds(stream, CONTROL)):
+        protocol.connect(conn)
+        answers[name] = _serve(protocol, conn, chunks, h.srv.control.execute)
+        protocol.disconnect(conn)
+    whole = [json.loads(line) for line in answers["whole"].splitlines()]
+    assert [answer["ok"] for answer in whole] == [True, True, False, False, True]
+    assert whole[0]["result"] == "pong" and whole[1]["result"]["jobs"] == [] and whole[4]["result"] is None
+    assert "unknown field 'robt'" in whole[2]["error"] and "one JSON object" in whole[3]["error"]
+    assert {name: answer for name, answer in answers.items() if answer != answers["whole"]} == {}
+
+
+def _echo(line):
+    return {"ok": True, "result": decode_request(line)}
+
+
+def test_a_control_turn_answers_at_most_its_requests_and_leaves_the_rest_for_the_next():
+    protocol = ControlProtocol(lambda kind, **fields: None)
+    protocol.connect(1)
+    protocol.receive_data(1, b'{"cmd": "ping"}\n' * (CONTROL_TURN_REQUESTS + 2) + b'{"cmd": "pi')
+    assert protocol.turn(1, _echo, _keep) == INPUT_LEFT
+    assert protocol.data_to_send(1).count(b"\n") == CONTROL_TURN_REQUESTS
+    assert protocol.turn(1, _echo, _keep) == INPUT_DONE
+    assert protocol.data_to_send(1).count(b"\n") == 2 and protocol.input_bytes(1) == len(b'{"cmd": "pi')
+
+
+def test_a_control_line_too_long_is_answered_and_ends_the_client():
+    events = []
+    protocol = ControlProtocol(lambda kind, **fields: events.append((kind, fields)))
+    protocol.connect(1)
+    protocol.receive_data(1, b"x" * (CONTROL_LINE_MAX + 1))
+    assert protocol.turn(1, _echo, _keep) == INPUT_DONE and protocol.closing(1) and not protocol.finished(1)
+    answer = json.loads(protocol.data_to_send(1))
+    assert answer == {"ok": False, "error": f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed"}
+    assert protocol.finished(1) and events == [("control_closed", {"reason": "request line too long"})]
+
+
+def test_a_control_client_that_reads_no_answers_is_ended_at_the_outbox_bound():
+    """Answers of 1 MiB, none taken by the socket: one a turn (CONTROL_TURN_BYTES), and the client is ended
+    when an answer is due while more than CONTROL_OUTBOX_MAX bytes wait; what it was not given is handed back
+    with ``unsent`` and counts."""
+    events = []
+    protocol = ControlProtocol(lambda kind, **fields: events.append(fields["reason"]))
+    protocol.connect(1)
+    protocol.receive_data(1, b'{"cmd": "ping"}\n' * 10)
+    big = {"ok": True, "result": "x" * (1 << 20)}
+    pending = protocol.data_to_send(1)
+    turns = 0
+    while protocol.turn(1, lambda line: big, _keep) == INPUT_LEFT:
+        turns += 1
+        protocol.unsent(1, protocol.data_to_send(1))       # the socket took none of it
+    assert turns == CONTROL_OUTBOX_MAX // (1 << 20) and not protocol.is_connected(1) and pending == b""
+    assert events == [f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)"]
+    assert protocol.turn(1, _echo, _keep) == CLOSED
+
+
+def test_a_streamed_control_answer_is_encoded_over_several_turns_and_handed_out_whole():
+    numbers = list(range(5 * CONTROL_TURN_PIECES))
+    protocol = ControlProtocol(lambda kind, **fields: None)
+    protocol.connect(1)
+    protocol.receive_data(1, b'{"cmd": "state"}\n{"cmd": "ping"}\n')
+    answers = iter([Streamed(ok=True, result=numbers), {"ok": True, "result": "pong"}])
+    turns, out = 0, bytearray()
+    while protocol.turn(1, lambda line: next(answers), _keep) == INPUT_LEFT:
+        turns += 1
+        assert protocol.data_to_send(1) == b""                  # never part of an answer
+    out += protocol.data_to_send(1)
+    assert turns >= 4
+    assert [json.loads(line) for line in out.splitlines()] == [{"ok": True, "result": numbers},
+                                                                {"ok": True, "result": "pong"}]
 
 
 def _requests(chunks):
@@ -138,7 +240,7 @@ def _requests(chunks):
 
 def test_the_control_channel_reads_the_same_requests_however_its_input_is_cut():
     stream = b"".join(CONTROL)
-    expected = [{"cmd": "ping"}, {"cmd": "state", "robot": 0}]
+    expected = [{"cmd": "ping"}, {"cmd": "vision", "robot": 0}]
     for name, chunks in feeds(stream, CONTROL):
         requests = _requests(chunks)
         assert requests[:2] == expected, name

@@ -37,29 +37,26 @@ import json
 import math
 import selectors
 import socket
-from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 from tmsim.limits import (
     CONTROL_ANSWER_BYTES,
     CONTROL_CLIENTS_MAX,
     CONTROL_EVENTS_MAX,
-    CONTROL_LINE_MAX,
-    CONTROL_OUTBOX_MAX,
     CONTROL_TURN_BYTES,
-    CONTROL_TURN_PIECES,
-    CONTROL_TURN_REQUESTS,
 )
 from tmsim.net.tcp_listener import Listener, receive
 from tmsim.protocol.control import (
+    CLOSED,
+    INPUT_LEFT,
+    ControlProtocol,
     RequestError,
+    Streamed,
     bool_field,
     decode_request,
-    encode_answer,
     error_answer,
     fault_params,
     int_field,
-    next_line,
     operation_mode,
     plc_time,
     show,
@@ -73,28 +70,11 @@ if TYPE_CHECKING:
     from tmsim.net.server import SimServer
 
 
-class _Client:
-    __slots__ = ("sock", "rbuf", "wbuf", "closing", "encoding", "pieces")
-
-    def __init__(self, sock: socket.socket):
-        self.sock = sock
-        self.rbuf = bytearray()
-        self.wbuf = bytearray()
-        self.closing = False
-        self.encoding: Iterator[str] | None = None    # the pieces of a large answer still to encode (an iterator)
-        self.pieces: list[str] = []         # ... and those encoded so far
-
-
-class _Streamed(dict):
-    """An answer that is encoded a piece at a time over several turns (``ControlChannel._encode_more``):
-    a ``state`` whose variables hold more than CONTROL_TURN_BYTES (500 arrays of 2,048 numbers encode in
-    ~0.4 s, which no turn may take)."""
-
-
-_PIECES = json.JSONEncoder(allow_nan=False, ensure_ascii=False)
-
-
 class ControlChannel:
+    """The control channel's TCP adapter and its table of commands: the sockets, the selector, the round robin
+    of the clients' turns; the bytes, the bounds and the turns' contents are the ControlProtocol's
+    (tmsim/protocol/control.py)."""
+
     def __init__(self, server: SimServer, host: str = "127.0.0.1", port: int = 0):
         self.server = server
         server.handle("control_listen", self._accept)
@@ -103,9 +83,11 @@ class ControlChannel:
                                  "open the control channel on {where}")
         self.host = host
         self.port = self.listener.port
-        self.clients: dict[socket.socket, _Client] = {}
-        self.backlog: dict[socket.socket, _Client] = {}      # clients with requests left after their turn
+        self.protocol = ControlProtocol(server.log_server)
+        self.clients: dict[int, socket.socket] = {}          # connection number -> its socket
+        self.backlog: dict[int, None] = {}                    # clients with requests left after their turn, in order
         self.turns_deferred = 0                               # turns that left requests for a later turn
+        self._next_conn = 0
         self._commands = {
             "ping": lambda robot, req: "pong",
             "robots": lambda robot, req: [{"robot": r.index, "port": r.port, "node_state": r.session.node_state(),
@@ -139,162 +121,100 @@ class ControlChannel:
             sock.close()
             return
         sock.setblocking(False)
-        self.clients[sock] = _Client(sock)
-        self.server.selector.register(sock, selectors.EVENT_READ, ("control_conn", None, sock))
+        self._next_conn += 1
+        conn = self._next_conn
+        self.clients[conn] = sock
+        self.protocol.connect(conn)
+        self.server.selector.register(sock, selectors.EVENT_READ, ("control_conn", None, conn))
 
     def tick(self, now: float) -> None:
         """Called once a poll: resume accepting after a pause."""
         self.listener.tick(now)
 
-    def _serve_client(self, _robot: None, sock: socket.socket) -> None:
+    def _serve_client(self, _robot: None, conn: int) -> None:
         """The socket is ready: write what waits, then read; the requests are answered in the client's turn
         (``serve_backlog``, right after in the same poll). A client who has requests left over from its
         last turn is not read meanwhile."""
-        client = self.clients.get(sock)
-        if client is None:
+        sock = self.clients.get(conn)
+        if sock is None:
             return
-        if client.wbuf and not self._write(client):
+        if self.protocol.output_bytes(conn) and not self._flush(conn):
             return
-        if client.closing or sock in self.backlog:
+        if self.protocol.closing(conn) or conn in self.backlog:
             return
         data, failed = receive(sock)
         if data is None and not failed:
             return
         if not data:
-            self._close(sock)
+            self._close(conn)
             return
-        client.rbuf += data
-        self.backlog[sock] = client             # its turn comes in serve_backlog, between the robots' turns
+        self.protocol.receive_data(conn, data)
+        self.backlog[conn] = None               # its turn comes in serve_backlog, between the robots' turns
 
-    def _turn(self, client: _Client) -> None:
-        """Answer at most CONTROL_TURN_REQUESTS requests of ``client``, and none more once the answers of this
-        turn reach CONTROL_TURN_BYTES (a turn is bounded in work: 15 clients each sending 64 KiB of requests
-        must not hold the robots' servers); the rest waits in ``backlog`` for the next turn."""
-        sock, answered, written = client.sock, 0, 0
-        self.backlog.pop(sock, None)
-        if client.encoding is not None and not self._encode_more(client):
-            self.backlog[sock] = client
+    def _turn(self, conn: int) -> None:
+        """One turn of the client ``conn`` (ControlProtocol.turn: bounded in requests, answer bytes and
+        encoding work); a client with requests left waits in ``backlog`` for its next turn."""
+        self.backlog.pop(conn, None)
+        outcome = self.protocol.turn(conn, self.execute, self._flush)
+        if outcome == INPUT_LEFT:
+            self.backlog[conn] = None
             self.turns_deferred += 1
-            return
-        while not client.closing:
-            line, used = next_line(client.rbuf)
-            if line is None:                    # no complete line yet (used == 0)
-                if len(client.rbuf) > CONTROL_LINE_MAX:
-                    client.closing = True
-                    self.server.log_server("control_closed", reason="request line too long")
-                    self._answer(client, error_answer(f"request line longer than {CONTROL_LINE_MAX} bytes; "
-                                                f"connection closed"))
-                break
-            if answered >= CONTROL_TURN_REQUESTS or written >= CONTROL_TURN_BYTES:
-                self.backlog[sock] = client
-                self.turns_deferred += 1
-                return
-            del client.rbuf[:used]
-            if len(line) > CONTROL_LINE_MAX:
-                client.closing = True
-                self.server.log_server("control_closed", reason="request line too long")
-                answer = error_answer(f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed")
-            else:
-                answer = self.execute(line)
-            before = len(client.wbuf)
-            if type(answer) is _Streamed:
-                if not self._outbox_room(client):
-                    return
-                client.encoding = _PIECES.iterencode(answer)
-                if not self._encode_more(client):
-                    self.backlog[sock] = client
-                    self.turns_deferred += 1
-                    return
-            elif not self._answer(client, answer):
-                return
-            answered += 1
-            written += max(0, len(client.wbuf) - before) or 1
-        if client.closing and not client.wbuf:
-            self._close(sock)
+        elif outcome == CLOSED:
+            self._close(conn)
 
     def serve_backlog(self) -> None:
         """One turn for every client with requests left over (round robin). A client that does not read its
-        answers piles them up and is closed at CONTROL_OUTBOX_MAX (``_answer``)."""
-        for sock, client in list(self.backlog.items()):
-            if sock not in self.clients:
-                self.backlog.pop(sock, None)
+        answers piles them up and is closed at CONTROL_OUTBOX_MAX (the protocol ends it)."""
+        for conn in list(self.backlog):
+            if conn not in self.clients:
+                self.backlog.pop(conn, None)
             else:
-                self._turn(client)
+                self._turn(conn)
                 self.server.breathe()          # the robots' sockets are served between two turns
 
     @property
     def has_backlog(self) -> bool:
         return bool(self.backlog)
 
-    def _outbox_room(self, client) -> bool:
-        """False (and the client closed) when CONTROL_OUTBOX_MAX bytes of earlier answers are still unread."""
-        if len(client.wbuf) > CONTROL_OUTBOX_MAX:
-            self._close(client.sock, f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)")
+    def _flush(self, conn: int) -> bool:
+        """Write what the socket takes of the client's answers (the rest goes back to the protocol and the
+        socket is watched for writing); False when the client is gone (a send failed, or the protocol ended it
+        and its last answer is out)."""
+        sock = self.clients.get(conn)
+        if sock is None:
             return False
-        return True
-
-    def _encode_more(self, client) -> bool:
-        """Encode the next pieces of a large answer: at most CONTROL_TURN_PIECES pieces and about
-        CONTROL_TURN_BYTES characters a turn. True when the answer is complete (and queued whole: the
-        client never sees part of one), False when the rest waits for the client's next turn."""
-        size = 0
+        data = self.protocol.data_to_send(conn)
         try:
-            for _ in range(CONTROL_TURN_PIECES):
-                piece = next(client.encoding, None)
-                if piece is None:
-                    client.wbuf += ("".join(client.pieces) + "\n").encode("utf-8")
-                    break
-                client.pieces.append(piece)
-                size += len(piece)
-                if size >= CONTROL_TURN_BYTES:
-                    return False
-            else:
-                return False
-        except ValueError as exc:           # e.g. a value JSON cannot carry
-            client.wbuf += encode_answer(error_answer(f"the answer cannot be written as JSON ({exc})"))
-        client.encoding, client.pieces = None, []
-        return self._write(client)
-
-    def _answer(self, client, answer) -> bool:
-        """Queue one answer and write what the socket takes; False when the client was closed. A client is
-        closed when CONTROL_OUTBOX_MAX bytes of earlier answers are still unread (one answer may be larger)."""
-        if not self._outbox_room(client):
-            return False
-        try:
-            client.wbuf += encode_answer(answer)
-        except ValueError as exc:           # e.g. a value JSON cannot carry
-            client.wbuf += encode_answer(error_answer(f"the answer cannot be written as JSON ({exc})"))
-        return self._write(client)
-
-    def _write(self, client) -> bool:
-        try:
-            sent = client.sock.send(client.wbuf)
+            sent = sock.send(data) if data else 0
         except (BlockingIOError, InterruptedError):
             sent = 0
         except OSError:
-            self._close(client.sock)
+            self._close(conn)
             return False
-        del client.wbuf[:sent]
-        events = selectors.EVENT_READ | (selectors.EVENT_WRITE if client.wbuf else 0)
-        key = self.server.selector.get_key(client.sock)
+        del data[:sent]
+        self.protocol.unsent(conn, data)
+        events = selectors.EVENT_READ | (selectors.EVENT_WRITE if data else 0)
+        key = self.server.selector.get_key(sock)
         if key.events != events:
-            self.server.selector.modify(client.sock, events, key.data)
-        if client.closing and not client.wbuf:
-            self._close(client.sock)
+            self.server.selector.modify(sock, events, key.data)
+        if self.protocol.finished(conn):
+            self._close(conn)
             return False
         return True
 
-    def _close(self, sock: socket.socket, reason: str | None = None) -> None:
-        self.backlog.pop(sock, None)
-        if self.clients.pop(sock, None) is not None and reason:
-            self.server.log_server("control_closed", reason=reason)
+    def _close(self, conn: int) -> None:
+        self.backlog.pop(conn, None)
+        self.protocol.disconnect(conn)
+        sock = self.clients.pop(conn, None)
+        if sock is None:
+            return
         with contextlib.suppress(KeyError, ValueError):
             self.server.selector.unregister(sock)
         sock.close()
 
     def close(self) -> None:
-        for sock in list(self.clients):
-            self._close(sock)
+        for conn in list(self.clients):
+            self._close(conn)
         self.listener.close()
 
     # ---- requests -----------------------------------------------------------------------------
@@ -314,7 +234,7 @@ class ControlChannel:
             if "plc_time" in request:
                 robot.log.event("control", cmd=name, plc_time=plc_time(request))
             result = command(robot, request)
-            return _Streamed(ok=True, result=result) if type(result) is _Streamed else {"ok": True, "result": result}
+            return Streamed(ok=True, result=result) if type(result) is Streamed else {"ok": True, "result": result}
         except (ValueError, TypeError, TransitionError) as exc:
             return error_answer(str(exc))
         except Exception as exc:          # noqa: BLE001 - a request never ends the simulator
@@ -323,7 +243,7 @@ class ControlChannel:
     @staticmethod
     def _state(robot: Robot) -> dict:
         state = robot.state()
-        return _Streamed(state) if robot.session.variable_bytes() > CONTROL_TURN_BYTES else state
+        return Streamed(state) if robot.session.variable_bytes() > CONTROL_TURN_BYTES else state
 
     def _svr_config(self, robot: Robot, request: dict) -> dict:
         session = _svr(robot).session

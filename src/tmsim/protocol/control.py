@@ -1,15 +1,34 @@
 """The control channel's protocol, sans-I/O: one JSON request object per line in, one JSON answer per line out
-(docs/simulator.md, "Control channel"). ``next_line(buf)`` frames the byte stream (``(line, consumed)``, 0 = need
-more, as the frame codecs do); ``decode_request(line)`` checks a line (JSON, nesting, fields) and the field
-checkers check each value, all raising RequestError with the answer's text; ``encode_answer`` writes an answer.
-The TCP adapter and the table of commands are tmsim/net/control.py."""
+(docs/simulator.md, "Control channel").
+
+``ControlProtocol`` has the shape of the simulator's other two ports (the Listen node's ListenProtocol, the
+Ethernet Slave's SvrSession): a server calls ``connect`` / ``receive_data(conn, bytes)`` / ``disconnect``, gives
+each client bounded turns (``turn(conn, execute, flush)``: the protocol frames the lines, hands each request line
+to ``execute`` and queues the answer it returns) and takes ``data_to_send(conn)``. The protocol owns each client's
+receive buffer, its unsent answers, the answers encoded a piece at a time over several turns (``Streamed``) and
+the bounds of tmsim/limits.py (CONTROL_LINE_MAX, CONTROL_OUTBOX_MAX, CONTROL_TURN_REQUESTS, CONTROL_TURN_BYTES,
+CONTROL_TURN_PIECES); it logs event ``control_closed`` when it ends a client.
+
+The functions below are its parts: ``next_line(buf)`` frames the byte stream (``(line, consumed)``, 0 = need more,
+as the frame codecs do); ``decode_request(line)`` checks a line (JSON, nesting, fields) and the field checkers
+check each value, all raising RequestError with the answer's text; ``encode_answer`` writes an answer. The TCP
+adapter and the table of commands are tmsim/net/control.py."""
 from __future__ import annotations
 
 import json
 import math
 import re
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
 
-from tmsim.limits import CONTROL_DEPTH_MAX
+from tmsim.limits import (
+    CONTROL_DEPTH_MAX,
+    CONTROL_LINE_MAX,
+    CONTROL_OUTBOX_MAX,
+    CONTROL_TURN_BYTES,
+    CONTROL_TURN_PIECES,
+    CONTROL_TURN_REQUESTS,
+)
 
 
 class RequestError(ValueError):
@@ -132,3 +151,186 @@ def error_answer(text: str) -> dict:
 
 def encode_answer(answer: dict) -> bytes:
     return (json.dumps(answer, allow_nan=False, ensure_ascii=False) + "\n").encode("utf-8")
+
+
+# ---- the protocol object --------------------------------------------------------------------------------
+# outcome of one turn of a client (``ControlProtocol.turn``)
+INPUT_DONE = "done"                 # no complete request line is left in the receive buffer
+INPUT_LEFT = "left"                 # a bound of the turn ended it: requests (or a large answer) wait for the next
+CLOSED = "closed"                   # the protocol ended the client (or ``flush`` said it is gone): close it
+
+LINE_TOO_LONG = f"request line longer than {CONTROL_LINE_MAX} bytes; connection closed"
+
+
+class Streamed(dict):
+    """An answer that is encoded a piece at a time over several turns: a ``state`` whose variables hold more
+    than CONTROL_TURN_BYTES (500 arrays of 2,048 numbers encode in ~0.4 s, which no turn may take)."""
+
+
+_PIECES = json.JSONEncoder(allow_nan=False, ensure_ascii=False)
+
+
+@dataclass
+class _Client:
+    conn: int
+    rbuf: bytearray = field(default_factory=bytearray)      # bytes received and not answered yet
+    outbox: bytearray = field(default_factory=bytearray)    # answer bytes not handed out (or handed back) yet
+    closing: bool = False               # answer what is queued, then close (a request line was too long)
+    encoding: Iterator[str] | None = None                   # the pieces of a large answer still to encode ...
+    pieces: list[str] = field(default_factory=list)         # ... and those encoded so far
+
+
+class ControlProtocol:
+    """The clients of the control channel and their bytes (see the module docstring). ``log(kind, **fields)``
+    receives the channel's events (``control_closed`` with its ``reason``)."""
+
+    def __init__(self, log: Callable[..., None]):
+        self.log = log
+        self.clients: dict[int, _Client] = {}
+
+    # ---- connections --------------------------------------------------------------------------
+    def connect(self, conn: int) -> None:
+        self.clients[conn] = _Client(conn)
+
+    def disconnect(self, conn: int) -> None:
+        self.clients.pop(conn, None)
+
+    def is_connected(self, conn: int) -> bool:
+        return conn in self.clients
+
+    # ---- input --------------------------------------------------------------------------------
+    def receive_data(self, conn: int, data: bytes) -> None:
+        """Bytes received from connection ``conn``, kept for its next ``turn`` (unknown connection: ignored);
+        a partial line waits for the bytes that complete it."""
+        client = self.clients.get(conn)
+        if client is not None:
+            client.rbuf += data
+
+    def input_bytes(self, conn: int) -> int:
+        """Bytes of connection ``conn`` received and not answered yet."""
+        client = self.clients.get(conn)
+        return 0 if client is None else len(client.rbuf)
+
+    # ---- output -------------------------------------------------------------------------------
+    def data_to_send(self, conn: int) -> bytearray:
+        """The answer bytes for connection ``conn`` (whole answers: a client never gets part of one before the
+        rest is encoded); the protocol forgets them. What the socket did not take goes back with ``unsent``."""
+        client = self.clients.get(conn)
+        if client is None or not client.outbox:
+            return bytearray()
+        data, client.outbox = client.outbox, bytearray()
+        return data
+
+    def unsent(self, conn: int, rest: bytearray) -> None:
+        """``rest``, the end of what ``data_to_send`` gave that the socket did not take, waits again in front of
+        newer answers; it counts against CONTROL_OUTBOX_MAX."""
+        client = self.clients.get(conn)
+        if client is not None and rest:
+            if client.outbox:
+                client.outbox[:0] = rest
+            else:
+                client.outbox = rest
+
+    def output_bytes(self, conn: int) -> int:
+        """Answer bytes of connection ``conn`` waiting to be sent."""
+        client = self.clients.get(conn)
+        return 0 if client is None else len(client.outbox)
+
+    def finished(self, conn: int) -> bool:
+        """True when connection ``conn`` is to be closed now: the protocol ended it and its last answer is out
+        (or it is unknown)."""
+        client = self.clients.get(conn)
+        return client is None or (client.closing and not client.outbox)
+
+    def closing(self, conn: int) -> bool:
+        """True when the protocol ends connection ``conn`` once its answers are out: it reads no more of it."""
+        client = self.clients.get(conn)
+        return client is None or client.closing
+
+    # ---- turns --------------------------------------------------------------------------------
+    def turn(self, conn: int, execute: Callable[[bytes], dict], flush: Callable[[int], bool]) -> str:
+        """One turn of connection ``conn``: at most CONTROL_TURN_REQUESTS requests answered, and none more once
+        this turn's answers reach CONTROL_TURN_BYTES (a turn is bounded in work: 15 clients each sending 64 KiB
+        of requests must not hold the robots' servers); a ``Streamed`` answer is encoded CONTROL_TURN_PIECES
+        pieces a turn. ``execute(line)`` answers one request line (never raises); ``flush(conn)`` is called
+        after each answer is queued, to write what the socket takes (False: the connection is gone). A line
+        longer than CONTROL_LINE_MAX is answered and ends the client; so does more than CONTROL_OUTBOX_MAX bytes
+        of unread answers. Returns INPUT_DONE, INPUT_LEFT (call again in a later turn) or CLOSED."""
+        client = self.clients.get(conn)
+        if client is None:
+            return CLOSED
+        if client.encoding is not None and not self._encode_more(client, flush):
+            return INPUT_LEFT
+        answered = written = 0
+        while not client.closing:
+            line, used = next_line(client.rbuf)
+            if line is None:                    # no complete line yet (used == 0)
+                if len(client.rbuf) > CONTROL_LINE_MAX:
+                    client.closing = True
+                    self.log("control_closed", reason="request line too long")
+                    self._answer(client, error_answer(LINE_TOO_LONG), flush)
+                break
+            if answered >= CONTROL_TURN_REQUESTS or written >= CONTROL_TURN_BYTES:
+                return INPUT_LEFT
+            del client.rbuf[:used]
+            if len(line) > CONTROL_LINE_MAX:
+                client.closing = True
+                self.log("control_closed", reason="request line too long")
+                answer = error_answer(LINE_TOO_LONG)
+            else:
+                answer = execute(line)
+            before = len(client.outbox)
+            if type(answer) is Streamed:
+                if not self._outbox_room(client):
+                    return CLOSED
+                client.encoding = _PIECES.iterencode(answer)
+                if not self._encode_more(client, flush):
+                    return INPUT_LEFT
+            elif not self._answer(client, answer, flush):
+                return CLOSED
+            answered += 1
+            written += max(0, len(client.outbox) - before) or 1
+        return CLOSED if client.closing and not client.outbox else INPUT_DONE
+
+    def _outbox_room(self, client: _Client) -> bool:
+        """False (and the client ended) when CONTROL_OUTBOX_MAX bytes of earlier answers are still unsent."""
+        if len(client.outbox) > CONTROL_OUTBOX_MAX:
+            self.clients.pop(client.conn, None)
+            self.log("control_closed",
+                     reason=f"client does not read its answers (more than {CONTROL_OUTBOX_MAX} bytes waiting)")
+            return False
+        return True
+
+    def _answer(self, client: _Client, answer: dict, flush: Callable[[int], bool]) -> bool:
+        """Queue one answer and flush; False when the client is gone. A client is ended when CONTROL_OUTBOX_MAX
+        bytes of earlier answers are still unsent (one answer may be larger)."""
+        if not self._outbox_room(client):
+            return False
+        try:
+            client.outbox += encode_answer(answer)
+        except ValueError as exc:           # e.g. a value JSON cannot carry
+            client.outbox += encode_answer(error_answer(f"the answer cannot be written as JSON ({exc})"))
+        return flush(client.conn)
+
+    def _encode_more(self, client: _Client, flush: Callable[[int], bool]) -> bool:
+        """Encode the next pieces of a large answer: at most CONTROL_TURN_PIECES pieces and about
+        CONTROL_TURN_BYTES characters a turn. True when the answer is complete, queued whole and flushed; False
+        when the rest waits for the client's next turn (or the client is gone)."""
+        assert client.encoding is not None
+        size = 0
+        try:
+            for _ in range(CONTROL_TURN_PIECES):
+                piece = next(client.encoding, None)
+                if piece is None:
+                    client.outbox += ("".join(client.pieces) + "\n").encode("utf-8")
+                    break
+                client.pieces.append(piece)
+                size += len(piece)
+                if size >= CONTROL_TURN_BYTES:
+                    return False
+            else:
+                return False
+        except ValueError as exc:           # e.g. a value JSON cannot carry
+            client.outbox += encode_answer(error_answer(f"the answer cannot be written as JSON ({exc})"))
+        client.encoding, client.pieces = None, []
+        return flush(client.conn)
