@@ -138,9 +138,14 @@ class ControlChannel:
         sock = self.clients.get(conn)
         if sock is None:
             return
-        if self.protocol.output_bytes(conn) and not self._flush(conn):
+        protocol = self.protocol
+        if conn in self.backlog:                # (the frequent case under a flood: checked first)
+            if protocol.output_bytes(conn):
+                self._flush(conn)
             return
-        if self.protocol.closing(conn) or conn in self.backlog:
+        if protocol.output_bytes(conn) and not self._flush(conn):
+            return
+        if protocol.closing(conn):
             return
         data, failed = receive(sock)
         if data is None and not failed:
