@@ -8,9 +8,11 @@ import threading
 import time
 from collections.abc import Iterator
 
+import fake_plc
 from browser import Browser
 
 from cbt_hmi.web.mapping import Mapping
+from cbt_hmi.web.pagedesc import load_pages, program_table
 from cbt_hmi.web.server import HmiServer
 from tmsim.net.server import SimServer
 from vplc.api import load_plc
@@ -29,15 +31,26 @@ def serving(plc, mapping: Mapping) -> Iterator[HmiServer]:
     stop = threading.Event()
     thread = threading.Thread(target=plc.run_realtime, args=(stop,), daemon=True)
     thread.start()
-    server = HmiServer(plc, mapping, port=0)
-    server.start()
     try:
-        yield server
+        with fake_plc.serving(plc, mapping) as server:
+            yield server
     finally:
-        server.stop()
         stop.set()
         thread.join(timeout=5)
         plc.close()
+
+
+@contextlib.contextmanager
+def serving_user_program(folder: pathlib.Path, source: str, program: str) -> Iterator[tuple]:
+    """A user's own program (``folder/source``, PROGRAM ``program`` every 10 ms) with the page descriptions of its
+    folder and the variable table generated from its globals, served as by ``serving``: yields (plc, server)."""
+    plc = load_plc([str(folder / source)], task="Main@10ms", programs=[program])
+    pages, errors = load_pages(folder, plc)
+    assert errors == [], errors
+    mapping = Mapping(program_table(plc, pages), f"generated from {source}")
+    mapping.check_against_plc(plc)
+    with serving(plc, mapping) as server:
+        yield plc, server
 
 
 class System:

@@ -12,7 +12,7 @@ import urllib.request
 
 import pytest
 from browser import chromium_paths
-from hmi_system import serving
+from hmi_system import serving_user_program
 from panel_metrics import page_metrics
 
 from cbt_hmi.web.mapping import Mapping
@@ -29,13 +29,8 @@ def cell_plc(directory: pathlib.Path):
 
 @pytest.fixture(scope="module")
 def cell():
-    plc = cell_plc(CELL)
-    pages, errors = load_pages(CELL, plc)
-    assert errors == []
-    mapping = Mapping(program_table(plc, pages), "generated from Conveyor.st")
-    mapping.check_against_plc(plc)
-    with serving(plc, mapping) as server:
-        yield plc, server
+    with serving_user_program(CELL, "Conveyor.st", "Conveyor") as served:
+        yield served
 
 
 def test_the_variable_table_is_generated_from_the_programs_global_variables(cell):

@@ -10,12 +10,12 @@ import pathlib
 
 import pytest
 from browser import chromium_paths
-from hmi_system import serving
+from hmi_system import serving_user_program
 from panel_metrics import page_metrics
 
 from cbt_hmi import PAGES
 from cbt_hmi.web.mapping import DEFAULT_MAPPING, Mapping
-from cbt_hmi.web.pagedesc import DESC_DIR, load_pages, program_table
+from cbt_hmi.web.pagedesc import DESC_DIR, load_pages
 from cbt_hmi.web.shipped import render, shipped_table
 from vplc.api import load_plc
 
@@ -89,13 +89,8 @@ def test_mistakes_in_the_fb_instance_keys_are_named_with_file_and_line(examples,
 
 @pytest.fixture(scope="module")
 def gripper():
-    plc = load_plc([str(GRIPPER / "Gripper.st")], task="Main@10ms", programs=["Gripper"])
-    pages, errors = load_pages(GRIPPER, plc)
-    assert errors == []
-    mapping = Mapping(program_table(plc, pages), "generated from Gripper.st")
-    mapping.check_against_plc(plc)
-    with serving(plc, mapping) as server:
-        yield plc, server
+    with serving_user_program(GRIPPER, "Gripper.st", "Gripper") as served:
+        yield served
 
 
 def test_a_users_fb_instance_page_gets_its_table_from_the_description(gripper):
