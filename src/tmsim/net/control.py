@@ -37,7 +37,9 @@ import json
 import math
 import selectors
 import socket
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager
+from typing import TYPE_CHECKING, Any, Protocol
 
 from tmsim.limits import (
     CONTROL_ANSWER_BYTES,
@@ -65,9 +67,41 @@ from tmsim.protocol.control import (
 from tmsim.protocol.listen_session import TransitionError
 
 if TYPE_CHECKING:
-    from tmsim.net.ethernet_slave import EthernetSlave, SlaveService
-    from tmsim.net.robot_ports import Robot
-    from tmsim.net.server import SimServer
+    from tmsim.net.ethernet_slave import EthernetSlave
+    from tmsim.net.robot_ports import Robot, SlavePort
+
+
+class ControlHost(Protocol):
+    """What the control channel needs of the server it joins (``SimServer``): its one selector, lock and robot
+    clock, its robots and Ethernet Slave adapter, a handler for its own selector keys, the server's event log,
+    and ``breathe`` (serve the robots' sockets between two control turns)."""
+
+    @property
+    def selector(self) -> selectors.BaseSelector: ...
+
+    @property
+    def lock(self) -> AbstractContextManager[Any]: ...
+
+    @property
+    def now(self) -> float: ...
+
+    @property
+    def robots(self) -> Sequence[Robot]: ...
+
+    @property
+    def svr(self) -> EthernetSlave | None: ...
+
+    def handle(self, kind: str, handler: Callable[[Any, Any], None]) -> None:
+        """Serve the selector keys of ``kind`` with ``handler(robot, conn)``."""
+        ...
+
+    def log_server(self, kind: str, **fields: Any) -> None:
+        """Log an event of the server as a whole."""
+        ...
+
+    def breathe(self) -> None:
+        """Serve the robots' sockets that are ready now."""
+        ...
 
 
 class ControlChannel:
@@ -75,7 +109,7 @@ class ControlChannel:
     of the clients' turns; the bytes, the bounds and the turns' contents are the ControlProtocol's
     (tmsim/protocol/control.py)."""
 
-    def __init__(self, server: SimServer, host: str = "127.0.0.1", port: int = 0):
+    def __init__(self, server: ControlHost, host: str = "127.0.0.1", port: int = 0):
         self.server = server
         server.handle("control_listen", self._accept)
         server.handle("control_conn", self._serve_client)
@@ -330,7 +364,7 @@ def robot_numbering(count: int) -> str:
 _NO_SLAVE = "the Ethernet Slave is not running (simulator started with --no-svr)"
 
 
-def _svr(robot: Robot) -> SlaveService:
+def _svr(robot: Robot) -> SlavePort:
     """The robot's Ethernet Slave; RequestError when the simulator runs none."""
     service = robot.slave
     if service is None:

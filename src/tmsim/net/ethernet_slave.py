@@ -14,9 +14,9 @@ from __future__ import annotations
 import contextlib
 import selectors
 import socket
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from tmsim.limits import SVR_CLIENTS_MAX, SVR_OUTBOX_MAX
 from tmsim.net.tcp_listener import Listener, receive
@@ -25,7 +25,27 @@ from tmsim.robot.svr_source import RobotDataSource
 
 if TYPE_CHECKING:
     from tmsim.net.robot_ports import Robot
-    from tmsim.net.server import SimServer
+
+
+class SlaveHost(Protocol):
+    """What the Ethernet Slave adapter needs of the server it joins (``SimServer``): its one selector, the
+    host it listens on, the robot clock, the robots, and a handler for its own selector keys."""
+
+    @property
+    def selector(self) -> selectors.BaseSelector: ...
+
+    @property
+    def host(self) -> str: ...
+
+    @property
+    def now(self) -> float: ...
+
+    @property
+    def robots(self) -> Sequence[Robot]: ...
+
+    def handle(self, kind: str, handler: Callable[[Any, Any], None]) -> None:
+        """Serve the selector keys of ``kind`` with ``handler(robot, conn)``."""
+        ...
 
 
 class SvrConn:
@@ -55,10 +75,11 @@ class SlaveService:
 class EthernetSlave:
     """Ethernet Slave of every robot of ``server``; ``port`` 0 = ephemeral ports."""
 
-    def __init__(self, server: SimServer, port: int = 0, period: float = 0.1, mode: int = 1,
+    def __init__(self, server: SlaveHost, port: int = 0, period: float = 0.1, mode: int = 1,
                  items: Iterable[str] = DEFAULT_STREAM, variables: Iterable = ()):
         self.server = server
         self.listeners: list[Listener] = []
+        self._services: dict[int, SlaveService] = {}      # robot index -> its Ethernet Slave
         self._next_conn = 1
         server.handle("svr_listen", self._accept)
         server.handle("svr_conn", self._read)
@@ -67,6 +88,7 @@ class EthernetSlave:
                 log = robot.log.event
                 source = RobotDataSource(robot, log)
                 service = SlaveService(source, SvrSession(source, log, items, mode, period, variables=variables))
+                self._services[robot.index] = service
                 robot.attach_slave(service)
                 self._listen(robot, service, port + robot.index if port else 0)
         except OSError:
@@ -83,7 +105,7 @@ class EthernetSlave:
     def poll(self, now: float) -> None:
         """Stream the data tables that are due and send what is waiting (called by SimServer.poll)."""
         for robot in self.server.robots:
-            service = robot.slave
+            service = self._services.get(robot.index)
             if service is None:
                 continue
             if service.listener is not None:
@@ -93,7 +115,7 @@ class EthernetSlave:
                 self._flush(robot)
 
     def _accept(self, _none: None, robot: Robot) -> None:
-        service = _service(robot)
+        service = self._service(robot)
         listener = service.listener
         if listener is None:
             return
@@ -117,7 +139,7 @@ class EthernetSlave:
 
     def _read(self, _none: None, conn: SvrConn) -> None:
         robot = conn.robot
-        service = _service(robot)
+        service = self._service(robot)
         if conn.id not in service.conns:
             return
         data, failed = receive(conn.sock)
@@ -135,7 +157,7 @@ class EthernetSlave:
         self._flush(robot)
 
     def _flush(self, robot: Robot) -> None:
-        service = _service(robot)
+        service = self._service(robot)
         session = service.session
         for conn_id in list(session.clients):
             conn = service.conns.get(conn_id)
@@ -157,7 +179,7 @@ class EthernetSlave:
                 self._drop(robot, conn, f"client does not read (more than {SVR_OUTBOX_MAX} bytes waiting)")
 
     def _drop(self, robot: Robot, conn: SvrConn, reason: str) -> None:
-        service = _service(robot)
+        service = self._service(robot)
         if service.conns.pop(conn.id, None) is None:
             return
         with contextlib.suppress(KeyError, ValueError):
@@ -174,7 +196,7 @@ class EthernetSlave:
         ``refuse_writes`` (status=6): every well-formed write is answered with that status code (1..7), nothing is
         written; ``answer_other_item`` (item, instead): ``instead`` is sent wherever ``item`` would be.
         ValueError when unknown."""
-        service = _service(robot)
+        service = self._service(robot)
         service.session.inject(fault, **params)   # checks the fault and its parameters; arms the protocol's
         if fault == "disconnect":                 # ... the sockets are this adapter's
             for conn in list(service.conns.values()):
@@ -182,25 +204,25 @@ class EthernetSlave:
         robot.log.event("svr_fault", fault=fault, params=params)
 
     def clear_faults(self, robot: Robot) -> None:
-        _service(robot).session.clear_faults()
+        self._service(robot).session.clear_faults()
         robot.log.event("svr_fault", fault="cleared", params={})
 
     def close(self) -> None:
         for robot in self.server.robots:
-            if robot.slave is not None:
-                for conn in list(robot.slave.conns.values()):
+            service = self._services.get(robot.index)
+            if service is not None:
+                for conn in list(service.conns.values()):
                     self._drop(robot, conn, "simulator closed")
         for listener in self.listeners:
             listener.close()
         self.listeners = []
 
-
-def _service(robot: Robot) -> SlaveService:
-    """The robot's Ethernet Slave (every robot of a server that runs one has it from the start)."""
-    service = robot.slave
-    if service is None:
-        raise RuntimeError(f"robot {robot.index + 1} has no Ethernet Slave")
-    return service
+    def _service(self, robot: Robot) -> SlaveService:
+        """The robot's Ethernet Slave (every robot of a server that runs one has it from the start)."""
+        service = self._services.get(robot.index)
+        if service is None:
+            raise RuntimeError(f"robot {robot.index + 1} has no Ethernet Slave")
+        return service
 
 
 def _send(sock: socket.socket, data: bytes | bytearray) -> int:

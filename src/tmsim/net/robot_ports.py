@@ -6,7 +6,9 @@ the bytes; a ``Robot`` is what the control channel, the Ethernet Slave's stick b
 from __future__ import annotations
 
 import socket
-from typing import TYPE_CHECKING, Any
+from collections.abc import Mapping
+from contextlib import AbstractContextManager
+from typing import TYPE_CHECKING, Any, Protocol
 
 from tmsim.protocol.listen_session import ListenSession
 from tmsim.protocol.svr_session import SvrSession
@@ -19,9 +21,60 @@ from tmsim.robot.svr_source import RobotDataSource
 from tmsim.tmscript.profiles import Profile
 
 if TYPE_CHECKING:
-    from tmsim.net.ethernet_slave import SlaveService, SvrConn
-    from tmsim.net.server import SimServer
     from tmsim.net.tcp_listener import Listener
+    from tmsim.robot.eventlog import LogFile
+
+
+class RobotHost(Protocol):
+    """What a robot needs of the server that holds it (``SimServer``): the lock its calls take, the shares of
+    the event log bounds and the log file, and the calls that open, close and refuse its Listen-node sockets."""
+
+    @property
+    def lock(self) -> AbstractContextManager[Any]: ...
+
+    @property
+    def event_limit(self) -> int: ...
+
+    @property
+    def event_bytes_limit(self) -> int: ...
+
+    @property
+    def log_file(self) -> LogFile | None: ...
+
+    @property
+    def auto_enter(self) -> bool: ...
+
+    def open_port(self, robot: Robot) -> None:
+        """Listen on the robot's Listen-node port (no-op while it listens or refuses connections)."""
+        ...
+
+    def close_robot_sockets(self, robot: Robot) -> None:
+        """Close the robot's client connections and its listening socket."""
+        ...
+
+    def apply_refuse(self, robot: Robot) -> None:
+        """Close or reopen the robot's listening socket as its ``refuse_connections`` fault says."""
+        ...
+
+    def drop(self, robot: Robot, conn: Conn, reason: str) -> None:
+        """Close one client connection of the robot."""
+        ...
+
+
+class SlavePort(Protocol):
+    """What a robot shows of its Ethernet Slave (``ethernet_slave.SlaveService``, attached by that adapter)."""
+
+    @property
+    def session(self) -> SvrSession: ...
+
+    @property
+    def source(self) -> RobotDataSource: ...
+
+    @property
+    def conns(self) -> Mapping[int, Any]: ...
+
+    @property
+    def port(self) -> int | None: ...
 
 
 class Conn:
@@ -46,7 +99,7 @@ class Robot:
     log (``log``), its Listen node (``session``, ``listener``, ``conns``), its output-side faults (``faults``)
     and, when the server runs one, its Ethernet Slave (``slave``, attached by tmsim/net/ethernet_slave.py)."""
 
-    def __init__(self, server: SimServer, index: int, port: int, send_message: str, auto_enter: bool,
+    def __init__(self, server: RobotHost, index: int, port: int, send_message: str, auto_enter: bool,
                  profile: Profile, timeouts: tuple[float | None, float | None],
                  frames: tuple[Any, Any] = (None, None)):
         self._server = server
@@ -63,13 +116,13 @@ class Robot:
         self.port_hold: socket.socket | None = None    # the Listen-node port, bound but not listening while closed
         self.conns: dict[int, Conn] = {}
         self.reading_paused: bool = False
-        self.slave: SlaveService | None = None  # the robot's Ethernet Slave; None with --no-svr
+        self.slave: SlavePort | None = None  # the robot's Ethernet Slave; None with --no-svr
 
     def camera(self) -> Camera:
         """The robot's virtual camera (its vision jobs, tmsim/robot/camera.py)."""
         return camera_of(self.session.robot)
 
-    def attach_slave(self, service: SlaveService) -> None:
+    def attach_slave(self, service: SlavePort) -> None:
         """The server runs an Ethernet Slave: this robot's (tmsim/net/ethernet_slave.py builds it)."""
         self.slave = service
 
@@ -85,8 +138,8 @@ class Robot:
         return None if self.slave is None else self.slave.source
 
     @property
-    def svr_conns(self) -> dict[int, SvrConn]:
-        """The Ethernet Slave's client connections."""
+    def svr_conns(self) -> Mapping[int, Any]:
+        """The Ethernet Slave's client connections (``ethernet_slave.SvrConn`` by connection number)."""
         return {} if self.slave is None else self.slave.conns
 
     @property
