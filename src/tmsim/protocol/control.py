@@ -29,6 +29,7 @@ from tmsim.limits import (
     CONTROL_TURN_PIECES,
     CONTROL_TURN_REQUESTS,
 )
+from tmsim.protocol.clients import Clients
 
 
 class RequestError(ValueError):
@@ -186,7 +187,7 @@ class ControlProtocol:
 
     def __init__(self, log: Callable[..., None]):
         self.log = log
-        self.clients: dict[int, _Client] = {}
+        self.clients: Clients[_Client] = Clients()
 
     # ---- connections --------------------------------------------------------------------------
     def connect(self, conn: int) -> None:
@@ -202,14 +203,11 @@ class ControlProtocol:
     def receive_data(self, conn: int, data: bytes) -> None:
         """Bytes received from connection ``conn``, kept for its next ``turn`` (unknown connection: ignored);
         a partial line waits for the bytes that complete it."""
-        client = self.clients.get(conn)
-        if client is not None:
-            client.rbuf += data
+        self.clients.buffer_data(conn, data)
 
     def input_bytes(self, conn: int) -> int:
         """Bytes of connection ``conn`` received and not answered yet."""
-        client = self.clients.get(conn)
-        return 0 if client is None else len(client.rbuf)
+        return self.clients.input_bytes(conn)
 
     # ---- output -------------------------------------------------------------------------------
     def data_to_send(self, conn: int) -> bytearray:

@@ -20,6 +20,7 @@ from typing import Protocol
 
 from tmsim.limits import CPERR_BURST, CPERR_PER_S, RECEIVE_TURN, TurnBudget
 from tmsim.protocol import codec
+from tmsim.protocol.clients import Clients
 from tmsim.robot.eventlog import text as _text
 from tmsim.tmscript.work import WorkMeter
 
@@ -69,7 +70,7 @@ class ListenProtocol:
     def __init__(self, node: Node, log: Callable[..., None]):
         self._node = node
         self.log = log
-        self.clients: dict[int, Client] = {}
+        self.clients: Clients[Client] = Clients()
 
     # ---- connections --------------------------------------------------------------------------
     def connect(self, conn: int, peer: str = "127.0.0.1") -> None:
@@ -137,14 +138,11 @@ class ListenProtocol:
 
     def buffer_data(self, conn: int, data: bytes) -> None:
         """Bytes received from connection ``conn``, kept for ``turn`` (unknown connection: ignored)."""
-        client = self.clients.get(conn)
-        if client is not None:
-            client.rbuf += data
+        self.clients.buffer_data(conn, data)
 
     def input_bytes(self, conn: int) -> int:
         """Bytes of connection ``conn`` received and not processed yet."""
-        client = self.clients.get(conn)
-        return 0 if client is None else len(client.rbuf)
+        return self.clients.input_bytes(conn)
 
     def unanswered_bad(self, conn: int) -> int:
         """Bad packets of connection ``conn`` not answered (CPERR limit) and not logged yet."""
