@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
 from tmsim.limits import SVR_CLIENTS_MAX, SVR_OUTBOX_MAX
-from tmsim.net.tcp_listener import Listener, receive
+from tmsim.net.tcp_listener import Listener, receive, send_out
 from tmsim.protocol.svr_session import DEFAULT_STREAM, SvrSession
 from tmsim.robot.svr_source import RobotDataSource
 
@@ -165,13 +165,7 @@ class EthernetSlave:
                 continue
             frames = session.data_to_send(conn_id)
             try:
-                for frame in frames:
-                    if conn.wbuf:
-                        conn.wbuf += frame
-                    else:
-                        conn.wbuf += frame[_send(conn.sock, frame):]
-                if conn.wbuf:
-                    del conn.wbuf[:_send(conn.sock, conn.wbuf)]
+                send_out(conn.sock, conn.wbuf, frames)
             except OSError as exc:
                 self._drop(robot, conn, f"send failed: {exc.strerror}")
                 continue
@@ -225,8 +219,3 @@ class EthernetSlave:
         return service
 
 
-def _send(sock: socket.socket, data: bytes | bytearray) -> int:
-    try:
-        return sock.send(data)
-    except (BlockingIOError, InterruptedError):
-        return 0

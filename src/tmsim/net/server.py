@@ -47,7 +47,7 @@ from tmsim.net.ethernet_slave import EthernetSlave
 from tmsim.net.fairness import FairScheduler
 from tmsim.net.fairness import is_greedy as _is_greedy
 from tmsim.net.robot_ports import Conn, Robot
-from tmsim.net.tcp_listener import Listener, receive
+from tmsim.net.tcp_listener import Listener, receive, send_out
 from tmsim.robot.eventlog import LogFile
 from tmsim.tmscript.profiles import Profile
 
@@ -427,14 +427,7 @@ class SimServer:
             else:
                 chunks, close = frames, False
             try:
-                for chunk in chunks:              # one send per reply frame when the socket keeps up
-                    if conn.wbuf:
-                        conn.wbuf += chunk
-                    else:
-                        sent = _send(conn.sock, chunk)
-                        conn.wbuf += chunk[sent:]
-                if conn.wbuf:
-                    del conn.wbuf[:_send(conn.sock, conn.wbuf)]
+                send_out(conn.sock, conn.wbuf, chunks)
             except OSError as exc:
                 self.drop(robot, conn, f"send failed: {exc.strerror}")
                 continue
@@ -481,9 +474,4 @@ def _collect_garbage(idle: bool) -> None:
         gc.collect(2 if old >= 10 else 1 if middle >= 10 else 0)
 
 
-def _send(sock: socket.socket, data: bytes | bytearray) -> int:
-    try:
-        return sock.send(data)
-    except (BlockingIOError, InterruptedError):
-        return 0
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import contextlib
 import selectors
 import socket
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from tmsim.limits import ACCEPT_BACKOFF_S, OUT_OF_DESCRIPTORS, RECV_BYTES
@@ -25,6 +25,26 @@ def receive(sock: socket.socket) -> tuple[bytes | None, str | None]:
         return None, None
     except OSError as exc:
         return None, f"receive failed: {exc.strerror}"
+
+
+def send_out(sock: socket.socket, wbuf: bytearray, frames: Iterable[bytes | bytearray]) -> None:
+    """Hand ``frames`` to a non-blocking connection: each straight to the socket while nothing waits before it (one
+    send per frame when the peer keeps up), the rest appended to ``wbuf``, which is then offered again; what the
+    socket does not take stays in ``wbuf``, in order. A failed send raises OSError (the caller drops the client)."""
+    for frame in frames:
+        if wbuf:
+            wbuf += frame
+        else:
+            wbuf += frame[_send(sock, frame):]
+    if wbuf:
+        del wbuf[:_send(sock, wbuf)]
+
+
+def _send(sock: socket.socket, data: bytes | bytearray) -> int:
+    try:
+        return sock.send(data)
+    except (BlockingIOError, InterruptedError):
+        return 0
 
 
 class Listener:
