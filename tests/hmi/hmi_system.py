@@ -54,9 +54,12 @@ def serving_user_program(folder: pathlib.Path, source: str, program: str) -> Ite
 
 
 class System:
-    def __init__(self, browser: Browser):
+    """The robot simulator, the examples on the virtual PLC in real time and the HMI server, for one browser;
+    ``speedup``: the robot model's speed against the wall clock."""
+
+    def __init__(self, browser: Browser, speedup: float = SIM_SPEEDUP):
         self.mapping = Mapping.load()
-        self.sim = SimServer(port=0, robots=1, speedup=SIM_SPEEDUP, svr_port=0)
+        self.sim = SimServer(port=0, robots=1, speedup=speedup, svr_port=0)
         self.sim.start_background()
         self.robot = self.sim.robots[0]
         self.plc = load_plc(SOURCES)
@@ -83,6 +86,11 @@ class System:
     def read(self, name):
         with self.plc.lock:
             return self.plc.read(name)
+
+    def state(self) -> dict:
+        """The simulated robot's state (pose, motion, queue)."""
+        with self.sim.lock:
+            return self.robot.state()
 
     def events(self, kind: str, since: float = -1.0) -> list[dict]:
         """Events of one kind logged after the robot-clock time ``since`` (the in-memory log is capped, so

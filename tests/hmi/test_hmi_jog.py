@@ -4,72 +4,24 @@ jog button moves the robot, releasing it stops the robot at once; a page that fa
 is released by the PLC; Teach stores the robot's position into the table the page lists."""
 from __future__ import annotations
 
-import pathlib
-import threading
 import time
 
 import pytest
+from hmi_system import System
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 
-from cbt_hmi.web.mapping import Mapping
-from cbt_hmi.web.server import HmiServer
-from tmsim.net.server import SimServer
-from vplc.api import load_plc
-
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-SOURCES = [str(ROOT / "lib" / "CBT_Commands_Lib"), str(ROOT / "examples")]
 WAIT_S = 20
 
 
-class Cell:
-    """Robot simulator, the example programs on the virtual PLC in real time and the HMI server."""
+class Cell(System):
+    """The engineer's jog cell: the robot model in real time (speedup 1), the connection made before the page opens."""
 
     def __init__(self, browser):
-        self.mapping = Mapping.load()
-        self.sim = SimServer(port=0, robots=1, svr_port=0, auto_enter=True)
-        self.sim.start_background()
-        self.robot = self.sim.robots[0]
-        self.plc = load_plc(SOURCES)
-        self.mapping.check_against_plc(self.plc)
+        super().__init__(browser, speedup=1.0)
         with self.plc.lock:
-            self.plc.write("Connect_AddressIP", "127.0.0.1")
-            self.plc.write("Connect_Dest_PortIP", self.sim.ports[0])
-            self.plc.write("Connect_SvrPort", self.robot.svr_port)
             self.plc.write("Connect_Execute", True)
-        self.stop_event = threading.Event()
-        self.plc_thread = threading.Thread(target=self.plc.run_realtime, args=(self.stop_event,),
-                                           kwargs={"spin_ns": 0}, daemon=True)
-        self.plc_thread.start()
-        self.hmi = HmiServer(self.plc, self.mapping, port=0)
-        self.hmi.start()
-        self.browser = browser
-        self.wait(lambda: self.read("Connect_Connected") and self.read("ReadPos_Valid"), "the connection")
-
-    def close(self):
-        self.hmi.stop()
-        self.stop_event.set()
-        self.plc_thread.join(timeout=5)
-        self.plc.close()
-        self.sim.close()
-
-    def read(self, name):
-        with self.plc.lock:
-            return self.plc.read(name)
-
-    def state(self):
-        with self.sim.lock:
-            return self.robot.state()
-
-    def events(self, kind):
-        with self.sim.lock:
-            return [e for e in self.robot.events if e["kind"] == kind]
-
-    def wait(self, predicate, what, timeout=WAIT_S):
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            assert time.monotonic() < deadline, f"timed out after {timeout} s waiting for {what}"
-            time.sleep(0.02)
+        self.wait(lambda: self.read("Connect_Connected") and self.read("ReadPos_Valid"), "the connection", WAIT_S)
 
     def open(self):
         self.browser.open(self.hmi.page_url("jog", "engineer"))
