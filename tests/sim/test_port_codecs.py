@@ -33,6 +33,21 @@ def feeds(stream: bytes, frames: list[bytes]):
     yield "glued", [stream]
 
 
+def answers_by_feed(session, frames: list[bytes], drained) -> dict[str, bytes]:
+    """Each way of cutting the stream of ``frames`` fed to ``session`` on a fresh connection: {name: answer bytes};
+    ``drained(conn)`` is true when the session holds nothing more of that connection."""
+    answers, conn = {}, 1000
+    for name, chunks in feeds(b"".join(frames), frames):
+        conn += 1
+        session.connect(conn)
+        for chunk in chunks:
+            session.receive_data(conn, chunk)
+        answers[name] = b"".join(session.data_to_send(conn))
+        assert drained(conn), name
+        session.disconnect(conn)
+    return answers
+
+
 @pytest.fixture(scope="module")
 def h():
     harness = Harness(svr_port=0, svr_options={"period": 0}, control_port=0)
@@ -50,16 +65,7 @@ LISTEN = [codec.encode("TMSTA", "00"),
 
 def test_the_listen_node_answers_the_same_however_its_input_is_cut(h):
     session = h.robot.session
-    stream = b"".join(LISTEN)
-    answers, conn = {}, 1000
-    for name, chunks in feeds(stream, LISTEN):
-        conn += 1
-        session.connect(conn)
-        for chunk in chunks:
-            session.receive_data(conn, chunk)
-        answers[name] = b"".join(session.data_to_send(conn))
-        assert session.input_bytes(conn) == 0, name
-        session.disconnect(conn)
+    answers = answers_by_feed(session, LISTEN, lambda conn: session.input_bytes(conn) == 0)
     whole = answers["whole"]
     assert [item.header for item in codec.decode_all(bytearray(whole))] == ["TMSTA", "CPERR", "TMSTA", "CPERR"]
     assert b"CPERR,2,02" in whole and b"CPERR,2,03" in whole
@@ -108,16 +114,7 @@ SVR = [codec.encode("TMSVR", "R1,12,Robot_Link\r\nProject_Run"),
 
 def test_the_ethernet_slave_answers_the_same_however_its_input_is_cut(h):
     session = h.robot.svr
-    stream = b"".join(SVR)
-    answers, conn = {}, 1000
-    for name, chunks in feeds(stream, SVR):
-        conn += 1
-        session.connect(conn)
-        for chunk in chunks:
-            session.receive_data(conn, chunk)
-        answers[name] = b"".join(session.data_to_send(conn))
-        assert not session.has_output(conn), name
-        session.disconnect(conn)
+    answers = answers_by_feed(session, SVR, lambda conn: not session.has_output(conn))
     whole = answers["whole"]
     replies = codec.decode_all(bytearray(whole), {"TMSVR", "CPERR"})
     assert [item.data.split(b",")[0] for item in replies] == [b"R1", b"W2", b"02", b"R4"]
