@@ -5,6 +5,21 @@
 
 function customLabel(item) { return item.unit ? `${item.label} (${item.unit})` : item.label; }
 
+/* the described inputs of a page as one fieldset of fields with label, unit and limits (a user's page and a
+   shipped command page without a parameter structure alike) */
+function inputsFieldset(inputs, legend) {
+  const fs = document.createElement("fieldset");
+  fs.innerHTML = `<legend>${legend}</legend>`;
+  const grid = document.createElement("div");
+  grid.className = "grid wide";
+  for (const item of inputs) {
+    LABELS[item.variable] = item.label;          // error texts name the field as the page does
+    grid.append(makeField(item.variable, MAP.variables[item.variable], customLabel(item)));
+  }
+  fs.append(grid);
+  return fs;
+}
+
 /* the main page of a table generated from a user program (no CBT example variables): one tile per page */
 function customIndexPage() {
   const main = frame("Main", true);
@@ -37,18 +52,7 @@ async function customPage(key) {
   hideRobotPill();
   const params = document.createElement("div");
   params.className = "params full";
-  if (page.inputs.length) {
-    const fs = document.createElement("fieldset");
-    fs.innerHTML = "<legend>Settings</legend>";
-    const grid = document.createElement("div");
-    grid.className = "grid wide";
-    for (const item of page.inputs) {
-      LABELS[item.variable] = item.label;        // error texts name the field as the page does
-      grid.append(makeField(item.variable, MAP.variables[item.variable], customLabel(item)));
-    }
-    fs.append(grid);
-    params.append(fs);
-  }
+  if (page.inputs.length) params.append(inputsFieldset(page.inputs, "Settings"));
   const side = document.createElement("div");
   side.className = "side";
   const buttons = document.createElement("div");

@@ -511,16 +511,7 @@ async function fbPage(key, page) {
   if (param) {
     buildStruct(params, param, MAP.variables[param].type, page.parameters.legend);
   } else {
-    const fs = document.createElement("fieldset");
-    fs.innerHTML = `<legend>${page.legend || "Settings"}</legend>`;
-    const grid = document.createElement("div");
-    grid.className = "grid wide";
-    for (const item of page.inputs) {
-      LABELS[item.variable] = item.label;
-      grid.append(makeField(item.variable, MAP.variables[item.variable], item.unit ? `${item.label} (${item.unit})` : item.label));
-    }
-    fs.append(grid);
-    params.append(fs);
+    params.append(inputsFieldset(page.inputs, page.legend || "Settings"));      // custom.js
   }
   const side = document.createElement("div");
   side.className = "side";
