@@ -66,6 +66,11 @@ class Browser:
             shutil.rmtree(self.profile, ignore_errors=True)
 
     def open(self, url: str):
+        """Load ``url`` afresh. Our addresses carry the access key in the fragment, and going to the address the
+        tab already shows only moves to the fragment: the old page would go on running, and a command it was
+        still finishing (Play holding Done for 1.5 s, then releasing) would write into the next test's message
+        line. A blank page in between ends the old page's scripts first."""
+        self.driver.get("about:blank")
         self.driver.get(url)
         self.wait_for(lambda d: d.execute_script("return document.querySelector('#message') !== null "
                                                  "&& document.querySelector('#pill-plc').textContent "

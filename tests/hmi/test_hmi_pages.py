@@ -45,6 +45,16 @@ def page(stack):
     return plc, open_page
 
 
+def test_opening_the_page_a_tab_already_shows_loads_it_afresh(page):
+    """Our addresses carry the access key in the fragment; opening the same address again must end the old page's
+    scripts (a Play still holding Done once wrote into the next test's message line)."""
+    _, open_page = page
+    browser = open_page("index")
+    browser.driver.execute_script("window.leftOver = 'the old page'")
+    browser = open_page("index")
+    assert browser.driver.execute_script("return window.leftOver === undefined")
+
+
 @pytest.mark.parametrize("name", PAGES)
 def test_every_page_fits_the_800x480_panel(page, name):
     _, open_page = page
