@@ -93,6 +93,8 @@ SERVE_ITEMS = 8                             # items of one client's input proces
 SERVE_SCAN = 256                            # ... and decoded (bad packets not answered count here only)
 CPERR_BURST = 16                            # CPERR answers to bad packets a client gets at once ...
 CPERR_PER_S = 100                           # ... then at most this many per second (robot clock)
+CPERR_SETTING_MAX = 10_000                  # the largest burst / rate ``configure`` gives a Listen node's CPERR limit
+PORT_EVENTS_MAX = 10_000                    # events a port protocol without a log callback keeps for events()
 OUTBOX_TOTAL_MAX = 16 << 20                 # unsent bytes of all clients of one robot
 PENDING_BYTES_MAX = 32 << 20                # bytes of buffered scripts, all robots together (each robot at
                                             # least 4 frames of 64 KiB)

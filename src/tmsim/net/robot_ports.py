@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from contextlib import AbstractContextManager
 from typing import TYPE_CHECKING, Any, Protocol
 
-from tmsim.protocol.listen_session import ListenSession
+from tmsim.protocol.listen_session import NODE_FAULTS, ListenSession
 from tmsim.protocol.svr_session import SvrSession
 from tmsim.robot.camera import Camera, camera_of
 from tmsim.robot.eventlog import EventLog
@@ -195,14 +195,12 @@ class Robot:
     def inject(self, fault: str, **params: Any) -> None:
         """Arm a fault (see docs/simulator.md, 'Fault injection'); raises ValueError when unknown or when a
         parameter is out of its range (faults.PARAMS)."""
-        checked = check_fault_params(fault, params)
+        check_fault_params(fault, params)
         with self._server.lock:
-            if fault == "reply_error":
-                self.session.add_reply_errors(checked["count"])
-            elif fault == "leave_node":
-                self.session.leave_node(path=checked["path"], source="fault")
-            elif fault == "stop_project":
-                self.stop_project()
+            if fault in NODE_FAULTS:             # the Listen node's own faults (ListenSession.inject)
+                self.session.inject(fault, **params)
+                if fault == "stop_project":
+                    self._server.close_robot_sockets(self)
             elif fault == "refuse_connections":
                 self.faults.arm(fault, **params)
                 self._server.apply_refuse(self)
@@ -218,7 +216,7 @@ class Robot:
             held = self.faults
             self.faults = FaultState()
             self.faults.adopt(held)          # frames already held back still leave at their time
-            self.session.clear_reply_errors()
+            self.session.clear_faults()
             self._server.apply_refuse(self)
             self.log.event("fault", fault="cleared", params={})
 

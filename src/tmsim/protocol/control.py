@@ -20,6 +20,7 @@ import math
 import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 from tmsim.limits import (
     CONTROL_DEPTH_MAX,
@@ -30,6 +31,7 @@ from tmsim.limits import (
     CONTROL_TURN_REQUESTS,
 )
 from tmsim.protocol.clients import Clients
+from tmsim.protocol.port_events import PortEvents
 
 
 class RequestError(ValueError):
@@ -183,11 +185,49 @@ class _Client:
 
 class ControlProtocol:
     """The clients of the control channel and their bytes (see the module docstring). ``log(kind, **fields)``
-    receives the channel's events (``control_closed`` with its ``reason``)."""
+    receives the channel's events (``control_closed`` with its ``reason``); built without it, the protocol keeps
+    them for ``events()`` (tmsim/protocol/port_events.py).
 
-    def __init__(self, log: Callable[..., None]):
-        self.log = log
+    Like every port of the simulator it has ``inject`` / ``clear_faults`` / ``configure`` / ``config``, but the
+    control channel is the simulator's own tool, not a port of the robot: it has no faults (``inject`` raises
+    ValueError "the control channel has no faults") and no settings of its own (its bounds are the CONTROL_*
+    of tmsim/limits.py, the same for every channel: ``configure`` with any setting raises ValueError)."""
+
+    def __init__(self, log: Callable[..., None] | None = None):
+        self._events = PortEvents()
+        self.log: Callable[..., None] = self._events.record if log is None else log
         self.clients: Clients[_Client] = Clients()
+
+    # ---- events, faults and settings ----------------------------------------------------------
+    def events(self) -> list[dict[str, Any]]:
+        """The events produced since the last call, oldest first, each ``{"kind": ..., **fields}``; they are
+        forgotten. Empty when the protocol was built with a ``log`` callback (it got them as they happened)."""
+        return self._events.take()
+
+    @property
+    def events_dropped(self) -> int:
+        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
+        return self._events.dropped
+
+    def inject(self, fault: str, **params: Any) -> None:
+        """The control channel has no faults: always ValueError naming ``fault`` (the robots' faults are
+        injected with the request ``inject`` / ``svr_inject`` it carries, on the robot's ports)."""
+        raise ValueError(f"the control channel has no faults (asked for '{fault}'); inject a robot's faults "
+                         f"with the request \"inject\" or \"svr_inject\"")
+
+    def clear_faults(self) -> None:
+        """Nothing to clear: the control channel has no faults."""
+
+    def configure(self, **settings: Any) -> None:
+        """The control channel has no settings: a setting is a ValueError naming it (its bounds are the
+        CONTROL_* of tmsim/limits.py); with none, nothing happens."""
+        for name in settings:
+            raise ValueError(f"unknown setting '{name}' of the control channel: it has none (its bounds are the "
+                             f"CONTROL_* of tmsim/limits.py)")
+
+    def config(self) -> dict[str, Any]:
+        """What ``configure`` set: nothing (an empty dict)."""
+        return {}
 
     # ---- connections --------------------------------------------------------------------------
     def connect(self, conn: int) -> None:

@@ -10,17 +10,21 @@ counted and reported as event ``cperr_suppressed``), the outboxes, and the event
 A server calls ``connect`` / ``receive_data(conn, bytes)`` / ``disconnect`` and takes ``data_to_send(conn)``
 (one bytes object per frame, so each goes out in one send). A server that shares its input fairly between
 clients (tmsim/net/fairness.py) calls ``buffer_data`` and then ``turn(conn, budget)`` in bounded turns (a
-``TurnBudget`` of tmsim/limits.py) instead of ``receive_data``.
+``TurnBudget`` of tmsim/limits.py) instead of ``receive_data``. The events go to the ``log`` callback the
+protocol was built with (the server's event log); built without one, it keeps them for ``events()``
+(tmsim/protocol/port_events.py). ``configure(cperr_burst=..., cperr_per_s=...)`` sets the CPERR limit of its
+clients.
 """
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
-from tmsim.limits import CPERR_BURST, CPERR_PER_S, RECEIVE_TURN, TurnBudget
+from tmsim.limits import CPERR_BURST, CPERR_PER_S, CPERR_SETTING_MAX, RECEIVE_TURN, TurnBudget
 from tmsim.protocol import codec
 from tmsim.protocol.clients import Clients
+from tmsim.protocol.port_events import PortEvents
 from tmsim.robot.eventlog import text as _text
 from tmsim.tmscript.work import WorkMeter
 
@@ -28,6 +32,22 @@ from tmsim.tmscript.work import WorkMeter
 INPUT_DONE = "done"                 # no complete item is left in the receive buffer
 INPUT_LEFT = "left"                 # a bound of the turn ended it: input may be left for the next turn
 FRAME_LIMIT = "frame_limit"         # the connection's received frames reached the budget's ``frame_limit``
+
+# configure(): setting -> (lowest, highest), integers
+PROTOCOL_SETTINGS = {"cperr_burst": (1, CPERR_SETTING_MAX), "cperr_per_s": (0, CPERR_SETTING_MAX)}
+
+
+def check_settings(port: str, settings: dict[str, Any], ranges: dict[str, tuple[int, int]]) -> dict[str, int]:
+    """``settings`` checked against ``ranges`` (name -> (lowest, highest), integers); ValueError naming the
+    first unknown setting or value out of its range, with what is allowed."""
+    for name, value in settings.items():
+        if name not in ranges:
+            raise ValueError(f"unknown setting '{name}' of the {port}; known: {', '.join(ranges)}")
+        low, high = ranges[name]
+        if type(value) is not int or not low <= value <= high:
+            raise ValueError(f"setting '{name}' of the {port} must be an integer {low}..{high}, got {value!r}")
+    return dict(settings)
+
 
 # a frame queued for a client: (the frame's bytes, its header, its data as given to the codec)
 Outgoing = tuple[bytes, str, bytes | str]
@@ -67,14 +87,45 @@ class Node(Protocol):
 class ListenProtocol:
     """The clients of one robot's Listen node and their bytes (see the module docstring)."""
 
-    def __init__(self, node: Node, log: Callable[..., None]):
+    def __init__(self, node: Node, log: Callable[..., None] | None = None):
         self._node = node
-        self.log = log
+        self._events = PortEvents()
+        self.log: Callable[..., None] = self._events.record if log is None else log
         self.clients: Clients[Client] = Clients()
+        self.cperr_burst = CPERR_BURST      # CPERR answers to bad packets a client gets at once ...
+        self.cperr_per_s = CPERR_PER_S      # ... then at most this many per second of robot clock
+
+    # ---- events and settings ------------------------------------------------------------------
+    def events(self) -> list[dict[str, Any]]:
+        """The events produced since the last call, oldest first, each ``{"kind": ..., **fields}``; they are
+        forgotten. Empty when the protocol was built with a ``log`` callback (it got them as they happened)."""
+        return self._events.take()
+
+    @property
+    def events_dropped(self) -> int:
+        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
+        return self._events.dropped
+
+    def configure(self, **settings: Any) -> None:
+        """Set the CPERR limit on bad packets: ``cperr_burst`` (1..CPERR_SETTING_MAX) answers at once, then
+        ``cperr_per_s`` (0..CPERR_SETTING_MAX) per second of robot clock; a connected client keeps the answers it
+        has left (at most the new burst). ValueError naming an unknown setting or a value out of its range;
+        nothing changes then."""
+        checked = check_settings("Listen node protocol", settings, PROTOCOL_SETTINGS)
+        if "cperr_burst" in checked:
+            self.cperr_burst = checked["cperr_burst"]
+            for client in self.clients.values():
+                client.cperr_tokens = min(client.cperr_tokens, float(self.cperr_burst))
+        if "cperr_per_s" in checked:
+            self.cperr_per_s = checked["cperr_per_s"]
+
+    def config(self) -> dict[str, Any]:
+        """What ``configure`` set."""
+        return {"cperr_burst": self.cperr_burst, "cperr_per_s": self.cperr_per_s}
 
     # ---- connections --------------------------------------------------------------------------
     def connect(self, conn: int, peer: str = "127.0.0.1") -> None:
-        self.clients[conn] = Client(peer, self._node.now)
+        self.clients[conn] = Client(peer, self._node.now, float(self.cperr_burst))
         self.log("connect", conn=conn, peer=peer)
 
     def disconnect(self, conn: int) -> None:
@@ -197,9 +248,10 @@ class ListenProtocol:
         return handled, INPUT_LEFT
 
     def _cperr_tokens(self, client: Client) -> float:
-        """Token bucket of CPERR answers to bad packets: CPERR_BURST at once, CPERR_PER_S per second."""
+        """Token bucket of CPERR answers to bad packets: ``cperr_burst`` at once (CPERR_BURST unless configured),
+        ``cperr_per_s`` per second (CPERR_PER_S)."""
         now = self._node.now
-        client.cperr_tokens = min(CPERR_BURST, client.cperr_tokens + (now - client.cperr_at) * CPERR_PER_S)
+        client.cperr_tokens = min(self.cperr_burst, client.cperr_tokens + (now - client.cperr_at) * self.cperr_per_s)
         client.cperr_at = now
         return client.cperr_tokens
 

@@ -6,8 +6,13 @@ the scripts of all clients are checked and run strictly in arrival order, one at
 (``ListenProtocol``, tmsim/protocol/listen_protocol.py: receive buffers, decoding, the CPERR limit on bad
 packets, outboxes, the frame events); the node hands a server the protocol's port interface unchanged:
 ``connect`` / ``receive_data(conn, bytes)`` or ``buffer_data`` + ``turn(conn, budget)`` / ``disconnect`` /
-``data_to_send(conn)``. A server also calls ``advance(now)``; the control channel uses the control methods
-(``enter_node``, ``stop_project`` ...) and the queries (``node_state()``, ``snapshot()`` ...).
+``data_to_send(conn)``, and ``events()``: the events of the node and of its protocol, in the order they happened,
+when the node was built without a ``log`` callback (with one, the callback gets them: the server's event log).
+A server also calls ``advance(now)``; the control channel uses the control methods (``enter_node``,
+``stop_project`` ...) and the queries (``node_state()``, ``snapshot()`` ...). Like every port of the simulator
+the node has ``inject(fault, **params)`` / ``clear_faults()`` for its own faults (``NODE_FAULTS``: the faults on
+the wire are the TCP adapter's, tmsim/robot/faults.py) and ``configure(**settings)`` / ``config()``
+(``NODE_SETTINGS``).
 """
 from __future__ import annotations
 
@@ -17,9 +22,10 @@ from collections.abc import Callable, Generator
 from dataclasses import dataclass
 from typing import Any
 
-from tmsim.limits import WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN, TurnBudget
+from tmsim.limits import NODE_TIMEOUT_MAX_S, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN, TurnBudget
 from tmsim.protocol import codec
-from tmsim.protocol.listen_protocol import Client, ListenProtocol, outgoing
+from tmsim.protocol.listen_protocol import PROTOCOL_SETTINGS, Client, ListenProtocol, check_settings, outgoing
+from tmsim.robot.faults import check_params as check_fault_params
 from tmsim.robot.model import RobotModel
 from tmsim.tmscript.interp import Context, ScriptRuntimeError, run_script, variable_memory
 from tmsim.tmscript.parser import Line, iter_lines
@@ -50,6 +56,11 @@ TRANSITIONS = {
 _PRIORITY = re.compile(r"^\s*(ScriptExit|StopAndClearBuffer)\s*\(\s*(\d)\s*\)\s*$")
 _PRIORITY_ARGS = {"ScriptExit": (0, 1), "StopAndClearBuffer": (0, 1, 2)}
 
+# the node's own faults (``inject``); their parameters and ranges are tmsim/robot/faults.py PARAMS
+NODE_FAULTS = ("reply_error", "leave_node", "stop_project")
+# ``configure``: the node's settings (the protocol's, PROTOCOL_SETTINGS, are passed on to it)
+NODE_SETTINGS = ("data_timeout", "connection_timeout", "profile", *PROTOCOL_SETTINGS)
+
 
 @dataclass
 class Packet:
@@ -79,11 +90,11 @@ class ListenSession:
         self.robot.tag_history, self.robot.stop_tags = self.profile.tag_history, self.profile.stop_tags
         self.meter = self.robot.meter       # work of the current turn (tmsim/tmscript/work.py), shared with the robot
         self.send_message = send_message
-        self.log = log or (lambda kind, **fields: None)
+        self.protocol = ListenProtocol(self, log)         # the node's bytes: buffers, decoding, CPERR limit
+        self.log: Callable[..., None] = self.protocol.log  # ``log``, or the protocol's store of events()
         self.state = STOPPED
         self.exit_path: str | None = None
         self.now = 0.0
-        self.protocol = ListenProtocol(self, self.log)    # the node's bytes: buffers, decoding, CPERR limit
         self.clients: dict[int, Client] = self.protocol.clients     # (the same dict: who is connected)
         self.pending: deque[Packet] = deque()
         self.running: Running | None = None
@@ -186,6 +197,17 @@ class ListenSession:
 
     def is_connected(self, conn: int) -> bool:
         return self.protocol.is_connected(conn)
+
+    def events(self) -> list[dict[str, Any]]:
+        """The events of the node and of its protocol since the last call, oldest first, each
+        ``{"kind": ..., **fields}`` (the kinds of docs/simulator.md "Event log"); they are forgotten. Empty when
+        the node was built with a ``log`` callback."""
+        return self.protocol.events()
+
+    @property
+    def events_dropped(self) -> int:
+        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
+        return self.protocol.events_dropped
 
     # ---- input --------------------------------------------------------------------------------
     def handle(self, conn: int, item: codec.Frame | codec.BadFrame | codec.Garbage) -> None:
@@ -486,6 +508,67 @@ class ListenSession:
         self.robot.stop_and_clear()
         if self.state != STOPPED:
             self.fire("robot_fault", reason=reason)
+
+    def inject(self, fault: str, **params: Any) -> None:
+        """Arm one of the node's faults (docs/simulator.md, "Fault injection"; ranges: tmsim/robot/faults.py):
+        ``reply_error`` (count=1, 1..10^6): the next ``count`` scripts are answered ``ID,ERROR;1`` without
+        running (the reply of an invalid script, TMscript 2.24 §15.3 "Return" 2); ``leave_node`` (path="Pass" or
+        "Fail"): the flow leaves the Listen node by that exit (§15.1, the node's two exit conditions), as
+        ``leave_node``; ``stop_project``: the project stops, as ``stop_project``. ValueError naming an unknown
+        fault, an unknown parameter or a value out of its range; TransitionError when the node's state does not
+        allow it (``leave_node`` outside the node); nothing changes then. The faults on the wire (delays,
+        split and glued frames, black hole ...) act on sockets and timing: the server's (``Robot.inject``)."""
+        if fault not in NODE_FAULTS:
+            raise ValueError(f"unknown Listen node fault '{fault}'; the node's faults: {', '.join(NODE_FAULTS)}")
+        checked = check_fault_params(fault, params)
+        if fault == "reply_error":
+            self.add_reply_errors(checked["count"])
+        elif fault == "leave_node":
+            self.leave_node(path=checked["path"], source="fault")
+        else:
+            self.stop_project()         # source "control", as the event has always said for this fault
+
+    def clear_faults(self) -> None:
+        """End the node's faults: the scripts still to be answered ERROR;1 are run again."""
+        self.clear_reply_errors()
+
+    def configure(self, **settings: Any) -> None:
+        """Set what a user of the node sets on its constructor or the command line: ``data_timeout`` /
+        ``connection_timeout`` (seconds, 0 .. NODE_TIMEOUT_MAX_S; 0 or None: none; no packet / no client while
+        in the node for that long leaves it by its Fail path, TMscript 2.24 §15.1 "Connection Timeout" / "Data
+        Timeout"), ``profile`` (a tmsim.tmscript.profiles.Profile:
+        the TMflow version whose functions the checker knows from the next script on, the queue tags kept and
+        what a stop does to them), and the protocol's CPERR limit ``cperr_burst`` / ``cperr_per_s``
+        (ListenProtocol.configure). ValueError naming an unknown setting or a value out of its range; nothing
+        changes then."""
+        for name in settings:
+            if name not in NODE_SETTINGS:
+                raise ValueError(f"unknown setting '{name}' of the Listen node; known: {', '.join(NODE_SETTINGS)}")
+        timeouts = {}
+        for name in ("data_timeout", "connection_timeout"):
+            if name in settings:
+                value = settings[name]
+                if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                          or not 0 <= value <= NODE_TIMEOUT_MAX_S):
+                    raise ValueError(f"setting '{name}' of the Listen node must be 0 (none) .. "
+                                     f"{NODE_TIMEOUT_MAX_S:g} seconds or None, got {value!r}")
+                timeouts[name] = float(value) if value else None
+        profile = settings.get("profile", self.profile)
+        if not isinstance(profile, Profile):
+            raise ValueError(f"setting 'profile' of the Listen node must be a tmsim.tmscript.profiles.Profile, "
+                             f"got {profile!r}")
+        protocol_settings = {name: settings[name] for name in PROTOCOL_SETTINGS if name in settings}
+        check_settings("Listen node protocol", protocol_settings, PROTOCOL_SETTINGS)
+        self.protocol.configure(**protocol_settings)
+        for name, seconds in timeouts.items():
+            setattr(self, name, seconds)
+        self.profile = profile
+        self.robot.tag_history, self.robot.stop_tags = profile.tag_history, profile.stop_tags
+
+    def config(self) -> dict[str, Any]:
+        """What ``configure`` set (timeouts in seconds, None: none)."""
+        return {"data_timeout": self.data_timeout, "connection_timeout": self.connection_timeout,
+                "profile": self.profile, **self.protocol.config()}
 
     def add_reply_errors(self, count: int) -> None:
         """The next ``count`` scripts are answered ERROR;1 without running (fault injection)."""

@@ -14,6 +14,8 @@ and performed only when every item passes.
 ``source`` gives the values and performs writes (``tmsim.robot.svr_source.RobotDataSource``): ``values(names)``
 -> {name: value}, ``write({name: value})``, ``auto_mode``. The global variables of the robot's project (§17.2
 "Global Variable") are items of the session itself: ``declare`` adds one, ``variables`` holds their values.
+The events go to the ``log`` callback the session was built with (the server's event log); built without one,
+it keeps them for ``events()`` (tmsim/protocol/port_events.py).
 """
 from __future__ import annotations
 
@@ -23,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from tmsim.protocol import codec
 from tmsim.protocol import svr_table as table
+from tmsim.protocol.port_events import PortEvents
 from tmsim.protocol.svr_table import ITEMS, Item, SvrContentError, SvrValueError
 
 if TYPE_CHECKING:
@@ -70,7 +73,8 @@ class SvrSession:
                  stream_items: Iterable[str] = DEFAULT_STREAM, stream_mode: int = 1, period: float = 0.1,
                  write_permission: bool = True, variables: Iterable = ()):
         self.source = source
-        self.log = log or (lambda kind, **fields: None)
+        self._events = PortEvents()
+        self.log: Callable[..., None] = self._events.record if log is None else log
         self.items: dict[str, Item] = dict(ITEMS)   # the predefined items and the declared global variables
         self.variables: dict[str, object] = {}      # value of every declared global variable
         for variable in variables:
@@ -109,6 +113,17 @@ class SvrSession:
         self.stream_mode, self.period = mode, period
         if write_permission is not None:
             self.write_permission = bool(write_permission)
+
+    def events(self) -> list[dict[str, Any]]:
+        """The events produced since the last call, oldest first, each ``{"kind": ..., **fields}`` (``svr_*``,
+        docs/simulator.md); they are forgotten. Empty when the session was built with a ``log`` callback (it got
+        them as they happened)."""
+        return self._events.take()
+
+    @property
+    def events_dropped(self) -> int:
+        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
+        return self._events.dropped
 
     def config(self) -> dict:
         """What ``configure`` set: the streamed items in order, the mode, the period and the write permission."""

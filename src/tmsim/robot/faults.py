@@ -19,7 +19,8 @@ black_hole           enabled=True
 refuse_connections   enabled=True
     the listening socket is closed (connects are refused); existing clients stay
 
-Session-level faults handled in net.robot_ports.Robot.inject: reply_error, leave_node, stop_project, disconnect.
+Session-level faults: reply_error, leave_node, stop_project (the Listen node's own:
+protocol.listen_session.ListenSession.inject) and disconnect (net.robot_ports.Robot.inject).
 Parameters are checked by ``check_params`` (PARAMS below); a value outside its range is a ValueError.
 Clearing the faults (``adopt``) keeps what is held back: it still leaves, whole and in order.
 """
