@@ -24,7 +24,7 @@ from .runtime.engine import Engine, Task
 from .runtime.faults import PlcFault
 from .runtime.program import Program, program_key
 from .runtime.stats import OverrunCount, ScanStats
-from .runtime.values import PathError, Resolver, parse_duration
+from .runtime.values import PathError, Resolver, Slot, parse_duration
 
 if TYPE_CHECKING:
     from .runtime.motion import MotionController
@@ -321,7 +321,23 @@ class Plc:
             self._resolver.write(path, value, raw)
 
     def var_type(self, path: str) -> str:
+        """The IEC type text of the variable at ``path`` (``BOOL``, ``STRING[50]``, ``ARRAY[1..3] OF INT``)."""
         return self._resolver.type_text(path)
+
+    def type_of(self, path: str) -> T.Type:
+        """The declared type of the variable at ``path`` (a ``vplc.frontend.types`` type: what a tool needs to
+        judge or show a value before it reads or writes one); ``PathError`` for a bad path, as ``read`` gives."""
+        with self.lock:
+            return self._resolver.type_of(path)
+
+    def lasting_slot(self, path: str) -> Slot | None:
+        """``(container, key, type)`` of a variable declared directly in a program instance or a global list:
+        ``container[key]`` is its runtime value (before conversion to the API value) for as long as the
+        controller exists, so a tool sampling it every scan may read it there without walking the path.
+        None for a member or an array element (an assignment may replace what holds them); ``PathError`` for
+        a bad path, as ``read`` gives."""
+        with self.lock:
+            return self._resolver.lasting_slot(path)
 
     def run_until(self, pred: Callable[[], object], timeout_ns: int,
                   on_scan: Callable[[int], object] | None = None) -> bool:

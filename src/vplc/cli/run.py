@@ -324,7 +324,7 @@ class Watch:
         from ..runtime.values import plc_text
         self.plc, self.paths = plc, paths
         plc.var_type(paths[0])                                                   # PathError first
-        self.text = {p: plc_text(plc._resolver._locate(p)[2]) for p in paths}   # PLC notation, per type
+        self.text = {p: plc_text(plc.type_of(p)) for p in paths}   # PLC notation, per type
         self.values: dict[str, object] = {}
         self.width = max(len(p) for p in paths)
 

@@ -343,7 +343,7 @@ def parse_value(plc: Plc, path: str, text: str, compared: bool = False) -> Any:
     """An ST literal for the variable at ``path`` -> the API value (bool/int/float/str); PathError if it
     does not fit the variable's type (its range, its enumeration values, its STRING capacity: what a write
     would refuse). ``compared``: the value of a condition or an expectation, not of a write."""
-    t = plc._resolver._locate(path)[2]
+    t = plc.type_of(path)
     value = _literal(plc, path, t, text, compared)
     from_python(value, t, path)          # the check the write makes, made before the first scan
     return value
@@ -451,7 +451,7 @@ def _resolve_term(plc: Plc, term: Term | Expect, where: str) -> None:
     if path is None:                          # `time`: its value was read with the line
         return
     try:
-        t = plc._resolver._locate(path)[2]
+        t = plc.type_of(path)
         term.value = _literal(plc, path, t, term.text, compared=True)
     except PathError as exc:
         raise ScenarioError(f"{where}: {exc}") from None

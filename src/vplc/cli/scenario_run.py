@@ -34,14 +34,10 @@ class Signal:
 
     def __init__(self, plc: Plc, path: str) -> None:
         from ..runtime.values import converter
-        res = plc._resolver
-        container, key, t = res._locate(path)
-        root, steps = res._parse(path)
-        owner = plc.instances[root] if root is not None else plc.globals
+        slot = plc.lasting_slot(path)                                         # PathError for a bad path
         self.path, self.read = path, None
-        lasting = (getattr(owner, "__dict__", None), plc.globals.__dict__)     # a VAR_EXTERNAL lands in the globals
-        if len(steps) == 1 and not steps[0][3] and any(container is d for d in lasting):
-            self.container, self.key, self.conv = container, key, converter(t)
+        if slot is not None:
+            self.container, self.key, self.conv = slot.container, slot.key, converter(slot.type)
         else:
             self.container, self.key, self.conv = None, None, _same
             self.read = lambda: plc.read(path)

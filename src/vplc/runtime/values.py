@@ -4,8 +4,8 @@ enumeration values as their name. Writes are type-checked."""
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, MutableMapping
+from typing import Any, NamedTuple
 
 from ..frontend import types as T
 from . import iec
@@ -39,6 +39,14 @@ def type_text(t: T.Type) -> str:
     ns = getattr(u, "namespace", None)
     name = getattr(u, "qualified_name", None) or u.name
     return f"{ns}\\{u.name}" if ns and "\\" not in name else name
+
+
+class Slot(NamedTuple):
+    """Where a variable's runtime value lives: ``container[key]``, of the declared type ``type``."""
+
+    container: MutableMapping[Any, Any]
+    key: Any
+    type: T.Type
 
 
 class Resolver:
@@ -144,6 +152,23 @@ class Resolver:
             raise PathError(f"`{shown}` is a VAR_EXTERNAL of {where}, but no global variable `{shown}` exists "
                             f"(in {path!r})")
         return getattr(g, "i__members", None) or g.__dict__, ent[0], ent[1]
+
+    def type_of(self, path: str) -> T.Type:
+        """The declared type of the variable at ``path``; PathError for a path that names no variable."""
+        return self._locate(path)[2]
+
+    def lasting_slot(self, path: str) -> Slot | None:
+        """The slot of a variable declared directly in a program instance or a global list (a program's
+        VAR_EXTERNAL too: it is the global), which lives as long as the controller; None for anything deeper
+        (members, array elements: an assignment may replace their containers). PathError for a bad path."""
+        container, key, t = self._locate(path)
+        root, steps = self._parse(path)
+        plc = self.plc
+        owner = plc.instances[root] if root is not None else plc.globals
+        lasting = (getattr(owner, "__dict__", None), plc.globals.__dict__)
+        if len(steps) == 1 and not steps[0][3] and any(container is d for d in lasting):
+            return Slot(container, key, t)
+        return None
 
     def read(self, path: str) -> Any:
         c, k, t = self._locate(path)

@@ -11,7 +11,7 @@ class Recorder:
         self.labels = labels or paths            # row names of the SVG diagram
         self.kinds = []
         for p in paths:
-            t = T.base_of(plc._resolver._locate(p)[2])           # raises PathError for a bad path
+            t = T.base_of(plc.type_of(p))                       # raises PathError for a bad path
             if isinstance(t, T.ElementaryType) and t.kind == "bool":
                 self.kinds.append(("bool", 1))
             elif isinstance(t, T.ElementaryType) and t.kind == "real":
