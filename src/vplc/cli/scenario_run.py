@@ -9,7 +9,7 @@ lines wait for something that does not change (docs/toolchain/runtime.md section
 from __future__ import annotations
 
 import operator
-from collections.abc import Callable
+from collections.abc import Callable, MutableMapping
 from typing import TYPE_CHECKING, Any
 
 from ..runtime.values import PathError
@@ -35,7 +35,11 @@ class Signal:
     def __init__(self, plc: Plc, path: str) -> None:
         from ..runtime.values import converter
         slot = plc.lasting_slot(path)                                         # PathError for a bad path
-        self.path, self.read = path, None
+        self.path = path
+        self.read: Callable[[], Any] | None = None
+        self.container: MutableMapping[Any, Any] | None
+        self.key: Any
+        self.conv: Callable[[Any], Any]
         if slot is not None:
             self.container, self.key, self.conv = slot.container, slot.key, converter(slot.type)
         else:
