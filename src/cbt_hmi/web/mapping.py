@@ -58,7 +58,9 @@ class Leaf:
         return f"{self.min} .. {self.max}"
 
 
-def _string_length(type_text: str) -> int | None:
+def string_length(type_text: str) -> int | None:
+    """The length of a STRING type text (``STRING[20]`` -> 20; a bare ``STRING`` counts as 80), None for any
+    other type: the mapping's checks and the page descriptions judge text inputs by it."""
     if type_text.startswith("STRING[") and type_text.endswith("]"):
         return int(type_text[7:-1])
     return 80 if type_text == "STRING" else None
@@ -116,7 +118,7 @@ class Mapping:
         definition = types.get(type_name)
         if definition is None:
             if type_name not in INT_RANGES and type_name not in REAL_TYPES and type_name != "BOOL" \
-                    and _string_length(type_name) is None and type_name not in ("DATE_AND_TIME", "DT", "TIME"):
+                    and string_length(type_name) is None and type_name not in ("DATE_AND_TIME", "DT", "TIME"):
                 raise MappingError(f"{self.source}: '{path}' has unknown type '{type_name}'")
             self.leaves[path] = Leaf(path, spec, access, role)
         elif "enum" in definition:
@@ -162,7 +164,7 @@ class Mapping:
             bare = actual.rsplit("\\", 1)[-1]
             expected = leaf.type
             same = bare == expected or (expected in ("DATE_AND_TIME", "DT") and bare in ("DATE_AND_TIME", "DT"))
-            declared_length, expected_length = _string_length(bare), _string_length(expected)
+            declared_length, expected_length = string_length(bare), string_length(expected)
             if not same and declared_length is not None and expected_length is not None:
                 same = declared_length >= expected_length or leaf.access == "r"
             if not same:
@@ -204,7 +206,7 @@ def validate(leaf: Leaf, value: object) -> object:
         if (leaf.min is not None and value < leaf.min) or (leaf.max is not None and value > leaf.max):
             raise RequestError(f"{where}: {value:g} is out of range {leaf.min} .. {leaf.max}")
         return value
-    size = _string_length(leaf.type)
+    size = string_length(leaf.type)
     if size is not None:
         if not isinstance(value, str):
             raise RequestError(f"{where} is {leaf.type}: expected text, got {json.dumps(value)}")

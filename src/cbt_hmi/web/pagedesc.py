@@ -33,7 +33,7 @@ from collections.abc import Callable
 from typing import Any, NamedTuple, NoReturn
 
 from .. import PAGES
-from .mapping import DEFAULT_MAPPING, INT_RANGES, REAL_TYPES, _string_length
+from .mapping import DEFAULT_MAPPING, INT_RANGES, REAL_TYPES, string_length
 
 DESC_DIR = PAGES / "desc"          # the shipped pages' descriptions (package data)
 PAGE_KEYS = {"title", "inputs", "status", "command"}
@@ -153,7 +153,7 @@ def type_name(compiled) -> str:
 
 
 def _is_scalar(declared: str) -> bool:
-    return declared in NUMERIC or declared == "BOOL" or _string_length(declared) is not None
+    return declared in NUMERIC or declared == "BOOL" or string_length(declared) is not None
 
 
 def collect_types(compiled, types: dict[str, dict]) -> None:
@@ -214,7 +214,7 @@ def _check_value(compiled, value, where: str, line: int, fail: Fail) -> None:
                 low, high = INT_RANGES[declared]
                 if not isinstance(value, int) or not low <= value <= high:
                     fail(line, f"{where} is {declared}: {json.dumps(value)} is not a whole number in {low}..{high}")
-        if _string_length(declared) is not None and not isinstance(value, str):
+        if string_length(declared) is not None and not isinstance(value, str):
             fail(line, f"{where} is {declared}: give text, not {json.dumps(value)}")
 
 
@@ -454,7 +454,7 @@ def _check_item(section: str, item, parent_line: int, types: dict[str, Global], 
             fail(line, f"'abnormal' (true or false) is for BOOL status values; '{name}' is {declared}")
         result["abnormal"] = item["abnormal"]
     if "pattern" in item:
-        if item["pattern"] != "ipv4" or _string_length(bare) is None:
+        if item["pattern"] != "ipv4" or string_length(bare) is None:
             fail(line, f"'pattern' of '{name}': \"ipv4\" (an IPv4 address), for STRING variables only")
         result["pattern"] = "ipv4"
     if "range_of" in item:
@@ -520,7 +520,7 @@ def table_document(plc, pages: dict[str, dict], every_global: bool, title: str) 
         spec["access"] = "rw"
         if role == "engineer" or spec.get("role") == "engineer":
             spec["role"] = "engineer"
-        size = _string_length(spec["type"])
+        size = string_length(spec["type"])
         if size is not None:
             spec["maxlen"] = size - 1                # Sysmac STRING[n] holds n-1 characters (NUL)
         for key, target in (("execute", "execute"), ("pattern", "pattern"), ("range_of", "input"),

@@ -419,7 +419,7 @@ def compare(a: Any, op: str, b: Any) -> bool:
     if op == "<>":
         return not compare(a, "=", b)
     try:
-        return _ORDER[op](a, b)
+        return ORDERINGS[op](a, b)
     except TypeError:
         return False
 
@@ -464,7 +464,8 @@ def _resolve_term(plc: Plc, term: Term | Expect, where: str) -> None:
         raise ScenarioError(f"{where}: `{term.op}` compares numbers; {path} is a {plc.var_type(path)}")
 
 
-_ORDER = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
+# the ordering comparisons a condition or an expectation may use, by their ST spelling (= and <> compare any value)
+ORDERINGS = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
 
 
 def seconds(t_ns: int) -> str:

@@ -13,7 +13,7 @@ from collections.abc import Callable, MutableMapping
 from typing import TYPE_CHECKING, Any
 
 from ..runtime.values import PathError
-from .scenario import _ORDER, Expect, Reaction, Scenario, compare, fmt, seconds
+from .scenario import ORDERINGS, Expect, Reaction, Scenario, compare, fmt, seconds
 
 if TYPE_CHECKING:
     from ..api import Plc
@@ -66,8 +66,8 @@ def comparator(op: str, b: Any) -> Callable[[Any], bool]:
             (lambda a: not (isinstance(a, str) and a.upper() == b))
     if isinstance(b, float):
         return lambda a: compare(a, op, b)
-    if op in _ORDER:
-        order = _ORDER[op]
+    if op in ORDERINGS:
+        order = ORDERINGS[op]
         return lambda a: order(a, b)
     return (lambda a: a == b) if op == "=" else (lambda a: a != b)
 
