@@ -12,6 +12,7 @@ import errno
 import importlib
 import os
 import sys
+from typing import NoReturn
 
 from ..frontend.diagnostics import ERROR, NOTE, WARNING, to_json
 
@@ -19,7 +20,7 @@ EXTENSION_MODULES = ("vplc.cli.run", "vplc.cli.test", "vplc.export", "vplc.cli.d
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):  # usage errors: message + hint, exit 2, never a traceback
+    def error(self, message: str) -> NoReturn:  # usage errors: message + hint, exit 2, never a traceback
         self.print_usage(sys.stderr)
         self.exit(2, f"{self.prog}: error: {message}\n")
 

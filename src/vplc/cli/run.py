@@ -17,6 +17,7 @@ import signal
 import sys
 import threading
 import time
+from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 from ..runtime.values import parse_duration
@@ -26,6 +27,7 @@ from .scenario_run import Runner
 
 if TYPE_CHECKING:
     from ..api import Plc
+    from ..runtime.stats import OverrunCount, ScanStats
     from ..trace import Recorder
 
 
@@ -142,7 +144,8 @@ def run_cmd(args: argparse.Namespace) -> int:
             link.close()
 
 
-def _load_and_run(args, scenario, link, duration, wd, window) -> int:
+def _load_and_run(args: argparse.Namespace, scenario: scn.Scenario, link: simlink.SimControl | None,
+                  duration: int | None, wd: int, window: tuple[int, int] | None) -> int:
     from ..api import LoadError, PlcFault, load_plc, parse_task
     from ..runtime.stats import OverrunCount, ScanStats
     from ..runtime.values import PathError
@@ -239,14 +242,14 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM during a run: it ends like Ctrl-C, with the final values, the statistics and the trace written."""
 
 
-def _terminate(signum, frame) -> None:
+def _terminate(signum: int, frame: FrameType | None) -> None:
     raise Terminated()
 
 
 _NOT_SET = object()
 
 
-def _on_sigterm(handler):
+def _on_sigterm(handler: Any) -> Any:
     """Install ``handler`` for SIGTERM and return the one it replaces (``_NOT_SET`` where signals cannot be set:
     a thread other than the main one, a platform without SIGTERM; then nothing is installed or restored)."""
     if handler is _NOT_SET or not hasattr(signal, "SIGTERM"):
@@ -376,7 +379,7 @@ class Hooks:
         self.runner.after_scan(t_ns)
 
 
-def _run_virtual(plc, hooks, stats) -> None:
+def _run_virtual(plc: Plc, hooks: Hooks, stats: ScanStats | OverrunCount | None) -> None:
     period = plc.period_ns
     t = 0
     while hooks.before(t):
@@ -389,11 +392,11 @@ def _run_virtual(plc, hooks, stats) -> None:
         t += period
 
 
-def _run_realtime(plc, hooks, stats, spin_ns) -> None:
+def _run_realtime(plc: Plc, hooks: Hooks, stats: ScanStats | OverrunCount | None, spin_ns: int) -> None:
     stop = threading.Event()
     pending: list[int] = []                # the scan time of a scan whose results are not judged yet
 
-    def on_scan(now_ns):
+    def on_scan(now_ns: int) -> None:
         if pending:                        # the previous scan is complete: judge it
             hooks.after(pending.pop())
         if not hooks.before(now_ns):

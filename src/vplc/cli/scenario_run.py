@@ -50,7 +50,7 @@ class Signal:
         self.expects: list[Expect] = []
 
 
-def _same(v):
+def _same(v: Any) -> Any:
     return v
 
 
@@ -240,7 +240,7 @@ class Runner:
         else:
             self.link.post(request, r.where)
 
-    def _write(self, path, value, where) -> None:
+    def _write(self, path: str, value: Any, where: str) -> None:
         try:
             self.plc.write(path, value)
         except PathError as exc:

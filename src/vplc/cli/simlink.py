@@ -18,7 +18,9 @@ import math
 import queue
 import socket
 import threading
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 
 class CommandError(ValueError):
@@ -125,11 +127,11 @@ def known_commands() -> list[str]:
     return [*COMMANDS, *ALIASES]
 
 
-def _example(name, allowed) -> str:
+def _example(name: str, allowed: Iterable[str]) -> str:
     return f"`{name} ... {next(iter(allowed))}=1`"
 
 
-def _value(text: str, kind: str, key: str):
+def _value(text: str, kind: str, key: str) -> Any:
     if kind == "list":
         return [item for item in text.split(",") if item]
     if kind == "text":
@@ -179,7 +181,7 @@ def describe(request: dict) -> str:
     return " ".join(words)
 
 
-def _word(value) -> str:
+def _word(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, list):
@@ -264,7 +266,7 @@ class SimControl:
         """Send and judge the answer in the calling thread (virtual time: deterministic order)."""
         self._judge(request, where)
 
-    def _judge(self, request, where) -> None:
+    def _judge(self, request: dict, where: str) -> None:
         try:
             answer = self.call(request)
             problem = None if answer["ok"] else f"the simulator refused `{describe(request)}`: {answer.get('error')}"

@@ -20,9 +20,10 @@ from ..frontend import ast as A
 from ..runtime.values import parse_duration
 
 if TYPE_CHECKING:
+    from ..api import Plc
     from ..project import Project
     from ..runtime.faults import PlcFault
-    from ..runtime.testing import TestCase
+    from ..runtime.testing import Failure, TestCase
 
 RUNNER = "VPLC_TestRunner"
 
@@ -54,7 +55,7 @@ def find_suites(proj: Project) -> list[str]:
     return suites
 
 
-def _calls_test(pou) -> bool:
+def _calls_test(pou: A.Pou) -> bool:
     for stmt in pou.body:
         for node in A.walk(stmt):
             if isinstance(node, A.Call) and isinstance(node.callee, A.Name) and node.callee.name.name.upper() == "TEST":
@@ -136,20 +137,20 @@ def run_tests(args: argparse.Namespace) -> int:
     return report(results, errors, args, elapsed)
 
 
-def _inst_of(path: str | None):
+def _inst_of(path: str | None) -> str | None:
     if not path or "." not in path:
         return None
     return path.split(".")[1].split("[")[0]
 
 
-def _fault_failure(fault):
+def _fault_failure(fault: PlcFault) -> Failure:
     from ..runtime.testing import Failure
     text = str(fault).split(": major fault in ", 1)[-1]
     return Failure(fault.file or "<unknown>", fault.line or 0, f"major fault in {text}")
 
 
-def _all_finished(plc) -> bool:
-    col = getattr(plc.engine, "tests", None)          # the TEST() collector, once a suite has run (runtime/testing)
+def _all_finished(plc: Plc) -> bool:
+    col = plc.engine.tests                            # the TEST() collector, once a suite has run (runtime/testing)
     if col is None or not col.tests:
         return False
     return all(t.finished for t in col.tests.values())
@@ -185,7 +186,7 @@ def report(results: list[TestCase], errors: list[tuple[str | None, PlcFault]], a
     return 0 if failed == 0 else 1
 
 
-def _unfinished(tc):
+def _unfinished(tc: TestCase) -> Failure:
     from ..runtime.testing import Failure
     return Failure("<runner>", 0, "test did not call TEST_FINISHED() before the timeout")
 

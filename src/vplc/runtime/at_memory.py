@@ -7,7 +7,10 @@ memory belongs to one PLC (its Globals object), like every other variable.
 """
 from __future__ import annotations
 
-from .unions import ElementView, _decode, _encode
+from collections.abc import Iterable
+from typing import Any
+
+from .unions import ElementView, Scalar, _decode, _encode
 
 
 class AreaMemory:
@@ -23,14 +26,14 @@ class AreaMemory:
         return mem
 
 
-def _read(mem: bytearray, offset: int, size: int, kind: str):
+def _read(mem: bytearray, offset: int, size: int, kind: str) -> Scalar:
     first, shift = offset >> 3, offset & 7
     last = (offset + size + 7) >> 3
     raw = int.from_bytes(mem[first:last], "little") >> shift
     return _decode(raw & ((1 << size) - 1), kind, size)
 
 
-def _write(mem: bytearray, offset: int, size: int, kind: str, value) -> None:
+def _write(mem: bytearray, offset: int, size: int, kind: str, value: Scalar) -> None:
     first, shift = offset >> 3, offset & 7
     last = (offset + size + 7) >> 3
     raw = int.from_bytes(mem[first:last], "little")
@@ -46,10 +49,10 @@ class AreaArray(ElementView):
     def __init__(self, mem: bytearray, offset: int, kind: str, size: int, n: int) -> None:
         self.mem, self.offset, self.kind, self.size, self.n = mem, offset, kind, size, n
 
-    def _get(self, i: int):
+    def _get(self, i: int) -> Scalar:
         return _read(self.mem, self.offset + i * self.size, self.size, self.kind)
 
-    def _set(self, i: int, v) -> None:
+    def _set(self, i: int, v: Scalar) -> None:
         _write(self.mem, self.offset + i * self.size, self.size, self.kind, v)
 
 
@@ -60,12 +63,12 @@ def area_property(area: str, bank: int, words: int, word: int, bit: int, kind: s
     if kind == "bool" and count:
         size = 1
 
-    def mem(s) -> bytearray:
+    def mem(s: Any) -> bytearray:                # s: the PLC's instance of the generated Globals class
         return s.i__mem.area(area, bank, words)
     if count is None:
         return property(lambda s: _read(mem(s), offset, size, kind),
                         lambda s, v: _write(mem(s), offset, size, kind, v))
 
-    def set_all(s, values) -> None:
+    def set_all(s: Any, values: Iterable[Scalar]) -> None:
         AreaArray(mem(s), offset, kind, size, count)[:] = list(values)
     return property(lambda s: AreaArray(mem(s), offset, kind, size, count), set_all)

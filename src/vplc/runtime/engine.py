@@ -26,6 +26,7 @@ from .sockets import SocketManager
 
 if TYPE_CHECKING:
     from .motion import MotionController
+    from .testing import Collector
 
 
 @dataclass
@@ -94,6 +95,7 @@ class Engine:
         self.motion: MotionController | None = None   # the virtual axes (Plc attaches them), read by MC_* FBs
         self.instruction_errors: collections.deque[str] = collections.deque(maxlen=100)   # the latest, located
         self.instruction_error_count = 0
+        self.tests: Collector | None = None     # the TEST() results (runtime/testing.py), once a suite has run
 
     def instruction_error(self, message: str) -> None:
         """An instruction ended in error where the controller goes on (ENO FALSE, Out unchanged, e.g. W502 2-269):

@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import CodeType
 from typing import TYPE_CHECKING, Any
@@ -24,7 +25,7 @@ if TYPE_CHECKING:
 __all__ = ["GEN_FILE", "HELPERS", "Image", "InstanceSpec", "PouClass", "Program", "TaskSpec", "program_key"]
 
 
-def make_watchdog(deadline: list, probation: list, limit_s: list):
+def make_watchdog(deadline: list, probation: list, limit_s: list) -> Callable[..., None]:
     """The check generated loops call once the scan's wall-clock deadline ``deadline[0]`` (start + ``limit_s[0]``)
     has passed. Wall time alone would fault a scan whose thread the host did not run (a loaded machine, parallel
     tests), so the first pass starts a probation instead: the deadline moves by ``limit_s[0]`` and the thread's CPU

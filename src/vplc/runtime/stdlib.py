@@ -6,17 +6,19 @@ in the namespace of the generated module (``NAMESPACE``).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
 
 from ..frontend import builtins as B
 from ..frontend import types as T
 from . import iec
 from .faults import RuntimeFaultError
 
+_Obj = TypeVar("_Obj")
 
-def _nan_on_domain(fn):
-    def f(x):
+
+def _nan_on_domain(fn: Callable[[Any], float]) -> Callable[[Any], float]:
+    def f(x: Any) -> float:
         try:
             return fn(x)
         except (ValueError, OverflowError):
@@ -24,13 +26,13 @@ def _nan_on_domain(fn):
     return f
 
 
-def _fmod(a, b):
+def _fmod(a: float, b: float) -> float:
     if b == 0:
         raise RuntimeFaultError(f"division by zero ({a} MOD 0)")
     return math.fmod(a, b)
 
 
-def _mux(k, values):
+def _mux(k: int, values: Sequence[Any]) -> Any:
     if not 0 <= k < len(values):
         raise RuntimeFaultError(f"MUX selector {k} out of range 0..{len(values) - 1}")
     return values[k]
@@ -94,24 +96,25 @@ def _find(a: str, b: str) -> int:
     return a.find(b) + 1 if b else 0
 
 
-def _sinit(obj, **values):
+def _sinit(obj: _Obj, **values: Any) -> _Obj:
     obj.__dict__.update(values)
     return obj
 
 
-def _fill(items: list, n: int, make):
+def _fill(items: list[Any], n: int, make: Callable[[], Any]) -> list[Any]:
     items = items[:n]
     while len(items) < n:
         items.append(make())
     return items
 
 
-MATH = {name: _nan_on_domain(fn) for name, fn in {
+_MATH_FUNCTIONS: dict[str, Callable[[float], float]] = {
     "SQRT": math.sqrt, "LN": math.log, "LOG": math.log10, "EXP": math.exp, "SIN": math.sin, "COS": math.cos,
     "TAN": math.tan, "ASIN": math.asin, "ACOS": math.acos, "ATAN": math.atan,
-    "DEGTORAD": math.radians, "RADTODEG": math.degrees}.items()}       # W560 2-209 (Omron, builtins.py)
+    "DEGTORAD": math.radians, "RADTODEG": math.degrees}               # W560 2-209 (Omron, builtins.py)
+MATH = {name: _nan_on_domain(fn) for name, fn in _MATH_FUNCTIONS.items()}
 
-NAMESPACE = {
+NAMESPACE: dict[str, Any] = {
     "_fmod": _fmod, "_mux": _mux, "_bcd_decode": _bcd_decode, "_bcd_encode": _bcd_encode,
     "_left": _left, "_right": _right, "_mid": _mid, "_insert": _insert,
     "_delete": _delete, "_replace": _replace, "_find": _find, "_sinit": _sinit, "_fill": _fill,
@@ -124,7 +127,9 @@ NAMESPACE = {
 
 # ---- conversions -----------------------------------------------------------------------------------
 
-def _kind(t):
+def _kind(t: T.Type) -> tuple[str, Any]:
+    """(kind, base type): the base type is an ElementaryType for the elementary kinds and a StringType for
+    "string" (Any: its callers use it by the kind, a pairing mypy cannot follow)."""
     t = T.base_of(t)
     if isinstance(t, T.EnumType):
         return "int", T.base_of(t.base)
@@ -176,7 +181,7 @@ def string_converter(t: T.Type, dialect: str = "sysmac") -> Callable[[Any], str]
     return lambda v: to_string(v, t, dialect)
 
 
-def _parse_number(s: str, real: bool):
+def _parse_number(s: str, real: bool) -> int | float:
     text = s.strip().replace("_", "")
     try:
         if real:
@@ -241,7 +246,7 @@ def gen_builtin(gen: Any, b: Any) -> str:      # the compiler's ExprGen, the che
     signed = isinstance(rt, T.ElementaryType) and rt.kind in ("int", "time")
     real = isinstance(rt, T.ElementaryType) and rt.kind == "real"
 
-    def fix(code):
+    def fix(code: str) -> str:
         if real:
             return f"_f32({code})" if bits == 32 else code
         if isinstance(rt, T.ElementaryType) and rt.kind in ("int", "uint", "bit", "time"):

@@ -6,16 +6,21 @@ from __future__ import annotations
 
 import math
 import struct
+from collections.abc import MutableMapping, MutableSequence
+from typing import TYPE_CHECKING, Any
 
 from ..frontend import types as T
 from . import iec
 from .faults import RuntimeFaultError
 
+if TYPE_CHECKING:
+    from .engine import Engine
+
 LOW_HIGH, HIGH_LOW = 0, 1
 _NS = 1_000_000_000
 
 
-def _value_bytes(v, t) -> bytes:
+def _value_bytes(v: Any, t: T.Type) -> bytes:
     """Little-endian memory image of a value of elementary type ``t``."""
     b = T.base_of(t)
     if isinstance(b, T.EnumType):
@@ -47,9 +52,14 @@ def _order(data: bytes, order: int) -> bytes:
     return bytes(out)
 
 
-def _elementary(t):
+def _elementary(t: T.Type) -> T.ElementaryType | T.StringType:
+    """The base type of ``t`` (an enumeration's storage type for an enumeration). The checker lets these
+    instructions take only elementary values (checker/scope.py); anything else is a fault naming it."""
     b = T.base_of(t)
-    return T.base_of(b.base) if isinstance(b, T.EnumType) else b
+    b = T.base_of(b.base) if isinstance(b, T.EnumType) else b
+    if not isinstance(b, (T.ElementaryType, T.StringType)):
+        raise RuntimeFaultError(f"the memory image of a {b} is not modelled by vplc")
+    return b
 
 
 def ToAryByte(rt, In, In_t, Order, AryOut) -> int:
@@ -69,7 +79,7 @@ def ToAryByte(rt, In, In_t, Order, AryOut) -> int:
     return len(data)
 
 
-def _decode(data: bytes, b):
+def _decode(data: bytes, b: T.ElementaryType) -> bool | int | float:
     """A value of elementary type ``b`` from its little-endian memory image ``data`` (exactly its size)."""
     if b.kind == "real":
         return struct.unpack("<f" if len(data) == 4 else "<d", data)[0]
@@ -78,7 +88,7 @@ def _decode(data: bytes, b):
     return int.from_bytes(data, "little", signed=b.kind == "int")
 
 
-def _size(b) -> int:
+def _size(b: T.ElementaryType) -> int:
     return 4 if b.kind == "real" and b.bits == 32 else max(1, b.bits // 8)
 
 
@@ -102,7 +112,8 @@ def AryByteTo(rt, In, Size, Order, OutVal, OutVal_t) -> bool:
     return True
 
 
-def _bytes_to_array(data: bytes, order: int, out, b) -> None:
+def _bytes_to_array(data: bytes, order: int, out: MutableSequence[Any],
+                    b: T.ElementaryType | T.StringType) -> None:
     """An array OutVal: a BOOL array takes the bits, bit 0 of the first byte into OutVal[0] (W502 2-461: In[0] into
     OutVal[0] .. OutVal[7], In[1] into OutVal[8] .. OutVal[15], ...; _HIGH_LOW swaps the bytes two by two first);
     other arrays take one element per element size. Elements the bytes do not reach keep their values; bytes
@@ -142,7 +153,7 @@ UNCHANGED = _Unchanged("")       # an assignment of the call keeps its destinati
 KEEPS_OUT_ON_ERROR = frozenset({"RealToFormatString", "LrealToFormatString"})
 
 
-def _format(rt, name: str, x: float, Exponent: bool, Sign: bool, MinLen: int, DecPlace: int) -> str:
+def _format(rt: Engine, name: str, x: float, Exponent: bool, Sign: bool, MinLen: int, DecPlace: int) -> str:
     """W502 2-269: the fraction is rounded half to even (1.5 -> 2, 2.5 -> 2), which Python's formatting of the
     binary value does. DecPlace greater than MinLen is an error: ENO FALSE and Out does not change, so the
     instruction error is recorded and the assignment keeps its destination (UNCHANGED)."""
@@ -233,11 +244,11 @@ def ModReal(rt, In1, In2) -> float:
     return math.fmod(In1, In2)                   # the sign of In1, as the division's remainder
 
 
-def _step(ref, t, delta: int) -> bool:
+def _step(ref: tuple[MutableMapping[Any, Any], Any], t: T.Type, delta: int) -> bool:
     container, key = ref
     b = _elementary(t)
-    value = container[key] + delta
-    if b.kind != "real":
+    value = container[key] + delta              # (a STRING, which the checker refuses here, fails at the +)
+    if isinstance(b, T.ElementaryType) and b.kind != "real":
         bits = b.bits
         value &= (1 << bits) - 1
         if b.kind == "int" and value >= 1 << (bits - 1):

@@ -46,7 +46,7 @@ class Collector:
         return list(self.tests.values())
 
 
-def _where(rt):
+def _where(rt: Engine) -> tuple[str, int, str]:
     f: FrameType | None = sys._getframe(2)
     while f is not None and f.f_code.co_filename != GEN_FILE:
         f = f.f_back
@@ -57,8 +57,8 @@ def _where(rt):
     return file, line, getattr(s, "i__path", "<unknown>")
 
 
-def _collector(rt) -> Collector:
-    c = getattr(rt, "tests", None)
+def _collector(rt: Engine) -> Collector:
+    c = rt.tests
     if c is None:
         c = rt.tests = Collector()
     return c
@@ -89,7 +89,7 @@ def IS_TEST_FINISHED(rt: Engine, Name: str) -> bool:
     return bool(tc and tc.finished)
 
 
-def _record(rt, ok: bool, text: str) -> bool:
+def _record(rt: Engine, ok: bool, text: str) -> bool:
     if ok:
         return True
     file, line, suite = _where(rt)
@@ -114,7 +114,7 @@ def AssertFalse(rt: Engine, Condition: bool, Message: str) -> bool:
     return _record(rt, not Condition, _msg(Message or "", "expected FALSE, got TRUE"))
 
 
-def _fmt(v) -> str:
+def _fmt(v: object) -> str:
     if isinstance(v, bool):
         return "TRUE" if v else "FALSE"
     if isinstance(v, str):
@@ -122,19 +122,19 @@ def _fmt(v) -> str:
     return str(v)
 
 
-def _equals(rt, Expected, Actual, Message) -> bool:
+def _equals(rt: Engine, Expected: object, Actual: object, Message: str) -> bool:
     return _record(rt, Expected == Actual, _msg(Message or "", f"expected {_fmt(Expected)}, got {_fmt(Actual)}"))
 
 
 def _equals_bits(bits: int) -> Callable[[Engine, int, int, str], bool]:
     """AssertEquals_BYTE .. _LWORD: the values in the notation the controller shows them, 16#4006 (not 16390)."""
-    def equals(rt, Expected, Actual, Message) -> bool:
+    def equals(rt: Engine, Expected: int, Actual: int, Message: str) -> bool:
         return _record(rt, Expected == Actual, _msg(Message or "", f"expected {T.bits_literal(Expected, bits)}, "
                                                                    f"got {T.bits_literal(Actual, bits)}"))
     return equals
 
 
-def _equals_real(rt, Expected, Actual, Delta, Message) -> bool:
+def _equals_real(rt: Engine, Expected: float, Actual: float, Delta: float, Message: str) -> bool:
     ok = not (math.isnan(Expected) or math.isnan(Actual)) and abs(Expected - Actual) <= abs(Delta or 0.0)
     return _record(rt, ok, _msg(Message or "", f"expected {Expected:g} (+/- {Delta:g}), got {Actual:g}"))
 

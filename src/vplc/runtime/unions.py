@@ -9,9 +9,14 @@ one element after the other. Integers read signed or unsigned as their type, REA
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterable, Iterator
+from typing import Any, overload
+
+# what a member of a union or a variable in a memory area holds: BOOL, an integer or bit string, REAL/LREAL
+Scalar = bool | int | float
 
 
-def _decode(bits: int, kind: str, size: int):
+def _decode(bits: int, kind: str, size: int) -> Scalar:
     if kind == "bool":
         return bool(bits & 1)
     if kind == "real":
@@ -21,7 +26,7 @@ def _decode(bits: int, kind: str, size: int):
     return bits
 
 
-def _encode(value, kind: str, size: int) -> int:
+def _encode(value: Scalar, kind: str, size: int) -> int:
     if kind == "bool":
         return 1 if value else 0
     if kind == "real":
@@ -29,12 +34,12 @@ def _encode(value, kind: str, size: int) -> int:
     return int(value) & ((1 << size) - 1)
 
 
-def read(cell: list, kind: str, size: int, offset: int = 0):
+def read(cell: list[int], kind: str, size: int, offset: int = 0) -> Scalar:
     """The member of ``size`` bits at bit ``offset`` of the union's image."""
     return _decode(cell[0] >> offset & ((1 << size) - 1), kind, size)
 
 
-def write(cell: list, kind: str, size: int, value, offset: int = 0) -> None:
+def write(cell: list[int], kind: str, size: int, value: Scalar, offset: int = 0) -> None:
     mask = ((1 << size) - 1) << offset
     cell[0] = (cell[0] & ~mask) | (_encode(value, kind, size) << offset)
 
@@ -45,10 +50,10 @@ class ElementView:
     __slots__ = ("n",)
     n: int                                  # the number of elements, set by the subclass
 
-    def _get(self, i: int):
+    def _get(self, i: int) -> Scalar:
         raise NotImplementedError
 
-    def _set(self, i: int, v) -> None:
+    def _set(self, i: int, v: Scalar) -> None:
         raise NotImplementedError
 
     def _checked(self, i: int) -> int:
@@ -59,22 +64,28 @@ class ElementView:
     def __len__(self) -> int:
         return self.n
 
-    def __getitem__(self, i):
+    @overload
+    def __getitem__(self, i: int) -> Scalar: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> list[Scalar]: ...
+
+    def __getitem__(self, i: int | slice) -> Scalar | list[Scalar]:
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(self.n))]
         return self._get(self._checked(i))
 
-    def __setitem__(self, i, v) -> None:
+    def __setitem__(self, i: int | slice, v: Any) -> None:
         if isinstance(i, slice):
             for k, x in zip(range(*i.indices(self.n)), v, strict=False):
                 self[k] = x
             return
         self._set(self._checked(i), v)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Scalar]:
         return (self[i] for i in range(self.n))
 
-    def __eq__(self, other) -> bool:
+    def __eq__(self, other: Any) -> bool:          # compared with a list (or another view) by its elements
         return list(self) == list(other)
 
     def __repr__(self) -> str:
@@ -86,13 +97,13 @@ class MemberArray(ElementView):
     the image, so the other members see it)."""
     __slots__ = ("cell", "kind", "size")
 
-    def __init__(self, cell: list, kind: str, size: int, n: int) -> None:
+    def __init__(self, cell: list[int], kind: str, size: int, n: int) -> None:
         self.cell, self.kind, self.size, self.n = cell, kind, size, n
 
-    def _get(self, i: int):
+    def _get(self, i: int) -> Scalar:
         return read(self.cell, self.kind, self.size, i * self.size)
 
-    def _set(self, i: int, v) -> None:
+    def _set(self, i: int, v: Scalar) -> None:
         write(self.cell, self.kind, self.size, v, i * self.size)
 
 
@@ -101,7 +112,7 @@ def member_property(kind: str, size: int, count: int | None) -> property:
     if count is None:
         return property(lambda s: read(s.i__m, kind, size), lambda s, v: write(s.i__m, kind, size, v))
 
-    def set_all(s, values) -> None:
+    def set_all(s: Any, values: Iterable[Scalar]) -> None:      # s: an instance of the generated union class
         view = MemberArray(s.i__m, kind, size, count)
         view[:] = list(values)
     return property(lambda s: MemberArray(s.i__m, kind, size, count), set_all)
@@ -112,13 +123,13 @@ class Members:
     by name (vplc.api's read/write, the HMI, traces)."""
     __slots__ = ("union",)
 
-    def __init__(self, union) -> None:
+    def __init__(self, union: Any) -> None:         # an instance of a generated union class
         self.union = union
 
-    def __getitem__(self, key: str):
+    def __getitem__(self, key: str) -> Any:
         return getattr(self.union, key)
 
-    def __setitem__(self, key: str, value) -> None:
+    def __setitem__(self, key: str, value: Any) -> None:
         setattr(self.union, key, value)
 
     def __contains__(self, key: str) -> bool:

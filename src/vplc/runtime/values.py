@@ -101,12 +101,13 @@ class Resolver:
             self._parsed[path] = plan
         return plan
 
-    def _locate(self, path: str):
+    def _locate(self, path: str) -> tuple[Any, Any, T.Type]:
         """-> (container, key, type) of the variable at ``path``."""
         root, steps = self._parse(path)
         plc = self.plc
         obj = plc.instances[root] if root is not None else plc.globals
-        container, key, cur_t = None, None, (obj.i__type if root is not None else None)
+        container, key = None, None
+        cur_t: T.Type | None = obj.i__type if root is not None else None
         for seg, name, shown, indexes in steps:
             value = obj if container is None else container[key]
             info = getattr(type(value), "i__vars", None)
@@ -116,7 +117,7 @@ class Resolver:
             if ent is None:
                 where = getattr(value, "i__path", None) or getattr(getattr(value, "i__type", None), "name", "value")
                 raise PathError(f"`{shown}` is not a variable of {where} (in {path!r})")
-            attr, cur_t = ent
+            attr, step_t = ent
             # a union's members live in its memory image: it lends a mapping view of them (runtime/unions.py)
             container, key = getattr(value, "i__members", None) or value.__dict__, attr
             if key + "__r" in container:                 # scalar VAR_IN_OUT: follow the reference
@@ -124,9 +125,9 @@ class Resolver:
             elif type(container) is dict and key not in container:     # (a union's view holds all members)
                 external = self._external(value, name, shown, path)
                 if external is not None:
-                    container, key, cur_t = external
+                    container, key, step_t = external
             for idx in indexes:
-                at = T.unalias(cur_t)
+                at = T.unalias(step_t)
                 if not isinstance(at, T.ArrayType):
                     raise PathError(f"`{seg}` is not an array (in {path!r})")
                 arr = container[key]
@@ -134,8 +135,9 @@ class Resolver:
                     off = iec.ixo(idx[0], arr) if at.open else iec.ixn(idx, tuple(at.dims))
                 except iec.RuntimeFaultError as exc:
                     raise PathError(f"{exc} (in {path!r})") from None
-                container, key, cur_t = arr, off, at.element
-        if container is None:
+                container, key, step_t = arr, off, at.element
+            cur_t = step_t
+        if container is None or cur_t is None:        # (every step gives a type: no step, no variable)
             raise PathError(f"{path!r} names a program instance, not a variable")
         return container, key, cur_t
 
@@ -213,18 +215,18 @@ def converter(t: T.Type) -> Callable[[Any], Any]:
         for name, val in u.values.items():
             names.setdefault(val, name)              # the first name declared for a value, as before
 
-        def enum_name(v, names=names):
+        def enum_name(v: Any, names: dict[int, str] = names) -> Any:
             return names.get(v, v)
         conv = enum_name
     elif isinstance(u, T.ArrayType):
         element = u.element
 
-        def elements(v, element=element):
+        def elements(v: Any, element: T.Type = element) -> list[Any]:
             each = converter(element)
             return [each(x) for x in v]
         conv = elements
     elif isinstance(u, (T.StructType, T.PouType)):
-        def members(v):
+        def members(v: Any) -> dict[str, Any]:
             info = getattr(type(v), "i__vars", {})
             return {attr: converter(ft)(getattr(v, attr)) for attr, ft in info.values() if hasattr(v, attr)}
         conv = members
@@ -246,13 +248,14 @@ def plc_text(t: T.Type) -> Callable[[Any], str]:
     return _text(t, top=True)
 
 
-def _text(t, top: bool = False):
+def _text(t: T.Type, top: bool = False) -> Callable[[Any], str]:
     u = T.base_of(t)
     if isinstance(u, T.ElementaryType):
         if u.kind == "bool":
             return lambda v: "TRUE" if v else "FALSE"
         if u.kind == "bit":
-            return lambda v, bits=u.bits: T.bits_literal(v, bits) if isinstance(v, int) else str(v)
+            bits = u.bits
+            return lambda v: T.bits_literal(v, bits) if isinstance(v, int) else str(v)
         if u.kind in ("time", "ltime"):
             return lambda v: duration_literal(v) if isinstance(v, int) else str(v)
         if u.kind == "real":
@@ -263,7 +266,7 @@ def _text(t, top: bool = False):
     if isinstance(u, T.ArrayType):
         each = _text(u.element)
 
-        def array(v):
+        def array(v: Any) -> str:
             shown = [each(x) for x in v[:WATCH_ELEMENTS]]
             if len(v) > WATCH_ELEMENTS:
                 shown.append(f"… {len(v) - WATCH_ELEMENTS} more")
@@ -277,7 +280,7 @@ def _text(t, top: bool = False):
     else:
         return str
 
-    def struct(v):
+    def struct(v: Any) -> str:
         if not isinstance(v, dict):
             return str(v)
         parts = []
