@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 import struct
-from collections.abc import MutableMapping, MutableSequence
 from typing import TYPE_CHECKING, Any
 
 from ..frontend import types as T
@@ -17,6 +16,11 @@ if TYPE_CHECKING:
     from .engine import Engine
 
 LOW_HIGH, HIGH_LOW = 0, 1
+# how generated code hands an instruction its parameters: an ARRAY as a list (or, given ``a[i]``, a view of the
+# array from that element), a VAR_IN_OUT scalar as a (container, key) reference (compiler/codegen_expr.py ref:
+# an instance's __dict__ and a name, a list and an index, a union's member view and a name)
+Array = list[Any] | iec.ArrView
+Ref = tuple[Any, Any]
 _NS = 1_000_000_000
 
 
@@ -62,7 +66,7 @@ def _elementary(t: T.Type) -> T.ElementaryType | T.StringType:
     return b
 
 
-def ToAryByte(rt, In, In_t, Order, AryOut) -> int:
+def ToAryByte(rt: Engine, In: Any, In_t: T.Type, Order: int, AryOut: Array) -> int:
     """W502 2-453 .. 2-455: In (a value, or an array of values: their bytes one after the other) into AryOut."""
     u = T.unalias(In_t)
     if isinstance(u, T.ArrayType):
@@ -92,7 +96,7 @@ def _size(b: T.ElementaryType) -> int:
     return 4 if b.kind == "real" and b.bits == 32 else max(1, b.bits // 8)
 
 
-def AryByteTo(rt, In, Size, Order, OutVal, OutVal_t) -> bool:
+def AryByteTo(rt: Engine, In: Array, Size: int, Order: int, OutVal: Any, OutVal_t: T.Type) -> bool:
     """W502 2-459 .. 2-461: Size bytes of In, in Order, into OutVal (a value, or an array of values)."""
     if Size > len(In):
         raise RuntimeFaultError(f"AryByteTo: Size {Size} exceeds the {len(In)} bytes of the array")
@@ -112,7 +116,7 @@ def AryByteTo(rt, In, Size, Order, OutVal, OutVal_t) -> bool:
     return True
 
 
-def _bytes_to_array(data: bytes, order: int, out: MutableSequence[Any],
+def _bytes_to_array(data: bytes, order: int, out: Array,
                     b: T.ElementaryType | T.StringType) -> None:
     """An array OutVal: a BOOL array takes the bits, bit 0 of the first byte into OutVal[0] (W502 2-461: In[0] into
     OutVal[0] .. OutVal[7], In[1] into OutVal[8] .. OutVal[15], ...; _HIGH_LOW swaps the bytes two by two first);
@@ -130,7 +134,7 @@ def _bytes_to_array(data: bytes, order: int, out: MutableSequence[Any],
         out[i] = _decode(data[i * n:(i + 1) * n], b)
 
 
-def StringToAry(rt, In, AryOut) -> int:
+def StringToAry(rt: Engine, In: str, AryOut: Array) -> int:
     data = In.encode("latin-1", "replace")
     if len(data) > len(AryOut):
         raise RuntimeFaultError(f"StringToAry: {len(data)} characters do not fit in the {len(AryOut)}-byte array")
@@ -138,7 +142,7 @@ def StringToAry(rt, In, AryOut) -> int:
     return len(data)
 
 
-def AryToString(rt, In, Size) -> str:
+def AryToString(rt: Engine, In: Array, Size: int) -> str:
     if Size > len(In):
         raise RuntimeFaultError(f"AryToString: Size {Size} exceeds the {len(In)} bytes of the array")
     data = iec.bytes_of(In, Size)
@@ -165,15 +169,15 @@ def _format(rt: Engine, name: str, x: float, Exponent: bool, Sign: bool, MinLen:
     return text.rjust(int(MinLen))
 
 
-def RealToFormatString(rt, In, Exponent, Sign, MinLen, DecPlace) -> str:
+def RealToFormatString(rt: Engine, In: float, Exponent: bool, Sign: bool, MinLen: int, DecPlace: int) -> str:
     return _format(rt, "RealToFormatString", In, Exponent, Sign, MinLen, DecPlace)
 
 
-def LrealToFormatString(rt, In, Exponent, Sign, MinLen, DecPlace) -> str:
+def LrealToFormatString(rt: Engine, In: float, Exponent: bool, Sign: bool, MinLen: int, DecPlace: int) -> str:
     return _format(rt, "LrealToFormatString", In, Exponent, Sign, MinLen, DecPlace)
 
 
-def stores_out(rt, value: str, capacity: int, name: str) -> bool:
+def stores_out(rt: Engine, value: str, capacity: int, name: str) -> bool:
     """May the result of instruction ``name`` go into the STRING variable connected to Out? Not after an error,
     nor when the text is longer than the variable (W502 2-269: that too is an error and Out does not change)."""
     if value is UNCHANGED:
@@ -185,66 +189,66 @@ def stores_out(rt, value: str, capacity: int, name: str) -> bool:
     return True
 
 
-def GetTime(rt) -> int:
+def GetTime(rt: Engine) -> int:
     return rt.clock_dt_ns()
 
 
-def SecToDt(rt, In) -> int:
+def SecToDt(rt: Engine, In: int) -> int:
     return In * _NS
 
 
-def DtToSec(rt, In) -> int:
+def DtToSec(rt: Engine, In: int) -> int:
     return In // _NS
 
 
-def NanoSecToTime(rt, In) -> int:
+def NanoSecToTime(rt: Engine, In: int) -> int:
     return In
 
 
-def TimeToNanoSec(rt, In) -> int:
+def TimeToNanoSec(rt: Engine, In: int) -> int:
     return In
 
 
-def VPLC_ScanTime(rt) -> int:
+def VPLC_ScanTime(rt: Engine) -> int:
     return rt.now_ns
 
 
-def SecToTime(rt, In) -> int:
+def SecToTime(rt: Engine, In: int) -> int:
     return In * _NS
 
 
-def TimeToSec(rt, In) -> int:
+def TimeToSec(rt: Engine, In: int) -> int:
     return int(In / _NS)                         # toward zero: the fraction of a second is cut off
 
 
-def CopyDwordToReal(rt, In) -> float:
+def CopyDwordToReal(rt: Engine, In: int) -> float:
     return struct.unpack("<f", struct.pack("<I", In & 0xFFFF_FFFF))[0]
 
 
-def CopyRealToDword(rt, In) -> int:
+def CopyRealToDword(rt: Engine, In: float) -> int:
     return struct.unpack("<I", struct.pack("<f", In))[0]
 
 
-def CopyLwordToLreal(rt, In) -> float:
+def CopyLwordToLreal(rt: Engine, In: int) -> float:
     return struct.unpack("<d", struct.pack("<Q", In & 0xFFFF_FFFF_FFFF_FFFF))[0]
 
 
-def CopyLrealToLword(rt, In) -> int:
+def CopyLrealToLword(rt: Engine, In: float) -> int:
     return struct.unpack("<Q", struct.pack("<d", In))[0]
 
 
-def EnumToNum(rt, In, In_t) -> int:
+def EnumToNum(rt: Engine, In: int, In_t: T.Type) -> int:
     return int(In)                               # an enumeration value is held as its number
 
 
-def ModReal(rt, In1, In2) -> float:
+def ModReal(rt: Engine, In1: float, In2: float) -> float:
     if In2 == 0:
         rt.instruction_error("ModReal: In2 is 0; Out is 0")
         return 0.0
     return math.fmod(In1, In2)                   # the sign of In1, as the division's remainder
 
 
-def _step(ref: tuple[MutableMapping[Any, Any], Any], t: T.Type, delta: int) -> bool:
+def _step(ref: Ref, t: T.Type, delta: int) -> bool:
     container, key = ref
     b = _elementary(t)
     value = container[key] + delta              # (a STRING, which the checker refuses here, fails at the +)
@@ -257,15 +261,15 @@ def _step(ref: tuple[MutableMapping[Any, Any], Any], t: T.Type, delta: int) -> b
     return True
 
 
-def Inc(rt, InOut, InOut_t) -> bool:
+def Inc(rt: Engine, InOut: Ref, InOut_t: T.Type) -> bool:
     return _step(InOut, InOut_t, 1)
 
 
-def Dec(rt, InOut, InOut_t) -> bool:
+def Dec(rt: Engine, InOut: Ref, InOut_t: T.Type) -> bool:
     return _step(InOut, InOut_t, -1)
 
 
-def AryMove(rt, In, AryOut, Size) -> bool:
+def AryMove(rt: Engine, In: Array, AryOut: Array, Size: int) -> bool:
     """Size elements from In to AryOut; a structure element is copied into the existing one (other references to
     it see the new value)."""
     if Size > len(In) or Size > len(AryOut):
@@ -281,46 +285,46 @@ def AryMove(rt, In, AryOut, Size) -> bool:
     return True
 
 
-def SizeOfAry(rt, In) -> int:
+def SizeOfAry(rt: Engine, In: Array) -> int:
     return len(In)
 
 
-def ClearString(rt, InOut) -> bool:
+def ClearString(rt: Engine, InOut: Ref) -> bool:
     container, key = InOut
     container[key] = ""
     return True
 
 
-def GetMyTaskInterval(rt) -> int:
+def GetMyTaskInterval(rt: Engine) -> int:
     task = getattr(rt, "current_task", None)
     return task.period_ns if task is not None else rt.period_ns
 
 
-def Get1sClk(rt) -> bool:
+def Get1sClk(rt: Engine) -> bool:
     return rt.now_ns % 1_000_000_000 < 500_000_000
 
 
-def Get100msClk(rt) -> bool:
+def Get100msClk(rt: Engine) -> bool:
     return rt.now_ns % 100_000_000 < 50_000_000
 
 
-def Get1msClk(rt) -> bool:
+def Get1msClk(rt: Engine) -> bool:
     return rt.now_ns % 1_000_000 < 500_000
 
 
-def Get10msClk(rt) -> bool:
+def Get10msClk(rt: Engine) -> bool:
     return rt.now_ns % 10_000_000 < 5_000_000
 
 
-def Get1minClk(rt) -> bool:
+def Get1minClk(rt: Engine) -> bool:
     return rt.now_ns % 60_000_000_000 < 30_000_000_000
 
 
-def Get1usCnt(rt) -> int:
+def Get1usCnt(rt: Engine) -> int:
     return rt.now_ns // 1_000                    # W560 2-1465; counted from the start of the run
 
 
-def Get1msCnt(rt) -> int:
+def Get1msCnt(rt: Engine) -> int:
     return rt.now_ns // 1_000_000
 
 
