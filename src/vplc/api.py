@@ -125,7 +125,7 @@ def compile_program(paths: SourcePaths, *, dialect: str = "sysmac", count_statem
     return program
 
 
-def _fingerprint(paths, dialect: str, count_statements: bool):
+def _fingerprint(paths: list[str | os.PathLike[str]], dialect: str, count_statements: bool) -> bytes | None:
     """Digest of the files ``load_project`` would read, or None when any of them is unreadable (the front
     end then reports it)."""
     from .frontend.diagnostics import DiagnosticBag
@@ -208,7 +208,8 @@ class Plc:
             raise LoadError(f"error: no PROGRAM named `{name}` in the loaded sources")
         return key
 
-    def _instance(self, inst_name: str, key: str):
+    def _instance(self, inst_name: str, key: str) -> tuple[Any, Callable[..., Any]]:
+        """A new instance of the PROGRAM ``key`` named ``inst_name`` and its body function (a task's entry)."""
         inst = self.module.classes[key](inst_name)
         self.instances[inst_name.upper()] = inst
         return inst, self.module.bodies[key]

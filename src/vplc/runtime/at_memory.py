@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from .unions import ElementView, Scalar, _decode, _encode
+from .unions import ElementView, Scalar, decode_bits, encode_bits
 
 
 class AreaMemory:
@@ -30,7 +30,7 @@ def _read(mem: bytearray, offset: int, size: int, kind: str) -> Scalar:
     first, shift = offset >> 3, offset & 7
     last = (offset + size + 7) >> 3
     raw = int.from_bytes(mem[first:last], "little") >> shift
-    return _decode(raw & ((1 << size) - 1), kind, size)
+    return decode_bits(raw & ((1 << size) - 1), kind, size)
 
 
 def _write(mem: bytearray, offset: int, size: int, kind: str, value: Scalar) -> None:
@@ -38,7 +38,7 @@ def _write(mem: bytearray, offset: int, size: int, kind: str, value: Scalar) -> 
     last = (offset + size + 7) >> 3
     raw = int.from_bytes(mem[first:last], "little")
     mask = ((1 << size) - 1) << shift
-    raw = (raw & ~mask) | (_encode(value, kind, size) << shift)
+    raw = (raw & ~mask) | (encode_bits(value, kind, size) << shift)
     mem[first:last] = raw.to_bytes(last - first, "little")
 
 

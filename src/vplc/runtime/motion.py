@@ -91,11 +91,12 @@ class Axis:
         ref.Scale.MinPos = cfg.limit_negative if cfg.limit_negative is not None else 0.0
         ref.DrvStatus.Ready = ref.DrvStatus.MainPower = True
         ref.Details.Homed = self.homed
-        self._set_state(DISABLED)
+        self.set_state(DISABLED)
         self._write()
 
     # ---- what the program sees -------------------------------------------------------------------
-    def _set_state(self, state: str) -> None:
+    def set_state(self, state: str) -> None:
+        """Enter the PLCopen axis state ``state``: its Status flag, Ready and Details.Idle as the program reads them."""
         st = self.ref.Status
         setattr(st, self.state, False)
         self.state = state
@@ -139,13 +140,14 @@ class Axis:
         return maximum if value <= 0.0 or value > maximum else value
 
     # ---- commands -----------------------------------------------------------------------------------
-    def _finish(self, cmd: Command | None, status: str) -> None:
+    def end_command(self, cmd: Command | None, status: str) -> None:
+        """End ``cmd`` with ``status`` (done, aborted ...) if it is still waiting or running; None is no command."""
         if cmd is not None and cmd.status in (WAITING, ACTIVE):
             cmd.status = status
 
     def abort_all(self) -> None:
-        self._finish(self.active, ABORTED)
-        self._finish(self.queued, ABORTED)
+        self.end_command(self.active, ABORTED)
+        self.end_command(self.queued, ABORTED)
         self.active = self.queued = None
 
     def start(self, cmd: Command, t: float, at_end: bool = False) -> None:
@@ -154,7 +156,7 @@ class Axis:
         if self.profile is not None and not at_end:
             self.pos, self.vel, self.acc, _ = self.profile.at(t)
         if self.active is not cmd:
-            self._finish(self.active, ABORTED)
+            self.end_command(self.active, ABORTED)
         if self.stop_cmd is not None and cmd.kind != "stop":
             self.stop_cmd = None
         self.active, cmd.status = cmd, ACTIVE
@@ -167,14 +169,14 @@ class Axis:
             self.ref.Details.VelLimit = limited
             self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, cmd.direction * vt, cmd.acc,
                                                                         cmd.dec, cmd.jerk, self.acc, vlim))
-            self._set_state(CONTINUOUS)
+            self.set_state(CONTINUOUS)
         elif k == "position":
             self.plan_to(cmd, t)
-            self._set_state(DISCRETE)
+            self.set_state(DISCRETE)
         elif k in ("halt", "stop"):
             self.profile = Profile(t, self.pos, self.vel, plan_velocity(self.vel, 0.0, cmd.dec, cmd.dec, cmd.jerk,
                                                                         self.acc, vlim))
-            self._set_state(DISCRETE if k == "halt" else STOPPING)
+            self.set_state(DISCRETE if k == "halt" else STOPPING)
 
     def plan_to(self, cmd: Command, t: float) -> None:
         vmax, limited = self.vmax_of(cmd.velocity)
@@ -218,7 +220,7 @@ class Axis:
                     break
             if self.queued is not None:
                 self.pos, self.vel = prof.x_end, prof.v_end
-                self._finish(cmd, DONE)
+                self.end_command(cmd, DONE)
                 nxt, self.queued, self.active = self.queued, None, None
                 self.start(nxt, prof.t_end, at_end=True)
                 prof = self.profile
@@ -233,18 +235,18 @@ class Axis:
         cmd = self.active
         if self.state == ERRORSTOP:
             self.limit_stop = False
-            self._set_state(ERRORSTOP)
+            self.set_state(ERRORSTOP)
             return
         if cmd is not None and cmd.kind == "stop":
             cmd.status = DONE
             if not self.stop_execute:
                 self.release_stop()
             else:
-                self._set_state(STOPPING)
+                self.set_state(STOPPING)
             return
-        self._finish(cmd, DONE)
+        self.end_command(cmd, DONE)
         self.active = None
-        self._set_state(STANDSTILL)
+        self.set_state(STANDSTILL)
 
     def release_stop(self) -> None:
         """MC_Stop is done and its Execute is FALSE: the axis leaves Stopping (W507 state chart)."""
@@ -252,7 +254,7 @@ class Axis:
         if self.active is not None and self.active.kind == "stop":
             self.active = None
         if self.state == STOPPING and self.profile is None:
-            self._set_state(STANDSTILL)
+            self.set_state(STANDSTILL)
 
     def run_instant(self) -> None:
         """MC_Home (zero position preset) and MC_SetPosition given in this period."""
@@ -262,7 +264,7 @@ class Axis:
             self.define_position(cmd.target, True)
             cmd.status = DONE
             if self.state == HOMING:
-                self._set_state(STANDSTILL)
+                self.set_state(STANDSTILL)
         self.instant.clear()
 
     def _guard_limits(self, prof: Profile, x: float, v: float, a: float, finished: bool,
@@ -300,12 +302,12 @@ class Axis:
     def error(self, code: int) -> None:
         """An axis minor fault: the commands are aborted, the axis goes to ErrorStop (W507 state chart)."""
         self.abort_all()
-        self._finish(self.stop_cmd, ABORTED)
+        self.end_command(self.stop_cmd, ABORTED)
         self.stop_cmd = None
         if not self.error_code:
             self.error_code = code
             self.ref.MFaultLvl.Active, self.ref.MFaultLvl.Code = True, code
-        self._set_state(ERRORSTOP)
+        self.set_state(ERRORSTOP)
 
     def instruction_error(self, code: int, t: float) -> None:
         """An instruction refused on this axis: on an NJ/NX it is an error of the axis (the instruction's Error
@@ -330,15 +332,15 @@ class Axis:
         self.powered = self.ref.DrvStatus.ServoOn = on
         if not on:
             self.abort_all()
-            self._finish(self.stop_cmd, ABORTED)
+            self.end_command(self.stop_cmd, ABORTED)
             self.stop_cmd = None
             self.profile = None
             self.vel = self.acc = 0.0
             self._write()
             if self.state != ERRORSTOP:
-                self._set_state(DISABLED)
+                self.set_state(DISABLED)
         elif self.state == DISABLED:
-            self._set_state(STANDSTILL)
+            self.set_state(STANDSTILL)
 
     def reset(self) -> bool:
         """MC_Reset: clear the axis error once the axis has stopped. False while it still decelerates."""
@@ -349,7 +351,7 @@ class Axis:
         self.error_code = 0
         self.error_serial += 1
         self.ref.MFaultLvl.Active, self.ref.MFaultLvl.Code = False, 0
-        self._set_state(STANDSTILL if self.powered else DISABLED)
+        self.set_state(STANDSTILL if self.powered else DISABLED)
         return True
 
     def define_position(self, x: float, homed: bool = True) -> None:

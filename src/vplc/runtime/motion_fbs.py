@@ -312,7 +312,7 @@ class MC_Stop(_MoveFB):
                         jerk=axis.jerk(self.Jerk))
         axis.abort_all()
         if axis.stop_cmd is not None and axis.stop_cmd.fb is not self:
-            axis._finish(axis.stop_cmd, M.ABORTED)
+            axis.end_command(axis.stop_cmd, M.ABORTED)
         axis.stop_cmd, axis.stop_execute = cmd, True
         axis.start(cmd, _now(self))
         self._issue(cmd)
@@ -347,7 +347,7 @@ class MC_Home(_ExecuteFB):
             return code or M.ERR_MOVING
         cmd = M.Command("home", self, axis.cfg.home_position)
         axis.instant.append(cmd)
-        axis._set_state(M.HOMING)
+        axis.set_state(M.HOMING)
         self._issue(cmd)
         return 0
 

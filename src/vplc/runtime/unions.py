@@ -16,7 +16,9 @@ from typing import Any, overload
 Scalar = bool | int | float
 
 
-def _decode(bits: int, kind: str, size: int) -> Scalar:
+def decode_bits(bits: int, kind: str, size: int) -> Scalar:
+    """The value of ``size`` bits of an image as a member of ``kind`` (bool, int, uint/bit, real) reads it; a
+    union and a memory area (at_memory.py) share this layout."""
     if kind == "bool":
         return bool(bits & 1)
     if kind == "real":
@@ -26,7 +28,8 @@ def _decode(bits: int, kind: str, size: int) -> Scalar:
     return bits
 
 
-def _encode(value: Scalar, kind: str, size: int) -> int:
+def encode_bits(value: Scalar, kind: str, size: int) -> int:
+    """The ``size`` bits that hold ``value`` as a member of ``kind``: the inverse of ``decode_bits``."""
     if kind == "bool":
         return 1 if value else 0
     if kind == "real":
@@ -36,12 +39,12 @@ def _encode(value: Scalar, kind: str, size: int) -> int:
 
 def read(cell: list[int], kind: str, size: int, offset: int = 0) -> Scalar:
     """The member of ``size`` bits at bit ``offset`` of the union's image."""
-    return _decode(cell[0] >> offset & ((1 << size) - 1), kind, size)
+    return decode_bits(cell[0] >> offset & ((1 << size) - 1), kind, size)
 
 
 def write(cell: list[int], kind: str, size: int, value: Scalar, offset: int = 0) -> None:
     mask = ((1 << size) - 1) << offset
-    cell[0] = (cell[0] & ~mask) | (_encode(value, kind, size) << offset)
+    cell[0] = (cell[0] & ~mask) | (encode_bits(value, kind, size) << offset)
 
 
 class ElementView:
