@@ -319,3 +319,68 @@ def test_using_directive_outside_a_pou_is_refused(tmp_path):
 def test_namespace_declarations_nested_too_deep_are_refused(tmp_path):
     t = '<NamespaceDecl name="N">' * 40 + '</NamespaceDecl>' * 40
     refused(write(tmp_path, doc(t)), "deeper than 32")
+
+
+def _pin_in(name, src) -> str:
+    return f'<InputVariable parameterName="{name}">{cin(src)}</InputVariable>'
+
+
+def _pin_out(name, out, **attrs) -> str:
+    a = "".join(f' {k}="{v}"' for k, v in attrs.items())
+    return (f'<OutputVariable parameterName="{name}"{a}><ConnectionPointOut connectionPointOutId="{out}"/>'
+            '</OutputVariable>')
+
+
+def _source(var, out) -> str:
+    return (f'<FbdObject xsi:type="DataSource" identifier="{var}">'
+            f'<ConnectionPointOut connectionPointOutId="{out}"/></FbdObject>')
+
+
+def _sink(var, src) -> str:
+    return f'<FbdObject xsi:type="DataSink" identifier="{var}">{cin(src)}</FbdObject>'
+
+
+def _block(type_name, inputs, outputs) -> str:
+    return (f'<FbdObject xsi:type="Block" typeName="{type_name}"><InputVariables>{inputs}</InputVariables>'
+            f'<OutputVariables>{outputs}</OutputVariables></FbdObject>')
+
+
+def test_an_in_out_drawn_as_an_input_and_an_output_of_the_same_name_is_the_in_out(tmp_path):
+    # W502 draws Inc with InOut on both sides of the box (IEC 61131-3's graphical VAR_IN_OUT); a file that lists
+    # it under InputVariables and OutputVariables passes the variable: the output is the counter after the call,
+    # the unnamed output the BOOL result (it was read as the result and refused as BOOL := UDINT)
+    inc = _block("Inc", _pin_in("EN", 2) + _pin_in("InOut", 3),
+                 _pin_out("ENO", 4) + _pin_out("InOut", 5) + _pin_out("", 6))
+    rungs = [RAIL + contact("Go", 1, 2) + _source("Count", 3) + inc + _sink("Count", 5) + coil("Ran", 6)]
+    r = Run(write(tmp_path, iec10_program({"Go": "BOOL", "Ran": "BOOL", "Count": "UDINT"}, rungs)))
+    assert r.scan(Go=True)["Count"] == 1 and r["Ran"] is True
+    assert r.scan(Go=True)["Count"] == 2, "the output is the in-out's variable, not a second increment"
+    assert r.scan(Go=False)["Count"] == 2, "without EN the instruction does not run"
+    assert diagnostics(tmp_path / "sysmac.xml") == []
+
+
+TOGGLE = """FUNCTION Toggle : BOOL
+VAR_IN_OUT X : BOOL; END_VAR
+X := NOT X;
+Toggle := FALSE;
+END_FUNCTION
+"""
+
+
+def test_an_in_out_output_of_the_same_name_is_never_read_as_the_functions_result(tmp_path):
+    # the silent misread this prevents: Q took Toggle's result (always FALSE) instead of X after the call
+    (tmp_path / "Toggle.st").write_text(TOGGLE, encoding="utf-8")
+    rungs = [RAIL + _source("B", 3) + _block("Toggle", _pin_in("EN", 1) + _pin_in("X", 3),
+                                              _pin_out("ENO", 4) + _pin_out("X", 5)) + _sink("Q", 5)]
+    r = Run(write(tmp_path, iec10_program({"B": "BOOL", "Q": "BOOL"}, rungs)), extra=[tmp_path / "Toggle.st"])
+    assert r.scan()["B"] is True and r["Q"] is True
+    assert r.scan()["B"] is False and r["Q"] is False
+
+
+def test_a_negated_in_out_drawn_on_both_sides_is_refused_by_name(tmp_path):
+    (tmp_path / "Toggle.st").write_text(TOGGLE, encoding="utf-8")
+    rungs = [RAIL + _source("B", 3) + _block("Toggle", _pin_in("EN", 1) + _pin_in("X", 3),
+                                              _pin_out("ENO", 4) + _pin_out("X", 5, negated="true")) + _sink("Q", 5)]
+    write(tmp_path, iec10_program({"B": "BOOL", "Q": "BOOL"}, rungs))
+    err = refused(tmp_path / "sysmac.xml", "rung 1", "block Toggle", "in-out `X`", "negated")
+    assert err.severity == "error"
