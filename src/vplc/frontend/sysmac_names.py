@@ -80,7 +80,13 @@ _W560_PAGES_TEXT = (
 # each): declaring a variable of one is ST1007, not "unknown data type".
 _SYSTEM_TYPES = {"_sTimer": "W560 2-152, Timer", "_sSDO_ACCESS": "W502, EtherCAT Communications Instructions",
                  "_sNXUNIT_ID": "W502, NX Unit Instructions", "_eMC_COORD_SYSTEM": "W508, axes group instructions",
-                 "_eMC_TRANSITION_MODE": "W508, axes group instructions"}
+                 "_eMC_TRANSITION_MODE": "W508, axes group instructions",
+                 "_sGROUP_REF": "W507/W508, axes groups: MC_Group000, _MC_GRP[n]"}
+
+# Values of those enumerations that published axes-group code names (an enumeration the prelude does not declare
+# leaves its values undeclared too): MC_MoveLinear*'s TransitionMode and CoordSystem inputs (W508).
+_SYSTEM_ENUM_VALUES = {"_mcTMNone": "_eMC_TRANSITION_MODE", "_mcTMCornerSuperimposed": "_eMC_TRANSITION_MODE",
+                       "_mcACS": "_eMC_COORD_SYSTEM"}
 
 SYSMAC_NAMES: dict[str, tuple[str, str]] = {}
 for _section, _names in _W502_SECTIONS.items():
@@ -93,6 +99,8 @@ for _n in _W508_MOTION:
     SYSMAC_NAMES.setdefault(_n.upper(), ("motion instruction", "W508"))
 for _n, _where in _SYSTEM_TYPES.items():
     SYSMAC_NAMES.setdefault(_n.upper(), ("system-defined data type", _where))
+for _n, _enum in _SYSTEM_ENUM_VALUES.items():
+    SYSMAC_NAMES.setdefault(_n.upper(), ("enumeration value", f"W508, {_enum}, axes group instructions"))
 for _n in _W501_SYSVARS:
     SYSMAC_NAMES.setdefault(_n.upper(), ("system-defined variable", "W501, system-defined variables"))
 

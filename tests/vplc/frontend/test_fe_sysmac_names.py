@@ -154,3 +154,14 @@ def test_names_sysmac_studio_does_not_accept_are_st1011_in_sysmac_only(tmp_path)
     assert codes(proj, "error") == ["ST1011"] * 7
     assert "program `P_Main` starts with `P_`" in next(d.message for d in proj.diagnostics if "P_Main" in d.message)
     assert "ST1011" not in codes(check_text(tmp_path, src, "iec.st", dialect="iec"))
+
+
+def test_axes_group_type_and_its_enumeration_values_are_st1007_not_unknown(tmp_path):
+    # published group code (an inline-ST rung of a Sysmac project): MC_Group000 : _sGROUP_REF and
+    # TransitionMode := _mcTMCornerSuperimposed were "unknown data type" / "not declared"
+    proj = check_text(tmp_path, program("m := _mcTMCornerSuperimposed; c := _mcACS;",
+                                        "G : _sGROUP_REF; m : INT; c : INT;"))
+    errors = [d for d in proj.diagnostics if d.severity == "error"]
+    assert [d.code for d in errors] == ["ST1007"] * 3
+    assert "Sysmac system-defined data type `_sGROUP_REF` (W507/W508, axes groups" in errors[0].message
+    assert "Sysmac enumeration value `_mcTMCornerSuperimposed` (W508, _eMC_TRANSITION_MODE" in errors[1].message
