@@ -33,7 +33,8 @@ _W508_MOTION = ("MC_Power", "MC_Home", "MC_HomeWithParameter", "MC_Move", "MC_Mo
                 "MC_ImmediateStop", "MC_Reset", "MC_ReadAxisError", "MC_SetPosition", "MC_SetOverride",
                 "MC_ChangeAxisUse", "MC_TorqueControl", "MC_SetTorqueLimit", "MC_ZoneSwitch", "MC_TouchProbe",
                 "MC_AbortTrigger", "MC_CamIn", "MC_CamOut", "MC_GearIn", "MC_GearOut", "MC_GearInPos",
-                "MC_MoveLink", "MC_CombineAxes", "MC_Phasing", "MC_SyncMoveVelocity", "MC_DigitalCamSwitch",
+                "MC_MoveLink", "MC_CombineAxes", "MC_Phasing", "MC_SyncMoveVelocity", "MC_SyncMoveAbsolute",
+                "MC_DigitalCamSwitch",
                 "MC_GroupEnable", "MC_GroupDisable", "MC_GroupStop", "MC_GroupReset", "MC_GroupImmediateStop",
                 "MC_MoveLinear", "MC_MoveLinearAbsolute", "MC_MoveLinearRelative", "MC_MoveCircular2D",
                 "MC_ReadGroupError", "MC_Write", "MC_ReadStatus")

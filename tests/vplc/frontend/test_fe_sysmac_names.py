@@ -165,3 +165,13 @@ def test_axes_group_type_and_its_enumeration_values_are_st1007_not_unknown(tmp_p
     assert [d.code for d in errors] == ["ST1007"] * 3
     assert "Sysmac system-defined data type `_sGROUP_REF` (W507/W508, axes groups" in errors[0].message
     assert "Sysmac enumeration value `_mcTMCornerSuperimposed` (W508, _eMC_TRANSITION_MODE" in errors[1].message
+
+
+def test_cyclic_synchronous_positioning_is_st1007_not_an_unknown_type(tmp_path):
+    # a published delta-robot FB streams joint angles with MC_SyncMoveAbsolute (W508): it was "unknown data type
+    # `MC_SyncMoveAbsolute`, did you mean MC_MOVEABSOLUTE?"
+    proj = check_text(tmp_path, program("S(Axis := _MC_AX[0], Execute := TRUE, Position := 1.0);",
+                                        "S : MC_SyncMoveAbsolute;"))
+    errors = [d for d in proj.diagnostics if d.severity == "error"]
+    assert errors and {d.code for d in errors} == {"ST1007"}
+    assert "Sysmac motion instruction `MC_SyncMoveAbsolute` (W508) is not modelled by vplc" in errors[0].message
