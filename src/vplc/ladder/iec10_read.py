@@ -434,8 +434,9 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
 def _inouts_drawn_on_both_sides(e: Element, where: str) -> None:
     """An in-out written as an input and an output of the same name is an in-out.
 
-    IEC 61131-3 draws a VAR_IN_OUT on both sides of the box, joined through it, and W502 draws Omron's
-    in-out instructions that way (``Inc``: ``InOut`` left and right). Files written by hand or by generators
+    IEC 61131-3 draws a VAR_IN_OUT on both sides of the box, joined through it, and Omron's instruction pages
+    draw their in-outs that way (W560 2-231, ``Inc``: ``InOut`` on the input and on the output side, ``Out`` the
+    result; W560 is the NY-series manual of W502's instruction set). Files written by hand or by generators
     list such a pin under ``InputVariables`` and ``OutputVariables`` instead of ``InOutVariables``. A POU's
     names are unique, so an output named like an input can only be the in-out's variable after the call;
     read as a result it would give the function's return value (``Inc``'s BOOL) to whatever the output
