@@ -421,7 +421,7 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
                 e.inouts.append(Pin(v.get("parameterName", ""), _point_ins(v, outs)))
             for v in obj.iterfind("OutputVariables/OutputVariable"):
                 e.outputs.append(Pin(v.get("parameterName", ""), negated=_flag(v, "negated", where)))
-            _inouts_drawn_on_both_sides(e, where)
+            _join_inouts(e, where)
         if e.kind != "block" and e.kind not in ("left_rail", "in_var", "label"):
             e.inputs = [Pin("", _point_ins(obj, outs))]
         if e.kind == "label":
@@ -431,30 +431,12 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
     return rung
 
 
-def _inouts_drawn_on_both_sides(e: Element, where: str) -> None:
-    """An in-out written as an input and an output of the same name is an in-out.
-
-    IEC 61131-3 draws a VAR_IN_OUT on both sides of the box, joined through it, and Omron's instruction pages
-    draw their in-outs that way (W560 2-231, ``Inc``: ``InOut`` on the input and on the output side, ``Out`` the
-    result; W560 is the NY-series manual of W502's instruction set). Files written by hand or by generators
-    list such a pin under ``InputVariables`` and ``OutputVariables`` instead of ``InOutVariables``. A POU's
-    names are unique, so an output named like an input can only be the in-out's variable after the call;
-    read as a result it would give the function's return value (``Inc``'s BOOL) to whatever the output
-    feeds."""
-    inout_names = {p.name.upper() for p in e.inouts}
-    inputs = {p.name.upper(): p for p in e.inputs if p.name and p.name.upper() != "EN"}
-    for out in list(e.outputs):
-        key = out.name.upper()
-        pin = inputs.get(key)
-        if not key or pin is None or key in inout_names:
-            continue
-        if out.negated or pin.negated or pin.edge != "none":
-            raise FormatError(where, f"in-out `{out.name}` (an input and an output of the same name) is negated "
-                                     "or edge-detected; an in-out passes the variable itself")
-        e.inputs.remove(pin)
-        e.outputs.remove(out)
-        e.inouts.append(Pin(pin.name, pin.conns))
-        inout_names.add(key)
+def _join_inouts(e: Element, where: str) -> None:
+    """An in-out written as an input and an output of the same name is the in-out (Element's method)."""
+    bad = e.join_inouts_drawn_on_both_sides()
+    if bad is not None:
+        raise FormatError(where, f"in-out `{bad}` (an input and an output of the same name) is negated or "
+                                 "edge-detected; an in-out passes the variable itself")
 
 
 def _flag(el: ET.Element, name: str, where: str, true=("true", "1")) -> bool:

@@ -64,6 +64,31 @@ class Element:
         """The input point of a simple element (contact, coil, variable, jump, return)."""
         return self.inputs[0] if self.inputs and self.kind != "block" else None
 
+    def join_inouts_drawn_on_both_sides(self) -> str | None:
+        """Read an input and an output of the same name as one in-out; the name of a negated or edge-detected
+        one (which cannot be an in-out), else None.
+
+        IEC 61131-3 draws a VAR_IN_OUT on both sides of the box, joined through it, and Omron's instruction
+        pages draw their in-outs that way (W560 2-231, ``Inc``: ``InOut`` on the input and on the output side,
+        ``Out`` the result; W560 is the NY-series manual of W502's instruction set). Hand-written and generated
+        files list such a pin as an input and an output instead of an in-out. A POU's names are unique, so an
+        output named like an input can only be the in-out's variable after the call; read as a result it
+        would give the function's return value (``Inc``'s BOOL) to whatever the output feeds."""
+        inout_names = {p.name.upper() for p in self.inouts}
+        inputs = {p.name.upper(): p for p in self.inputs if p.name and p.name.upper() != "EN"}
+        for out in list(self.outputs):
+            key = out.name.upper()
+            pin = inputs.get(key)
+            if not key or pin is None or key in inout_names:
+                continue
+            if out.negated or pin.negated or pin.edge != "none":
+                return out.name
+            self.inputs.remove(pin)
+            self.outputs.remove(out)
+            self.inouts.append(Pin(pin.name, pin.conns))
+            inout_names.add(key)
+        return None
+
     def describe(self) -> str:
         """How diagnostics and the drawing name the element: ``contact Start``, ``block CBT_MoveAbsolute``."""
         if self.kind == "block":

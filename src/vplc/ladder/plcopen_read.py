@@ -219,6 +219,10 @@ def _element(el: ET.Element, pou: str) -> Element:
             e.inouts.append(Pin(v.get("formalParameter", ""), _conns(v.find("connectionPointIn"))))
         for v in el.iterfind("outputVariables/variable"):
             e.outputs.append(Pin(v.get("formalParameter", ""), negated=_flag(v, "negated")))
+        bad = e.join_inouts_drawn_on_both_sides()
+        if bad is not None:
+            raise FormatError(where, f"in-out `{bad}` (an input and an output of the same name) is negated or "
+                                     "edge-detected; an in-out passes the variable itself")
     return e
 
 

@@ -127,3 +127,26 @@ def test_a_function_working_on_an_in_out_runs_though_nothing_reads_its_result(tm
     r.scan(Go=True)
     r.scan(Go=False)
     assert r["N"] == 2
+
+
+def test_an_in_out_drawn_as_an_input_and_an_output_of_the_same_name_is_the_in_out(tmp_path):
+    """W560 2-231 draws Inc's InOut on both sides of the box; a PLCopen file that lists it as an input and an output
+    passes the variable: the InOut output is N after the call, Out the BOOL result (it was taken as the result)."""
+    body = [rail(1), contact(2, "Go", 1), invar(3, "N"),
+            block(4, "Inc", {"EN": 2, "InOut": 3}, ["ENO", "InOut", "Out"]),
+            outvar(5, "Copy", (4, "InOut")), coil(6, "Ran", (4, "Out")), right(7, (4, "ENO"))]
+    r = Run.of(tmp_path, {"Go": "BOOL", "N": "INT", "Copy": "INT", "Ran": "BOOL"}, body)
+    r.scan(Go=True)
+    assert r["N"] == 1 and r["Copy"] == 1 and r["Ran"] is True
+    r.scan(Go=True)
+    assert r["N"] == 2 and r["Copy"] == 2
+
+
+def test_a_negated_in_out_drawn_on_both_sides_is_refused_naming_it(tmp_path):
+    body = [rail(1), invar(3, "N"), block(4, "Inc", {"EN": 1, "InOut": 3}, ["ENO", "InOut"]),
+            outvar(5, "Copy", (4, "InOut"))]
+    path = program(tmp_path, {"N": "INT", "Copy": "INT"}, body)
+    path.write_text(path.read_text().replace('<variable formalParameter="InOut"><connectionPointOut/>',
+                                             '<variable formalParameter="InOut" negated="true"><connectionPointOut/>'))
+    errors = _errors(path)
+    assert errors and "in-out `InOut`" in errors[0].message and "negated" in errors[0].message
