@@ -52,13 +52,15 @@ MAX_OVERRIDE = 5.0             # MC_SetOverride VelFactor 0 .. 500 %
 class Command:
     """One execution of a motion instruction on an axis."""
 
-    __slots__ = ("kind", "fb", "status", "in_velocity", "target", "velocity", "acc", "dec", "jerk", "direction")
+    __slots__ = ("kind", "fb", "status", "in_velocity", "target", "velocity", "acc", "dec", "jerk", "direction",
+                 "distance")
 
     def __init__(self, kind: str, fb: Any, target: float = 0.0, velocity: float = 0.0, acc: float = 0.0,
                  dec: float = 0.0, jerk: float = 0.0, direction: float = 1.0) -> None:
         self.kind, self.fb, self.status, self.in_velocity = kind, fb, WAITING, False
         self.target, self.velocity, self.acc, self.dec, self.direction = target, velocity, acc, dec, direction
         self.jerk = jerk
+        self.distance: float | None = None      # a relative move whose target is counted when it starts
 
 
 class Axis:
@@ -68,6 +70,7 @@ class Axis:
         self.cfg, self.ref = cfg, ref
         self.state = DISABLED
         self.pos = self.vel = self.acc = 0.0
+        self.jerk_now = 0.0                     # jerk of the profile segment at the last evaluation
         self.homed = cfg.homed
         self.powered = False
         self.power_request = False
@@ -110,7 +113,12 @@ class Axis:
         cmd, act = ref.Cmd, ref.Act
         cmd.Pos = act.Pos = self.pos
         cmd.Vel = act.Vel = self.vel
-        cmd.AccDec = self.acc
+        # W507 6-28, Cmd.AccDec and Cmd.Jerk: AccDec is plus while the axis accelerates (its speed grows, from
+        # rest too) and minus while it decelerates, whatever the direction of travel; Jerk is plus while the
+        # magnitude of AccDec grows and minus while it falls; both 0 when the instruction's rate is 0.
+        a, v, j = self.acc, self.vel, self.jerk_now
+        cmd.AccDec = 0.0 if a == 0.0 else abs(a) if v == 0.0 or (a > 0.0) == (v > 0.0) else -abs(a)
+        cmd.Jerk = 0.0 if j == 0.0 else abs(j) if a == 0.0 or (j > 0.0) == (a > 0.0) else -abs(j)
         ref.Details.InHome = self.homed and self.pos == self.cfg.home_position and self.vel == 0.0
 
     # ---- limits ------------------------------------------------------------------------------------
@@ -171,6 +179,8 @@ class Axis:
                                                                         cmd.dec, cmd.jerk, self.acc, vlim))
             self.set_state(CONTINUOUS)
         elif k == "position":
+            if cmd.distance is not None:        # PLCopen MC_MoveRelative: from where the motion starts
+                cmd.target, cmd.distance = self.pos + cmd.distance, None
             self.plan_to(cmd, t)
             self.set_state(DISCRETE)
         elif k in ("halt", "stop"):
@@ -208,9 +218,13 @@ class Axis:
         prof = self.profile
         while prof is not None:
             x, v, a, finished = prof.at(t)
+            jerk = prof.jerk
             if self.limits_active():
-                prof, x, v, a, finished = self._guard_limits(prof, x, v, a, finished, t)
-            self.pos, self.vel, self.acc = x, v, a
+                guarded = self._guard_limits(prof, x, v, a, finished, t)
+                if guarded[0] is not prof:      # the software-limit stop is a trapezoid
+                    jerk = 0.0
+                prof, x, v, a, finished = guarded
+            self.pos, self.vel, self.acc, self.jerk_now = x, v, a, jerk
             cmd = self.active
             if not finished or prof.hold:
                 break
@@ -226,7 +240,7 @@ class Axis:
                 prof = self.profile
                 continue
             self.profile = None
-            self.vel = self.acc = 0.0
+            self.vel = self.acc = self.jerk_now = 0.0
             self._end_of_motion()
             break
         self._write()
@@ -335,7 +349,7 @@ class Axis:
             self.end_command(self.stop_cmd, ABORTED)
             self.stop_cmd = None
             self.profile = None
-            self.vel = self.acc = 0.0
+            self.vel = self.acc = self.jerk_now = 0.0
             self._write()
             if self.state != ERRORSTOP:
                 self.set_state(DISABLED)

@@ -187,7 +187,10 @@ class _MoveFB(_ExecuteFB):
             axis.queued = cmd
             self._issue(cmd)
             return 0
-        if axis.queued is not None and axis.queued.fb is self:
+        queued = axis.queued
+        if queued is not None:                  # PLCopen Part 1 _mcAborting: the buffer is cleared
+            if queued.fb is not self:
+                axis.end_command(queued, M.ABORTED)
             axis.queued = None
         axis.start(cmd, _now(self))
         self._issue(cmd)
@@ -203,7 +206,7 @@ class MC_MoveAbsolute(_MoveFB):
         self.Position = 0.0
         self.Direction = 0
 
-    def target(self, axis: M.Axis) -> float:
+    def target(self, axis: M.Axis) -> float | None:
         return self.Position
 
     def begin(self, axis: M.Axis) -> int:
@@ -213,28 +216,39 @@ class MC_MoveAbsolute(_MoveFB):
         if not 0 <= self.Direction <= 4:
             return M.ERR_DIRECTION
         x = self.target(axis)
-        if not math.isfinite(x) or not axis.in_limits(x):
+        if x is None:                           # counted when the motion starts (MC_MoveRelative, Buffered)
+            if not math.isfinite(self.Distance):
+                return M.ERR_POSITION
+        elif not math.isfinite(x) or not axis.in_limits(x):
             return M.ERR_POSITION
         cfg = axis.cfg
-        cmd = M.Command("position", self, x, self.Velocity, axis.ramp(self.Acceleration, cfg.max_acceleration),
+        cmd = M.Command("position", self, 0.0 if x is None else x, self.Velocity,
+                        axis.ramp(self.Acceleration, cfg.max_acceleration),
                         axis.ramp(self.Deceleration, cfg.max_deceleration), axis.jerk(self.Jerk))
+        if x is None:
+            cmd.distance = self.Distance
         return self._give(axis, cmd)
 
 
 class MC_MoveRelative(MC_MoveAbsolute):
     """W508 MC_MoveRelative: the target is Distance from the command position when the motion starts (from the
-    target of the command before it when Buffered)."""
+    target of the command before it when Buffered; after a buffered-upon MC_MoveVelocity or MC_Halt, which
+    have no target, from where the axis is when this motion starts: PLCopen Part 1, "relative to the set
+    position at the time of the execution")."""
 
     def __init__(self, rt: Any, path: str) -> None:
         super().__init__(rt, path)
         self.Distance = 0.0
 
-    def target(self, axis: M.Axis) -> float:
+    def target(self, axis: M.Axis) -> float | None:
         base = axis.pos
         act = axis.active
-        if self.BufferMode == 1 and act is not None and act.kind == "position" and act.status == M.ACTIVE:
-            base = act.target
-        elif axis.profile is not None:
+        if self.BufferMode == 1 and act is not None and act.status == M.ACTIVE:
+            if act.kind == "position":
+                return act.target + self.Distance
+            if act.fb is not self and not act.in_velocity:
+                return None                     # waits for a motion without a target: counted when it starts
+        if axis.profile is not None:
             base = axis.profile.at(_now(self))[0]
         return base + self.Distance
 

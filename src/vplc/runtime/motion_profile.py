@@ -21,7 +21,7 @@ class Profile:
     """Motion from (t0, x0, v0, a0) as segments (duration, acceleration at its start, jerk); after the last
     segment the axis keeps the final velocity (0 for a positioning, the target velocity for velocity control)."""
 
-    __slots__ = ("parts", "i", "t_end", "x_end", "v_end", "hold")
+    __slots__ = ("parts", "i", "t_end", "x_end", "v_end", "hold", "jerk")
 
     def __init__(self, t0: float, x0: float, v0: float, segments: Iterable[Segment],
                  target: float | None = None) -> None:
@@ -36,6 +36,7 @@ class Profile:
         self.parts, self.i, self.t_end = parts, 0, t
         self.x_end, self.v_end = (target, 0.0) if target is not None else (x, v)
         self.hold = False           # True: a positioning held at velocity 0 by a 0 % override
+        self.jerk = 0.0             # jerk of the segment the last at() fell in (0 after the last segment)
 
     def at(self, t: float) -> tuple[float, float, float, bool]:
         """(position, velocity, acceleration, finished) at time t (seconds)."""
@@ -44,8 +45,10 @@ class Profile:
             i += 1
         self.i = i
         if i == len(parts):
+            self.jerk = 0.0
             return self.x_end + self.v_end * (t - self.t_end), self.v_end, 0.0, True
         _, ts, x, v, a, j = parts[i]
+        self.jerk = j
         tau = t - ts
         if j:
             return x + (v + (a / 2 + j * tau / 6) * tau) * tau, v + (a + j * tau / 2) * tau, a + j * tau, False
