@@ -279,7 +279,8 @@ def _pou(el: ET.Element) -> PouText:
                     "ParameterSetVariableAdditionalProperties")
                 constant = lst.get("constant") == "true" or (
                     props is not None and props.get("constant", "false") in ("true", "1"))
-                params.append((int(v.get("orderWithinParamSet", len(params))), PARAMS[lst.tag], lst, v, constant))
+                order = _count(v, "orderWithinParamSet", len(params), f"{name}:variable {v.get('name', '')}")
+                params.append((order, PARAMS[lst.tag], lst, v, constant))
     params.sort(key=lambda p: p[0])
     if out.kind == "FUNCTION":                           # Sysmac's EN / ENO are vplc's implicit EN / ENO
         params = [p for p in params if not _en_eno(p[1], p[3])]
@@ -300,7 +301,7 @@ def _pou(el: ET.Element) -> PouText:
     if kinds == {"ST"}:
         out.st_body = "\n".join((c.findtext("ST") or "") for c in contents)
     elif kinds <= {"LdSection", "LD"}:
-        contents.sort(key=lambda c: int(c.get("evaluationOrder", "0") or 0))
+        contents.sort(key=lambda c: _count(c, "evaluationOrder", 0, f"{name}:body {c.get('name', '')}".rstrip()))
         rungs = []
         for section in contents:
             rungs += _rungs(section, name)
@@ -318,9 +319,20 @@ def _en_eno(kind: str, v: ET.Element) -> bool:
         (v.findtext("Type/TypeName") or "").strip().upper() == "BOOL"
 
 
+def _count(el: ET.Element, attr: str, default: int, where: str) -> int:
+    """An ordering attribute (orderWithinParamSet, evaluationOrder: xsd:integer); anything else is refused."""
+    text = (el.get(attr) or "").strip()
+    if not text:
+        return default
+    try:
+        return int(text)
+    except ValueError:
+        raise FormatError(where, f'{attr}="{text[:40]}" is not an integer') from None
+
+
 def _rungs(section: ET.Element, pou: str) -> list[Rung]:
     items = list(section.iterfind("Rung"))
-    items.sort(key=lambda r: int(r.get("evaluationOrder", "0") or 0))
+    items.sort(key=lambda r: _count(r, "evaluationOrder", 0, f"{pou}:rung"))
     return [_rung(r, pou, n) for n, r in enumerate(items, start=1)]
 
 

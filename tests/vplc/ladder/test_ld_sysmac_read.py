@@ -273,7 +273,13 @@ def test_files_of_earlier_exports_load_with_a_warning_naming_the_rule(tmp_path):
 def test_malformed_sysmac_attributes_are_errors_with_their_place_never_a_traceback(tmp_path):
     bad = {
         "order": (doc(_param_fb("").replace('orderWithinParamSet="0"', 'orderWithinParamSet="x"')),
-                  "the XML does not follow the format"),
+                  'Fb:variable Limit: orderWithinParamSet="x" is not an integer'),
+        "rung": (iec10_program({"A": "BOOL"}, [RAIL]).replace('<Rung evaluationOrder="1"',
+                                                              '<Rung evaluationOrder="1st"'),
+                 'Main:rung: evaluationOrder="1st" is not an integer'),
+        "body": (iec10_program({"A": "BOOL"}, [RAIL]).replace('name="S" evaluationOrder="1"',
+                                                              'name="S" evaluationOrder="?"'),
+                 'Main:body S: evaluationOrder="?" is not an integer'),
         "latch": (iec10_program({"A": "BOOL", "Q": "BOOL"}, [RAIL + contact("A", 1, 2) + coil("Q", 2, latch="on")]),
                   'Main:rung 1:coil Q: latch="on" is not one of none, set, reset'),
         "both": (iec10_program({"A": "BOOL", "Q": "BOOL"},
