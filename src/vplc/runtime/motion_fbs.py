@@ -206,8 +206,9 @@ class MC_MoveAbsolute(_MoveFB):
         self.Position = 0.0
         self.Direction = 0
 
-    def target(self, axis: M.Axis) -> float | None:
-        return self.Position
+    def target(self, axis: M.Axis) -> tuple[float, float | None]:
+        """(target, None), or (0.0, distance) for a motion whose target is counted from where it starts."""
+        return self.Position, None
 
     def begin(self, axis: M.Axis) -> int:
         code = _state_error(axis) or self._ramps(True)
@@ -215,18 +216,16 @@ class MC_MoveAbsolute(_MoveFB):
             return code
         if not 0 <= self.Direction <= 4:
             return M.ERR_DIRECTION
-        x = self.target(axis)
-        if x is None:                           # counted when the motion starts (MC_MoveRelative, Buffered)
-            if not math.isfinite(self.Distance):
+        x, later = self.target(axis)
+        if later is not None:                   # counted when the motion starts (MC_MoveRelative, Buffered)
+            if not math.isfinite(later):
                 return M.ERR_POSITION
         elif not math.isfinite(x) or not axis.in_limits(x):
             return M.ERR_POSITION
         cfg = axis.cfg
-        cmd = M.Command("position", self, 0.0 if x is None else x, self.Velocity,
-                        axis.ramp(self.Acceleration, cfg.max_acceleration),
+        cmd = M.Command("position", self, x, self.Velocity, axis.ramp(self.Acceleration, cfg.max_acceleration),
                         axis.ramp(self.Deceleration, cfg.max_deceleration), axis.jerk(self.Jerk))
-        if x is None:
-            cmd.distance = self.Distance
+        cmd.distance = later
         return self._give(axis, cmd)
 
 
@@ -240,17 +239,17 @@ class MC_MoveRelative(MC_MoveAbsolute):
         super().__init__(rt, path)
         self.Distance = 0.0
 
-    def target(self, axis: M.Axis) -> float | None:
+    def target(self, axis: M.Axis) -> tuple[float, float | None]:
         base = axis.pos
         act = axis.active
         if self.BufferMode == 1 and act is not None and act.status == M.ACTIVE:
             if act.kind == "position":
-                return act.target + self.Distance
+                return act.target + self.Distance, None
             if act.fb is not self and not act.in_velocity:
-                return None                     # waits for a motion without a target: counted when it starts
+                return 0.0, self.Distance       # waits for a motion without a target: counted when it starts
         if axis.profile is not None:
             base = axis.profile.at(_now(self))[0]
-        return base + self.Distance
+        return base + self.Distance, None
 
 
 class MC_MoveVelocity(_MoveFB):

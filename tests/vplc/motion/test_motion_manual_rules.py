@@ -96,3 +96,99 @@ def test_a_buffered_relative_move_after_move_velocity_counts_from_where_it_start
     _run_to_done(rig, "rel")
     assert rig.ax("Cmd.Pos") == pytest.approx(10.2, abs=1e-12)
     assert rig.state() == "Standstill"
+
+
+def test_a_move_to_where_the_axis_already_is_is_done_in_the_next_call(rig):
+    """W508 (zh) MC_MoveAbsolute / MC_MoveRelative output timing: Busy and Active from the Execute edge, Done once
+    the motion is complete, which for no distance is the motion processing of that same period."""
+    rig.set(pos1=0.0, doAbs1=True)
+    rig.scan()
+    assert rig.outputs("abs1") == (True, True, False, False, False)
+    rig.scan()
+    assert rig.outputs("abs1") == (False, False, True, False, False) and rig.state() == "Standstill"
+    rig.set(dist=0.0, doRel=True)
+    rig.scan(2)
+    assert rig.outputs("rel") == (False, False, True, False, False) and rig.ax("Cmd.Pos") == 0.0
+
+
+def test_move_velocity_zero_is_accepted_and_holds_the_axis_in_continuous(rig):
+    """W508 (zh) MC_MoveVelocity: Velocity "positive or 0". Velocity 0 is no error: the axis is in Continuous,
+    InVelocity comes once it runs at 0, and the instruction keeps Busy and Active (it still controls the axis)."""
+    rig.set(vv=0.0, doVel=True)
+    rig.scan()
+    assert rig.outputs("vel", ("Busy", "Active", "InVelocity", "Error")) == (True, True, False, False)
+    rig.scan(3)
+    assert rig.outputs("vel", ("Busy", "Active", "InVelocity", "Error")) == (True, True, True, False)
+    assert (rig.state(), rig.ax("Cmd.Vel")) == ("Continuous", 0.0)
+
+
+def test_halt_at_rest_is_done_at_once_and_a_buffered_halt_waits_for_the_move(rig):
+    """PLCopen Part 1 MC_Halt (W508's page was not readable): Done once the velocity is 0 (at rest: in the next
+    call), the axis back in Standstill; Buffered, it starts when the running positioning is Done."""
+    rig.set(doHalt=True)
+    rig.scan()
+    assert rig.outputs("hlt") == (True, True, False, False, False)
+    rig.scan()
+    assert rig.outputs("hlt") == (False, False, True, False, False) and rig.state() == "Standstill"
+    rig.set(doHalt=False)
+    rig.scan()
+    rig.set(pos1=10.0, doAbs1=True)
+    rig.scan(2)
+    rig.plc.write("Main.hlt.BufferMode", 1)
+    rig.set(doHalt=True)
+    rig.scan()
+    assert rig.outputs("hlt") == (True, False, False, False, False), "waiting: Busy, not Active"
+    _run_to_done(rig, "abs1")
+    assert rig.r("hlt.Done") and rig.ax("Cmd.Pos") == 10.0
+
+
+def test_servo_off_while_mc_stop_holds_the_axis_aborts_the_stop(rig):
+    """W508 (zh) MC_Power: servo OFF aborts the instructions running on the axis (CommandAborted) and the axis is
+    Disabled; with the servo ON again the axis is in Standstill, MC_Stop no longer holds it."""
+    rig.set(doVel=True)
+    rig.scan(30)
+    rig.set(doStop=True)
+    rig.scan(5)
+    assert rig.state() == "Stopping"
+    rig.set(power=False)
+    rig.scan()
+    assert rig.state() == "Disabled"
+    rig.scan()
+    assert rig.outputs("stp") == (False, False, False, True, False)
+    rig.set(power=True)
+    rig.scan(2)
+    assert rig.state() == "Standstill"
+
+
+def test_an_instruction_error_aborts_the_running_and_the_waiting_move(rig):
+    """Section 5.2 (an instruction error is an error of the axis, W508 (zh) output timing of MC_Power and MC_Stop):
+    the running and the buffered instruction both end in CommandAborted, the axis goes to ErrorStop."""
+    rig.set(pos1=100.0, doAbs1=True)
+    rig.scan(2)
+    rig.set(dist=5.0, bufRel=1, doRel=True)
+    rig.scan()
+    rig.set(doSetPos=True)                           # refused while the axis moves
+    rig.scan()
+    assert rig.r("setp.Error") and rig.state() == "ErrorStop"
+    rig.scan()
+    assert rig.outputs("abs1") == (False, False, False, True, False)
+    assert rig.outputs("rel") == (False, False, False, True, False)
+
+
+def test_a_new_execute_edge_while_busy_goes_to_the_new_position_without_command_aborted(rig):
+    """Re-execution with new inputs (W508 1-1 "changing input variables during execution" was not readable; the
+    rule vplc chose, section 5.2): the instance takes the new Position from where the axis is, reports no
+    CommandAborted, and is Done once, on the new target."""
+    rig.set(pos1=100.0, doAbs1=True)
+    rig.scan(50)
+    rig.set(doAbs1=False)
+    rig.scan()
+    rig.set(pos1=5.0, doAbs1=True)
+    rig.scan()
+    assert rig.outputs("abs1") == (True, True, False, False, False)
+    aborted = False
+    while not rig.r("abs1.Done"):
+        rig.scan()
+        aborted = aborted or rig.r("abs1.CommandAborted")
+        assert rig.k < 5000
+    assert not aborted and rig.ax("Cmd.Pos") == 5.0 and rig.state() == "Standstill"
