@@ -116,9 +116,10 @@ class Axis:
         # W507 6-28, Cmd.AccDec and Cmd.Jerk: AccDec is plus while the axis accelerates (its speed grows, from
         # rest too) and minus while it decelerates, whatever the direction of travel; Jerk is plus while the
         # magnitude of AccDec grows and minus while it falls; both 0 when the instruction's rate is 0.
+        # (0.0 - x rather than -x: no -0.0 in the axis variable.)
         a, v, j = self.acc, self.vel, self.jerk_now
-        cmd.AccDec = 0.0 if a == 0.0 else abs(a) if v == 0.0 or (a > 0.0) == (v > 0.0) else -abs(a)
-        cmd.Jerk = 0.0 if j == 0.0 else abs(j) if a == 0.0 or (j > 0.0) == (a > 0.0) else -abs(j)
+        cmd.AccDec = a if v > 0.0 else 0.0 - a if v < 0.0 else abs(a)
+        cmd.Jerk = j if a > 0.0 else 0.0 - j if a < 0.0 else abs(j)
         ref.Details.InHome = self.homed and self.pos == self.cfg.home_position and self.vel == 0.0
 
     # ---- limits ------------------------------------------------------------------------------------
