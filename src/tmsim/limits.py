@@ -85,6 +85,10 @@ RECV_BYTES = 65_536                         # bytes taken from one connection pe
 EVENTS_KEPT_MAX = 40_000                    # events kept in memory, all robots together (see also EVENT_BYTES_MAX)
 POLL_BUDGET_S = 0.004                       # backlog turns of one poll stop after this long (wall clock)
 IO_SLICE_S = 0.0003                         # between two turns the sockets are polled this often (wall clock)
+LOOP_WAIT_MIN_S = 0.002                     # serve_forever waits at least this long between two polls (wall clock)
+                                            # while something is due: an arm moving, a dense data table ...
+LOOP_WAIT_MAX_S = 0.05                      # ... and at most this long when nothing is (a socket or a call from
+                                            # another thread ends the wait at once)
 EVENT_BYTES_MAX = 20 << 20                  # event log kept in memory, all robots together
 LOG_FILE_BYTES_MAX = 64 << 20               # the --log file: then renamed to FILE.1 and begun anew
 ACCEPT_BACKOFF_S = 0.1                      # out of descriptors: stop accepting for this long

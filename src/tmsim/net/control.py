@@ -165,6 +165,11 @@ class ControlChannel:
         """Called once a poll: resume accepting after a pause."""
         self.listener.tick(now)
 
+    def next_due(self, now: float) -> float | None:
+        """When ``tick`` has work: the end of an accept pause (None: none). Requests left over from a turn are
+        ``has_backlog``; unsent answers wait for their socket to be writable (the selector)."""
+        return self.listener.paused_until
+
     def _serve_client(self, _robot: None, conn: int) -> None:
         """The socket is ready: write what waits, then read; the requests are answered in the client's turn
         (``serve_backlog``, right after in the same poll). A client who has requests left over from its

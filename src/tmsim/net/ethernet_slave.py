@@ -114,6 +114,20 @@ class EthernetSlave:
                 service.session.advance(now)
                 self._flush(robot)
 
+    def next_due(self, now: float) -> float | None:
+        """The earliest robot-clock time at which ``poll`` has work: a data table due (``SvrSession.next_due``), the
+        end of an accept pause, ``now`` while a client's socket has not taken all its output. None: nothing."""
+        due = None
+        for service in self._services.values():
+            for conn in service.conns.values():
+                if conn.wbuf:
+                    return now
+            paused = None if service.listener is None else service.listener.paused_until
+            for at in (service.session.next_due(now), paused):
+                if at is not None and (due is None or at < due):
+                    due = at
+        return due
+
     def _accept(self, _none: None, robot: Robot) -> None:
         service = self._service(robot)
         listener = service.listener

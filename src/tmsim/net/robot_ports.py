@@ -147,6 +147,26 @@ class Robot:
         """The port the Ethernet Slave listens on."""
         return None if self.slave is None else self.slave.port
 
+    def next_due(self, now: float) -> float | None:
+        """The earliest robot-clock time at which a poll has work for this robot's Listen node without new input:
+        its session's (``ListenSession.next_due``: the arm moving, a script's wait, the node's timeouts), its held
+        output (``FaultState.next_due``: reply_delay, glue_replies, split_replies), the end of an accept pause,
+        ``now`` while output waits to be written or a client's socket has not taken all of it. None: nothing."""
+        due = self.session.next_due(now)
+        if self.conns:
+            if self.session.has_output():
+                return now
+            for conn in self.conns.values():
+                if conn.wbuf:
+                    return now
+            held = self.faults.next_due(now)
+            if held is not None and (due is None or held < due):
+                due = held
+        paused = None if self.listener is None else self.listener.paused_until
+        if paused is not None and (due is None or paused < due):
+            due = paused
+        return due
+
     # ---- the event log (``log``), read by the control channel, the demo and the tests -----------
     @property
     def events(self) -> list[dict]:

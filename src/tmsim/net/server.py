@@ -1,7 +1,8 @@
 """SimServer: TCP adapter around the sans-I/O sessions (selectors, non-blocking, bounded buffers).
 
 ``poll(now_s)`` is one non-blocking step on a virtual clock: advance the robot models, accept,
-read, process, write. ``start_background()`` runs the same step in a thread on the wall clock.
+read, process, write. ``start_background()`` runs the same step in a thread on the wall clock, and between two
+steps sleeps until the next thing is due (``next_due``), a socket is ready or another thread wakes it.
 
 Limits (per robot unless noted):
 * frame DATA <= FRAME_DATA_MAX (64 KiB); longer declared lengths are answered with CPERR 01
@@ -36,6 +37,8 @@ from tmsim.limits import (
     IO_SLICE_S,
     LISTEN_CLIENTS_MAX,
     LISTEN_OUTBOX_MAX,
+    LOOP_WAIT_MAX_S,
+    LOOP_WAIT_MIN_S,
     OUTBOX_TOTAL_MAX,
     PENDING_BYTES_MAX,
     POLL_BUDGET_S,
@@ -56,6 +59,45 @@ GC_IDLE = 700               # manage_gc: collect young objects in an idle poll o
 GC_FORCE = 20_000           # ...and in any poll once this many are (a flood leaves no idle poll)
 
 
+class ServerLock:
+    """The server's lock: re-entrant, and when a thread other than the one serving the loop lets go of it (its
+    outermost release: a ``Robot`` call, a control call, a test's ``with server.lock:``), what is due may have
+    changed (a node entered, a fault armed, a motion queued): ``on_release`` then wakes the sleeping loop."""
+
+    def __init__(self, on_release: Callable[[], None]) -> None:
+        self._lock = threading.RLock()
+        self._depth = 0                     # the owner's nesting (changed by the owning thread only)
+        self._on_release = on_release
+
+    def acquire(self, blocking: bool = True, timeout: float = -1) -> bool:
+        if not self._lock.acquire(blocking, timeout):
+            return False
+        self._depth += 1
+        return True
+
+    def release(self) -> None:
+        """RuntimeError, as an RLock's, when the calling thread does not hold the lock."""
+        self._depth -= 1
+        try:
+            if self._depth == 0:
+                self._on_release()
+            self._lock.release()
+        except RuntimeError:
+            self._depth += 1
+            raise
+
+    def __enter__(self) -> bool:
+        self._lock.acquire()
+        self._depth += 1
+        return True
+
+    def __exit__(self, *_exc: object) -> None:
+        self._depth -= 1
+        if not self._depth:
+            self._on_release()
+        self._lock.release()
+
+
 class SimServer:
     def __init__(self, host: str = "127.0.0.1", port: int = 0, robots: int = 1, speedup: float = 1.0,
                  auto_enter: bool = True, send_message: str = "Listen1", log_path: str | os.PathLike[str] | None = None,
@@ -69,7 +111,12 @@ class SimServer:
         if not (math.isfinite(speedup) and speedup > 0):
             raise ValueError(f"speedup must be a positive number, got {speedup}")
         self.host, self.speedup, self.auto_enter = host, speedup, auto_enter
-        self.lock = threading.RLock()
+        self._serving: int | None = None     # the thread in serve_forever
+        self._sleeping = False                # ... waits in select() for what is due (next_due)
+        self._wake_pending = False            # a wake-up byte is on its way
+        self.loop_waits = 0                   # serve_forever's waits so far (public counters, for tests and benches)
+        self.wakeups = 0                      # wake-ups sent to it (``wake``: a call from another thread)
+        self.lock = ServerLock(self._released)
         self.event_limit = event_limit or EVENTS_KEPT_MAX // robots    # per robot: all robots together keep <= 40,000
         self.event_bytes_limit = EVENT_BYTES_MAX // robots           # per robot: all together keep <= 20 MiB
         try:
@@ -77,6 +124,10 @@ class SimServer:
         except OSError as exc:
             raise OSError(exc.errno, f"cannot open the event log {log_path}: {exc.strerror}") from None
         self.selector = selectors.DefaultSelector()
+        self._waker, self._wake_socket = socket.socketpair()    # written by ``wake``, read by the loop
+        for end in (self._waker, self._wake_socket):
+            end.setblocking(False)
+        self.selector.register(self._wake_socket, selectors.EVENT_READ, ("wake", None, None))
         profile = profile or Profile(tag_history=tag_history)
         self.robots = [Robot(self, i, port + i if port else 0, send_message, auto_enter, profile,
                              (data_timeout, connection_timeout), (bases, tools)) for i in range(robots)]
@@ -85,7 +136,8 @@ class SimServer:
         self._stop = threading.Event()
         self._now = 0.0
         # selector key kind -> handler (see handle)
-        self._dispatch: dict[str, Callable[[Any, Any], None]] = {"listen": self._accept, "conn": self._read}
+        self._dispatch: dict[str, Callable[[Any, Any], None]] = {"listen": self._accept, "conn": self._read,
+                                                                  "wake": self._woken}
         self._touched: list[Robot] = []       # robots that received data and still have to advance
         # which client's input goes next and how much; a robot's share of PENDING_BYTES_MAX (at least 4 frames)
         self.fair = FairScheduler(self, max(4 * FRAME_DATA_MAX, PENDING_BYTES_MAX // robots))
@@ -182,6 +234,8 @@ class SimServer:
                 self.svr.close()
                 self.svr = None
             self.selector.close()
+            self._waker.close()
+            self._wake_socket.close()
             if self.log_file is not None:
                 for robot in self.robots:
                     robot.log.stop_writing()
@@ -189,13 +243,101 @@ class SimServer:
                 self.log_file = None
 
     def serve_forever(self, stop_event: threading.Event) -> None:
-        """Serve in the calling thread on the wall clock (scaled by ``speedup``) until stop_event is set."""
+        """Serve in the calling thread on the wall clock (scaled by ``speedup``) until stop_event is set (seen
+        within LOOP_WAIT_MAX_S; ``stop()`` wakes the loop at once).
+
+        Between two polls the loop sleeps in the selector until the next thing is due (``next_due``, converted
+        to wall seconds through ``speedup``), at least LOOP_WAIT_MIN_S (while an arm moves or a data table
+        streams densely: the 2 ms steps the robot clock always had) and at most LOOP_WAIT_MAX_S; a ready socket
+        ends the wait at once, and so does any call from another thread that takes the server's lock
+        (``ServerLock``) or ``wake()``. Work left over from a turn (a flood's backlog) is served without a wait.
+        An idle robot costs no CPU."""
         if not self.started:
             self.start()
         origin = time.monotonic()
         offset = self._now
-        while not stop_event.is_set():
-            self.poll(offset + (time.monotonic() - origin) * self.speedup, timeout=0.002)
+
+        def clock() -> float:
+            return offset + (time.monotonic() - origin) * self.speedup
+
+        self._serving = threading.get_ident()
+        ready: list[tuple[selectors.SelectorKey, int]] | None = None
+        due: float | None = None
+        fresh = LOOP_WAIT_MIN_S * self.speedup
+        try:
+            while not stop_event.is_set():
+                with self.lock:         # one hold: a call of another thread comes before the poll or wakes the sleep
+                    now = clock()
+                    # a request right after the last poll, nothing due: served at once on the robots' state of that
+                    # poll (at most LOOP_WAIT_MIN_S old, as the 2 ms steps always were); else they advance first
+                    current = ready is not None and now - self._now <= fresh and (due is None or now < due)
+                    self._poll(now, 0.0, ready, advance=not current)
+                    now = clock()
+                    due = self._next_due(now)
+                    wait = self._loop_wait(now, due)
+                    self._sleeping = wait > 0.0
+                ready = None
+                if wait > 0.0 and not stop_event.is_set():       # (a poll may have read stop()'s wake-up)
+                    self.loop_waits += 1
+                    ready = self.selector.select(wait) or None    # served by the next poll (no second select)
+                    self._sleeping = False
+        finally:
+            self._serving = None
+            self._sleeping = False
+
+    def next_due(self, now: float | None = None) -> float | None:
+        """The earliest robot-clock time (s) at which a poll has work without new input, or None when nothing is
+        due until a client or a call changes something: each robot's (``Robot.next_due``: motions, scripts'
+        waits, Listen node timeouts, held output), the Ethernet Slave's (data tables), the control channel's;
+        ``now`` (default: the clock of the last poll) when work is left over from a turn."""
+        with self.lock:
+            return self._next_due(self._now if now is None else now)
+
+    def _next_due(self, now: float) -> float | None:
+        if self.fair.has_backlog or (self.control is not None and self.control.has_backlog):
+            return now
+        due = None
+        for robot in self.robots:      # (the loop asks after every poll: no lists, stop at the first "now")
+            at = robot.next_due(now)
+            if at is not None and (due is None or at < due):
+                if at <= now:
+                    return now
+                due = at
+        for port in (self.svr, self.control):
+            at = None if port is None else port.next_due(now)
+            if at is not None and (due is None or at < due):
+                due = at
+        return due
+
+    def _loop_wait(self, now: float, due: float | None) -> float:
+        """Wall seconds serve_forever may sleep after a poll until ``due`` (0: none, work is left over)."""
+        if due is None:
+            return LOOP_WAIT_MAX_S
+        if due <= now:
+            return 0.0 if self._has_work() else LOOP_WAIT_MIN_S
+        return min(LOOP_WAIT_MAX_S, max(LOOP_WAIT_MIN_S, (due - now) / self.speedup))
+
+    def wake(self) -> None:
+        """End serve_forever's wait now (thread-safe): what is due may have changed. Taking and releasing the
+        server's lock from another thread does it."""
+        if self._wake_pending:
+            return
+        self._wake_pending = True
+        self.wakeups += 1
+        with contextlib.suppress(OSError):      # (a full pipe: a wake-up is waiting already; closed: stopped)
+            self._waker.send(b"w")
+
+    def _released(self) -> None:
+        """ServerLock: another thread lets go of the lock while the loop sleeps."""
+        if self._sleeping and threading.get_ident() != self._serving:
+            self.wake()
+
+    def _woken(self, _robot: None, _conn: None) -> None:
+        """The wake-up socket is readable: read what ``wake`` wrote (the poll that reads it is the wake-up)."""
+        self._wake_pending = False
+        with contextlib.suppress(OSError):
+            while self._wake_socket.recv(4096):
+                pass
 
     def start_background(self) -> SimServer:
         """Serve in a thread on the wall clock (scaled by ``speedup``) until ``stop()``."""
@@ -210,6 +352,7 @@ class SimServer:
     def stop(self) -> None:
         if self._thread is not None:
             self._stop.set()
+            self.wake()
             self._thread.join(timeout=5)
             self._thread = None
 
@@ -223,9 +366,18 @@ class SimServer:
         the planning of all robots (and the pushes of a tag reached leave robot by robot).
         """
         with self.lock:
+            self._poll(now_s, timeout)
+
+    def _poll(self, now_s: float, timeout: float, ready: list[tuple[selectors.SelectorKey, int]] | None = None,
+              advance: bool = True) -> None:
+        """``poll``, the lock held. From serve_forever: ``ready``, what its wait found ready (instead of a first
+        select: a key that went stale meanwhile finds its connection gone, or nothing to read, and is passed
+        over); ``advance`` False: the robots, the Ethernet Slave and the control channel stay at the last poll's
+        time (nothing of theirs is due) and the sockets are served at once."""
+        self._slice_start = time.perf_counter()
+        self._poll_end = self._slice_start + POLL_BUDGET_S
+        if advance:
             self._now = max(self._now, now_s)
-            self._slice_start = time.perf_counter()
-            self._poll_end = self._slice_start + POLL_BUDGET_S
             for robot in self.robots:
                 session = robot.session
                 if robot.listener is not None:
@@ -238,19 +390,19 @@ class SimServer:
                 self.svr.poll(self._now)
             if self.control is not None:
                 self.control.tick(self._now)
-            ready = self._serve(0.0 if self._has_work() else timeout)
-            self.fair.serve_backlog()
-            if self.control is not None and self.control.backlog:
-                self.control.serve_backlog()
-            self._start_touched()
-            for robot in self.robots:
-                self.flush(robot)
-                if not robot.session.project_running() and (robot.listener is not None or robot.conns):
-                    self.close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
-                if robot.reading_paused and not self.fair.buffer_full(robot, 0.5):
-                    self._set_reading(robot, True)
-            if self.manage_gc:
-                _collect_garbage(idle=not ready)
+        served = self._serve(0.0 if self._has_work() else timeout, selected=ready)
+        self.fair.serve_backlog()
+        if self.control is not None and self.control.backlog:
+            self.control.serve_backlog()
+        self._start_touched()
+        for robot in self.robots:
+            self.flush(robot)
+            if not robot.session.project_running() and (robot.listener is not None or robot.conns):
+                self.close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
+            if robot.reading_paused and not self.fair.buffer_full(robot, 0.5):
+                self._set_reading(robot, True)
+        if self.manage_gc:
+            _collect_garbage(idle=not served)
 
     def _has_work(self) -> bool:
         """Work is left over from earlier turns (client input, control requests): the next poll must not wait."""
@@ -300,14 +452,16 @@ class SimServer:
         """Back-pressure: the robot's script buffer is full; its clients are read again once it is half empty."""
         self._set_reading(robot, False)
 
-    def _serve(self, timeout: float, quick_only: bool = False) -> int:
+    def _serve(self, timeout: float, quick_only: bool = False,
+               selected: list[tuple[selectors.SelectorKey, int]] | None = None) -> int:
         """Accept and read every ready socket; the replies are written at once. Robots that received
         something are remembered in ``_touched`` for ``_start_touched``.
 
         Fairness: clients whose last read filled the receive size or who have input left over ("greedy",
         i.e. flooding) are served after the others, and every IO_SLICE_S in between them the sockets are
-        polled again for the others' new requests (``quick_only``: serve only those)."""
-        ready = self.selector.select(timeout)
+        polled again for the others' new requests (``quick_only``: serve only those). ``selected``: the
+        sockets found ready already (no select)."""
+        ready = self.selector.select(timeout) if selected is None else selected
         ready.sort(key=_is_greedy)
         checked = time.perf_counter()
         for key, _mask in ready:

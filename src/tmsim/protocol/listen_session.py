@@ -432,6 +432,34 @@ class ListenSession:
         self._pump()
         self._check_drain()
 
+    def next_due(self, now: float) -> float | None:
+        """The earliest robot-clock time at which ``advance`` has work without new input (a server sleeps until
+        then): ``now`` while the arm moves or has queued items to start (its events, the next motion on time) or a
+        turn's work is left; the deadline of the running script's wait (Sleep, a WaitQueueTag timeout, a vision
+        job's time); the node's data / connection timeout. None while nothing is due until a client or a control
+        call changes something (a paused arm, a script waiting for a tag of a paused arm, a stopped project)."""
+        if self.state == STOPPED:
+            return None
+        robot = self.robot
+        if not robot.idle and not robot.paused:
+            return now
+        if self.state == EXITING and robot.idle and self.running is None:
+            return now
+        due = None
+        run = self.running
+        if run is not None and run.wait is not None:
+            kind, _tag, due = run.wait
+            if kind == "turn":
+                return now
+        if self.state == IN_NODE:
+            if self.connection_timeout and not self.clients:
+                at = self.entered_at + self.connection_timeout
+                due = at if due is None else min(due, at)
+            if self.data_timeout:
+                at = self.last_packet + self.data_timeout
+                due = at if due is None else min(due, at)
+        return due
+
     def _check_timeouts(self):
         if self.connection_timeout and not self.clients and self.now - self.entered_at >= self.connection_timeout:
             self.fire("leave_node", path="Fail", reason="connection timeout")

@@ -248,6 +248,13 @@ class SvrSession:
         for conn in self.clients:
             self._out(conn, frame)
 
+    def next_due(self, now: float) -> float | None:
+        """The robot-clock time the next data table is due (``advance`` sends it then); None while none is streamed
+        (period 0, no client, or the fault ``stall``)."""
+        if not self.period or not self.clients or self.stalled:
+            return None
+        return max(now, self.next_stream)
+
     def _content(self, mode, names) -> bytes:
         if self.swap is not None:
             asked, instead = self.swap

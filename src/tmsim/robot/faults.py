@@ -170,6 +170,33 @@ class FaultState:
         self._queues.pop(conn, None)
         self._partial.pop(conn, None)
 
+    def next_due(self, now: float) -> float | None:
+        """The earliest robot-clock time at which ``take`` releases something held back: ``now`` while pieces of a
+        split frame wait (one piece a poll) or released frames are ready to leave; the release time of the first
+        held frame of a connection (reply_delay); for glue_replies, the time its oldest released frame has
+        waited ``max_wait`` (unless ``count`` frames wait before). None when nothing is held."""
+        if not (self._queues or self._partial):
+            return None
+        if any(self._partial.values()):
+            return now
+        due: float | None = None
+        for out in self._queues.values():
+            if not out:
+                continue
+            released = 0
+            for release, _queued, _frame in out:
+                if release > now:
+                    break
+                released += 1
+            if not released:
+                at = out[0][0]
+            elif self.glue and released < self.glue and released == len(out):
+                at = max(now, min(item[1] for item in out) + self.glue_wait)
+            else:
+                at = now
+            due = at if due is None else min(due, at)
+        return due
+
     def take(self, conn: int, now: float) -> tuple[list[bytes], bool]:
         """(list of byte chunks to write now, close-after-writing flag)."""
         pending = self._queues.get(conn)
