@@ -100,7 +100,7 @@ def test_an_e_stop_is_one_alarm_with_its_consequences_as_details(plant):
     details = [d["text"] for d in alarm["details"]]
     assert details == ["Robot: Robot error 16#00010001: Emergency stop",
                        ("Connection 16#4006: Connection to the robot lost, reconnecting — Robot error stopped the "
-                        "project: code and text in CBT_RobotStatus"),
+                        "project"),          # the operator's words: not "code and text in CBT_RobotStatus" (issue 25)
                        "Move Absolute 16#4006: Robot error stopped the project"]
     assert summary["robot"] == "E-stop"
 

@@ -20,6 +20,17 @@ function idText(id) { return "16#" + Number(id).toString(16).toUpperCase().padSt
 function robotCode(code) { return "16#" + (Number(code) >>> 0).toString(16).toUpperCase().padStart(8, "0"); }
 function operatorRemedy(id) { const row = alarms.texts[idText(id)]; return row ? row.operator || "" : ""; }
 
+/* An FB's ErrorDescrip is written for the engineer, and a few name a function block ("Robot not connected: CBT_Connect
+   is retrying (see its ErrorID); nothing sent"). The operator reads it up to that clause, then the operator remedy of
+   the ErrorID table; the whole text stays in the Command Status area and on the FB's page. alarms.py's
+   operator_text is the same rule for the alarm texts (test_hmi_operator_review.py checks both on every ErrorID). */
+function operatorText(descrip) {
+  const text = String(descrip || ""), at = text.search(/\bCBT_\w/);
+  if (at < 0) return text;
+  const cut = text.lastIndexOf(": ", at);
+  return cut > 0 ? text.slice(0, cut) : "";
+}
+
 async function loadAlarms() {
   try { alarms.texts = await (await fetch("errors.json")).json(); } catch (e) { alarms.texts = {}; }
 }
@@ -203,7 +214,7 @@ function projectFinished(what) {
       const v = live.values;
       if (live.polls >= firstPoll && (v.Project_Done === true || v.Project_Error === true)) {
         const ok = v.Project_Done === true;
-        if (!ok) message(`${what}: Error ${idText(v.Project_ErrorID)} – ${v.Project_ErrorDescrip || ""}. ` +
+        if (!ok) message(`${what}: Error ${idText(v.Project_ErrorID)} – ${operatorText(v.Project_ErrorDescrip)}. ` +
           operatorRemedy(v.Project_ErrorID), "error");
         try { await api("/api/write", { values: { Project_Execute: false } }); } catch (e) { /* reported below */ }
         resolve(ok);
@@ -245,7 +256,7 @@ const ROBOT_TILE_VARS = ["RobotStatus_Valid", "RobotStatus", "Connect_Reconnecti
 /* ---------- the FB's answer on the message line ---------- */
 function errorMessage(what, v, group) {
   const id = v[`${group}_ErrorID`], remedy = operatorRemedy(id);
-  return `${what}: Error ${idText(id)} – ${v[`${group}_ErrorDescrip`] || ""}.${remedy ? " " + remedy : ""}`;
+  return `${what}: Error ${idText(id)} – ${operatorText(v[`${group}_ErrorDescrip`])}.${remedy ? " " + remedy : ""}`;
 }
 
 function watchResult(group, what, doneText) {      // doneText: what Done means for this command

@@ -518,28 +518,37 @@ async function fbPage(key, page) {
   const buttons = document.createElement("div");
   buttons.className = "buttons";
   const presets = page.presets || {};
+  /* A preset fills only the fields this role may change: a locked field keeps the PLC's value (the operator's
+     Connect page showed the preset's port, not the one in use). A preset that would fill none of them, or whose
+     values this role cannot send, is disabled rather than a key that only changes what the page shows. */
+  const presetFields = (values) => (param ? inputsUnder(params, param).map((el) =>
+    [el, pick(values, el.dataset.path.slice(param.length))]) :
+    Object.entries(values).map(([v, val]) => [params.querySelector(`[data-path="${v}"]`), val]))
+    .filter(([el, val]) => el && !el.disabled && val !== undefined && val !== null);
+  const presetKeys = [];
   Object.keys(presets).forEach((name, i) => {
     const b = document.createElement("button");
     b.className = "wide"; b.id = i ? `btn-preset-${i + 1}` : "btn-preset"; b.textContent = name;
-    if (page.act) b.disabled = !mayWrite(execVar);
     b.onclick = () => {
       if (page.act) {                          // Stop page: "Stop Immediately" stops now, not only fills the form
         if (param) fillFrom(params, param, presets[name]);
         sendStop(presets[name].Mode, name);
         return;
       }
-      if (param) fillFrom(params, param, presets[name]);
-      else for (const [v, val] of Object.entries(presets[name])) setInput(params.querySelector(`[data-path="${v}"]`), val);
+      for (const [el, val] of presetFields(presets[name])) setInput(el, val);
+      params.dispatchEvent(new Event("fill"));
       refreshLimits(params, param);
-      message(exec.disabled ? `${name}: fields filled; sending them needs ${ACCESS.role === "monitor" ?
-        "the operator address" : "the engineer address"}.` : `${name}: fields filled, press ${execLabel} to send.`);
+      message(`${name}: fields filled, press ${execLabel} to send.`);
     };
+    presetKeys.push([b, name]);
     buttons.append(b);
   });
   const exec = document.createElement("button");
   exec.className = "primary" + (page.reset ? "" : " wide");     // red is the header's Stop key only
   exec.id = "btn-execute"; exec.textContent = execLabel;
   exec.disabled = !mayWrite(execVar);
+  for (const [b, name] of presetKeys)
+    b.disabled = exec.disabled || (!page.act && presetFields(presets[name]).length === 0);
   exec.onclick = () => {
     const result = collect(params, param);
     if (result.error) { message(result.error + " — nothing was sent.", "error"); return; }

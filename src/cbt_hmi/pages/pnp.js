@@ -47,10 +47,13 @@ function pnpOptions() {
   if (state === "Faulted" && v.PnP_OutcomeUnknown)
     text = `Fault ${idText(v.PnP_MoveErrorID)}: the robot's answer was lost, the last command may have run. ` +
       "Press Reset, then Start: the cycle first checks where the robot is and goes on from there.";
-  else if (state === "Faulted" && v.PnP_MoveError)
-    text = `Fault ${idText(v.PnP_MoveErrorID)}: ${v.PnP_MoveErrorDescrip}. Remove the cause, press Reset, then Start.`;
+  else if (state === "Faulted" && v.PnP_MoveError)       // the operator's words, not the FB's (alarms.js)
+    text = `Fault ${idText(v.PnP_MoveErrorID)}: ${operatorText(v.PnP_MoveErrorDescrip)}. ` +
+      `${operatorRemedy(v.PnP_MoveErrorID) || "Remove the cause."} Here: press Reset, then Start.`;
   if ((state === "Idle" || state === "Stopped") && !connected)
-    text = "The robot is not connected: connect it on the Connect page, then press Start.";
+    text = v.Connect_Execute === true ?                      // Connect is on: CBT_Connect reconnects by itself
+      "The link to the robot is down and the PLC is reconnecting: wait for Robot ready in the header, then press Start." :
+      "The robot is not connected: connect it on the Connect page, then press Start.";
   else if ((state === "Idle" || state === "Stopped") && stopHeld)
     text = "Stop Motion is still active: wait until it is released, then press Start.";
   if (v.PnP_OutcomeUnknown && (state === "Idle" || state === "Stopped"))
@@ -64,6 +67,8 @@ function showPnPState() {
   const box = document.getElementById("pnp-state");
   if (!box) return;
   const { state, text, enabled } = pnpOptions();
+  if (state === "Faulted" && box.dataset.state !== "Faulted")      // the line no longer says "Start: … Running"
+    message(`Cycle: Faulted – ${text}`, "error");
   box.dataset.state = state || "";
   document.getElementById("pnp-state-name").textContent = state ? `Cycle: ${state}` : "Cycle: –";
   document.getElementById("pnp-state-text").textContent = text;
@@ -267,6 +272,6 @@ async function pnpPage() {
   startPolling(["PnP_Example_Execute", "PnP_State", "PnP_OutcomeUnknown", "PnP_Segment", "PnP_Waiting", "PnP_GripperClosed", "PnP_CycleCount", "PnP_MoveBusy",
     "PnP_MoveActive", "PnP_MoveError", "PnP_MoveErrorID", "PnP_MoveErrorDescrip", "PnP_Move_CmdID_Ack",
     "ProgramControl_Busy", "ProgramControl_Done", "ProgramControl_Error", "ProgramControl_ErrorID",
-    "ProgramControl_CommandAborted", "ProgramControl_ErrorDescrip", "Connect_Connected", "ReadPos_Valid",
+    "ProgramControl_CommandAborted", "ProgramControl_ErrorDescrip", "Connect_Execute", "Connect_Connected", "ReadPos_Valid",
     "ReadPos_Position", ...ROBOT_STATUS]);
 }

@@ -319,8 +319,10 @@ function robotView(container, preview) {
     const other = sideAxis() === "X" ? "Y" : "X", toggle = container.querySelector("#side-axis");
     toggle.textContent = `${other}–Z view`;
     toggle.title = toggle.ariaLabel = `Show the side view ${other}–Z (on every page)`;
-    container.querySelector("#tcp-pos").textContent = p ?
-      `TCP X ${p.X.toFixed(1)} Y ${p.Y.toFixed(1)} Z ${p.Z.toFixed(1)}` : "TCP not valid (robot not connected)";
+    // without the PLC the last position is no longer valid (####, as every value); a short text when the robot gives
+    // none, so the preview's note beside it keeps its room at 800x480
+    container.querySelector("#tcp-pos").textContent = !live.online && !live.fault ? "TCP ####" : p ?
+      `TCP X ${p.X.toFixed(1)} Y ${p.Y.toFixed(1)} Z ${p.Z.toFixed(1)}` : "TCP not valid";
     const note = container.querySelector("#view-note"), pv = VIEW.preview;
     note.textContent = pv && pv.refused ? `✕ ${pv.refused.short}` : (pv && pv.note) || "";
     note.title = pv && pv.refused ? pv.refused.reason : "";

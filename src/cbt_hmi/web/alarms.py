@@ -30,6 +30,7 @@ import json
 import logging
 import pathlib
 import queue
+import re
 import threading
 import time
 from collections import deque
@@ -75,6 +76,21 @@ STATUS = ["Connect_Execute", "Connect_Connected", "Connect_Reconnecting", "Conne
 
 def id_text(error_id: int) -> str:
     return f"16#{error_id:04X}"
+
+
+FB_NAME = re.compile(r"\bCBT_\w")
+
+
+def operator_text(descrip: str | None) -> str:
+    """An FB's ErrorDescrip as the operator reads it: up to the clause that names a function block ("Robot not
+    connected: CBT_Connect is retrying ..." -> "Robot not connected"); the operator remedy says what to do. The pages'
+    operatorText (alarms.js) is the same rule."""
+    text = descrip or ""
+    found = FB_NAME.search(text)
+    if found is None:
+        return text
+    cut = text.rfind(": ", 0, found.start())
+    return text[:cut] if cut > 0 else ""
 
 
 def stamp(seconds: float) -> str:
@@ -317,7 +333,7 @@ class AlarmSystem:
         if executing and not connected and (v.get("Connect_Reconnecting") or v.get("Connect_Error")):
             error_id = int(v.get("Connect_ErrorID") or 0) or int(v.get("Robot_LastErrorID") or 0)
             row = self.errors.get(id_text(error_id), {}) if error_id else {}
-            reason = v.get("Connect_ErrorDescrip") if v.get("Connect_Error") else row.get("text", "")
+            reason = operator_text(v.get("Connect_ErrorDescrip") if v.get("Connect_Error") else row.get("text", ""))
             attempt = f" (attempt {v['Connect_RetryCount']})" if v.get("Connect_RetryCount") else ""
             out["link"] = self._cause("link", error_id, reason=f" — {reason}" if reason else "", attempt=attempt,
                                       lost="Connection to the robot lost, reconnecting" if self._was_connected
@@ -415,7 +431,7 @@ class AlarmSystem:
             row = self.errors.get(id_text(error_id), {})
             if row.get("hmi", "alarm") != "alarm":
                 continue                                  # a refused start: the page's message line says it
-            text = v.get(f"{group}_ErrorDescrip") or row.get("text", "")
+            text = operator_text(v.get(f"{group}_ErrorDescrip") or row.get("text", ""))
             self._events.append((mono, {"rank": COMMAND_RANK, "priority": COMMAND_PRIORITY, "source": source,
                                         "text": text, "remedy": row.get("operator", ""), "error_id": error_id}))
         waiting = []
