@@ -1,0 +1,535 @@
+"""Every input of every public FB at its edges, the robot's own log as the witness (the maintainers' probe).
+
+For each case either nothing reaches the robot and the FB ends in Error with the ErrorID of docs/library/errors.tsv
+and its text in ErrorDescrip, or exactly one script reaches it whose call carries exactly the values given (numbers
+as CBTi_FormatReal prints them: up to 3 decimals, no exponent, docs/library/design.md) and the FB reports Done
+only when the robot did it (a motion: its motion_end; any other command: the robot's OK). Besides the values at
+and just past each bound (REAL: the next 32-bit float, NaN, +/-Inf, -0.0, the smallest subnormal), undefined
+enumeration values, names with TMscript's delimiters, and the PLCopen edges: Execute held, pulsed for one scan,
+re-raised while Busy, inputs changed while Busy, two FBs started in one scan, the link lost at each step.
+Virtual time; one simulator and one PLC per case (the compiled library is shared, a rig costs milliseconds)."""
+from __future__ import annotations
+
+import csv
+import struct
+from dataclasses import dataclass, field
+
+import pytest
+from rig import HOME_JOINTS, ROOT, Rig, circ, move_abs, rel
+
+from tmsim.protocol import svr_table as table
+from vplc.runtime.values import PathError
+
+ERRORS = {int(r["id"][3:], 16): r["text"]
+          for r in csv.DictReader((ROOT / "docs/library/errors.tsv").open(encoding="utf-8"), delimiter="\t")}
+
+NAN = struct.unpack("<f", struct.pack("<I", 0x7FC00000))[0]
+NAN_PAYLOAD = struct.unpack("<f", struct.pack("<I", 0xFFC12345))[0]          # negative quiet NaN with a payload
+INF = struct.unpack("<f", struct.pack("<I", 0x7F800000))[0]
+NEG_INF = struct.unpack("<f", struct.pack("<I", 0xFF800000))[0]
+NEG_ZERO = struct.unpack("<f", struct.pack("<I", 0x80000000))[0]
+TINY = struct.unpack("<f", struct.pack("<I", 0x00000001))[0]                  # smallest subnormal, 1.4e-45
+MAX_REAL = struct.unpack("<f", struct.pack("<I", 0x7F7FFFFF))[0]
+
+
+def f32(value: float) -> float:
+    return struct.unpack("<f", struct.pack("<f", value))[0]
+
+
+def past(limit: float, up: bool) -> float:
+    """The next 32-bit float beyond ``limit`` (up: towards +Inf)."""
+    bits = struct.unpack("<I", struct.pack("<f", limit))[0]
+    if limit == 0:
+        return TINY if up else -TINY
+    bits += 1 if up == (limit > 0) else -1
+    return struct.unpack("<f", struct.pack("<I", bits))[0]
+
+
+def num(value: float) -> str:
+    """A REAL as the library must print it into a script: the 32-bit value rounded to 3 decimals, trailing zeros
+    dropped, no '+' and no exponent (TMscript 2.24 §1.3 numeric literals; design.md, CBTi_FormatReal)."""
+    milli = round(f32(value) * 1000)
+    sign = "-" if milli < 0 else ""
+    whole, frac = divmod(abs(milli), 1000)
+    text = f"{sign}{whole}"
+    if frac:
+        text += "." + f"{frac:03d}".rstrip("0")
+    return text
+
+
+def pose_text(p: dict) -> str:
+    return ",".join(num(p[k]) for k in ("X", "Y", "Z", "RX", "RY", "RZ"))
+
+
+# ---- the rig around one command ----------------------------------------------------------------------------------
+@dataclass
+class Outcome:
+    done: bool
+    error: bool
+    aborted: bool
+    error_id: int
+    descrip: str
+    scripts: list[str] = field(default_factory=list)         # every TMSCT script sent since the Execute edge
+    svr: list = field(default_factory=list)                  # every Ethernet Slave request since the edge
+    motion_ends: int = 0
+
+
+def script_frames(rig) -> list[str]:
+    return [s for _, s in rig.scripts_in()]
+
+
+def svr_frames(rig) -> list:
+    """Every Ethernet Slave request the robot took: (kind, mode, items) - a write's items {name: value text}, a
+    read's [name]."""
+    return [(e["kind"], e["mode"], e["items"]) for e in rig.robot.events if e["kind"] in ("svr_read", "svr_write")]
+
+
+def has(rig, path: str) -> bool:
+    try:
+        rig.read(path)
+    except PathError:
+        return False
+    return True
+
+
+def command(rig, fb: str, execute: str, seconds: float = 30.0, hold: bool = True) -> Outcome:
+    """Raise ``execute``, wait until the FB ends, lower it; what the FB reported and what the robot received."""
+    before, svr_before = len(script_frames(rig)), len(svr_frames(rig))
+    ends_before = len(rig.events("motion_end"))
+    rig.write(execute, True)
+    if not hold:
+        rig.scans(1)
+        rig.write(execute, False)
+    seen = {}
+    outs = [o for o in ("Done", "Error", "CommandAborted") if has(rig, f"{fb}.{o}")]
+
+    def ended():
+        for out in outs:
+            if rig.read(f"{fb}.{out}"):
+                seen.setdefault("at", (out, rig.read(f"{fb}.ErrorID"), rig.read(f"{fb}.ErrorDescrip"),
+                                       len(rig.events("motion_end")) - ends_before))
+                return True
+        return False
+    assert rig.until(ended, seconds), f"{fb} still Busy after {seconds} s"
+    out, error_id, descrip, ends = seen["at"]
+    rig.write(execute, False)
+    rig.scans(3)
+    return Outcome(out == "Done", out == "Error", out == "CommandAborted", error_id, descrip,
+                   script_frames(rig)[before:], svr_frames(rig)[svr_before:], ends)
+
+
+def refused(res: Outcome, code: int) -> None:
+    """Nothing reached the robot; Error with the documented ErrorID and its text."""
+    assert res.scripts == [] and res.svr == [], f"sent although refused: {res.scripts or res.svr}"
+    assert res.error and not res.done, res
+    assert res.error_id == code, f"ErrorID {res.error_id:#06x}, expected {code:#06x}: {res.descrip}"
+    assert res.descrip == ERRORS[code][:80], res.descrip
+
+
+def sent(res: Outcome, call: str, motion: bool = False) -> str:
+    """Exactly one script reached the robot and its command line is ``call``; Done only once the robot did it."""
+    assert len(res.scripts) == 1, f"{len(res.scripts)} scripts sent: {res.scripts}"
+    lines = res.scripts[0].split("\r\n")
+    body = [line for line in lines if not line.startswith(("QueueTag(", "ScriptExit(", "StopAndClearBuffer("))]
+    assert body == [call], f"sent {lines}, expected the line {call!r}"
+    if res.done and motion:                    # a non-blended motion: Done when it arrived
+        assert res.motion_ends == 1, "Done without the robot finishing the motion"
+    if not res.done:
+        assert res.error or res.aborted, res
+        assert res.error_id == 0 or res.descrip, res
+    return res.scripts[0]
+
+
+@pytest.fixture
+def lib():
+    r = Rig()
+    yield r
+    r.close()
+
+
+# ---- CBT_MoveAbsolute, CBT_MoveRelative, CBT_MoveCircle: the numbers ---------------------------------------------
+ABS_FORMATS = ["JPP", "CPP", "CPR", "CAP", "CAR", "CDP", "CDR"]            # eCBT_MovCmdAbs_DataFormat's order
+REL_FORMATS = ["JPP", "CPP", "CPR", "CAP", "CAR", "TPP", "TPR", "TAP", "TAR", "CDP", "CDR", "TDP", "TDR"]
+CIRCLE_FORMATS = ["CPP", "CAP", "CDP"]
+
+
+def fmt_name(value, names: list[str]) -> str:
+    """TM's three letters of a data format given by name ('CPR_Abs') or by its enumeration value."""
+    return value[:3] if isinstance(value, str) else names[value]
+
+
+def abs_call(p: dict) -> str:
+    cmd = "PTP" if p["MovementCommand"] in (1, "PTP") else "Line"
+    fmt = fmt_name(p["DataFormat"], ABS_FORMATS)
+    blend = p["BlendingValue"] if p["BlendingEnable"] else 0
+    return (f'{cmd}("{fmt}",{pose_text(p["TargetPosition"])},{p["Speed"]},{p["AccelTime"]},{blend},'
+            f'{"false" if p["PrecisePositioning"] else "true"})')
+
+
+def line_abs(**kw):
+    """A Line to a reachable Cartesian point (the simulator's home TCP region) unless overridden."""
+    base = dict(MovementCommand="Line", DataFormat="CPP_Abs",
+                TargetPosition=dict(X=417.5, Y=-122.3, Z=359.7, RX=180, RY=0, RZ=90))
+    base.update(kw)
+    return move_abs(**base)
+
+
+MOVE_ABS_CASES = [
+    # (id, parameter values, refused with / None = sent)
+    ("speed%_1", move_abs(Speed=1, AccelTime=0), None),
+    ("speed%_100", move_abs(Speed=100, AccelTime=9999), None),
+    ("speed%_0", move_abs(Speed=0), 0x1013),
+    ("speed%_101", move_abs(Speed=101), 0x1013),
+    ("speed%_65535", move_abs(Speed=65535), 0x1013),
+    ("speedmm_4500", line_abs(DataFormat="CAP_Abs", Speed=4500), None),
+    ("speedmm_1", line_abs(DataFormat="CAR_Abs", Speed=1, PrecisePositioning=True), None),
+    ("speedmm_0", line_abs(DataFormat="CAP_Abs", Speed=0), 0x1014),
+    ("speedmm_4501", line_abs(DataFormat="CDP_Abs", Speed=4501), 0x1014),
+    ("accel_10000", move_abs(AccelTime=10000), 0x1015),
+    ("accel_65535", move_abs(AccelTime=65535), 0x1015),
+    ("blend%_100", move_abs(BlendingEnable=True, BlendingValue=100), None),
+    ("blend%_101", move_abs(BlendingEnable=True, BlendingValue=101), 0x1016),
+    ("blend%_off_65535", move_abs(BlendingEnable=False, BlendingValue=65535), None),
+    ("blendmm_1000", line_abs(DataFormat="CPR_Abs", BlendingEnable=True, BlendingValue=1000), None),
+    ("blendmm_1001", line_abs(DataFormat="CDR_Abs", BlendingEnable=True, BlendingValue=1001), 0x1017),
+    ("ptp_with_line_format", move_abs(MovementCommand="PTP", DataFormat="CPR_Abs"), 0x1011),
+    ("line_with_joint_format", move_abs(MovementCommand="Line", DataFormat="JPP_Abs"), 0x1012),
+    ("pose_on_line", line_abs(RobotPoseEnable=True), 0x1018),
+    ("target_-0.0", move_abs(TargetPosition={**HOME_JOINTS, "X": NEG_ZERO}), None),
+    ("target_subnormal", move_abs(TargetPosition={**HOME_JOINTS, "RZ": -TINY}), None),
+    ("target_0.0005", move_abs(TargetPosition={**HOME_JOINTS, "RZ": 0.0005}), None),
+    ("target_-0.0004", move_abs(TargetPosition={**HOME_JOINTS, "RZ": -0.0004}), None),
+    ("target_3_decimals", move_abs(TargetPosition={**HOME_JOINTS, "RZ": -12.345}), None),
+    ("target_100000", move_abs(TargetPosition={**HOME_JOINTS, "X": 100000.0}), None),
+    ("target_-100000", line_abs(TargetPosition=dict(X=-100000.0, Y=0, Z=0, RX=0, RY=0, RZ=0)), None),
+    ("target_past_100000", move_abs(TargetPosition={**HOME_JOINTS, "X": past(100000.0, True)}), 0x101A),
+    ("target_past_-100000", move_abs(TargetPosition={**HOME_JOINTS, "RZ": past(-100000.0, False)}), 0x101A),
+    ("target_nan", move_abs(TargetPosition={**HOME_JOINTS, "Y": NAN}), 0x101A),
+    ("target_nan_payload", move_abs(TargetPosition={**HOME_JOINTS, "RX": NAN_PAYLOAD}), 0x101A),
+    ("target_inf", move_abs(TargetPosition={**HOME_JOINTS, "Z": INF}), 0x101A),
+    ("target_-inf", move_abs(TargetPosition={**HOME_JOINTS, "RY": NEG_INF}), 0x101A),
+    ("target_max_real", move_abs(TargetPosition={**HOME_JOINTS, "X": MAX_REAL}), 0x101A),
+]
+
+
+@pytest.mark.parametrize("values,code", [c[1:] for c in MOVE_ABS_CASES], ids=[c[0] for c in MOVE_ABS_CASES])
+def test_move_absolute_numbers(lib, values, code):
+    lib.set_struct("MoveParam", values)
+    res = command(lib, "mover", "MoveExec")
+    if code is not None:
+        refused(res, code)
+    else:
+        sent(res, abs_call(values), motion=not values["BlendingEnable"])
+
+
+@pytest.mark.parametrize("member,raw,code", [
+    ("MovementCommand", -1, 0x1010), ("MovementCommand", 2, 0x1010), ("MovementCommand", 32767, 0x1010),
+    ("DataFormat", -1, 0x1011), ("DataFormat", 7, 0x1011), ("DataFormat", 255, 0x1011),
+    ("RobotPose.Pose1", 2, 0x1019), ("RobotPose.Pose2", -1, 0x1019), ("RobotPose.Pose3", 9, 0x1019),
+    ("BufferMode", 2, 0x1030), ("BufferMode", -1, 0x1030),
+])
+def test_move_absolute_undefined_enumeration_values_are_refused(lib, member, raw, code):
+    lib.set_struct("MoveParam", move_abs(MovementCommand="PTP", DataFormat="CPP_Abs", RobotPoseEnable=True,
+                                         RobotPose=dict(Pose1="Righty", Pose2="Above", Pose3="NoFlip"),
+                                         TargetPosition=dict(X=417.5, Y=-122.3, Z=359.7, RX=180, RY=0, RZ=90)))
+    lib.write("mover.BufferMode" if member == "BufferMode" else f"MoveParam.{member}", raw, raw=True)
+    refused(command(lib, "mover", "MoveExec"), code)
+
+
+def test_move_absolute_d_format_on_tmflow_1_is_refused(lib):
+    lib.write("Cobot.RobotSoftware", "TMflow1x")
+    lib.set_struct("MoveParam", line_abs(DataFormat="CDP_Abs"))
+    refused(command(lib, "mover", "MoveExec"), 0x1027)
+
+
+REL_CASES = [
+    ("tool_line_mm", rel(DataFormat="TAR_Rel", Speed=4500, BlendingEnable=True, BlendingValue=1000), None),
+    ("tool_ptp", rel(MovementCommand="PTP", DataFormat="TPP_Rel", Speed=100), None),
+    ("tool_ptp_with_line_format", rel(MovementCommand="PTP", DataFormat="TPR_Rel"), 0x1011),
+    ("joint_line", rel(DataFormat="JPP_Rel"), 0x1012),
+    ("speed%_0", rel(DataFormat="TPP_Rel", Speed=0), 0x1013),
+    ("speedmm_4501", rel(DataFormat="TDP_Rel", Speed=4501), 0x1014),
+    ("accel_10000", rel(AccelTime=10000), 0x1015),
+    ("blend%_101", rel(DataFormat="TAP_Rel", BlendingEnable=True, BlendingValue=101), 0x1016),
+    ("blendmm_1001", rel(DataFormat="TDR_Rel", BlendingEnable=True, BlendingValue=1001), 0x1017),
+    ("delta_-0.0", rel(TargetPosition=dict(X=NEG_ZERO, Y=0, Z=-20.5, RX=0, RY=0, RZ=0)), None),
+    ("delta_100000", rel(TargetPosition=dict(X=100000.0, Y=0, Z=0, RX=0, RY=0, RZ=0)), None),
+    ("delta_past", rel(TargetPosition=dict(X=0, Y=past(-100000.0, False), Z=0, RX=0, RY=0, RZ=0)), 0x101A),
+    ("delta_nan", rel(TargetPosition=dict(X=0, Y=0, Z=NAN, RX=0, RY=0, RZ=0)), 0x101A),
+    ("delta_inf", rel(TargetPosition=dict(X=0, Y=0, Z=0, RX=0, RY=0, RZ=INF)), 0x101A),
+    ("delta_-inf", rel(TargetPosition=dict(X=NEG_INF, Y=0, Z=0, RX=0, RY=0, RZ=0)), 0x101A),
+]
+
+
+def rel_call(p: dict) -> str:
+    cmd = "PTP" if p["MovementCommand"] in (1, "PTP") else "Line"
+    fmt = fmt_name(p["DataFormat"], REL_FORMATS)
+    blend = p["BlendingValue"] if p["BlendingEnable"] else 0
+    return (f'Move_{cmd}("{fmt}",{pose_text(p["TargetPosition"])},{p["Speed"]},{p["AccelTime"]},{blend},'
+            f'{"false" if p["PrecisePositioning"] else "true"})')
+
+
+@pytest.mark.parametrize("values,code", [c[1:] for c in REL_CASES], ids=[c[0] for c in REL_CASES])
+def test_move_relative_numbers(lib, values, code):
+    lib.set_struct("RelParam", values)
+    res = command(lib, "rel", "RelExec")
+    if code is not None:
+        refused(res, code)
+    else:
+        sent(res, rel_call(values), motion=not values["BlendingEnable"])
+
+
+@pytest.mark.parametrize("member,raw,code", [
+    ("MovementCommand", 2, 0x1010), ("MovementCommand", -1, 0x1010),
+    ("DataFormat", 14, 0x1012), ("DataFormat", -1, 0x1012), ("BufferMode", 3, 0x1030)])
+def test_move_relative_undefined_enumeration_values_are_refused(lib, member, raw, code):
+    lib.set_struct("RelParam", rel())
+    lib.write("rel.BufferMode" if member == "BufferMode" else f"RelParam.{member}", raw, raw=True)
+    refused(command(lib, "rel", "RelExec"), code)
+
+
+CIRCLE_CASES = [
+    ("arc_0", circ(ArcAngle=0), None),
+    ("arc_360", circ(DataFormat="CPP_Circle", ArcAngle=360, Speed=100, AccelTime=9999), None),
+    ("arc_361", circ(ArcAngle=361), 0x101B),
+    ("arc_65535", circ(ArcAngle=65535), 0x101B),
+    ("mm_speed_4500", circ(DataFormat="CAP_Circle", Speed=4500, BlendingEnable=True, BlendingValue=100), None),
+    ("blend_101", circ(BlendingEnable=True, BlendingValue=101), 0x1016),
+    ("speed%_101", circ(DataFormat="CPP_Circle", Speed=101), 0x1013),
+    ("speed%_0", circ(DataFormat="CPP_Circle", Speed=0), 0x1013),
+    ("speedmm_4501", circ(DataFormat="CAP_Circle", Speed=4501), 0x1014),
+    ("speedmm_0", circ(DataFormat="CDP_Circle", Speed=0), 0x1014),
+    ("accel_10000", circ(AccelTime=10000), 0x1015),
+    ("arc_point_nan", circ(ArcPoint=dict(X=NAN, Y=0, Z=0, RX=0, RY=0, RZ=0)), 0x101D),
+    ("end_point_-inf", circ(EndPoint=dict(X=0, Y=0, Z=0, RX=0, RY=0, RZ=NEG_INF)), 0x101D),
+    ("end_point_past", circ(EndPoint=dict(X=0, Y=0, Z=past(100000.0, True), RX=0, RY=0, RZ=0)), 0x101D),
+    ("points_at_limits", circ(ArcPoint=dict(X=-100000.0, Y=100000.0, Z=0.001, RX=NEG_ZERO, RY=0, RZ=0),
+                              EndPoint=dict(X=100000.0, Y=-99999.992, Z=0, RX=0, RY=0, RZ=0)), None),
+]
+
+
+def circle_call(p: dict) -> str:
+    blend = p["BlendingValue"] if p["BlendingEnable"] else 0
+    fmt = fmt_name(p["DataFormat"], CIRCLE_FORMATS)
+    return (f'Circle("{fmt}",{pose_text(p["ArcPoint"])},{pose_text(p["EndPoint"])},{p["Speed"]},'
+            f'{p["AccelTime"]},{blend},{p["ArcAngle"]},{"false" if p["PrecisePositioning"] else "true"})')
+
+
+@pytest.mark.parametrize("values,code", [c[1:] for c in CIRCLE_CASES], ids=[c[0] for c in CIRCLE_CASES])
+def test_move_circle_numbers(lib, values, code):
+    lib.set_struct("CircParam", values)
+    res = command(lib, "circ", "CircExec")
+    if code is not None:
+        refused(res, code)
+    else:
+        sent(res, circle_call(values), motion=not values["BlendingEnable"])
+
+
+@pytest.mark.parametrize("member,raw,code", [("DataFormat", 3, 0x101C), ("DataFormat", 4, 0x101C),
+                                             ("DataFormat", -1, 0x101C), ("BufferMode", 2, 0x1030)])
+def test_move_circle_undefined_enumeration_values_are_refused(lib, member, raw, code):
+    lib.set_struct("CircParam", circ())
+    lib.write("circ.BufferMode" if member == "BufferMode" else f"CircParam.{member}", raw, raw=True)
+    refused(command(lib, "circ", "CircExec"), code)
+
+
+# ---- CBT_ChangeBase, CBT_ChangeTCP ------------------------------------------------------------------------------
+ZERO_POSE = dict(X=0, Y=0, Z=0, RX=0, RY=0, RZ=0)
+
+
+@pytest.mark.parametrize("member,value,code", [
+    ("X", 100000.0, None), ("Y", -100000.0, None), ("Z", NEG_ZERO, None), ("RX", TINY, None),
+    ("RY", -99999.992, None), ("RZ", 0.0015, None),
+    ("X", past(100000.0, True), 0x101E), ("Y", past(-100000.0, False), 0x101E), ("Z", NAN, 0x101E),
+    ("RX", NAN_PAYLOAD, 0x101E), ("RY", INF, 0x101E), ("RZ", NEG_INF, 0x101E), ("X", -MAX_REAL, 0x101E)])
+def test_change_base_numbers(lib, member, value, code):
+    pose = {**ZERO_POSE, member: value}
+    lib.set_struct("BaseParam.Transformation", pose)
+    res = command(lib, "base", "BaseExec")
+    if code is not None:
+        refused(res, code)
+        return
+    sent(res, f"ChangeBase({pose_text(pose)})")
+    assert res.done
+    assert lib.events("setting")[-1]["pose"] == pytest.approx(tuple(f32(pose[k]) for k in pose), abs=5e-4)
+
+
+def tcp_values(**kw):
+    p = dict(TCPOffset=dict(ZERO_POSE, Z=120.5), Weight=1.5, MomentOfInertia=dict(Ixx=0, Iyy=0, Izz=0),
+             MassCenter=dict(ZERO_POSE, Z=60.25))
+    for key, value in kw.items():
+        part, _, member = key.partition("__")
+        if member:
+            p[part] = {**p[part], member: value}
+        else:
+            p[part] = value
+    return p
+
+
+def tcp_call(p: dict) -> str:
+    inertia = p["MomentOfInertia"]
+    return (f'ChangeTCP({pose_text(p["TCPOffset"])},{num(p["Weight"])},{num(inertia["Ixx"])},{num(inertia["Iyy"])},'
+            f'{num(inertia["Izz"])},{pose_text(p["MassCenter"])})')
+
+
+@pytest.mark.parametrize("kw,code", [
+    (dict(Weight=0.0), None), (dict(Weight=14.0), None), (dict(Weight=NEG_ZERO), None),
+    (dict(Weight=past(14.0, True)), 0x1020), (dict(Weight=-TINY), 0x1020), (dict(Weight=NAN), 0x1020),
+    (dict(Weight=INF), 0x1020), (dict(Weight=NEG_INF), 0x1020),
+    (dict(MomentOfInertia__Ixx=100000.0, MomentOfInertia__Iyy=0.001, MomentOfInertia__Izz=NEG_ZERO), None),
+    (dict(MomentOfInertia__Ixx=past(100000.0, True)), 0x1021), (dict(MomentOfInertia__Iyy=-TINY), 0x1021),
+    (dict(MomentOfInertia__Izz=NAN), 0x1021), (dict(MomentOfInertia__Izz=INF), 0x1021),
+    (dict(TCPOffset__X=-100000.0, MassCenter__RZ=100000.0), None),
+    (dict(TCPOffset__RZ=past(100000.0, True)), 0x101F), (dict(TCPOffset__Y=NAN), 0x101F),
+    (dict(MassCenter__X=NEG_INF), 0x101F), (dict(MassCenter__Z=NAN_PAYLOAD), 0x101F),
+    # all sixteen numbers at their longest text: the script must still be sent whole
+    (dict(TCPOffset={k: -99999.992 for k in ZERO_POSE}, Weight=13.999,
+          MomentOfInertia=dict(Ixx=99999.992, Iyy=99999.992, Izz=99999.992),
+          MassCenter={k: -99999.992 for k in ZERO_POSE}), None),
+], ids=lambda v: ",".join(f"{k}={v[k]}" for k in v) if isinstance(v, dict) else str(v))
+def test_change_tcp_numbers(lib, kw, code):
+    values = tcp_values(**kw)
+    lib.set_struct("TcpParam", values)
+    res = command(lib, "tcp", "TcpExec")
+    if code is not None:
+        refused(res, code)
+    else:
+        sent(res, tcp_call(values))
+        assert res.done
+
+
+# ---- CBT_SetOutput, CBT_Stop, CBT_ProgramControl -----------------------------------------------------------------
+@pytest.mark.parametrize("module,channel,code", [
+    ("ControlBox", 0, None), ("ControlBox", 15, None), ("ControlBox", 16, 0x1025), ("ControlBox", 65535, 0x1025),
+    ("EndModule", 0, None), ("EndModule", 3, None), ("EndModule", 4, 0x1025),
+    (-1, 0, 0x1024), (2, 0, 0x1024), (127, 0, 0x1024)])
+def test_set_output_module_and_channel(lib, module, channel, code):
+    lib.write("OutParam.Module", module, raw=isinstance(module, int))
+    lib.write("OutParam.Channel", channel)
+    lib.write("OutParam.Value", True)
+    res = command(lib, "dout", "OutExec")
+    if code is not None:
+        refused(res, code)
+    else:
+        sent(res, f'IO["{module}"].DO[{channel}]=1')
+        assert res.done
+
+
+@pytest.mark.parametrize("mode,script", [("StopNormal", "StopAndClearBuffer()"),
+                                         ("StopImmediate", "StopAndClearBuffer(0)"),
+                                         ("StopAbortScript", "StopAndClearBuffer(1)"),
+                                         ("StopDiscardAll", "StopAndClearBuffer(2)"),
+                                         (-1, 0x1023), (4, 0x1023), (99, 0x1023)])
+def test_stop_modes(lib, mode, script):
+    lib.write("StopParam.Mode", mode, raw=isinstance(mode, int))
+    res = command(lib, "stop", "StopExec")
+    if isinstance(script, int):
+        refused(res, script)
+        assert not lib.read("Cobot.Stopping")
+    else:
+        assert res.done and res.scripts == [script]
+
+
+@pytest.mark.parametrize("cmd,expected", [("Pause", "Pause()"), ("Resume", "Resume()"),
+                                          (-1, 0x1022), (2, 0x1022), (200, 0x1022)])
+def test_program_control_commands(lib, cmd, expected):
+    lib.write("PrgParam.Command", cmd, raw=isinstance(cmd, int))
+    res = command(lib, "prg", "PrgExec")
+    if isinstance(expected, int):
+        refused(res, expected)
+    else:
+        assert res.done and res.scripts == [expected]
+
+
+# ---- CBT_ReadVariable, CBT_WriteVariable: names, types, counts, texts, floats (Ethernet Slave) -------------------
+SPECS = ["g_text:string", "g_texts:string[2]", "g_f:float", "g_fs:float[2]", "g_n:int",
+         "g_" + "x" * 30 + ":int"]                                  # a name of 32 characters
+
+
+@pytest.fixture
+def var():
+    r = Rig(program="Main_Var.st", svr_port=0, svr_options={"variables": [table.parse_variable(s) for s in SPECS]})
+    assert r.until(lambda: r.read("Cobot.Status.SlaveLink"), 1)
+    yield r
+    r.close()
+
+
+def svr_writes(rig) -> list:
+    return [e for e in rig.robot.events if e["kind"] == "svr_write"]
+
+
+def set_variable(rig, path, name, kind, count=1, member=None, values=()):
+    rig.write(f"{path}.Name", name)
+    rig.write(f"{path}.DataType", kind, raw=isinstance(kind, int))
+    rig.write(f"{path}.Count", count)
+    for k, value in enumerate(values, start=1):
+        rig.write(f"{path}.{member}[{k}]", value)
+
+
+@pytest.mark.parametrize("text", ["a,b", "$", "$R$N", "*", "50 %", "a=b;c", "{x}", "\\", "'", "é", "Ω≈",
+                                  "", "x" * 80, " lead and trail "],
+                         ids=["comma", "dollar", "dollar_escape", "star", "percent", "equals", "braces",
+                              "backslash", "quote1", "latin1", "non_latin", "empty", "80_bytes", "spaces"])
+def test_write_variable_text_arrives_exactly(var, text):
+    """A text with TMscript's delimiters reaches the robot's variable unchanged: one write, nothing refused. The
+    robot's texts are UTF-8 (CBT_ReadVariable.md); vplc holds a STRING as one character per byte, so a non-ASCII
+    text is written as its UTF-8 bytes, as an HMI writing UTF-8 into the controller leaves it."""
+    set_variable(var, "WrVar", "g_text", "VarString", 1, "StringValue", [text.encode("utf-8").decode("latin-1")])
+    res = command(var, "wr", "WrExec")
+    assert res.done, (hex(res.error_id), res.descrip)
+    assert res.svr == [("svr_write", 2, {"g_text": text})]
+    assert var.robot.svr.variables["g_text"] == text
+    assert res.scripts == []
+
+
+@pytest.mark.parametrize("text", ['say "hi"', '"', "a\r\nb", "a\rb", "b\n"], ids=["quotes", "quote", "crlf", "cr",
+                                                                                 "lf"])
+def test_write_variable_text_the_format_cannot_carry_is_refused(var, text):
+    set_variable(var, "WrVar", "g_texts", "VarString", 2, "StringValue", ["ok", text])
+    refused(command(var, "wr", "WrExec"), 0x1054)
+    assert svr_writes(var) == []
+
+
+@pytest.mark.parametrize("value,code", [(1000000.0, None), (-1000000.0, None), (NEG_ZERO, None), (TINY, None),
+                                        (-0.0005, None), (past(1000000.0, True), 0x1053),
+                                        (past(-1000000.0, False), 0x1053), (NAN, 0x1053), (NAN_PAYLOAD, 0x1053),
+                                        (INF, 0x1053), (NEG_INF, 0x1053)])
+def test_write_variable_float_edges(var, value, code):
+    set_variable(var, "WrVar", "g_fs", "VarFloat", 2, "FloatValue", [1.5, value])
+    res = command(var, "wr", "WrExec")
+    if code is not None:
+        refused(res, code)
+        return
+    assert res.done, res.descrip
+    assert len(res.svr) == 1
+    assert var.robot.svr.variables["g_fs"] == pytest.approx([1.5, float(num(value))], abs=1e-9)
+
+
+def test_write_variable_checks_only_the_elements_it_writes(var):
+    """Count 1: FloatValue[2..16] are not written, so a NaN there is not an error."""
+    set_variable(var, "WrVar", "g_f", "VarFloat", 1, "FloatValue", [2.25, NAN])
+    res = command(var, "wr", "WrExec")
+    assert res.done and var.robot.svr.variables["g_f"] == pytest.approx(2.25)
+
+
+@pytest.mark.parametrize("fb,path,execute", [("wr", "WrVar", "WrExec"), ("rd", "RdVar", "RdExec")])
+@pytest.mark.parametrize("name,kind,count,code", [
+    ("", "VarInt", 1, 0x1050), ("1g", "VarInt", 1, 0x1050),
+    ("g n", "VarInt", 1, 0x1050), ("g,n", "VarInt", 1, 0x1050), ('g"n', "VarInt", 1, 0x1050),
+    ("g=n", "VarInt", 1, 0x1050), ("g$n", "VarInt", 1, 0x1050), ("g*n", "VarInt", 1, 0x1050),
+    ("g_né", "VarInt", 1, 0x1050), ("g\r\nn", "VarInt", 1, 0x1050), ("g_n", -1, 1, 0x1051), ("g_n", 4, 1, 0x1051),
+    ("g_n", "VarInt", 0, 0x1052), ("g_n", "VarInt", 17, 0x1052), ("g_n", "VarInt", 65535, 0x1052),
+    ("g_n", "VarInt", 1, None), ("g_" + "x" * 30, "VarInt", 1, None), ("_g", "VarInt", 1, 0x4040)],
+    ids=["empty", "digit_first", "space", "comma", "quote", "equals", "dollar", "star", "non_ascii",
+         "crlf", "type_-1", "type_4", "count_0", "count_17", "count_65535", "valid", "32_chars", "not_on_robot"])
+def test_variable_name_type_and_count(var, fb, path, execute, name, kind, count, code):
+    set_variable(var, path, name, kind, count, "IntValue", [7])
+    res = command(var, fb, execute)
+    if code is not None and code < 0x2000:
+        refused(res, code)
+        return
+    if code is None:                                              # sent once, the name exactly as given
+        assert res.done, res.descrip
+        assert len(res.svr) == 1 and list(res.svr[0][2]) == [name], res.svr
+    else:                                                         # the robot's answer: sent, and refused there
+        assert res.error and res.error_id == code and res.descrip == ERRORS[code][:80]
