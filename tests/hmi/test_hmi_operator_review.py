@@ -238,3 +238,12 @@ def test_history_breaks_no_word_in_two(browser, stack):
     assert broken == [], broken
     browser.screenshot("review_history")
     browser.click("btn-alarm-history-close")
+
+
+def test_the_connect_page_explains_the_link_in_the_operators_words(browser, stack):
+    """It said "TMflow, port 5890" (the demo's robot listened elsewhere), "16#2006" and "(Reconnecting, RetryCount)"."""
+    open_page(browser, stack, "connect")
+    text = browser.driver.find_element(By.CSS_SELECTOR, ".connectinfo p").text
+    assert text.startswith("While Connect is on, the PLC keeps the link to the robot"), text
+    for engineer_word in ("5890", "16#", "RetryCount", "CBT_", "TMflow"):
+        assert engineer_word not in text, (engineer_word, text)
