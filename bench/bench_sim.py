@@ -13,6 +13,8 @@ What is measured, and why this way:
   millisecond and their motions last equally long), the worst case for a single-threaded server.
 Targets (issue 5): >= 5,000 round trips/s; worst reply latency <= 5 ms; <= 60 MB RSS with 32 robots.
 Target (issue 12): a well-behaved client is answered within 10 ms (p99) while other clients flood the robot.
+Idle CPU (issue 22): the simulator with nobody connected sleeps until something is due; no target (it was ~3-6 %
+of a core when its loop woke every 2 ms).
 """
 from __future__ import annotations
 
@@ -200,6 +202,19 @@ def bench_flood(port, flooders=1, seconds=3.0, warm_up=0.3):
     return latencies, flood["in"], flood["out"]
 
 
+def bench_idle_cpu(seconds=4.0):
+    """CPU share of one core the simulator (the CLI, one robot, Ethernet Slave on) takes with nobody connected."""
+    proc, _ports = start_cli(1)
+    try:
+        time.sleep(0.5)                                     # past start-up
+        cpu, wall = cpu_s(proc.pid), time.perf_counter()
+        time.sleep(seconds)
+        return (cpu_s(proc.pid) - cpu) / (time.perf_counter() - wall)
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=10)
+
+
 def bench_poll_cost(robots=32, iterations=2000):
     srv = SimServer(port=0, robots=robots).start()
     try:
@@ -260,6 +275,8 @@ def main():
         print(f"{flooders} client(s) flooding '$' bytes, one client doing TMSTA 00 round trips on the same robot: "
               f"latency median / p99 / worst {ms(latencies)}   (target p99 <= 10 ms; {len(latencies):,d} round "
               f"trips in 3 s); flood {flood_in / 1e6:.1f} MB in, {flood_out / 1e6:.2f} MB of CPERR out")
+    print(f"simulator idle, nobody connected (one robot, Ethernet Slave on): {bench_idle_cpu():.1%} of one core   "
+          f"(no target)")
     cost = bench_poll_cost()
     print(f"poll() with 32 idle robots (in-process, virtual clock): {cost * 1e6:.1f} us per call   (no target)")
     return 0
