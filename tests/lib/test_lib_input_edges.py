@@ -533,3 +533,157 @@ def test_variable_name_type_and_count(var, fb, path, execute, name, kind, count,
         assert len(res.svr) == 1 and list(res.svr[0][2]) == [name], res.svr
     else:                                                         # the robot's answer: sent, and refused there
         assert res.error and res.error_id == code and res.descrip == ERRORS[code][:80]
+
+
+# ---- CBT_VisionJob: job and variable names, mode, speeds, index --------------------------------------------------
+LONG_JOB = "J" * 32                                                  # the longest job name TMflow takes
+
+
+@pytest.fixture
+def vis():
+    from tmsim.robot.camera import camera_of
+    r = Rig(program="Main_Vision.st")
+    camera = camera_of(r.robot.session.robot)
+    for job in ("job1", LONG_JOB):
+        camera.define(job, objects=[[417.5, -122.3, 300, 0, 0, 0]], seconds=0.1)
+    yield r
+    r.close()
+
+
+def vision_call(job: str, mode: str, speed: int, accel: int) -> str:
+    call = {"VisionAtPosition": f'Vision_DoJob("{job}")', "VisionPTP": f'Vision_DoJob_PTP("{job}",{speed},{accel})',
+            "VisionLine": f'Vision_DoJob_Line("{job}",{speed})'}[mode]
+    return f'ListenSend(90,GetString(Vision_IsJobAvailable("{job}")))\r\nListenSend(91,GetString({call}))'
+
+
+@pytest.mark.parametrize("kw,code", [
+    (dict(JobName=""), 0x1060), (dict(JobName='job"1'), 0x1060), (dict(JobName="job,1"), 0x1060),
+    (dict(JobName="job 1"), 0x1060), (dict(JobName="job$1"), 0x1060), (dict(JobName="job*1"), 0x1060),
+    (dict(JobName="jöb1"), 0x1060), (dict(JobName="job1\r\n"), 0x1060), (dict(JobName="1job"), 0x1060),
+    (dict(JobName=LONG_JOB, ObjectVariable=LONG_JOB + "_Base_TM"), None),
+    (dict(Mode=3), 0x1061), (dict(Mode=-1), 0x1061),
+    (dict(Mode="VisionPTP", Speed=0), 0x1062), (dict(Mode="VisionLine", Speed=101), 0x1062),
+    (dict(Mode="VisionLine", Speed=-32768), 0x1062), (dict(Mode="VisionPTP", Speed=1, AccelTime=1), None),
+    (dict(Mode="VisionLine", Speed=100), None), (dict(Mode="VisionAtPosition", Speed=-5, AccelTime=-5), None),
+    (dict(Mode="VisionPTP", AccelTime=0), 0x1063), (dict(Mode="VisionPTP", AccelTime=10001), 0x1063),
+    (dict(Mode="VisionPTP", AccelTime=10000), None), (dict(Mode="VisionLine", AccelTime=-1), None),
+    (dict(ObjectVariable=""), 0x1064), (dict(ObjectVariable="job1,Base"), 0x1064),
+    (dict(ObjectVariable='job1"'), 0x1064), (dict(ObjectVariable="V" * 48), None),
+    (dict(ObjectIndex=-1), 0x1065), (dict(ObjectIndex=64), 0x1065), (dict(ObjectIndex=32767), 0x1065),
+    (dict(ObjectIndex=63), None)],
+    ids=lambda v: ",".join(f"{k}={v[k]!r}" for k in v) if isinstance(v, dict) else str(v))
+def test_vision_job_inputs(vis, kw, code):
+    p = dict(JobName="job1", Mode="VisionAtPosition", Speed=100, AccelTime=200, ObjectVariable="job1_Base_TM",
+             ObjectIndex=0)
+    p.update(kw)
+    for key, value in p.items():
+        vis.write(f"VisParam.{key}", value, raw=key == "Mode" and isinstance(value, int))
+    res = command(vis, "vis", "VisExec")
+    if code is not None:
+        refused(res, code)
+        return
+    assert res.scripts[0] == vision_call(p["JobName"], p["Mode"], p["Speed"], p["AccelTime"]), res.scripts
+    assert sum("Vision_DoJob" in s for s in res.scripts) == 1         # the job ran once
+    assert res.done, res.descrip
+    assert vis.read("vis.Found") == (p["ObjectIndex"] == 0 and p["ObjectVariable"].endswith("_Base_TM"))
+
+
+# ---- CBT_Teach, CBT_ReadActualPosition, CBT_ProjectControl, CBT_SetOverride, CBT_Jog, CBT_Connect ---------------
+@pytest.mark.parametrize("name", ['a,b"$*', "P\r\n1", "Ω", "x" * 23], ids=["delimiters", "crlf", "utf8", "23_chars"])
+def test_teach_name_is_stored_as_given_and_never_sent(name):
+    r = Rig(program="Main_Jog.st")
+    try:
+        stored = name.encode("utf-8").decode("latin-1")
+        r.write("TeachName", stored)
+        res = command(r, "teach", "TeachExec", seconds=3)
+        assert res.done, res.descrip
+        assert r.read("Table[1].Name") == stored and r.read("Table[1].Taught")
+        assert not any(stored in s for s in res.scripts)
+    finally:
+        r.close()
+
+
+@pytest.mark.parametrize("period_ms,ok", [(10, True), (10000, True), (9, False), (10001, False), (0, False),
+                                          (-1, False)])
+def test_read_actual_position_period(lib, period_ms, ok):
+    lib.write("ReadPeriod", period_ms * 1_000_000)                    # TIME in ns
+    lib.write("ReadEnable", True)
+    assert lib.until(lambda: lib.read("rd.Valid") or lib.read("rd.Error"), 1)
+    if ok:
+        assert lib.read("rd.Valid") and not lib.read("rd.Error")
+    else:
+        before = len(script_frames(lib))
+        lib.scans(300)
+        assert lib.read("rd.Error") and lib.read("rd.ErrorID") == 0x1004
+        assert lib.read("rd.ErrorDescrip") == ERRORS[0x1004][:80]
+        assert len(script_frames(lib)) == before                      # nothing asked of the robot
+    lib.write("ReadEnable", False)
+    lib.scans(2)
+    assert not lib.read("rd.Error")
+
+
+@pytest.mark.parametrize("raw", [-1, 3, 255])
+def test_project_control_undefined_command(lib, raw):
+    lib.write("ProjCmd", raw, raw=True)
+    refused(command(lib, "proj", "ProjExec"), 0x1026)
+
+
+@pytest.fixture
+def cell():
+    r = Rig(program="Main_Cell.st", svr_port=0)
+    r.write("StatusEnable", True)
+    assert r.until(lambda: r.read("status.Valid"), 1)
+    yield r
+    r.close()
+
+
+@pytest.mark.parametrize("value,code", [(5, None), (100, None), (95, None), (0, 0x1040), (4, 0x1040), (7, 0x1040),
+                                        (101, 0x1040), (105, 0x1040), (255, 0x1040)])
+def test_set_override_values(cell, value, code):
+    cell.write("OvrValue", value)
+    res = command(cell, "ovr", "OvrExec", seconds=5)
+    if code is not None:
+        refused(res, code)
+        return
+    assert res.done, res.descrip
+    assert res.svr == [("svr_write", 2, {"Project_Speed": str(value)})] or \
+        [s[2] for s in res.svr] == [{"Project_Speed": value}], res.svr
+    assert res.scripts == []
+
+
+@pytest.mark.parametrize("path,value,code", [("JogAxis", 0, 0x1071), ("JogAxis", 7, 0x1071), ("JogAxis", 255, 0x1071),
+                                             ("JogVelocity", 0, 0x1072), ("JogVelocity", 101, 0x1072),
+                                             ("JogVelocity", 65535, 0x1072), ("JogFrame", 3, 0x1070),
+                                             ("JogFrame", -1, 0x1070), ("JogFrame", 127, 0x1070)])
+def test_jog_inputs_out_of_range(path, value, code):
+    r = Rig(program="Main_Jog.st")
+    try:
+        r.write(path, value, raw=path == "JogFrame")
+        before = len(script_frames(r))
+        r.write("JogFwd", True)
+        r.scans(20)
+        assert r.read("jog.Error") and r.read("jog.ErrorID") == code and r.read("jog.ErrorDescrip") == ERRORS[code][:80]
+        assert len(script_frames(r)) == before
+    finally:
+        r.close()
+
+
+@pytest.mark.parametrize("address", ["", "127.0.0.1,5890", '127.0.0.1"', "127.0.0.1$R$N", "*", "999.1.1.1",
+                                     "127.0.0.1 ", "localhost", "::1", "1" * 49],
+                         ids=["empty", "comma", "quote", "crlf", "star", "octet_999", "trailing_space", "name",
+                              "ipv6", "49_chars"])
+def test_connect_address_that_is_not_an_ipv4_address_never_connects(address):
+    """Empty: 16#1002 at once; anything else that is not a dotted IPv4 address: an error with its text, never
+    Connected, and the robot sees no connection."""
+    r = Rig(connect=False)
+    try:
+        r.write("Ip", address)
+        r.write("ConnExec", True)
+        assert r.until(lambda: r.read("conn.Error"), 15), "no error for a bad address"
+        error_id = r.read("conn.ErrorID")
+        assert r.read("conn.ErrorDescrip") == ERRORS[error_id][:80]
+        if address == "":
+            assert error_id == 0x1002
+        assert not r.read("Cobot.Connected") and r.events("connect") == []
+    finally:
+        r.close()
