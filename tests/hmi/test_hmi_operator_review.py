@@ -247,3 +247,24 @@ def test_the_connect_page_explains_the_link_in_the_operators_words(browser, stac
     assert text.startswith("While Connect is on, the PLC keeps the link to the robot"), text
     for engineer_word in ("5890", "16#", "RetryCount", "CBT_", "TMflow"):
         assert engineer_word not in text, (engineer_word, text)
+
+
+@pytest.mark.parametrize("page, target", [("moveabs", "MoveAbs_Param.TargetPosition"),
+                                          ("moverel", "MoveRel_Param.TargetPosition"),
+                                          ("movecircle", "MoveCircle_Param.ArcPoint"),
+                                          ("movecircle", "MoveCircle_Param.EndPoint"),
+                                          ("changebase", "ChangeBase_Param.Transformation")])
+def test_the_target_is_in_sight_when_a_motion_page_opens(browser, stack, page, target):
+    """Move Absolute opened with its Target Position below the fold of the settings at 800x480: the six fields the
+    operator came to change needed a scroll first. The target comes first now, the settings under it."""
+    open_page(browser, stack, page)
+    hidden = browser.driver.execute_script("""
+        const box = document.querySelector('.params').getBoundingClientRect(), out = [];
+        for (const k of ['X', 'Y', 'Z', 'RX', 'RY', 'RZ']) {
+          const r = document.querySelector(`[data-path="${arguments[0]}.${k}"]`).getBoundingClientRect();
+          if (r.top < box.top || r.bottom > box.bottom || r.bottom > innerHeight) out.push(k);
+        }
+        return out;""", target)
+    assert hidden == [], (page, target, hidden)
+    if page == "moveabs":
+        browser.screenshot("review_moveabs_target_first")

@@ -207,8 +207,10 @@ function buildStruct(container, path, typeName, legendText) {
   for (const [field, spec] of checks) row.append(makeField(`${path}.${field}`, spec, LABELS[field] || field));
   if (scalars.length) fs.append(grid);
   if (checks.length) fs.append(row);
-  container.prepend(fs);
+  /* the target (a pose: Target Position, Arc and End Point, the base, the TCP offset) first, in sight at 800x480
+     without scrolling; the settings under it, then the optional Robot Pose */
   const pose = container.querySelector('fieldset[data-member="RobotPose"]');
+  container.insertBefore(fs, pose);
   const poseOn = container.querySelector(`[data-path="${path}.RobotPoseEnable"]`);
   if (pose && poseOn) {                          // shown only when it is sent (PTP CPP with Enable Robot Pose)
     const show = () => { pose.hidden = !poseOn.checked; };
