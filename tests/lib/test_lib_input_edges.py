@@ -687,3 +687,222 @@ def test_connect_address_that_is_not_an_ipv4_address_never_connects(address):
         assert not r.read("Cobot.Connected") and r.events("connect") == []
     finally:
         r.close()
+
+
+# ---- PLCopen: Execute held, pulsed, re-raised; inputs changed while Busy; two FBs in one scan ---------------------
+SLOW = dict(TargetPosition={**HOME_JOINTS, "RZ": 60.0}, Speed=20)         # about 1 s of motion
+
+
+def setup_command(rig, fb: str) -> tuple[str, str]:
+    """Valid parameters for one FB of Main_Lib.st; (instance, Execute variable)."""
+    if fb == "mover":
+        rig.set_struct("MoveParam", move_abs(**SLOW))
+        return "mover", "MoveExec"
+    if fb == "rel":
+        rig.set_struct("RelParam", rel())
+        return "rel", "RelExec"
+    if fb == "circ":
+        rig.set_struct("CircParam", circ())
+        return "circ", "CircExec"
+    if fb == "base":
+        rig.set_struct("BaseParam.Transformation", dict(ZERO_POSE, X=10.5))
+        return "base", "BaseExec"
+    if fb == "tcp":
+        rig.set_struct("TcpParam", tcp_values())
+        return "tcp", "TcpExec"
+    if fb == "dout":
+        rig.set_struct("OutParam", dict(Module="EndModule", Channel=2, Value=True))
+        return "dout", "OutExec"
+    if fb == "prg":
+        rig.write("PrgParam.Command", "Resume")
+        return "prg", "PrgExec"
+    rig.write("StopParam.Mode", "StopNormal")
+    return "stop", "StopExec"
+
+
+FBS = ["mover", "rel", "circ", "base", "tcp", "dout", "prg", "stop"]
+OUTS = ("Done", "Busy", "Error", "CommandAborted")
+
+
+def trace(rig, fb: str, scans: int, on_scan=None) -> list[dict]:
+    """The FB's outputs after each of ``scans`` scans."""
+    rows = []
+    for n in range(scans):
+        if on_scan:
+            on_scan(n)
+        rig.scans(1)
+        rows.append({o: rig.read(f"{fb}.{o}") for o in OUTS})
+    return rows
+
+
+@pytest.mark.parametrize("fb", FBS)
+def test_execute_held_sends_once_and_done_stays_until_it_falls(lib, fb):
+    inst, execute = setup_command(lib, fb)
+    lib.write(execute, True)
+    rows = trace(lib, inst, 3000)                                        # 3 s held
+    first = next(i for i, r in enumerate(rows) if r["Done"])
+    assert all(r["Done"] and not r["Busy"] and not r["Error"] for r in rows[first:])
+    assert all(r["Busy"] and not r["Done"] for r in rows[:first])
+    assert len(script_frames(lib)) == 1
+    if inst in ("mover", "rel"):
+        assert len(lib.events("motion_end")) == 1
+    lib.write(execute, False)
+    lib.scans(1)
+    assert not any(lib.read(f"{inst}.{o}") for o in OUTS)
+    lib.scans(500)
+    assert len(script_frames(lib)) == 1
+
+
+@pytest.mark.parametrize("fb", FBS)
+def test_execute_pulsed_for_one_scan_sends_once_and_shows_done_for_one_scan(lib, fb):
+    inst, execute = setup_command(lib, fb)
+    rows = trace(lib, inst, 3000, on_scan=lambda n: lib.write(execute, n == 0))
+    assert [r["Done"] for r in rows].count(True) == 1, "Done must show for exactly one scan"
+    assert not any(r["Error"] or r["CommandAborted"] for r in rows)
+    done_at = next(i for i, r in enumerate(rows) if r["Done"])
+    assert all(r["Busy"] for r in rows[:done_at]) and not any(r["Busy"] for r in rows[done_at:])
+    assert len(script_frames(lib)) == 1
+    if inst in ("mover", "rel"):
+        assert len(lib.events("motion_end")) == 1
+
+
+@pytest.mark.parametrize("fb,member,raw,code", [("mover", "MoveParam.Speed", 0, 0x1013),
+                                                ("base", "BaseParam.Transformation.X", NAN, 0x101E),
+                                                ("dout", "OutParam.Channel", 99, 0x1025),
+                                                ("stop", "StopParam.Mode", 9, 0x1023)])
+def test_a_refused_pulse_shows_error_for_one_scan(lib, fb, member, raw, code):
+    inst, execute = setup_command(lib, fb)
+    lib.write(member, raw, raw=isinstance(raw, int) and fb == "stop")
+    rows = trace(lib, inst, 5, on_scan=lambda n: lib.write(execute, n == 0))
+    assert [r["Error"] for r in rows] == [True, False, False, False, False]
+    assert not any(r["Busy"] or r["Done"] for r in rows)
+    assert script_frames(lib) == []
+
+
+def test_execute_re_raised_while_busy_starts_one_new_command_per_edge(lib):
+    """R5: the new edge replaces the running command; the first motion was sent and runs (it is the robot's), the
+    second is sent once, and Done comes when the robot finished the second."""
+    inst, execute = setup_command(lib, "mover")
+    lib.write(execute, True)
+    assert lib.until(lambda: lib.read("mover.Active"), 1)
+    lib.write(execute, False)
+    lib.scans(1)
+    lib.set_struct("MoveParam.TargetPosition", {**HOME_JOINTS, "RZ": -30.0})
+    lib.write(execute, True)
+    lib.scans(1)
+    assert lib.read("mover.Busy") and not lib.read("mover.Done")
+    assert lib.until(lambda: lib.read("mover.Done") or lib.read("mover.Error"), 10)
+    assert lib.read("mover.Done"), lib.read("mover.ErrorDescrip")
+    ends = [round(e["joints"][5]) for e in lib.events("motion_end")]
+    assert ends == [60, -30], ends                                     # both ran, in order, Done after the second
+    scripts = script_frames(lib)
+    assert len(scripts) == 2 and "60" in scripts[0].split(",")[6] and "-30" in scripts[1].split(",")[6]
+    lib.write(execute, False)
+    lib.scans(500)
+    assert len(script_frames(lib)) == 2
+
+
+def test_inputs_changed_while_busy_are_not_taken(lib):
+    """R4: the parameters are latched at the edge: what the robot gets and where it ends are the edge's values."""
+    inst, execute = setup_command(lib, "mover")
+    lib.write(execute, True)
+    lib.scans(1)
+    lib.set_struct("MoveParam", move_abs(TargetPosition={**HOME_JOINTS, "RZ": -45.0}, Speed=100, DataFormat="CPR_Abs"))
+    lib.write("mover.BufferMode", "Aborting")
+    assert lib.until(lambda: lib.read("mover.Done") or lib.read("mover.Error"), 10)
+    assert lib.read("mover.Done"), lib.read("mover.ErrorDescrip")
+    assert [round(e["joints"][5]) for e in lib.events("motion_end")] == [60]
+    scripts = script_frames(lib)
+    assert len(scripts) == 1 and scripts[0].split("\r\n")[0] == abs_call(move_abs(**SLOW)), scripts
+
+
+def test_write_variable_text_changed_while_busy_is_not_taken(var):
+    set_variable(var, "WrVar", "g_text", "VarString", 1, "StringValue", ["first"])
+    var.write("WrExec", True)
+    var.scans(1)
+    var.write("WrVar.StringValue[1]", "second")
+    var.write("WrVar.Name", "g_n")
+    assert var.until(lambda: var.read("wr.Done") or var.read("wr.Error"), 3)
+    assert var.read("wr.Done") and var.robot.svr.variables["g_text"] == "first"
+    assert [w["items"] for w in svr_writes(var)] == [{"g_text": "first"}]
+
+
+def test_execute_re_raised_while_a_write_is_busy_is_ignored(var):
+    set_variable(var, "WrVar", "g_text", "VarString", 1, "StringValue", ["one"])
+    var.write("WrExec", True)
+    var.scans(1)
+    assert var.read("wr.Busy")
+    var.write("WrExec", False)
+    var.scans(1)
+    var.write("WrExec", True)
+    assert var.until(lambda: var.read("wr.Done") or var.read("wr.Error"), 3)
+    var.write("WrExec", False)
+    var.scans(100)
+    assert len(svr_writes(var)) == 1
+
+
+def test_every_fb_started_in_the_same_scan_sends_once_each_in_call_order(lib):
+    """Main_Lib.st calls mover, rel, circ, base, tcp, prg, stop, dout, ..., movers[1..4]: every one started in one
+    scan goes out once, in that order, and each ends Done (the stop last would abort the motions: left out)."""
+    started = [setup_command(lib, fb) for fb in ("mover", "base", "tcp", "dout")]
+    for k in (1, 2):
+        lib.set_struct(f"MParam[{k}]", move_abs(TargetPosition={**HOME_JOINTS, "RZ": 10.0 * k}))
+        started.append((f"movers[{k}]", f"MExec[{k}]"))
+    for _, execute in started:
+        lib.write(execute, True)
+    assert lib.until(lambda: all(lib.read(f"{i}.Done") or lib.read(f"{i}.Error") for i, _ in started), 20)
+    assert all(lib.read(f"{i}.Done") for i, _ in started), {i: lib.read(f"{i}.ErrorDescrip") for i, _ in started}
+    heads = [s.split("(")[0] for s in script_frames(lib)]
+    assert heads == ["PTP", "ChangeBase", "ChangeTCP", 'IO["EndModule"].DO[2]=1', "PTP", "PTP"], heads
+    assert len(lib.events("motion_end")) == 3
+
+
+
+# ---- the link lost at each step of a command ---------------------------------------------------------------------
+def lose_link(rig) -> None:
+    rig.robot.inject("disconnect")
+
+
+STEPS = ["before_the_edge", "in_the_edge_scan", "reply_held_back", "while_moving", "after_done"]
+
+
+@pytest.mark.parametrize("fb,step", [(fb, step) for fb in ("mover", "base", "dout") for step in STEPS
+                                     if fb == "mover" or step != "while_moving"])
+def test_link_lost_at_each_step_never_reports_what_the_robot_did_not_do(lib, fb, step):
+    """At most one frame; the FB ends (never Busy for good); Done only if the robot did it, else Error with a
+    documented ErrorID and its text. A command refused before the edge sends nothing."""
+    inst, execute = setup_command(lib, fb)
+    if step == "before_the_edge":
+        lose_link(lib)
+        assert lib.until(lambda: not lib.read("Cobot.Connected"), 2)
+    if step == "reply_held_back":
+        lib.robot.inject("reply_delay", seconds=0.3, count=1)
+    lib.write(execute, True)
+    if step == "in_the_edge_scan":
+        lose_link(lib)
+    lib.scans(1)
+    if step == "reply_held_back":
+        assert lib.until(lambda: len(script_frames(lib)) == 1, 1)
+        lose_link(lib)
+    if step == "while_moving":
+        assert lib.until(lambda: lib.read(f"{inst}.Active") or lib.read(f"{inst}.Done"), 2)
+        lose_link(lib)
+    if step == "after_done":
+        assert lib.until(lambda: lib.read(f"{inst}.Done"), 10)
+        lose_link(lib)
+    assert lib.until(lambda: not lib.read(f"{inst}.Busy"), 12), f"{inst} still Busy"
+    done, error_id = lib.read(f"{inst}.Done"), lib.read(f"{inst}.ErrorID")
+    lib.scans(3000)                                             # CBT_Connect reconnects; nothing is sent again
+    scripts = script_frames(lib)
+    assert len(scripts) <= 1, scripts
+    if step == "before_the_edge":
+        assert scripts == [] and error_id in (0x2001, 0x200C), hex(error_id)
+    if done:
+        assert len(scripts) == 1
+        if inst == "mover":
+            assert len(lib.events("motion_end")) == 1
+        elif inst == "base":
+            assert lib.events("setting")
+    else:
+        assert lib.read(f"{inst}.Error") and error_id in ERRORS, hex(error_id)
+        assert lib.read(f"{inst}.ErrorDescrip") == ERRORS[error_id][:80]
