@@ -166,7 +166,7 @@ def test_an_idle_loop_sleeps_instead_of_polling(long_sleep):
         sleeping(srv)
         before = srv.loop_waits
         threading.Event().wait(0.3)                        # the old loop polled 150 times meanwhile
-        assert srv.loop_waits - before <= 1
+        assert srv.loop_waits - before <= 2
     finally:
         srv.close()
 
@@ -241,7 +241,7 @@ def test_a_delayed_reply_leaves_at_its_time_from_a_sleeping_loop(long_sleep):
         peer.send(sta("00"))
         asked = robot.wait_event("frame_in", timeout=ANSWER_S, header="TMSTA")
         assert receive(peer) == [("TMSTA", "00,true,Listen1")]
-        assert srv.now >= asked["t"] + 1.0                 # not before its time
+        assert srv.now >= asked["t"] + 1.0 - 1e-6          # not before its time (event times are rounded to 1 us)
         peer.close()
     finally:
         srv.close()
