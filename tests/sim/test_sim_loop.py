@@ -15,6 +15,17 @@ ANSWER_S = 10.0          # wall seconds a test waits for what the loop sends (th
 
 # ---- what is due, on the virtual clock ------------------------------------------------------------------------
 
+def arrives_at(h, peer, due):
+    """A poll just before ``due`` sends ``peer`` nothing, the poll at ``due`` sends it something: what it got."""
+    before = len(peer.frames)
+    h.srv.poll(due - 0.001)
+    peer.pump()
+    assert len(peer.frames) == before, f"sent before it was due: {peer.texts()[before:]}"
+    h.srv.poll(due)
+    assert h.until(lambda: len(peer.frames) > before, timeout=0.01, dt=0.0001), "nothing sent when it was due"
+    return peer.texts()[before:]
+
+
 def test_an_idle_server_has_nothing_due(harness):
     harness.connect()
     harness.run(0.1)
@@ -46,11 +57,7 @@ def test_a_sleeping_script_is_due_at_its_deadline_and_answered_then(harness):
     started = harness.srv.now
     due = harness.srv.next_due()
     assert due == pytest.approx(started + 0.4, abs=0.006)
-    harness.srv.poll(due - 0.001)
-    peer.pump()
-    assert peer.texts() == []
-    harness.srv.poll(due)
-    assert harness.until(lambda: peer.texts() == [("TMSCT", "s,OK")], timeout=0.01, dt=0.0)
+    assert arrives_at(harness, peer, due) == [("TMSCT", "s,OK")]
 
 
 def test_the_listen_node_timeouts_are_due_when_they_expire():
@@ -75,11 +82,7 @@ def test_a_delayed_reply_is_due_at_its_release_and_leaves_then(harness):
     due = harness.srv.next_due()
     asked = harness.srv.now
     assert asked < due <= asked + 0.3
-    harness.srv.poll(due - 0.001)
-    peer.pump()
-    assert peer.texts() == []
-    harness.srv.poll(due)
-    assert harness.until(lambda: peer.texts() == [("TMSTA", "00,true,Listen1")], timeout=0.01, dt=0.0)
+    assert arrives_at(harness, peer, due) == [("TMSTA", "00,true,Listen1")]
     assert harness.srv.next_due() is None
 
 
@@ -90,8 +93,7 @@ def test_glued_replies_are_due_when_the_oldest_has_waited_max_wait(harness):
     assert harness.until(lambda: harness.srv.next_due() is not None, timeout=1)
     due = harness.srv.next_due()
     assert harness.srv.now < due <= harness.srv.now + 0.2
-    harness.srv.poll(due)
-    assert harness.until(lambda: peer.texts() == [("TMSTA", "00,true,Listen1")], timeout=0.01, dt=0.0)
+    assert arrives_at(harness, peer, due) == [("TMSTA", "00,true,Listen1")]
 
 
 def test_split_replies_are_due_at_every_poll_while_pieces_wait(harness):
@@ -112,12 +114,8 @@ def test_the_ethernet_slave_is_due_at_its_next_data_table_while_a_client_listens
         h.until(lambda: peer.frames, timeout=1)
         due = h.srv.next_due()
         assert due == pytest.approx(h.robot.svr.next_stream) and h.srv.now < due <= h.srv.now + 0.5
-        count = len(peer.frames)
-        h.srv.poll(due - 0.001)
-        peer.pump()
-        assert len(peer.frames) == count
-        h.srv.poll(due)
-        assert h.until(lambda: len(peer.frames) == count + 1, timeout=0.01, dt=0.0)
+        [(header, table)] = arrives_at(h, peer, due)
+        assert header == "TMSVR" and table.startswith("1,1,")      # the second data table (IDs 0..9 in turn)
         h.robot.svr.inject("stall")
         assert h.srv.next_due() is None
     finally:
