@@ -62,3 +62,31 @@ def test_the_variable_table_names_exit_listen_node_an_engineering_member(mapping
     assert mapping.leaves["MoveAbs_Param.ExitNode"].role == "engineer"
     assert mapping.leaves["PnP_MoveParameters[5].ExitNode"].role == "engineer"
     assert mapping.leaves["MoveAbs_Param.Speed"].role == "operator"
+
+
+@pytest.mark.parametrize("execute, setting", [("MoveRel_Execute", "MoveRel_Param"), ("MoveAbs_Execute", "MoveAbs_Param"),
+                                              ("MoveCircle_Execute", "MoveCircle_Param")])
+def test_exit_listen_node_left_ticked_by_the_engineer_does_not_go_with_the_operators_execute(
+        fake_plc, operator, client, execute, setting):
+    """Driving the demo: the engineer ran one Move Relative with Exit Listen Node; the box stayed TRUE in the PLC,
+    and the operator's next Move Relative (its box locked, so it could not untick it) left the Listen node again.
+    The operator's Execute is now refused while it is set; the engineer's goes on."""
+    fake_plc.vars[setting]["ExitNode"] = True
+    fake_plc.writes.clear()
+    status, answer = operator.json("/api/execute", {"execute": execute, "values": {f"{setting}.Speed": 20}})
+    assert status == 403, answer
+    assert answer["error"] == (
+        f"Exit Listen Node is ticked for this command ('{setting}.ExitNode', an engineering setting (it would make the "
+        "robot leave its Listen node)): the operator may not send it; ask the engineer to clear it. Nothing was sent")
+    assert fake_plc.writes == []
+    status, answer = client.json("/api/execute", {"execute": execute, "values": {f"{setting}.Speed": 20}})
+    assert status == 200, answer
+    fake_plc.vars[setting]["ExitNode"] = False
+    status, answer = operator.json("/api/execute", {"execute": execute, "values": {f"{setting}.Speed": 20}})
+    assert status == 200, answer
+
+
+def test_each_command_knows_the_engineering_settings_it_carries(mapping):
+    assert mapping.execute_settings["MoveRel_Execute"] == ["MoveRel_Param.ExitNode"]
+    assert mapping.execute_settings["SetOutput_Execute"] == ["SetOutput_Param.ExitNode"]
+    assert mapping.execute_settings["Stop_Execute"] == []

@@ -268,3 +268,19 @@ def test_the_target_is_in_sight_when_a_motion_page_opens(browser, stack, page, t
     assert hidden == [], (page, target, hidden)
     if page == "moveabs":
         browser.screenshot("review_moveabs_target_first")
+
+
+def test_the_operator_sees_why_a_move_with_exit_listen_node_left_ticked_is_not_sent(browser, stack):
+    stack.plc.vars["MoveRel_Param"]["ExitNode"] = True
+    try:
+        open_page(browser, stack, "moverel")
+        browser.click("btn-preset")                                 # the fake PLC's zeros are no valid move
+        box = browser.field("MoveRel_Param.ExitNode")
+        assert box.is_selected() and not box.is_enabled()          # shown as the PLC holds it, locked
+        stack.plc.writes.clear()
+        browser.click("btn-execute")
+        browser.wait_for(lambda d: "Exit Listen Node is ticked" in browser.message(), "the refusal")
+        assert "ask the engineer to clear it" in browser.message() and stack.plc.writes == []
+        browser.screenshot("review_moverel_exit_node_refused")
+    finally:
+        stack.plc.vars["MoveRel_Param"]["ExitNode"] = False

@@ -90,8 +90,22 @@ class Mapping:
                     raise MappingError(f"{source}: variable '{name}': role must be 'operator' or 'engineer', "
                                        f"not {role!r}")
                 self._expand(name, spec, access, role, types)
+            self.execute_settings = self._execute_settings(document)
         except (KeyError, TypeError, ValueError) as exc:
             raise MappingError(f"{source}: malformed variable table ({type(exc).__name__}: {exc})") from None
+
+    def _execute_settings(self, document: dict) -> dict[str, list[str]]:
+        """The engineering members each described command carries, by its Execute variable ('MoveRel_Execute' ->
+        ['MoveRel_Param.ExitNode']): the value the engineer left in the PLC goes with the operator's next Execute."""
+        settings: dict[str, list[str]] = {}
+        for page in document.get("page_descriptions", {}).values():
+            command, parameters = page.get("command") or {}, page.get("parameters") or {}
+            if command.get("variable") and parameters.get("variable"):
+                prefix = parameters["variable"] + "."
+                settings[command["variable"]] = sorted(
+                    path for path in self.leaves
+                    if path.startswith(prefix) and path.rpartition(".")[2] in self.engineering_members)
+        return settings
 
     @classmethod
     def load(cls, path: pathlib.Path | str = DEFAULT_MAPPING) -> Mapping:

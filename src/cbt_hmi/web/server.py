@@ -218,6 +218,23 @@ class HmiServer:
                                f"open the engineer address printed at start-up", HTTPStatus.FORBIDDEN)
         return leaf
 
+    def _refuse_engineering_settings_set(self, name: str) -> None:
+        """An engineering setting the engineer left set in the PLC (Exit Listen Node ticked for one move) goes with
+        every later Execute of that command: the operator's Execute would leave the Listen node again with a box
+        the operator may not untick. Refused (403) before anything is written."""
+        paths = self.mapping.execute_settings.get(name, [])
+        if not paths:
+            return
+        with self.plc.lock:
+            found = [path for path in paths if self.plc.read(path) is True]
+        if found:
+            member = found[0].rpartition(".")[2]
+            what = "Exit Listen Node is ticked" if member == "ExitNode" else f"'{member}' is set"
+            why = " (it would make the robot leave its Listen node)" if member == "ExitNode" else ""
+            raise RequestError(f"{what} for this command ('{found[0]}', an engineering setting{why}): the operator "
+                               f"may not send it; ask the engineer to clear it. Nothing was sent",
+                               HTTPStatus.FORBIDDEN)
+
     def _write_all(self, checked) -> int:
         """Write every value or none: on a refusal the ones already written get their old values back.
 
@@ -255,6 +272,8 @@ class HmiServer:
         values = body.get("values") or {}
         checked = self._checked(values, role) if values else []
         self._refuse_when_faulted()
+        if not role_at_least(role, "engineer"):
+            self._refuse_engineering_settings_set(leaf.path)
         # A clean rising edge: every task completes a cycle with Execute FALSE, then one with it TRUE, before
         # the answer goes back. A scan that only advances the clock (no task due) does not count, and
         # Execute requests are taken one at a time, so no command is ever merged with another or lost.
