@@ -284,3 +284,22 @@ def test_the_operator_sees_why_a_move_with_exit_listen_node_left_ticked_is_not_s
         browser.screenshot("review_moverel_exit_node_refused")
     finally:
         stack.plc.vars["MoveRel_Param"]["ExitNode"] = False
+
+
+def test_the_monitor_address_offers_no_pnp_key_and_reads_the_segment_names(browser, stack):
+    """The read-only monitor saw Preset Values, Pause and Resume as live keys (and Start, with the robot ready), and
+    the segment names faded to 45 % (about 2:1 contrast)."""
+    stack.set(PnP_State=0)
+    browser.open(f"{stack.server.url}pnp.html")                  # no key: the monitor
+    browser.wait_for(lambda d: "Cycle: Idle" in d.find_element(By.ID, "pnp-state").text, "the cycle's state")
+    keys = browser.driver.execute_script(
+        "return [...document.querySelectorAll('.side .buttons button')].map((b) => [b.id, b.disabled])")
+    assert keys and all(disabled for _, disabled in keys), keys
+    looks = browser.driver.execute_script("""
+        const g = document.getElementById('edit-0');
+        return [getComputedStyle(g).opacity, getComputedStyle(g.querySelector('text')).fill];""")
+    assert looks == ["1", "rgb(80, 91, 102)"], looks
+    browser.screenshot("review_pnp_monitor")
+    open_page(browser, stack, "pnp")                              # the operator: Start offered with the robot ready
+    browser.wait_for(lambda d: d.find_element(By.ID, "btn-execute").is_enabled(), "Start for the operator")
+    assert browser.driver.find_element(By.ID, "btn-pause").is_enabled()

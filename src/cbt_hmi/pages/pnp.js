@@ -58,8 +58,9 @@ function pnpOptions() {
     text = "Stop Motion is still active: wait until it is released, then press Start.";
   if (v.PnP_OutcomeUnknown && (state === "Idle" || state === "Stopped"))
     text += " The last command may have run: Start first checks where the robot is and goes on from there.";
-  const enabled = { "btn-execute": startable, "btn-stop": state === "Running" && v.PnP_Example_Execute === true,
-    "btn-reset": state === "Faulted" };
+  const enabled = { "btn-execute": startable && mayWrite("PnP_Example_Execute"),   // never for the monitor address
+    "btn-stop": state === "Running" && v.PnP_Example_Execute === true && mayWrite("PnP_Example_Execute"),
+    "btn-reset": state === "Faulted" && mayWrite("PnP_Reset") };
   return { state, text, enabled };
 }
 
@@ -263,6 +264,8 @@ async function pnpPage() {
   };
   const control = (cmd, what) => executeCommand("ProgramControl_Execute", { "ProgramControl_Param.Command": cmd }, what)
     .then((sent) => sent && watchResult("ProgramControl", what, what === "Pause" ? "the robot holds its path." : "the robot continues."));
+  for (const [id, variable] of [["btn-preset", "PnP_MoveParameters[0].Speed"], ["btn-pause", "ProgramControl_Execute"],
+    ["btn-resume", "ProgramControl_Execute"]]) document.getElementById(id).disabled = !mayWrite(variable);
   document.getElementById("btn-pause").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Pause, "Pause");
   document.getElementById("btn-resume").onclick = () => control(MAP.types.eCBT_PrgControlCmd.enum.Resume, "Resume");
   live.listeners.push(updatePnP, showPnPState, fetchTrail);
