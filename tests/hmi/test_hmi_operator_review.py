@@ -303,3 +303,34 @@ def test_the_monitor_address_offers_no_pnp_key_and_reads_the_segment_names(brows
     open_page(browser, stack, "pnp")                              # the operator: Start offered with the robot ready
     browser.wait_for(lambda d: d.find_element(By.ID, "btn-execute").is_enabled(), "Start for the operator")
     assert browser.driver.find_element(By.ID, "btn-pause").is_enabled()
+
+
+@pytest.mark.parametrize("size", [(800, 480), (1280, 800)], ids=["800x480", "1280x800"])
+def test_the_pnp_segment_names_sit_inside_the_drawing_and_beside_their_paths(browser, stack, size):
+    """At 800x480 the boxes of "2 Pick" and "5 Place" ran off the drawing's edges, and every column's names (172 px
+    boxes centred 78 px out) covered its down and up paths."""
+    d = browser.driver
+    dw, dh = d.execute_script("return [outerWidth - innerWidth, outerHeight - innerHeight]")
+    d.set_window_size(size[0] + dw, size[1] + dh)
+    try:
+        open_page(browser, stack, "pnp")
+        browser.click("btn-preset")
+        browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset")
+        browser.wait_for(lambda d: d.execute_script(
+            "return document.getElementById('seg-1').getBBox().height > 20"), "the drawing of the preset")
+        found = d.execute_script("""
+            const svg = document.getElementById('pnp-svg'), W = svg.viewBox.baseVal.width, out = [];
+            const paths = [1, 2, 4, 5].map((i) => document.getElementById('seg-' + i).getBBox());
+            for (const g of svg.querySelectorAll('.edit')) {
+              const r = g.querySelector('rect').getBBox();
+              if (r.x < 0 || r.x + r.width > W) out.push([g.id, 'outside', r.x, r.width, W]);
+              for (const p of paths)
+                if (r.x < p.x + p.width && p.x < r.x + r.width && r.y < p.y + p.height && p.y < r.y + r.height)
+                  out.push([g.id, 'covers a path', r.x, r.width, p.x]);
+              if (g.querySelector('text').getComputedTextLength() > r.width) out.push([g.id, 'text wider than box']);
+            }
+            return out;""")
+        assert found == [], found
+        browser.screenshot(f"review_pnp_names_{size[0]}x{size[1]}")
+    finally:
+        browser.fit()

@@ -157,7 +157,8 @@ function drawPnP() {
       d = `M${x1},${y1} Q${lx},${cy} ${x2},${y2}`; ly = (y1 + y2) / 4 + cy / 2 - 14;
     } else { d = `M${x1},${y1} L${x2},${y2}`; ly += 18; }
     out += `<path class="seg" id="seg-${i}" d="${d}"/>`;
-    labels.push(`<g class="edit" id="edit-${i}" data-seg="${i}"><rect x="${lx - 86}" y="${ly - 17}" width="172" height="34"/>
+    const side = vertical ? ` data-side="${x1 < W / 2 ? -1 : 1}" data-col="${x1}"` : "";
+    labels.push(`<g class="edit" id="edit-${i}" data-seg="${i}"${side}><rect x="${lx - 86}" y="${ly - 17}" width="172" height="34"/>
       <text x="${lx}" y="${ly + 5}" text-anchor="middle">${i + 1} ${PNP_SEGMENTS[i]} ✎</text></g>`);
   }
   pts.forEach((p) => { out += `<circle class="pt" cx="${X(p)}" cy="${Y(p)}" r="3.5"/>`; });
@@ -168,6 +169,17 @@ function drawPnP() {
     <text class="axis" x="${W - 12}" y="${by - 8}" text-anchor="end">${bar} mm</text>
     <text class="axis" x="6" y="${by}">Side ${axis}→ Z↑ (mm, base frame) · grid ${step} mm</text>`;
   svg.innerHTML = out;
+  /* each name's box as wide as its text; a column's names beside the column, clear of its two paths (a 172 px box
+     centred 78 px out covered them), and every box inside the drawing (at 800x480 "2 Pick" was cut at its edge) */
+  for (const g of svg.querySelectorAll(".edit")) {
+    const text = g.querySelector("text"), rect = g.querySelector("rect");
+    const w = Math.ceil(text.getComputedTextLength()) + 24;
+    let cx = g.dataset.side ? Number(g.dataset.col) + Number(g.dataset.side) * (w / 2 + 14) : Number(text.getAttribute("x"));
+    cx = Math.min(W - w / 2 - 2, Math.max(w / 2 + 2, cx));
+    text.setAttribute("x", String(cx));
+    rect.setAttribute("x", String(cx - w / 2));
+    rect.setAttribute("width", String(w));
+  }
   svg.dataset.axes = `${axis}-Z`;
   for (const g of svg.querySelectorAll(".edit")) g.onclick = () => openSegment(Number(g.dataset.seg));
   updatePnP();
