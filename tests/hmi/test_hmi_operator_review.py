@@ -334,3 +334,19 @@ def test_the_pnp_segment_names_sit_inside_the_drawing_and_beside_their_paths(bro
         browser.screenshot(f"review_pnp_names_{size[0]}x{size[1]}")
     finally:
         browser.fit()
+
+
+def test_the_operators_jog_page_locks_what_only_the_engineer_may_use_and_says_so(browser, stack):
+    """The operator's Jog / Teach page greyed the jog and Teach keys but left the speed and the point name as
+    editable-looking fields, with "Ready." on the message line."""
+    open_page(browser, stack, "jog")
+    looks = browser.driver.execute_script("""
+        return ['jog-velocity', 'teach-name'].map((id) => { const el = document.getElementById(id);
+          return [id, el.disabled, getComputedStyle(el).borderTopStyle]; });""")
+    assert looks == [["jog-velocity", True, "dashed"], ["teach-name", True, "dashed"]], looks
+    assert browser.message().startswith("Jog and Teach are commissioning: they need the engineer address.")
+    assert browser.driver.find_element(By.ID, "btn-teach-use").is_enabled()
+    browser.screenshot("review_jog_operator")
+    open_page(browser, stack, "jog", "engineer")
+    assert browser.driver.find_element(By.ID, "jog-velocity").is_enabled()
+    assert browser.message() == "Ready."

@@ -24,6 +24,7 @@ const JOG_STYLE = `
 .jog .indicators { grid-template-columns: repeat(4, minmax(0, 1fr)); }
 .jog .teach-row { display: flex; gap: 6px; align-items: center; margin-bottom: 4px; }
 .jog .teach-row input, .jog .teach-row select { height: 34px; font-size: 14px; }
+.jog input:disabled { background: #e3e7eb; color: #44505c; border: 1px dashed #8a96a2; cursor: not-allowed; }
 .jog .points-box { max-height: 276px; overflow-y: auto; }
 .jog table.points { border-collapse: collapse; font-size: 14px; width: 100%; }
 .jog table.points td { border-bottom: 1px solid #d5dbe1; padding: 1px 4px; }
@@ -202,6 +203,11 @@ function jogPage() {
   document.getElementById("teach-index").addEventListener("change", jogShow);
   document.getElementById("btn-teach-use").addEventListener("click", teachUse);
   document.getElementById("btn-teach-use").disabled = !mayWrite("MoveAbs_Param.TargetPosition.X");
+  // jogging and teaching are commissioning (engineer): their fields are locked like the keys, and the line says why
+  document.getElementById("jog-velocity").disabled = !mayWrite("Jog_Velocity");
+  document.getElementById("teach-name").disabled = !mayWrite("Teach_Name");
+  if (ACCESS.role === "operator")
+    message("Jog and Teach are commissioning: they need the engineer address. Use as target works for the operator.");
   window.addEventListener("blur", jogRelease);
   document.addEventListener("visibilitychange", () => { if (document.hidden) jogRelease(); });
   jogAxes();
