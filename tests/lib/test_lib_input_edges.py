@@ -906,3 +906,39 @@ def test_link_lost_at_each_step_never_reports_what_the_robot_did_not_do(lib, fb,
     else:
         assert lib.read(f"{inst}.Error") and error_id in ERRORS, hex(error_id)
         assert lib.read(f"{inst}.ErrorDescrip") == ERRORS[error_id][:80]
+
+
+# ---- the Ethernet Slave channel: two FBs started close together, in a user's call order ------------------------
+SVR_FBS = {"proj": ("ProjExec", "svr_write", {"Stick_Pause": 1}),
+           "ovr": ("OvrExec", "svr_write", {"Project_Speed": 30}),
+           "wr": ("WrExec", "svr_write", {"g_n": 7}), "rd": ("RdExec", "svr_read", ["g_n"])}
+
+
+@pytest.mark.parametrize("gap", range(0, 7))
+@pytest.mark.parametrize("first,second", [(a, b) for a in SVR_FBS for b in SVR_FBS if a != b])
+def test_ethernet_slave_fbs_started_close_together_send_each_request_once(first, second, gap):
+    """tests/lib/st/Main_SvrOrder.st calls CBT_ProjectControl, CBT_SetOverride, CBT_WriteVariable, CBT_ReadVariable
+    in that order; ``second`` starts ``gap`` scans after ``first``, so at some gap its first call sees the answer
+    to ``first``'s request before ``first`` took it. Each request reaches the robot exactly once and both FBs end
+    Done (before: CBT_ProjectControl, and CBT_SetOverride in its edge scan, took the channel over an answer its
+    owner had not taken yet, and the owner sent its request a second time)."""
+    r = Rig(program="Main_SvrOrder.st", svr_port=0,
+            svr_options={"variables": [table.parse_variable("g_n:int=0")]})
+    try:
+        assert r.until(lambda: r.read("status.Valid"), 1)
+        r.write("ProjCmd", "ProjectPause")
+        r.write("OvrValue", 30)
+        set_variable(r, "WrVar", "g_n", "VarInt", 1, "IntValue", [7])
+        set_variable(r, "RdVar", "g_n", "VarInt", 1)
+        before = len(r.robot.events)
+        r.write(SVR_FBS[first][0], True)
+        r.scans(gap)
+        r.write(SVR_FBS[second][0], True)
+        assert r.until(lambda: all(r.read(f"{fb}.Done") or r.read(f"{fb}.Error") for fb in (first, second)), 10)
+        assert r.read(f"{first}.Done") and r.read(f"{second}.Done"), \
+            [r.read(f"{fb}.ErrorDescrip") for fb in (first, second)]
+        requests = [(e["kind"], e["items"]) for e in r.robot.events[before:] if e["kind"] in ("svr_write", "svr_read")]
+        expected = [SVR_FBS[fb][1:] for fb in (first, second)]
+        assert sorted(map(repr, requests)) == sorted(map(repr, expected)), requests
+    finally:
+        r.close()
