@@ -942,3 +942,56 @@ def test_ethernet_slave_fbs_started_close_together_send_each_request_once(first,
         assert sorted(map(repr, requests)) == sorted(map(repr, expected)), requests
     finally:
         r.close()
+
+
+SVR_STEPS = ["before_the_edge", "in_the_edge_scan", "request_unanswered", "after_done"]
+
+
+@pytest.mark.parametrize("step", SVR_STEPS)
+@pytest.mark.parametrize("fb", ["proj", "ovr", "wr", "rd"])
+def test_ethernet_slave_link_lost_at_each_step(fb, step):
+    """The Ethernet Slave link lost around one request: at most one request reaches the robot, the FB ends, Done
+    only when the robot answered it (a write: the robot's value changed), else a documented ErrorID and its text;
+    nothing is sent again once the link is back."""
+    r = Rig(program="Main_SvrOrder.st", svr_port=0, svr_options={"variables": [table.parse_variable("g_n:int=0")]})
+    try:
+        assert r.until(lambda: r.read("status.Valid"), 1)
+        r.write("ProjCmd", "ProjectPause")
+        r.write("OvrValue", 30)
+        set_variable(r, "WrVar", "g_n", "VarInt", 1, "IntValue", [7])
+        set_variable(r, "RdVar", "g_n", "VarInt", 1)
+        execute, kind, items = SVR_FBS[fb]
+        before = len(r.robot.events)
+        if step == "before_the_edge":                                  # a silent Ethernet Slave: link down
+            r.robot.svr.inject("stall")
+            assert r.until(lambda: not r.read("Cobot.Status.SlaveLink"), 3)
+        if step == "request_unanswered":
+            r.robot.svr.inject("stall")
+        r.write(execute, True)
+        if step == "in_the_edge_scan":
+            r.robot.svr.inject("disconnect")
+        r.scans(1)
+        if step == "request_unanswered":
+            r.scans(50)
+            r.robot.svr.inject("disconnect")
+            r.robot.svr.clear_faults()
+        if step == "after_done":
+            assert r.until(lambda: r.read(f"{fb}.Done"), 10)
+            r.robot.svr.inject("disconnect")
+        assert r.until(lambda: not r.read(f"{fb}.Busy"), 10), f"{fb} still Busy"
+        done, error_id = r.read(f"{fb}.Done"), r.read(f"{fb}.ErrorID")
+        r.until(lambda: False, 3)                                      # the link comes back; nothing is resent
+        requests = [(e["kind"], e["items"]) for e in r.robot.events[before:] if e["kind"] in ("svr_write", "svr_read")]
+        assert len(requests) <= 1, requests
+        if step == "before_the_edge":                                  # refused in the edge scan, not sent
+            assert requests == [] and not done and error_id in (0x2011, 0x2020, 0x2021), hex(error_id)
+            assert r.read("Cobot.SvrCmdState") != "SvrCmdSent"
+        if done:
+            assert requests == [(kind, items)]
+            if fb == "wr":
+                assert r.robot.svr.variables["g_n"] == 7
+        else:
+            assert r.read(f"{fb}.Error") and error_id in ERRORS
+            assert r.read(f"{fb}.ErrorDescrip") == ERRORS[error_id][:80]
+    finally:
+        r.close()
