@@ -995,3 +995,50 @@ def test_ethernet_slave_link_lost_at_each_step(fb, step):
             assert r.read(f"{fb}.ErrorDescrip") == ERRORS[error_id][:80]
     finally:
         r.close()
+
+
+# ---- the whole script of the options: arm configuration, Aborting, ExitNode, InstantDO ---------------------------
+CPP_TARGET = dict(X=417.5, Y=-122.3, Z=359.7, RX=180, RY=0, RZ=90)
+
+
+@pytest.mark.parametrize("pose,text", [(("Righty", "Above", "NoFlip"), "0,2,4"), (("Lefty", "Below", "Flip"), "1,3,5"),
+                                       (("Lefty", "Above", "Flip"), "1,2,5"), (("Righty", "Below", "NoFlip"), "0,3,4")])
+def test_move_absolute_arm_configuration_is_the_three_pose_integers(lib, pose, text):
+    """TMscript 2.24 §13.8 PTP Syntax 2: Config1 0/1, Config2 2/3, Config3 4/5 after the precise-positioning flag."""
+    values = move_abs(DataFormat="CPP_Abs", TargetPosition=CPP_TARGET, RobotPoseEnable=True,
+                      RobotPose=dict(Pose1=pose[0], Pose2=pose[1], Pose3=pose[2]))
+    lib.set_struct("MoveParam", values)
+    res = command(lib, "mover", "MoveExec")
+    assert res.scripts and res.scripts[0].split("\r\n")[0] == abs_call(values)[:-1] + f",{text})", res.scripts
+
+
+@pytest.mark.parametrize("fb,param,values,tail", [
+    ("mover", "MoveParam", move_abs(ExitNode=True), "QueueTag(1)\r\nScriptExit()"),
+    ("rel", "RelParam", rel(ExitNode=True, BlendingEnable=True, BlendingValue=50), "ScriptExit()"),
+    ("circ", "CircParam", circ(ExitNode=True), "QueueTag(1)\r\nScriptExit()")])
+def test_exit_node_is_the_last_line_after_the_queue_tag(lib, fb, param, values, tail):
+    lib.set_struct(param, values)
+    res = command(lib, fb, {"mover": "MoveExec", "rel": "RelExec", "circ": "CircExec"}[fb])
+    assert len(res.scripts) == 1 and res.scripts[0].split("\r\n", 1)[1] == tail, res.scripts
+
+
+@pytest.mark.parametrize("fb,param,values,call", [
+    ("mover", "MoveParam", move_abs(), abs_call(move_abs())),
+    ("rel", "RelParam", rel(), rel_call(rel())),
+    ("circ", "CircParam", circ(), circle_call(circ()))])
+def test_aborting_is_one_script_stop_and_clear_then_the_motion(lib, fb, param, values, call):
+    """TMscript 2.24 §13.4: StopAndClearBuffer() first, in the same script, so nothing runs in between."""
+    lib.set_struct(param, values)
+    lib.write(f"{fb}.BufferMode", "Aborting")
+    res = command(lib, fb, {"mover": "MoveExec", "rel": "RelExec", "circ": "CircExec"}[fb])
+    assert len(res.scripts) == 1 and res.scripts[0].split("\r\n")[:2] == ["StopAndClearBuffer()", call], res.scripts
+    assert res.done
+
+
+@pytest.mark.parametrize("immediate,value,text", [(True, True, 'IO["ControlBox"].InstantDO[15]=1'),
+                                                  (True, False, 'IO["ControlBox"].InstantDO[15]=0'),
+                                                  (False, False, 'IO["ControlBox"].DO[15]=0')])
+def test_set_output_immediate_and_value(lib, immediate, value, text):
+    lib.set_struct("OutParam", dict(Module="ControlBox", Channel=15, Value=value, Immediate=immediate))
+    res = command(lib, "dout", "OutExec")
+    assert res.done and res.scripts == [text], res.scripts
