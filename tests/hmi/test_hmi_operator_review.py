@@ -350,3 +350,48 @@ def test_the_operators_jog_page_locks_what_only_the_engineer_may_use_and_says_so
     open_page(browser, stack, "jog", "engineer")
     assert browser.driver.find_element(By.ID, "jog-velocity").is_enabled()
     assert browser.message() == "Ready."
+
+
+UNDER_THE_MESSAGE = """
+    const top = document.getElementById('message').getBoundingClientRect().top, out = [];
+    for (const el of document.querySelectorAll('main *')) {
+      if (!el.getClientRects().length || el.children.length) continue;
+      const r = el.getBoundingClientRect();
+      let bottom = r.bottom, visibleTop = r.top;
+      for (let a = el.parentElement; a && a !== document.body; a = a.parentElement) {
+        const s = getComputedStyle(a);
+        if (s.overflowY !== 'visible') {
+          const box = a.getBoundingClientRect();
+          bottom = Math.min(bottom, box.bottom); visibleTop = Math.max(visibleTop, box.top);
+        }
+      }
+      if (bottom > top + 1 && bottom > visibleTop) out.push([el.id || el.className || el.tagName,
+        (el.textContent || '').trim().slice(0, 30), Math.round(bottom), Math.round(top)]);
+    }
+    return out;"""
+
+
+@pytest.mark.parametrize("page", ["index", "moverel", "moveabs", "connect", "stop", "pnp"])
+def test_a_long_answer_on_the_message_line_never_covers_the_page(browser, stack, page):
+    """With an alarm in the banner, a four-line answer (the operator's refused move) pushed the page under the message
+    line: the robot view's foot and zoom keys on the motion pages, Main's views gone to a strip. The line now takes
+    at most three lines (a longer answer scrolls in it), the settings and Main's alarm list give up room first."""
+    open_page(browser, stack, page)
+    stack.set(RS_EStop=True)
+    try:
+        browser.wait_for(lambda d: "Emergency stop pressed" in browser.banner(), "an alarm in the banner")
+        browser.driver.execute_script(
+            "message('Move Relative: Exit Listen Node is ticked for this command (MoveRel_Param.ExitNode, an "
+            "engineering setting (it would make the robot leave its Listen node)): the operator may not send it; ask "
+            "the engineer to clear it. Nothing was sent. ' + 'A fourth line of text for the panel. '.repeat(3), "
+            "'error')")
+        browser.wait_for(lambda d: d.execute_script(UNDER_THE_MESSAGE) == [],
+                         f"nothing under the message line: {browser.driver.execute_script(UNDER_THE_MESSAGE)}",
+                         timeout=3)
+        if page == "index":
+            views = browser.driver.execute_script(
+                "return document.getElementById('view-top').getBoundingClientRect().height")
+            assert views >= 50, views
+        browser.screenshot(f"review_long_message_{page}")
+    finally:
+        stack.set(RS_EStop=False)
