@@ -122,6 +122,33 @@ def test_a_consequence_lasting_after_its_cause_raises_no_alarm_until_it_has_clea
     assert listed(step(plant, times=int(ON_DELAY_S / 0.1) + 2)) == [("link", "active-unacknowledged")]
 
 
+def test_the_robot_error_an_e_stop_leaves_becomes_its_own_alarm_once_the_e_stop_is_released(plant):
+    """Driving the demo: the E-stop released, its alarm returned and was acknowledged, and the list was empty while
+    the robot error it left (and the stopped project) stood until Play: a condition that waits for the operator
+    with no alarm. It is an alarm of its own now, back to normal after Play; the E-stop stays one alarm while it is
+    pressed, and the link reconnecting after Play still raises none (it clears by itself)."""
+    plc, system, _ = plant
+    plc.vars["RobotStatus"]["EStop"] = True
+    step(plant)
+    plc.vars["RobotStatus"].update(RobotError=True, ErrorCode=0x20001, ErrorText="emergency stop pressed",
+                                   ProjectRunning=False, ProjectStopped=True)
+    plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_ErrorID=0x4006)
+    assert listed(step(plant, times=int(2 * ON_DELAY_S / 0.1) + 2)) == [("estop", "active-unacknowledged")]
+    plc.vars["RobotStatus"]["EStop"] = False
+    step(plant)
+    system.acknowledge(None, "operator")
+    summary = step(plant, times=int(2 * ON_DELAY_S / 0.1) + 2)
+    assert listed(summary) == [("robot", "active-unacknowledged")], listed(summary)
+    assert summary["alarms"][0]["text"] == "Robot error 16#00020001: emergency stop pressed"
+    assert "press Play on the Main screen" in summary["alarms"][0]["remedy"]
+    plc.vars["RobotStatus"].update(RobotError=False, ErrorCode=0, ErrorText="", ProjectRunning=True,
+                                   ProjectStopped=False)                          # Play
+    system.acknowledge(None, "operator")
+    assert step(plant, times=int(2 * ON_DELAY_S / 0.1) + 2)["alarms"] == []      # the link still reconnects
+    plc.vars.update(Connect_Connected=True, Connect_Reconnecting=False, Connect_ErrorID=0)
+    assert step(plant)["alarms"] == []
+
+
 def test_a_consequence_seen_before_its_cause_waits_for_it(plant):
     """The motion's 16#4006 reaches the PLC a sample before the Ethernet Slave shows the robot error: the on-delay
     lets the robot error take it as a detail instead of raising two alarms."""

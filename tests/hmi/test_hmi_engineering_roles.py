@@ -64,7 +64,8 @@ def test_the_variable_table_names_exit_listen_node_an_engineering_member(mapping
     assert mapping.leaves["MoveAbs_Param.Speed"].role == "operator"
 
 
-@pytest.mark.parametrize("execute, setting", [("MoveRel_Execute", "MoveRel_Param"), ("MoveAbs_Execute", "MoveAbs_Param"),
+@pytest.mark.parametrize("execute, setting", [("MoveRel_Execute", "MoveRel_Param"),
+                                              ("MoveAbs_Execute", "MoveAbs_Param"),
                                               ("MoveCircle_Execute", "MoveCircle_Param")])
 def test_exit_listen_node_left_ticked_by_the_engineer_does_not_go_with_the_operators_execute(
         fake_plc, operator, client, execute, setting):

@@ -5,9 +5,10 @@ turns what it reads into alarms:
 
 * one alarm per cause, ranked: PLC fault or stalled, E-stop, robot error, robot project stopped, robot outside
   its Listen node, link to the robot lost, a command that failed. A condition that comes while a higher-ranked
-  alarm is active is a consequence: it becomes a detail of that alarm, not an alarm of its own, also while it
-  lasts after its cause has gone (the link reconnecting after Play); it can raise an alarm again only after it
-  has cleared. Consequences wait
+  alarm is active is a consequence: it becomes a detail of that alarm, not an alarm of its own. One that lasts
+  after its cause has gone stays a detail if it clears by itself (the link reconnecting after Play: it can raise
+  an alarm again only after it has cleared); one that waits for the operator (the robot error an E-stop leaves
+  until Play) becomes an alarm of its own once no higher-ranked cause is active. Consequences wait
   ON_DELAY_S before they are raised (ISA-18.2 on-delay), so a cause seen a moment later still takes them; the
   first alarm of an episode (raised while no other alarm is listed) is marked first-out.
 * states: active-unacknowledged, active-acknowledged, returned-unacknowledged, normal (acknowledged and gone:
@@ -61,6 +62,7 @@ CAUSES = {
     "listen": (4, 2, "Robot", "The robot left the Listen node: commands from the PLC are refused", None),  # 16#4002
     "link": (5, 2, "Connection", "{lost}{attempt}{reason}", None),                     # remedy: its ErrorID
 }
+CLEARS_BY_ITSELF = {"link"}          # CBT_Connect reconnects by itself; the other causes wait for the operator
 COMMAND_RANK, COMMAND_PRIORITY = 6, 3
 REMEDY_IDS = {"robot": 0x4006, "project": 0x4007, "listen": 0x4002}
 
@@ -386,8 +388,14 @@ class AlarmSystem:
                     held.text, held.error_id, held.remedy = c["text"], c["error_id"], c["remedy"]
                     self.seq += 1
                 continue
-            if key in self._absorbed:                     # a cause's consequence lasting beyond it (the link
-                continue                                  # reconnecting after Play): still no alarm of its own
+            if key in self._absorbed:
+                # a consequence lasting beyond its cause: the link reconnecting after Play clears by itself and
+                # gets no alarm of its own; a robot error, a stopped project or the robot outside its node stays
+                # until the operator acts (Play once the E-stop is released), so when no higher-ranked cause is
+                # active any more it is an alarm of its own, not a condition left without one
+                if key in CLEARS_BY_ITSELF or self._top(c["rank"]) is not None:
+                    continue
+                self._absorbed.discard(key)
             top = self._top(c["rank"])
             if top is not None:                           # a consequence of an active cause
                 shown = f"{c['source']} {id_text(c['error_id'])}" if c["error_id"] else c["source"]
