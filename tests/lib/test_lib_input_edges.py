@@ -1042,3 +1042,39 @@ def test_set_output_immediate_and_value(lib, immediate, value, text):
     lib.set_struct("OutParam", dict(Module="ControlBox", Channel=15, Value=value, Immediate=immediate))
     res = command(lib, "dout", "OutExec")
     assert res.done and res.scripts == [text], res.scripts
+
+
+# ---- CBT_Teach: the entry selected at the edge, also when the selection changes while Busy ------------------------
+@pytest.mark.parametrize("svr", [False, True], ids=["listen_node", "ethernet_slave"])
+def test_teach_page_example_stores_into_the_entry_selected_at_the_edge(svr, tmp_path):
+    """CBT_Teach.md's example holds the index while Busy: the operator selecting entry 2 in the scan after pressing
+    Teach on entry 1 leaves entry 2 untouched (Point is an in-out, written in the scan the reading arrives; the
+    plain TeachTable[TeachIndex] wrote the position into entry 2)."""
+    from doc_steps import example_of, on_simulator, simulator
+
+    from vplc.api import load_plc
+    code, _ = example_of("CBT_Teach")
+    if svr:
+        code = code.replace("Time_Out := 30);", "Time_Out := 30, SvrPort := SVRPORT);")
+    srv = simulator() if not svr else None
+    if svr:
+        from tmsim.net.server import SimServer
+        srv = SimServer(host="127.0.0.1", port=0, auto_enter=True, svr_port=0)
+    srv.start()
+    try:
+        source = tmp_path / "teach_example.st"
+        source.write_text(on_simulator(code, srv).replace("SVRPORT", str(srv.robots[0].svr_port)), encoding="utf-8")
+        plc = load_plc([str(ROOT / "lib" / "CBT_Commands_Lib"), str(source)], task="Main@1ms")
+        pump = lambda now_ns: srv.poll(now_ns / 1e9)  # noqa: E731
+        assert plc.run_until(lambda: plc.read("Teach_Example.fbConnect.Connected"), 5_000_000_000, on_scan=pump)
+        plc.write("Teach_Example.TeachIndex", 1)
+        plc.write("Teach_Example.TeachButton", True)
+        plc.scan(plc.now_ns + plc.period_ns)
+        assert plc.read("Teach_Example.fbTeach.Busy") or plc.read("Teach_Example.fbTeach.Done")
+        plc.write("Teach_Example.TeachIndex", 2)
+        assert plc.run_until(lambda: plc.read("Teach_Example.fbTeach.Done"), 2_000_000_000, on_scan=pump)
+        assert plc.read("Teach_Example.TeachTable[1].Taught") and plc.read("Teach_Example.TeachTable[1].Name") == "Pick"
+        assert not plc.read("Teach_Example.TeachTable[2].Taught") and plc.read("Teach_Example.TeachTable[2].Name") == ""
+        plc.close()
+    finally:
+        srv.close()
