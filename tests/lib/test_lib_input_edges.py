@@ -1078,3 +1078,63 @@ def test_teach_page_example_stores_into_the_entry_selected_at_the_edge(svr, tmp_
         plc.close()
     finally:
         srv.close()
+
+
+# ---- Execute re-raised while Busy: one command per accepted edge, each reaching the robot once -----------------
+def reraise(rig, execute: str, busy: str, scans_after: int) -> None:
+    rig.write(execute, True)
+    assert rig.until(lambda: rig.read(busy), 1)
+    rig.scans(scans_after)
+    rig.write(execute, False)
+    rig.scans(1)
+    assert rig.read(busy), "ended before the second edge: not a re-raise while Busy"
+    rig.write(execute, True)
+
+
+@pytest.mark.parametrize("after", [0, 5, 60])
+def test_vision_job_re_raised_while_busy_runs_the_job_once_per_edge(vis, after):
+    """R5 (the command core): the second edge replaces the first, which the robot still runs; Done is the second's."""
+    vis.set_struct("VisParam", dict(JobName="job1", Mode="VisionAtPosition", Speed=100, AccelTime=200,
+                                    ObjectVariable="job1_Base_TM", ObjectIndex=0))
+    reraise(vis, "VisExec", "vis.Busy", after)
+    assert vis.until(lambda: vis.read("vis.Done") or vis.read("vis.Error"), 5)
+    assert vis.read("vis.Done") and vis.read("vis.Found"), vis.read("vis.ErrorDescrip")
+    vis.write("VisExec", False)
+    vis.scans(2000)
+    assert sum("Vision_DoJob" in s for s in script_frames(vis)) == 2
+
+
+@pytest.mark.parametrize("fb,after,requests", [("ovr", 0, 1), ("ovr", 3, 1), ("rd", 0, 1), ("wr", 0, 1),
+                                               ("proj", 0, 2), ("proj", 3, 2)])
+def test_ethernet_slave_fb_re_raised_while_busy(fb, after, requests):
+    """CBT_SetOverride, CBT_ReadVariable and CBT_WriteVariable ignore an edge while Busy (the request under way
+    ends first: one request); CBT_ProjectControl takes it as a new command (R5: two requests, each once)."""
+    r = Rig(program="Main_SvrOrder.st", svr_port=0, svr_options={"variables": [table.parse_variable("g_n:int=0")]})
+    try:
+        assert r.until(lambda: r.read("status.Valid"), 1)
+        r.write("ProjCmd", "ProjectPause")
+        r.write("OvrValue", 30)
+        set_variable(r, "WrVar", "g_n", "VarInt", 1, "IntValue", [7])
+        set_variable(r, "RdVar", "g_n", "VarInt", 1)
+        before = len(r.robot.events)
+        reraise(r, SVR_FBS[fb][0], f"{fb}.Busy", after)
+        assert r.until(lambda: r.read(f"{fb}.Done") or r.read(f"{fb}.Error"), 10)
+        assert r.read(f"{fb}.Done"), r.read(f"{fb}.ErrorDescrip")
+        r.write(SVR_FBS[fb][0], False)
+        r.until(lambda: False, 2)
+        sent = [e for e in r.robot.events[before:] if e["kind"] in ("svr_write", "svr_read")]
+        assert len(sent) == requests, sent
+    finally:
+        r.close()
+
+
+def test_stop_re_raised_while_busy_sends_one_stop_per_edge_and_releases_stopping(lib):
+    lib.write("StopParam.Mode", "StopNormal")
+    lib.robot.inject("reply_delay", seconds=0.2, count=1)
+    reraise(lib, "StopExec", "stop.Busy", 2)
+    assert lib.until(lambda: lib.read("stop.Done") or lib.read("stop.Error"), 3)
+    assert lib.read("stop.Done") and lib.read("Cobot.Stopping")
+    lib.write("StopExec", False)
+    lib.scans(300)
+    assert script_frames(lib) == ["StopAndClearBuffer()", "StopAndClearBuffer()"]
+    assert not lib.read("Cobot.Stopping") and lib.read("Cobot.StopHolders") == 0
