@@ -1138,3 +1138,26 @@ def test_stop_re_raised_while_busy_sends_one_stop_per_edge_and_releases_stopping
     lib.scans(300)
     assert script_frames(lib) == ["StopAndClearBuffer()", "StopAndClearBuffer()"]
     assert not lib.read("Cobot.Stopping") and lib.read("Cobot.StopHolders") == 0
+
+
+@pytest.mark.parametrize("path,value", [("JogAxis", 1), ("JogFrame", "JogTool"), ("JogVelocity", 100),
+                                        ("JogAxis", 0), ("JogVelocity", 0)])
+def test_jog_inputs_changed_while_held_are_not_taken(path, value):
+    """Frame, Axis and Velocity are taken at the press: changed while the button is held (even to an invalid
+    value) the robot keeps getting the pressed axis's increments, and nothing else."""
+    r = Rig(program="Main_Jog.st")
+    try:
+        r.write("JogFrame", "JogBase")
+        r.write("JogAxis", 3)
+        r.write("JogVelocity", 10)
+        r.write("JogFwd", True)
+        assert r.until(lambda: r.read("jog.Active"), 1)
+        pressed = script_frames(r)[-1].split("\r\n")[0]
+        before = len(script_frames(r))
+        r.write(path, value, raw=path == "JogFrame" and isinstance(value, int))
+        r.scans(400)
+        later = [s.split("\r\n")[0] for s in script_frames(r)[before:]]
+        assert later and set(later) == {pressed}, later
+        assert r.read("jog.Active") and not r.read("jog.Error")
+    finally:
+        r.close()
