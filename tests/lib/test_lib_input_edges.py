@@ -1161,3 +1161,16 @@ def test_jog_inputs_changed_while_held_are_not_taken(path, value):
         assert r.read("jog.Active") and not r.read("jog.Error")
     finally:
         r.close()
+
+
+@pytest.mark.parametrize("hold", [True, False], ids=["held", "pulsed"])
+def test_wait_queue_sends_one_tag_and_is_done_only_after_the_queued_motion(cell, hold):
+    """CBT_WaitQueue (an empty script with a queue tag, TMscript 2.24 §15.3 QueueTag): one frame per edge, Done
+    when the robot reached the tag, so after the motion queued before it finished."""
+    cell.set_struct("MoveParam", move_abs(**SLOW))
+    cell.write("MoveExec", True)
+    assert cell.until(lambda: cell.read("mover.Active"), 1)
+    before = len(script_frames(cell))
+    res = command(cell, "wait", "WaitExec", seconds=10, hold=hold)
+    assert res.done and res.motion_ends == 1, res
+    assert len(script_frames(cell)) - before == 1 and script_frames(cell)[-1].startswith("QueueTag(")
