@@ -1174,3 +1174,46 @@ def test_wait_queue_sends_one_tag_and_is_done_only_after_the_queued_motion(cell,
     res = command(cell, "wait", "WaitExec", seconds=10, hold=hold)
     assert res.done and res.motion_ends == 1, res
     assert len(script_frames(cell)) - before == 1 and script_frames(cell)[-1].startswith("QueueTag(")
+
+
+@pytest.mark.parametrize("fb", ["proj", "ovr", "wr", "rd"])
+def test_ethernet_slave_fb_pulsed_for_one_scan_shows_done_for_one_scan(fb):
+    r = Rig(program="Main_SvrOrder.st", svr_port=0, svr_options={"variables": [table.parse_variable("g_n:int=0")]})
+    try:
+        assert r.until(lambda: r.read("status.Valid"), 1)
+        r.write("ProjCmd", "ProjectPause")
+        r.write("OvrValue", 30)
+        set_variable(r, "WrVar", "g_n", "VarInt", 1, "IntValue", [7])
+        set_variable(r, "RdVar", "g_n", "VarInt", 1)
+        before = len(r.robot.events)
+        execute = SVR_FBS[fb][0]
+        rows = []
+        for n in range(2500):
+            r.write(execute, n == 0)
+            r.scans(1)
+            rows.append((r.read(f"{fb}.Done"), r.read(f"{fb}.Busy"), r.read(f"{fb}.Error")))
+        assert [d for d, _, _ in rows].count(True) == 1 and not any(e for _, _, e in rows), rows[:5]
+        done_at = [d for d, _, _ in rows].index(True)
+        assert all(b for _, b, _ in rows[:done_at]) and not any(b for _, b, _ in rows[done_at:])
+        sent = [e for e in r.robot.events[before:] if e["kind"] in ("svr_write", "svr_read")]
+        assert len(sent) == 1, sent
+    finally:
+        r.close()
+
+
+def test_vision_job_and_teach_pulsed_for_one_scan_show_done_for_one_scan(vis):
+    vis.set_struct("VisParam", dict(JobName="job1", Mode="VisionAtPosition", Speed=100, AccelTime=200,
+                                    ObjectVariable="job1_Base_TM", ObjectIndex=0))
+    rows = trace(vis, "vis", 1500, on_scan=lambda n: vis.write("VisExec", n == 0))
+    assert [r["Done"] for r in rows].count(True) == 1 and not any(r["Error"] for r in rows)
+    assert sum("Vision_DoJob" in s for s in script_frames(vis)) == 1
+    r = Rig(program="Main_Jog.st")
+    try:
+        done = []
+        for n in range(300):
+            r.write("TeachExec", n == 0)
+            r.scans(1)
+            done.append(r.read("teach.Done"))
+        assert done.count(True) == 1 and r.read("Table[1].Taught")
+    finally:
+        r.close()
