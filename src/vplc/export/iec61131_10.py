@@ -298,8 +298,18 @@ def _external_vars(el: ET.Element, item: PouItem, external: list) -> None:
                 _variable(lst, "Variable", d, "", plain=True)
 
 
-def used_globals(item: PouItem) -> list:
-    """(declaration, constant) of every global the POU's body names without a VAR_EXTERNAL, first use first."""
+def system_globals(project: Project) -> frozenset[int]:
+    """Identities of the system-defined variables' declarations (the prelude's global lists: P_On, _CurrentTime,
+    _MC_AX, ...). A POU uses them without an external variable (W501, system-defined variables; vplc's ST1009
+    exempts them too), so the export never writes them into ExternalVars: Sysmac Studio declares them itself."""
+    return frozenset(id(d) for unit in project.units if getattr(unit, "in_prelude", False)
+                     for item in unit.items if isinstance(item, A.GlobalVarList)
+                     for s in item.sections for d in s.vars)
+
+
+def used_globals(item: PouItem, system: frozenset[int] = frozenset()) -> list:
+    """(declaration, constant) of every user global the POU's body names without a VAR_EXTERNAL, first use first;
+    ``system``: the declarations of the system-defined variables (:func:`system_globals`), which are left out."""
     declared = {d.name.upper() for s in item.pou.sections for d in s.vars}
     seen: dict[str, tuple] = {}
     for node in (n for stmt in item.pou.body for n in A.walk(stmt)):
@@ -307,7 +317,7 @@ def used_globals(item: PouItem) -> list:
         if sym is None or getattr(sym, "section", None) != "VAR_GLOBAL" or sym.decl is None:
             continue
         key = sym.name.upper()
-        if key not in declared and key not in seen:
+        if key not in declared and key not in seen and id(sym.decl) not in system:
             seen[key] = (sym.decl, bool(sym.constant))
     return list(seen.values())
 
@@ -356,9 +366,11 @@ def build(export: ExportSet, project: Project, *, flat: bool = False,
             _namespace_decl(containers, ns)
     for t in export.types:
         _data_type(containers[None if flat else t.namespace], t, project)
+    system = system_globals(project)
     for p in export.pous:                           # NamespaceDecl holds no Program in the schema
         where = None if flat or p.kind == "PROGRAM" else p.namespace
-        _pou(containers[where], p, used_globals(p), using=p.namespace if not flat and where != p.namespace else None)
+        using = p.namespace if not flat and where != p.namespace else None
+        _pou(containers[where], p, used_globals(p, system), using=using)
     instances = _sub(root, "Instances")
     if export.globals:
         _globals(instances, export)

@@ -1,0 +1,61 @@
+"""Defects the wide export probe found (issue 24: every clean ST/XML program of the repository and the constructs
+of the issue's list exported, validated against Omron's schemas and loaded back), each pinned with a minimal source
+of our own. The probe itself runs permanently as tests/vplc/export/test_export_round_trip.py."""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from tests.vplc.export.conftest import q, run
+from vplc.api import load_plc
+
+SYSTEM_VARIABLES = """PROGRAM Main
+VAR_EXTERNAL
+    gCount : INT;
+END_VAR
+VAR
+    First : BOOL;
+    Seen : UDINT;
+END_VAR
+First := P_First_Run;
+IF P_On THEN
+    Seen := Seen + 1;
+END_IF;
+gCount := gCount + 1;
+END_PROGRAM
+VAR_GLOBAL
+    gCount : INT;
+END_VAR
+"""
+
+
+def test_system_defined_variables_are_not_written_as_external_variables(tmp_path, capsys):
+    # W501, system-defined variables: a POU reads P_On, P_First_Run, _MC_AX ... without an external variable
+    # (vplc's ST1009 exempts them too); before, the export declared each in ExternalVars with the prelude's type
+    src = tmp_path / "Main.st"
+    src.write_text(SYSTEM_VARIABLES, encoding="utf-8")
+    out = tmp_path / "main.xml"
+    code, _, err = run(capsys, "export", str(src), "-o", str(out))
+    assert code == 0, err
+    program = ET.parse(out).getroot().find(f"{q('Types')}/{q('GlobalNamespace')}/{q('Program')}")
+    externals = [v.get("name") for lst in program.findall(q("ExternalVars")) for v in lst.findall(q("Variable"))]
+    assert externals == ["gCount"]
+    code, _, err = run(capsys, "check", str(out))
+    assert code == 0 and "warning" not in err, err
+    plc = load_plc([str(out)])
+    try:
+        for n in range(3):
+            plc.scan(n * plc.period_ns)
+        assert (plc.read("Main.Seen"), plc.read("Main.First"), plc.read("Main.gCount")) == (3, False, 3)
+    finally:
+        plc.close()
+
+
+def test_a_user_global_used_without_var_external_is_still_declared_iec_dialect(tmp_path, capsys):
+    src = tmp_path / "Main.st"
+    src.write_text(SYSTEM_VARIABLES.replace("VAR_EXTERNAL\n    gCount : INT;\nEND_VAR\n", ""), encoding="utf-8")
+    out = tmp_path / "main.xml"
+    code, _, err = run(capsys, "export", str(src), "--dialect", "iec", "-o", str(out))
+    assert code == 0, err
+    program = ET.parse(out).getroot().find(f"{q('Types')}/{q('GlobalNamespace')}/{q('Program')}")
+    externals = [v.get("name") for lst in program.findall(q("ExternalVars")) for v in lst.findall(q("Variable"))]
+    assert externals == ["gCount"]
