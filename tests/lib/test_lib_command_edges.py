@@ -508,3 +508,28 @@ def test_vision_job_and_teach_pulsed_for_one_scan_show_done_for_one_scan(vis):
         assert done.count(True) == 1 and r.read("Table[1].Taught")
     finally:
         r.close()
+
+
+@pytest.mark.parametrize("frames", [1, 2, 3])
+@pytest.mark.parametrize("extra", [0, 1, 2])
+def test_vision_job_link_lost_at_each_of_its_three_requests(vis, frames, extra):
+    """The link lost after the job's script, the object count's or the object's request reached the robot (and
+    0..2 scans later): Done with Found only when all three were answered, else a documented ErrorID; nothing is
+    sent again when CBT_Connect has reconnected."""
+    vis.set_struct("VisParam", dict(JobName="job1", Mode="VisionAtPosition", Speed=100, AccelTime=200,
+                                    ObjectVariable="job1_Base_TM", ObjectIndex=0))
+    vis.write("VisExec", True)
+    assert vis.until(lambda: len(script_frames(vis)) >= frames, 3)
+    vis.scans(extra)
+    vis.robot.inject("disconnect")
+    assert vis.until(lambda: not vis.read("vis.Busy"), 12)
+    done, error_id = vis.read("vis.Done"), vis.read("vis.ErrorID")
+    sent = len(script_frames(vis))
+    vis.until(lambda: False, 3)
+    assert len(script_frames(vis)) == sent <= 3
+    assert sum("Vision_DoJob" in s for s in script_frames(vis)) == 1
+    if done:
+        assert sent == 3 and vis.read("vis.Found")
+    else:
+        assert vis.read("vis.Error") and vis.read("vis.ErrorDescrip") == ERRORS[error_id][:80], hex(error_id)
+        assert not vis.read("vis.Found")
