@@ -533,3 +533,26 @@ def test_vision_job_link_lost_at_each_of_its_three_requests(vis, frames, extra):
     else:
         assert vis.read("vis.Error") and vis.read("vis.ErrorDescrip") == ERRORS[error_id][:80], hex(error_id)
         assert not vis.read("vis.Found")
+
+
+@pytest.mark.parametrize("lose_after_ms", [0, 300, 2500])
+def test_set_output_wait_until_set_behind_a_motion_with_the_link_lost(lib, lose_after_ms):
+    """A queued output with WaitUntilSet waits for its queue tag: the link lost while the motion before it runs
+    ends it with a documented ErrorID unless the robot had set the output (its io event); sent once."""
+    lib.set_struct("MoveParam", move_abs(**SLOW))
+    lib.write("MoveExec", True)
+    lib.scans(2)
+    lib.set_struct("OutParam", dict(Module="EndModule", Channel=1, Value=True, WaitUntilSet=True))
+    lib.write("OutExec", True)
+    assert lib.until(lambda: len(script_frames(lib)) == 2, 1)
+    lib.until(lambda: False, lose_after_ms / 1000)
+    lib.robot.inject("disconnect")
+    assert lib.until(lambda: not lib.read("dout.Busy"), 12)
+    done, error_id = lib.read("dout.Done"), lib.read("dout.ErrorID")
+    set_by_robot = len(lib.events("io")) == 1
+    assert not done or set_by_robot, "Done without the robot setting the output"
+    assert done or lib.read("dout.Error")
+    if not done:
+        assert lib.read("dout.ErrorDescrip") == ERRORS[error_id][:80], hex(error_id)
+    lib.until(lambda: False, 3)
+    assert [s for s in script_frames(lib) if "DO[1]" in s] == ['IO["EndModule"].DO[1]=1\r\nQueueTag(2)']
