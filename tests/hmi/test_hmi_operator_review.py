@@ -290,7 +290,9 @@ def test_the_monitor_address_offers_no_pnp_key_and_reads_the_segment_names(brows
     """The read-only monitor saw Preset Values, Pause and Resume as live keys (and Start, with the robot ready), and
     the segment names faded to 45 % (about 2:1 contrast)."""
     stack.set(PnP_State=0)
+    browser.fresh()              # a tab without the key an earlier test's address left in its sessionStorage
     browser.open(f"{stack.server.url}pnp.html")                  # no key: the monitor
+    assert browser.driver.find_element(By.ID, "pill-role").text == "Monitor"
     browser.wait_for(lambda d: "Cycle: Idle" in d.find_element(By.ID, "pnp-state").text, "the cycle's state")
     keys = browser.driver.execute_script(
         "return [...document.querySelectorAll('.side .buttons button')].map((b) => [b.id, b.disabled])")
