@@ -547,3 +547,13 @@ def test_set_output_immediate_and_value(lib, immediate, value, text):
     lib.set_struct("OutParam", dict(Module="ControlBox", Channel=15, Value=value, Immediate=immediate))
     res = command(lib, "dout", "OutExec")
     assert res.done and res.scripts == [text], res.scripts
+
+
+@pytest.mark.parametrize("texts", [["}", "a,b}"], ["{", ""], ["$", "*"], ["\\", "\\\\"], ["a\tb", " "]],
+                         ids=["close_brace", "open_brace", "dollar_star", "backslashes", "tab_space"])
+def test_write_variable_text_array_with_the_array_delimiters_arrives_exactly(var, texts):
+    """An array is written as {"..","..."} (TMscript 2.24 §17.4.3): braces and commas inside the texts stay texts."""
+    set_variable(var, "WrVar", "g_texts", "VarString", 2, "StringValue", texts)
+    res = command(var, "wr", "WrExec")
+    assert res.done, res.descrip
+    assert len(res.svr) == 1 and var.robot.svr.variables["g_texts"] == texts
