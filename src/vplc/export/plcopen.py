@@ -13,7 +13,8 @@ tests/vplc/export/test_export_plcopen.py)::
 TC6 has no namespaces: an object of a library namespace carries it in ``addData`` (``data name=`` the URI
 below, ``<namespace name="CBT_Commands_Lib"/>``); IDEs that do not know it discard it (``handleUnknown``),
 and :mod:`vplc.ladder.plcopen_read` puts the object back into its namespace. An open array ``ARRAY[*]``
-(TC6 has no open dimension) is written as a ``derived`` type named ``ARRAY[*] OF BYTE``.
+(TC6 has no open dimension) is written as a ``derived`` type named ``ARRAY[*] OF BYTE``. A UNION (TC6 has
+none) and a rung of Sysmac inline ST are refused by name, never written with another meaning.
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from ..frontend import ast as A
 from ..ladder.plcopen_write import XHTML_NS, formatted, ld_body
 from ..project import Project
 from .iec61131_10 import COMPANY, PRODUCT, creation_time, to_bytes
-from .model import ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
+from .model import ExportError, ExportSet, PouItem, TypeItem, enum_values, expr_text, type_text
 
 PLCOPEN_NS = "http://www.plcopen.org/xml/tc6_0201"
 POU_TYPE = {"FUNCTION": "function", "FUNCTION_BLOCK": "functionBlock", "PROGRAM": "program"}
@@ -131,8 +132,14 @@ def _list_attrs(section: A.VarSection) -> dict:
 
 def _data_type(parent: ET.Element, item: TypeItem, project: Project) -> None:
     decl = item.decl
-    dt = _sub(parent, "dataType", {"name": decl.name})
     spec = decl.spec
+    if isinstance(spec, A.StructTypeRef) and spec.union:
+        # TC6 has no union: a struct would give every member its own memory (W501 6-3-6: a union's members share
+        # one), so another IDE, and vplc reading the file back, would run it with another meaning.
+        raise ExportError(f"{item.path}: data type `{decl.name}` is a UNION, which PLCopen TC6 cannot express (a "
+                          "struct would not share the members' memory); export it with --format iec61131-10 "
+                          "(StructTypeSpec overlap=\"true\")")
+    dt = _sub(parent, "dataType", {"name": decl.name})
     if isinstance(spec, A.EnumTypeRef):              # write the values the compiler counts, as the 61131-10 export
         values = enum_values(project, item)
         spec = A.EnumTypeRef([A.EnumValueDecl(v.name, A.Literal(kind="int", value=values[v.name.upper()],

@@ -59,3 +59,37 @@ def test_a_user_global_used_without_var_external_is_still_declared_iec_dialect(t
     program = ET.parse(out).getroot().find(f"{q('Types')}/{q('GlobalNamespace')}/{q('Program')}")
     externals = [v.get("name") for lst in program.findall(q("ExternalVars")) for v in lst.findall(q("Variable"))]
     assert externals == ["gCount"]
+
+
+UNION_SOURCE = """TYPE
+    uWord : UNION
+        W : WORD;
+        B : ARRAY[0..1] OF BYTE;
+    END_UNION;
+END_TYPE
+PROGRAM Main
+VAR
+    U : uWord;
+END_VAR
+U.W := WORD#16#1234;
+END_PROGRAM
+"""
+
+
+def test_plcopen_export_refuses_a_union_by_name_instead_of_writing_a_struct(tmp_path, capsys):
+    # W501 6-3-6: a union's members share one memory image; TC6 has no union, and a struct read back (by vplc or
+    # another IDE) gives B its own memory: U.B stayed [0, 0] after U.W := 16#1234 where it is [16#34, 16#12]
+    src = tmp_path / "Main.st"
+    src.write_text(UNION_SOURCE, encoding="utf-8")
+    out = tmp_path / "tc6.xml"
+    code, _, err = run(capsys, "export", str(src), "--format", "plcopen", "-o", str(out))
+    assert code == 1 and not out.exists()
+    assert "data type `uWord` is a UNION, which PLCopen TC6 cannot express" in err and "Traceback" not in err
+    code, _, err = run(capsys, "export", str(src), "--format", "iec61131-10", "-o", str(tmp_path / "smc.xml"))
+    assert code == 0, err
+    plc = load_plc([str(tmp_path / "smc.xml")])
+    try:
+        plc.scan(0)
+        assert plc.read("Main.U.B") == [0x34, 0x12]
+    finally:
+        plc.close()

@@ -32,8 +32,9 @@ FORMATS = ("iec61131-10", "plcopen")
 # Spellings of one elementary type (the PLCopen schema has one element for each).
 SAME_TYPE = {"DT": "DATE_AND_TIME", "TOD": "TIME_OF_DAY", "D": "DATE"}
 # Constructs a format cannot express, refused with exit 1 and a message naming them (docs/toolchain/export.md):
-# Sysmac has no alias or subrange data types; PLCopen TC6 has no inline ST.
-DOCUMENTED_REFUSALS = {"iec61131-10": ("is an alias or subrange type",), "plcopen": ("smcext:InlineST",)}
+# Sysmac has no alias or subrange data types; PLCopen TC6 has no inline ST and no union.
+DOCUMENTED_REFUSALS = {"iec61131-10": ("is an alias or subrange type",),
+                       "plcopen": ("smcext:InlineST", "is a UNION, which PLCopen TC6 cannot express")}
 
 
 def _alone() -> list:
