@@ -28,6 +28,7 @@ no wall-clock time, attributes in a fixed order, items in dependency order.
 from __future__ import annotations
 
 import os
+import re
 import time
 import xml.etree.ElementTree as ET
 
@@ -374,7 +375,49 @@ def build(export: ExportSet, project: Project, *, flat: bool = False,
     instances = _sub(root, "Instances")
     if export.globals:
         _globals(instances, export)
+    if flat:
+        _flatten_names(root, export)
     return root
+
+
+# ST text outside comments and string literals: a qualified name (``ns\Name``, ``ns\Inner\eMode``), or a comment or
+# string, which is kept as it is.
+_QUALIFIED = re.compile(r"""(?P<keep>\(\*.*?\*\)|/\*.*?\*/|//[^\n]*|'(?:\$.|[^'$])*'|"(?:\$.|[^"$])*")"""
+                        r"|(?P<name>[A-Za-z_]\w*(?:\\[A-Za-z_]\w*)+)", re.S)
+
+
+def _flatten_names(root: ET.Element, export: ExportSet) -> None:
+    """With ``--flat`` every object is written in the global namespace, so every reference to one must lose its
+    namespace too: type names, initial values (``ns\\eMode#Idle``), ladder block types and the ST bodies. Only
+    the namespaces of the exported objects are removed (a name of another namespace is left to the checker);
+    comments and string literals are not touched. Two objects that would get the same name are refused."""
+    spaces = {ns.upper() for ns in export.namespaces}
+    spaces |= {ns.upper().rsplit("\\", i)[0] for ns in export.namespaces for i in range(ns.count("\\") + 1)}
+    seen: dict[str, str] = {}
+    for item in export.items:
+        full = f"{item.namespace}\\{item.name}" if item.namespace else item.name
+        other = seen.setdefault(item.name.upper(), full)
+        if other != full:
+            raise ExportError(f"--flat: `{other}` and `{full}` would both be named `{item.name}` in the global "
+                              "namespace; export without --flat, or rename one")
+
+    def strip(text: str) -> str:
+        def one(m: re.Match) -> str:
+            name = m.group("name")
+            if name is None:
+                return m.group("keep")
+            prefix, _, last = name.rpartition("\\")
+            return last if prefix.upper() in spaces else name
+        return _QUALIFIED.sub(one, text) if "\\" in text else text
+
+    for el in root.iter():
+        if el.tag == "Documentation":
+            continue
+        if el.text:
+            el.text = strip(el.text)
+        for key, value in el.attrib.items():
+            if "\\" in value:
+                el.set(key, strip(value))
 
 
 def _globals(instances: ET.Element, export: ExportSet) -> None:

@@ -93,3 +93,70 @@ def test_plcopen_export_refuses_a_union_by_name_instead_of_writing_a_struct(tmp_
         assert plc.read("Main.U.B") == [0x34, 0x12]
     finally:
         plc.close()
+
+
+FLAT_SOURCE = """NAMESPACE nsCell
+TYPE
+    eMode : (Idle, Run := 5);
+END_TYPE
+NAMESPACE Io
+TYPE
+    stIn : STRUCT
+        Mode : nsCell\\eMode := nsCell\\eMode#Run;
+        Count : INT;
+    END_STRUCT;
+END_TYPE
+FUNCTION_BLOCK Tally
+VAR_IN_OUT
+    Data : nsCell\\Io\\stIn;
+END_VAR
+Data.Count := Data.Count + 1;
+END_FUNCTION_BLOCK
+END_NAMESPACE
+END_NAMESPACE
+PROGRAM Main
+VAR
+    In : nsCell\\Io\\stIn;
+    T : nsCell\\Io\\Tally;
+    Note : STRING[20] := 'nsCell\\Io\\stIn';   (* a comment naming nsCell\\Io\\Tally stays *)
+    Running : BOOL;
+END_VAR
+T(Data := In);   (* calls nsCell\\Io\\Tally *)
+Running := In.Mode = nsCell\\eMode#Run;
+END_PROGRAM
+"""
+
+
+def test_flat_export_drops_the_namespaces_from_every_reference(tmp_path, capsys):
+    # --flat writes every object in the global namespace; before, types, initial values and bodies still named
+    # nsCell\\Io\\stIn, so the file did not load (vplc: 'unknown data type'; lib + examples --flat: 111 errors)
+    src = tmp_path / "Cell.st"
+    src.write_text(FLAT_SOURCE, encoding="utf-8")
+    out = tmp_path / "flat.xml"
+    code, _, err = run(capsys, "export", str(src), "--flat", "-o", str(out))
+    assert code == 0, err
+    text = out.read_text(encoding="utf-8")
+    assert "nsCell\\eMode#Run" not in text and "<TypeName>stIn</TypeName>" in text and "T(Data := In);" in text
+    assert "<SimpleValue value=\"'nsCell\\Io\\stIn'\" />" in text, "a string literal is not a reference"
+    assert "T(Data := In);   (* calls nsCell\\Io\\Tally *)" in text, "nor is a comment"
+    assert "a comment naming nsCell\\Io\\Tally stays</Documentation>" in text
+    code, _, err = run(capsys, "check", str(out))
+    assert code == 0 and "error" not in err, err
+    plc = load_plc([str(out)])
+    try:
+        for n in range(3):
+            plc.scan(n * plc.period_ns)
+        assert (plc.read("Main.In.Count"), plc.read("Main.Running"), plc.read("Main.Note")) == (3, True,
+                                                                                                 "nsCell\\Io\\stIn")
+    finally:
+        plc.close()
+
+
+def test_flat_export_refuses_two_objects_that_would_get_one_name(tmp_path, capsys):
+    src = tmp_path / "Two.st"
+    src.write_text("NAMESPACE nsA\nTYPE\n    stP : STRUCT X : INT; END_STRUCT;\nEND_TYPE\nEND_NAMESPACE\n"
+                   "NAMESPACE nsB\nTYPE\n    stP : STRUCT Y : INT; END_STRUCT;\nEND_TYPE\nEND_NAMESPACE\n",
+                   encoding="utf-8")
+    code, _, err = run(capsys, "export", str(src), "--flat", "-o", str(tmp_path / "flat.xml"))
+    assert code == 1 and "--flat: `nsA\\stP` and `nsB\\stP` would both be named `stP`" in err, err
+    assert not (tmp_path / "flat.xml").exists()
