@@ -111,6 +111,11 @@ class _Comments:
         parts = [comment_text(self.text[s:e]) for s, e in self.spans if s >= start and e <= end]
         return " ".join(p for p in parts if p)
 
+    def line_end(self, offset: int) -> int:
+        """The end of the line holding ``offset`` (a declaration's own line comment ends before it)."""
+        end = self.text.find("\n", offset)
+        return len(self.text) if end < 0 else end
+
     def trailing(self, end: int) -> str:
         """The comments on the rest of the line after offset ``end`` (a declaration's line comment)."""
         line_end = self.text.find("\n", end)
@@ -169,9 +174,13 @@ def collect(project: Project) -> ExportSet:
             prev_end = item.span.end
             if isinstance(item, A.TypeBlock):
                 block_text = unit.span.file.text[item.span.start:item.span.end]
+                inside = item.span.start                     # comments inside the block, above a declaration
                 for i, decl in enumerate(item.decls):
                     ns = decl.namespace                      # the file's, or its NAMESPACE block's
-                    t = TypeItem(decl, ns, header if i == 0 else "", block_text, path)
+                    own = comments.between(inside, decl.span.start)
+                    doc = " ".join(c for c in (header if i == 0 else "", own) if c)
+                    inside = comments.line_end(decl.span.end)
+                    t = TypeItem(decl, ns, doc, block_text, path)
                     spec = decl.spec
                     if isinstance(spec, A.StructTypeRef):
                         t.member_comments = {id(f): comments.trailing(f.span.end) for f in spec.fields}

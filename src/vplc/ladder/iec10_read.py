@@ -219,7 +219,8 @@ def _data_type(dt: ET.Element) -> TypeText:
     if kind == "StructTypeSpec":
         # overlap="true": Sysmac's union, the members sharing one memory image (W501 6-3-6)
         word = "UNION" if spec.get("overlap", "false") in ("true", "1") else "STRUCT"
-        fields = "".join(f"    {_line(_var(m, where))}\n" for m in spec.iterfind("Member"))
+        fields = "".join(f"    {_line(m_var)}{_trailing(m_var.comment)}\n"
+                         for m_var in (_var(m, where) for m in spec.iterfind("Member")))
         text = f"{word}\n{fields}END_{word}"
     elif kind == "EnumTypeWithNamedValueSpec":
         values = ", ".join(f"{e.get('name')} := {e.get('value')}" for e in spec.iterfind("Enumerator"))
@@ -247,6 +248,11 @@ def _enum_base(base: ET.Element | None, where: str) -> str:
     if name.upper() not in ELEMENTARY:
         raise FormatError(where, f"enumeration base type `{name}` is not an elementary type")
     return f" {name}"
+
+
+def _trailing(comment: str) -> str:
+    """A member's Documentation as the comment at the end of its line, where the export reads it back from."""
+    return f" (* {comment.replace('(*', '( *').replace('*)', '* )')} *)" if comment else ""
 
 
 def _line(v: VarText) -> str:

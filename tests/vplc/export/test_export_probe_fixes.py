@@ -160,3 +160,34 @@ def test_flat_export_refuses_two_objects_that_would_get_one_name(tmp_path, capsy
     code, _, err = run(capsys, "export", str(src), "--flat", "-o", str(tmp_path / "flat.xml"))
     assert code == 1 and "--flat: `nsA\\stP` and `nsB\\stP` would both be named `stP`" in err, err
     assert not (tmp_path / "flat.xml").exists()
+
+
+DOCUMENTED_TYPES = """TYPE
+    (* Mode of the cell. *)
+    eMode : (Idle, Run);
+    (* One station: where it is and what it does. *)
+    stStation : STRUCT
+        Pos : LREAL;      (* mm from the home switch *)
+        Mode : eMode;     (* what the station does *)
+    END_STRUCT;
+END_TYPE
+"""
+
+
+def test_type_and_member_comments_survive_export_and_reading_back(tmp_path, capsys):
+    # A comment inside a TYPE block, above a declaration, is that type's Documentation (before: only a comment
+    # above TYPE was taken, for the first declaration); the reader writes a member's Documentation back as its line
+    # comment (before: dropped, so exporting an export lost every member comment of the library's structures)
+    src = tmp_path / "Types.st"
+    src.write_text(DOCUMENTED_TYPES, encoding="utf-8")
+    first, again = tmp_path / "first.xml", tmp_path / "again.xml"
+    code, _, err = run(capsys, "export", str(src), "-o", str(first))
+    assert code == 0, err
+    root = ET.parse(first).getroot()
+    docs = {d.get("name"): d.findtext(q("Documentation")) for d in root.iter(q("DataTypeDecl"))}
+    assert docs == {"eMode": "Mode of the cell.", "stStation": "One station: where it is and what it does."}
+    members = {m.get("name"): m.findtext(q("Documentation")) for m in root.iter(q("Member"))}
+    assert members == {"Pos": "mm from the home switch", "Mode": "what the station does"}
+    code, _, err = run(capsys, "export", str(first), "-o", str(again))
+    assert code == 0, err
+    assert again.read_bytes() == first.read_bytes()
