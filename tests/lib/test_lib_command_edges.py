@@ -13,46 +13,14 @@ from edges import (
     SVR_FBS,
     ZERO_POSE,
     abs_call,
-    cell_rig,
     command,
     script_frames,
     set_variable,
     svr_order_rig,
     svr_writes,
     tcp_values,
-    var_rig,
-    vision_rig,
 )
 from rig import HOME_JOINTS, ROOT, Rig, circ, move_abs, rel
-
-
-@pytest.fixture
-def lib():
-    r = Rig()
-    yield r
-    r.close()
-
-
-@pytest.fixture
-def var():
-    r = var_rig()
-    yield r
-    r.close()
-
-
-@pytest.fixture
-def vis():
-    r = vision_rig()
-    yield r
-    r.close()
-
-
-@pytest.fixture
-def cell():
-    r = cell_rig()
-    yield r
-    r.close()
-
 
 # ---- PLCopen: Execute held, pulsed, re-raised; inputs changed while Busy; two FBs in one scan ---------------------
 SLOW = dict(TargetPosition={**HOME_JOINTS, "RZ": 60.0}, Speed=20)         # about 1 s of motion
@@ -101,83 +69,83 @@ def trace(rig, fb: str, scans: int, on_scan=None) -> list[dict]:
 
 
 @pytest.mark.parametrize("fb", FBS)
-def test_execute_held_sends_once_and_done_stays_until_it_falls(lib, fb):
-    inst, execute = setup_command(lib, fb)
-    lib.write(execute, True)
-    rows = trace(lib, inst, 3000)                                        # 3 s held
+def test_execute_held_sends_once_and_done_stays_until_it_falls(rig, fb):
+    inst, execute = setup_command(rig, fb)
+    rig.write(execute, True)
+    rows = trace(rig, inst, 3000)                                        # 3 s held
     first = next(i for i, r in enumerate(rows) if r["Done"])
     assert all(r["Done"] and not r["Busy"] and not r["Error"] for r in rows[first:])
     assert all(r["Busy"] and not r["Done"] for r in rows[:first])
-    assert len(script_frames(lib)) == 1
+    assert len(script_frames(rig)) == 1
     if inst in ("mover", "rel"):
-        assert len(lib.events("motion_end")) == 1
-    lib.write(execute, False)
-    lib.scans(1)
-    assert not any(lib.read(f"{inst}.{o}") for o in OUTS)
-    lib.scans(500)
-    assert len(script_frames(lib)) == 1
+        assert len(rig.events("motion_end")) == 1
+    rig.write(execute, False)
+    rig.scans(1)
+    assert not any(rig.read(f"{inst}.{o}") for o in OUTS)
+    rig.scans(500)
+    assert len(script_frames(rig)) == 1
 
 
 @pytest.mark.parametrize("fb", FBS)
-def test_execute_pulsed_for_one_scan_sends_once_and_shows_done_for_one_scan(lib, fb):
-    inst, execute = setup_command(lib, fb)
-    rows = trace(lib, inst, 3000, on_scan=lambda n: lib.write(execute, n == 0))
+def test_execute_pulsed_for_one_scan_sends_once_and_shows_done_for_one_scan(rig, fb):
+    inst, execute = setup_command(rig, fb)
+    rows = trace(rig, inst, 3000, on_scan=lambda n: rig.write(execute, n == 0))
     assert [r["Done"] for r in rows].count(True) == 1, "Done must show for exactly one scan"
     assert not any(r["Error"] or r["CommandAborted"] for r in rows)
     done_at = next(i for i, r in enumerate(rows) if r["Done"])
     assert all(r["Busy"] for r in rows[:done_at]) and not any(r["Busy"] for r in rows[done_at:])
-    assert len(script_frames(lib)) == 1
+    assert len(script_frames(rig)) == 1
     if inst in ("mover", "rel"):
-        assert len(lib.events("motion_end")) == 1
+        assert len(rig.events("motion_end")) == 1
 
 
 @pytest.mark.parametrize("fb,member,raw,code", [("mover", "MoveParam.Speed", 0, 0x1013),
                                                 ("base", "BaseParam.Transformation.X", NAN, 0x101E),
                                                 ("dout", "OutParam.Channel", 99, 0x1025),
                                                 ("stop", "StopParam.Mode", 9, 0x1023)])
-def test_a_refused_pulse_shows_error_for_one_scan(lib, fb, member, raw, code):
-    inst, execute = setup_command(lib, fb)
-    lib.write(member, raw, raw=isinstance(raw, int) and fb == "stop")
-    rows = trace(lib, inst, 5, on_scan=lambda n: lib.write(execute, n == 0))
+def test_a_refused_pulse_shows_error_for_one_scan(rig, fb, member, raw, code):
+    inst, execute = setup_command(rig, fb)
+    rig.write(member, raw, raw=isinstance(raw, int) and fb == "stop")
+    rows = trace(rig, inst, 5, on_scan=lambda n: rig.write(execute, n == 0))
     assert [r["Error"] for r in rows] == [True, False, False, False, False]
     assert not any(r["Busy"] or r["Done"] for r in rows)
-    assert script_frames(lib) == []
+    assert script_frames(rig) == []
 
 
-def test_execute_re_raised_while_busy_starts_one_new_command_per_edge(lib):
+def test_execute_re_raised_while_busy_starts_one_new_command_per_edge(rig):
     """R5: the new edge replaces the running command; the first motion was sent and runs (it is the robot's), the
     second is sent once, and Done comes when the robot finished the second."""
-    inst, execute = setup_command(lib, "mover")
-    lib.write(execute, True)
-    assert lib.until(lambda: lib.read("mover.Active"), 1)
-    lib.write(execute, False)
-    lib.scans(1)
-    lib.set_struct("MoveParam.TargetPosition", {**HOME_JOINTS, "RZ": -30.0})
-    lib.write(execute, True)
-    lib.scans(1)
-    assert lib.read("mover.Busy") and not lib.read("mover.Done")
-    assert lib.until(lambda: lib.read("mover.Done") or lib.read("mover.Error"), 10)
-    assert lib.read("mover.Done"), lib.read("mover.ErrorDescrip")
-    ends = [round(e["joints"][5]) for e in lib.events("motion_end")]
+    inst, execute = setup_command(rig, "mover")
+    rig.write(execute, True)
+    assert rig.until(lambda: rig.read("mover.Active"), 1)
+    rig.write(execute, False)
+    rig.scans(1)
+    rig.set_struct("MoveParam.TargetPosition", {**HOME_JOINTS, "RZ": -30.0})
+    rig.write(execute, True)
+    rig.scans(1)
+    assert rig.read("mover.Busy") and not rig.read("mover.Done")
+    assert rig.until(lambda: rig.read("mover.Done") or rig.read("mover.Error"), 10)
+    assert rig.read("mover.Done"), rig.read("mover.ErrorDescrip")
+    ends = [round(e["joints"][5]) for e in rig.events("motion_end")]
     assert ends == [60, -30], ends                                     # both ran, in order, Done after the second
-    scripts = script_frames(lib)
+    scripts = script_frames(rig)
     assert len(scripts) == 2 and "60" in scripts[0].split(",")[6] and "-30" in scripts[1].split(",")[6]
-    lib.write(execute, False)
-    lib.scans(500)
-    assert len(script_frames(lib)) == 2
+    rig.write(execute, False)
+    rig.scans(500)
+    assert len(script_frames(rig)) == 2
 
 
-def test_inputs_changed_while_busy_are_not_taken(lib):
+def test_inputs_changed_while_busy_are_not_taken(rig):
     """R4: the parameters are latched at the edge: what the robot gets and where it ends are the edge's values."""
-    inst, execute = setup_command(lib, "mover")
-    lib.write(execute, True)
-    lib.scans(1)
-    lib.set_struct("MoveParam", move_abs(TargetPosition={**HOME_JOINTS, "RZ": -45.0}, Speed=100, DataFormat="CPR_Abs"))
-    lib.write("mover.BufferMode", "Aborting")
-    assert lib.until(lambda: lib.read("mover.Done") or lib.read("mover.Error"), 10)
-    assert lib.read("mover.Done"), lib.read("mover.ErrorDescrip")
-    assert [round(e["joints"][5]) for e in lib.events("motion_end")] == [60]
-    scripts = script_frames(lib)
+    inst, execute = setup_command(rig, "mover")
+    rig.write(execute, True)
+    rig.scans(1)
+    rig.set_struct("MoveParam", move_abs(TargetPosition={**HOME_JOINTS, "RZ": -45.0}, Speed=100, DataFormat="CPR_Abs"))
+    rig.write("mover.BufferMode", "Aborting")
+    assert rig.until(lambda: rig.read("mover.Done") or rig.read("mover.Error"), 10)
+    assert rig.read("mover.Done"), rig.read("mover.ErrorDescrip")
+    assert [round(e["joints"][5]) for e in rig.events("motion_end")] == [60]
+    scripts = script_frames(rig)
     assert len(scripts) == 1 and scripts[0].split("\r\n")[0] == abs_call(move_abs(**SLOW)), scripts
 
 
@@ -206,20 +174,20 @@ def test_execute_re_raised_while_a_write_is_busy_is_ignored(var):
     assert len(svr_writes(var)) == 1
 
 
-def test_every_fb_started_in_the_same_scan_sends_once_each_in_call_order(lib):
+def test_every_fb_started_in_the_same_scan_sends_once_each_in_call_order(rig):
     """Main_Lib.st calls mover, rel, circ, base, tcp, prg, stop, dout, ..., movers[1..4]: every one started in one
     scan goes out once, in that order, and each ends Done (the stop last would abort the motions: left out)."""
-    started = [setup_command(lib, fb) for fb in ("mover", "base", "tcp", "dout")]
+    started = [setup_command(rig, fb) for fb in ("mover", "base", "tcp", "dout")]
     for k in (1, 2):
-        lib.set_struct(f"MParam[{k}]", move_abs(TargetPosition={**HOME_JOINTS, "RZ": 10.0 * k}))
+        rig.set_struct(f"MParam[{k}]", move_abs(TargetPosition={**HOME_JOINTS, "RZ": 10.0 * k}))
         started.append((f"movers[{k}]", f"MExec[{k}]"))
     for _, execute in started:
-        lib.write(execute, True)
-    assert lib.until(lambda: all(lib.read(f"{i}.Done") or lib.read(f"{i}.Error") for i, _ in started), 20)
-    assert all(lib.read(f"{i}.Done") for i, _ in started), {i: lib.read(f"{i}.ErrorDescrip") for i, _ in started}
-    heads = [s.split("(")[0] for s in script_frames(lib)]
+        rig.write(execute, True)
+    assert rig.until(lambda: all(rig.read(f"{i}.Done") or rig.read(f"{i}.Error") for i, _ in started), 20)
+    assert all(rig.read(f"{i}.Done") for i, _ in started), {i: rig.read(f"{i}.ErrorDescrip") for i, _ in started}
+    heads = [s.split("(")[0] for s in script_frames(rig)]
     assert heads == ["PTP", "ChangeBase", "ChangeTCP", 'IO["EndModule"].DO[2]=1', "PTP", "PTP"], heads
-    assert len(lib.events("motion_end")) == 3
+    assert len(rig.events("motion_end")) == 3
 
 
 # ---- the link lost at each step of a command ---------------------------------------------------------------------
@@ -232,44 +200,44 @@ STEPS = ["before_the_edge", "in_the_edge_scan", "reply_held_back", "while_moving
 
 @pytest.mark.parametrize("fb,step", [(fb, step) for fb in ("mover", "base", "dout") for step in STEPS
                                      if fb == "mover" or step != "while_moving"])
-def test_link_lost_at_each_step_never_reports_what_the_robot_did_not_do(lib, fb, step):
+def test_link_lost_at_each_step_never_reports_what_the_robot_did_not_do(rig, fb, step):
     """At most one frame; the FB ends (never Busy for good); Done only if the robot did it, else Error with a
     documented ErrorID and its text. A command refused before the edge sends nothing."""
-    inst, execute = setup_command(lib, fb)
+    inst, execute = setup_command(rig, fb)
     if step == "before_the_edge":
-        lose_link(lib)
-        assert lib.until(lambda: not lib.read("Cobot.Connected"), 2)
+        lose_link(rig)
+        assert rig.until(lambda: not rig.read("Cobot.Connected"), 2)
     if step == "reply_held_back":
-        lib.robot.inject("reply_delay", seconds=0.3, count=1)
-    lib.write(execute, True)
+        rig.robot.inject("reply_delay", seconds=0.3, count=1)
+    rig.write(execute, True)
     if step == "in_the_edge_scan":
-        lose_link(lib)
-    lib.scans(1)
+        lose_link(rig)
+    rig.scans(1)
     if step == "reply_held_back":
-        assert lib.until(lambda: len(script_frames(lib)) == 1, 1)
-        lose_link(lib)
+        assert rig.until(lambda: len(script_frames(rig)) == 1, 1)
+        lose_link(rig)
     if step == "while_moving":
-        assert lib.until(lambda: lib.read(f"{inst}.Active") or lib.read(f"{inst}.Done"), 2)
-        lose_link(lib)
+        assert rig.until(lambda: rig.read(f"{inst}.Active") or rig.read(f"{inst}.Done"), 2)
+        lose_link(rig)
     if step == "after_done":
-        assert lib.until(lambda: lib.read(f"{inst}.Done"), 10)
-        lose_link(lib)
-    assert lib.until(lambda: not lib.read(f"{inst}.Busy"), 12), f"{inst} still Busy"
-    done, error_id = lib.read(f"{inst}.Done"), lib.read(f"{inst}.ErrorID")
-    lib.scans(3000)                                             # CBT_Connect reconnects; nothing is sent again
-    scripts = script_frames(lib)
+        assert rig.until(lambda: rig.read(f"{inst}.Done"), 10)
+        lose_link(rig)
+    assert rig.until(lambda: not rig.read(f"{inst}.Busy"), 12), f"{inst} still Busy"
+    done, error_id = rig.read(f"{inst}.Done"), rig.read(f"{inst}.ErrorID")
+    rig.scans(3000)                                             # CBT_Connect reconnects; nothing is sent again
+    scripts = script_frames(rig)
     assert len(scripts) <= 1, scripts
     if step == "before_the_edge":
         assert scripts == [] and error_id in (0x2001, 0x200C), hex(error_id)
     if done:
         assert len(scripts) == 1
         if inst == "mover":
-            assert len(lib.events("motion_end")) == 1
+            assert len(rig.events("motion_end")) == 1
         elif inst == "base":
-            assert lib.events("setting")
+            assert rig.events("setting")
     else:
-        assert lib.read(f"{inst}.Error") and error_id in ERRORS, hex(error_id)
-        assert lib.read(f"{inst}.ErrorDescrip") == ERRORS[error_id][:80]
+        assert rig.read(f"{inst}.Error") and error_id in ERRORS, hex(error_id)
+        assert rig.read(f"{inst}.ErrorDescrip") == ERRORS[error_id][:80]
 
 
 # ---- the Ethernet Slave channel: two FBs started close together, in a user's call order ------------------------
@@ -424,16 +392,16 @@ def test_ethernet_slave_fb_re_raised_while_busy(fb, after, requests):
         r.close()
 
 
-def test_stop_re_raised_while_busy_sends_one_stop_per_edge_and_releases_stopping(lib):
-    lib.write("StopParam.Mode", "StopNormal")
-    lib.robot.inject("reply_delay", seconds=0.2, count=1)
-    reraise(lib, "StopExec", "stop.Busy", 2)
-    assert lib.until(lambda: lib.read("stop.Done") or lib.read("stop.Error"), 3)
-    assert lib.read("stop.Done") and lib.read("Cobot.Stopping")
-    lib.write("StopExec", False)
-    lib.scans(300)
-    assert script_frames(lib) == ["StopAndClearBuffer()", "StopAndClearBuffer()"]
-    assert not lib.read("Cobot.Stopping") and lib.read("Cobot.StopHolders") == 0
+def test_stop_re_raised_while_busy_sends_one_stop_per_edge_and_releases_stopping(rig):
+    rig.write("StopParam.Mode", "StopNormal")
+    rig.robot.inject("reply_delay", seconds=0.2, count=1)
+    reraise(rig, "StopExec", "stop.Busy", 2)
+    assert rig.until(lambda: rig.read("stop.Done") or rig.read("stop.Error"), 3)
+    assert rig.read("stop.Done") and rig.read("Cobot.Stopping")
+    rig.write("StopExec", False)
+    rig.scans(300)
+    assert script_frames(rig) == ["StopAndClearBuffer()", "StopAndClearBuffer()"]
+    assert not rig.read("Cobot.Stopping") and rig.read("Cobot.StopHolders") == 0
 
 
 @pytest.mark.parametrize("path,value", [("JogAxis", 1), ("JogFrame", "JogTool"), ("JogVelocity", 100),
@@ -536,23 +504,23 @@ def test_vision_job_link_lost_at_each_of_its_three_requests(vis, frames, extra):
 
 
 @pytest.mark.parametrize("lose_after_ms", [0, 300, 2500])
-def test_set_output_wait_until_set_behind_a_motion_with_the_link_lost(lib, lose_after_ms):
+def test_set_output_wait_until_set_behind_a_motion_with_the_link_lost(rig, lose_after_ms):
     """A queued output with WaitUntilSet waits for its queue tag: the link lost while the motion before it runs
     ends it with a documented ErrorID unless the robot had set the output (its io event); sent once."""
-    lib.set_struct("MoveParam", move_abs(**SLOW))
-    lib.write("MoveExec", True)
-    lib.scans(2)
-    lib.set_struct("OutParam", dict(Module="EndModule", Channel=1, Value=True, WaitUntilSet=True))
-    lib.write("OutExec", True)
-    assert lib.until(lambda: len(script_frames(lib)) == 2, 1)
-    lib.until(lambda: False, lose_after_ms / 1000)
-    lib.robot.inject("disconnect")
-    assert lib.until(lambda: not lib.read("dout.Busy"), 12)
-    done, error_id = lib.read("dout.Done"), lib.read("dout.ErrorID")
-    set_by_robot = len(lib.events("io")) == 1
+    rig.set_struct("MoveParam", move_abs(**SLOW))
+    rig.write("MoveExec", True)
+    rig.scans(2)
+    rig.set_struct("OutParam", dict(Module="EndModule", Channel=1, Value=True, WaitUntilSet=True))
+    rig.write("OutExec", True)
+    assert rig.until(lambda: len(script_frames(rig)) == 2, 1)
+    rig.until(lambda: False, lose_after_ms / 1000)
+    rig.robot.inject("disconnect")
+    assert rig.until(lambda: not rig.read("dout.Busy"), 12)
+    done, error_id = rig.read("dout.Done"), rig.read("dout.ErrorID")
+    set_by_robot = len(rig.events("io")) == 1
     assert not done or set_by_robot, "Done without the robot setting the output"
-    assert done or lib.read("dout.Error")
+    assert done or rig.read("dout.Error")
     if not done:
-        assert lib.read("dout.ErrorDescrip") == ERRORS[error_id][:80], hex(error_id)
-    lib.until(lambda: False, 3)
-    assert [s for s in script_frames(lib) if "DO[1]" in s] == ['IO["EndModule"].DO[1]=1\r\nQueueTag(2)']
+        assert rig.read("dout.ErrorDescrip") == ERRORS[error_id][:80], hex(error_id)
+    rig.until(lambda: False, 3)
+    assert [s for s in script_frames(rig) if "DO[1]" in s] == ['IO["EndModule"].DO[1]=1\r\nQueueTag(2)']

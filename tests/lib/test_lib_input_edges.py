@@ -24,7 +24,6 @@ from edges import (
     TINY,
     ZERO_POSE,
     abs_call,
-    cell_rig,
     circle_call,
     command,
     f32,
@@ -40,40 +39,9 @@ from edges import (
     svr_writes,
     tcp_call,
     tcp_values,
-    var_rig,
     vision_call,
-    vision_rig,
 )
 from rig import HOME_JOINTS, Rig, circ, move_abs, rel
-
-
-@pytest.fixture
-def lib():
-    r = Rig()
-    yield r
-    r.close()
-
-
-@pytest.fixture
-def var():
-    r = var_rig()
-    yield r
-    r.close()
-
-
-@pytest.fixture
-def vis():
-    r = vision_rig()
-    yield r
-    r.close()
-
-
-@pytest.fixture
-def cell():
-    r = cell_rig()
-    yield r
-    r.close()
-
 
 # ---- CBT_MoveAbsolute, CBT_MoveRelative, CBT_MoveCircle: the numbers ---------------------------------------------
 MOVE_ABS_CASES = [
@@ -115,9 +83,9 @@ MOVE_ABS_CASES = [
 
 
 @pytest.mark.parametrize("values,code", [c[1:] for c in MOVE_ABS_CASES], ids=[c[0] for c in MOVE_ABS_CASES])
-def test_move_absolute_numbers(lib, values, code):
-    lib.set_struct("MoveParam", values)
-    res = command(lib, "mover", "MoveExec")
+def test_move_absolute_numbers(rig, values, code):
+    rig.set_struct("MoveParam", values)
+    res = command(rig, "mover", "MoveExec")
     if code is not None:
         refused(res, code)
     else:
@@ -130,18 +98,18 @@ def test_move_absolute_numbers(lib, values, code):
     ("RobotPose.Pose1", 2, 0x1019), ("RobotPose.Pose2", -1, 0x1019), ("RobotPose.Pose3", 9, 0x1019),
     ("BufferMode", 2, 0x1030), ("BufferMode", -1, 0x1030),
 ])
-def test_move_absolute_undefined_enumeration_values_are_refused(lib, member, raw, code):
-    lib.set_struct("MoveParam", move_abs(MovementCommand="PTP", DataFormat="CPP_Abs", RobotPoseEnable=True,
+def test_move_absolute_undefined_enumeration_values_are_refused(rig, member, raw, code):
+    rig.set_struct("MoveParam", move_abs(MovementCommand="PTP", DataFormat="CPP_Abs", RobotPoseEnable=True,
                                          RobotPose=dict(Pose1="Righty", Pose2="Above", Pose3="NoFlip"),
                                          TargetPosition=dict(X=417.5, Y=-122.3, Z=359.7, RX=180, RY=0, RZ=90)))
-    lib.write("mover.BufferMode" if member == "BufferMode" else f"MoveParam.{member}", raw, raw=True)
-    refused(command(lib, "mover", "MoveExec"), code)
+    rig.write("mover.BufferMode" if member == "BufferMode" else f"MoveParam.{member}", raw, raw=True)
+    refused(command(rig, "mover", "MoveExec"), code)
 
 
-def test_move_absolute_d_format_on_tmflow_1_is_refused(lib):
-    lib.write("Cobot.RobotSoftware", "TMflow1x")
-    lib.set_struct("MoveParam", line_abs(DataFormat="CDP_Abs"))
-    refused(command(lib, "mover", "MoveExec"), 0x1027)
+def test_move_absolute_d_format_on_tmflow_1_is_refused(rig):
+    rig.write("Cobot.RobotSoftware", "TMflow1x")
+    rig.set_struct("MoveParam", line_abs(DataFormat="CDP_Abs"))
+    refused(command(rig, "mover", "MoveExec"), 0x1027)
 
 
 REL_CASES = [
@@ -164,9 +132,9 @@ REL_CASES = [
 
 
 @pytest.mark.parametrize("values,code", [c[1:] for c in REL_CASES], ids=[c[0] for c in REL_CASES])
-def test_move_relative_numbers(lib, values, code):
-    lib.set_struct("RelParam", values)
-    res = command(lib, "rel", "RelExec")
+def test_move_relative_numbers(rig, values, code):
+    rig.set_struct("RelParam", values)
+    res = command(rig, "rel", "RelExec")
     if code is not None:
         refused(res, code)
     else:
@@ -176,10 +144,10 @@ def test_move_relative_numbers(lib, values, code):
 @pytest.mark.parametrize("member,raw,code", [
     ("MovementCommand", 2, 0x1010), ("MovementCommand", -1, 0x1010),
     ("DataFormat", 14, 0x1012), ("DataFormat", -1, 0x1012), ("BufferMode", 3, 0x1030)])
-def test_move_relative_undefined_enumeration_values_are_refused(lib, member, raw, code):
-    lib.set_struct("RelParam", rel())
-    lib.write("rel.BufferMode" if member == "BufferMode" else f"RelParam.{member}", raw, raw=True)
-    refused(command(lib, "rel", "RelExec"), code)
+def test_move_relative_undefined_enumeration_values_are_refused(rig, member, raw, code):
+    rig.set_struct("RelParam", rel())
+    rig.write("rel.BufferMode" if member == "BufferMode" else f"RelParam.{member}", raw, raw=True)
+    refused(command(rig, "rel", "RelExec"), code)
 
 
 CIRCLE_CASES = [
@@ -203,9 +171,9 @@ CIRCLE_CASES = [
 
 
 @pytest.mark.parametrize("values,code", [c[1:] for c in CIRCLE_CASES], ids=[c[0] for c in CIRCLE_CASES])
-def test_move_circle_numbers(lib, values, code):
-    lib.set_struct("CircParam", values)
-    res = command(lib, "circ", "CircExec")
+def test_move_circle_numbers(rig, values, code):
+    rig.set_struct("CircParam", values)
+    res = command(rig, "circ", "CircExec")
     if code is not None:
         refused(res, code)
     else:
@@ -214,10 +182,10 @@ def test_move_circle_numbers(lib, values, code):
 
 @pytest.mark.parametrize("member,raw,code", [("DataFormat", 3, 0x101C), ("DataFormat", 4, 0x101C),
                                              ("DataFormat", -1, 0x101C), ("BufferMode", 2, 0x1030)])
-def test_move_circle_undefined_enumeration_values_are_refused(lib, member, raw, code):
-    lib.set_struct("CircParam", circ())
-    lib.write("circ.BufferMode" if member == "BufferMode" else f"CircParam.{member}", raw, raw=True)
-    refused(command(lib, "circ", "CircExec"), code)
+def test_move_circle_undefined_enumeration_values_are_refused(rig, member, raw, code):
+    rig.set_struct("CircParam", circ())
+    rig.write("circ.BufferMode" if member == "BufferMode" else f"CircParam.{member}", raw, raw=True)
+    refused(command(rig, "circ", "CircExec"), code)
 
 
 # ---- CBT_ChangeBase, CBT_ChangeTCP ------------------------------------------------------------------------------
@@ -226,16 +194,16 @@ def test_move_circle_undefined_enumeration_values_are_refused(lib, member, raw, 
     ("RY", -99999.992, None), ("RZ", 0.0015, None),
     ("X", past(100000.0, True), 0x101E), ("Y", past(-100000.0, False), 0x101E), ("Z", NAN, 0x101E),
     ("RX", NAN_PAYLOAD, 0x101E), ("RY", INF, 0x101E), ("RZ", NEG_INF, 0x101E), ("X", -MAX_REAL, 0x101E)])
-def test_change_base_numbers(lib, member, value, code):
+def test_change_base_numbers(rig, member, value, code):
     pose = {**ZERO_POSE, member: value}
-    lib.set_struct("BaseParam.Transformation", pose)
-    res = command(lib, "base", "BaseExec")
+    rig.set_struct("BaseParam.Transformation", pose)
+    res = command(rig, "base", "BaseExec")
     if code is not None:
         refused(res, code)
         return
     sent(res, f"ChangeBase({pose_text(pose)})")
     assert res.done
-    assert lib.events("setting")[-1]["pose"] == pytest.approx(tuple(f32(pose[k]) for k in pose), abs=5e-4)
+    assert rig.events("setting")[-1]["pose"] == pytest.approx(tuple(f32(pose[k]) for k in pose), abs=5e-4)
 
 
 @pytest.mark.parametrize("kw,code", [
@@ -253,10 +221,10 @@ def test_change_base_numbers(lib, member, value, code):
           MomentOfInertia=dict(Ixx=99999.992, Iyy=99999.992, Izz=99999.992),
           MassCenter={k: -99999.992 for k in ZERO_POSE}), None),
 ], ids=lambda v: ",".join(f"{k}={v[k]}" for k in v) if isinstance(v, dict) else str(v))
-def test_change_tcp_numbers(lib, kw, code):
+def test_change_tcp_numbers(rig, kw, code):
     values = tcp_values(**kw)
-    lib.set_struct("TcpParam", values)
-    res = command(lib, "tcp", "TcpExec")
+    rig.set_struct("TcpParam", values)
+    res = command(rig, "tcp", "TcpExec")
     if code is not None:
         refused(res, code)
     else:
@@ -269,11 +237,11 @@ def test_change_tcp_numbers(lib, kw, code):
     ("ControlBox", 0, None), ("ControlBox", 15, None), ("ControlBox", 16, 0x1025), ("ControlBox", 65535, 0x1025),
     ("EndModule", 0, None), ("EndModule", 3, None), ("EndModule", 4, 0x1025),
     (-1, 0, 0x1024), (2, 0, 0x1024), (127, 0, 0x1024)])
-def test_set_output_module_and_channel(lib, module, channel, code):
-    lib.write("OutParam.Module", module, raw=isinstance(module, int))
-    lib.write("OutParam.Channel", channel)
-    lib.write("OutParam.Value", True)
-    res = command(lib, "dout", "OutExec")
+def test_set_output_module_and_channel(rig, module, channel, code):
+    rig.write("OutParam.Module", module, raw=isinstance(module, int))
+    rig.write("OutParam.Channel", channel)
+    rig.write("OutParam.Value", True)
+    res = command(rig, "dout", "OutExec")
     if code is not None:
         refused(res, code)
     else:
@@ -286,21 +254,21 @@ def test_set_output_module_and_channel(lib, module, channel, code):
                                          ("StopAbortScript", "StopAndClearBuffer(1)"),
                                          ("StopDiscardAll", "StopAndClearBuffer(2)"),
                                          (-1, 0x1023), (4, 0x1023), (99, 0x1023)])
-def test_stop_modes(lib, mode, script):
-    lib.write("StopParam.Mode", mode, raw=isinstance(mode, int))
-    res = command(lib, "stop", "StopExec")
+def test_stop_modes(rig, mode, script):
+    rig.write("StopParam.Mode", mode, raw=isinstance(mode, int))
+    res = command(rig, "stop", "StopExec")
     if isinstance(script, int):
         refused(res, script)
-        assert not lib.read("Cobot.Stopping")
+        assert not rig.read("Cobot.Stopping")
     else:
         assert res.done and res.scripts == [script]
 
 
 @pytest.mark.parametrize("cmd,expected", [("Pause", "Pause()"), ("Resume", "Resume()"),
                                           (-1, 0x1022), (2, 0x1022), (200, 0x1022)])
-def test_program_control_commands(lib, cmd, expected):
-    lib.write("PrgParam.Command", cmd, raw=isinstance(cmd, int))
-    res = command(lib, "prg", "PrgExec")
+def test_program_control_commands(rig, cmd, expected):
+    rig.write("PrgParam.Command", cmd, raw=isinstance(cmd, int))
+    res = command(rig, "prg", "PrgExec")
     if isinstance(expected, int):
         refused(res, expected)
     else:
@@ -427,27 +395,27 @@ def test_teach_name_is_stored_as_given_and_never_sent(name):
 
 @pytest.mark.parametrize("period_ms,ok", [(10, True), (10000, True), (9, False), (10001, False), (0, False),
                                           (-1, False)])
-def test_read_actual_position_period(lib, period_ms, ok):
-    lib.write("ReadPeriod", period_ms * 1_000_000)                    # TIME in ns
-    lib.write("ReadEnable", True)
-    assert lib.until(lambda: lib.read("rd.Valid") or lib.read("rd.Error"), 1)
+def test_read_actual_position_period(rig, period_ms, ok):
+    rig.write("ReadPeriod", period_ms * 1_000_000)                    # TIME in ns
+    rig.write("ReadEnable", True)
+    assert rig.until(lambda: rig.read("rd.Valid") or rig.read("rd.Error"), 1)
     if ok:
-        assert lib.read("rd.Valid") and not lib.read("rd.Error")
+        assert rig.read("rd.Valid") and not rig.read("rd.Error")
     else:
-        before = len(script_frames(lib))
-        lib.scans(300)
-        assert lib.read("rd.Error") and lib.read("rd.ErrorID") == 0x1004
-        assert lib.read("rd.ErrorDescrip") == ERRORS[0x1004][:80]
-        assert len(script_frames(lib)) == before                      # nothing asked of the robot
-    lib.write("ReadEnable", False)
-    lib.scans(2)
-    assert not lib.read("rd.Error")
+        before = len(script_frames(rig))
+        rig.scans(300)
+        assert rig.read("rd.Error") and rig.read("rd.ErrorID") == 0x1004
+        assert rig.read("rd.ErrorDescrip") == ERRORS[0x1004][:80]
+        assert len(script_frames(rig)) == before                      # nothing asked of the robot
+    rig.write("ReadEnable", False)
+    rig.scans(2)
+    assert not rig.read("rd.Error")
 
 
 @pytest.mark.parametrize("raw", [-1, 3, 255])
-def test_project_control_undefined_command(lib, raw):
-    lib.write("ProjCmd", raw, raw=True)
-    refused(command(lib, "proj", "ProjExec"), 0x1026)
+def test_project_control_undefined_command(rig, raw):
+    rig.write("ProjCmd", raw, raw=True)
+    refused(command(rig, "proj", "ProjExec"), 0x1026)
 
 
 @pytest.mark.parametrize("value,code", [(5, None), (100, None), (95, None), (0, 0x1040), (4, 0x1040), (7, 0x1040),
@@ -508,12 +476,12 @@ CPP_TARGET = dict(X=417.5, Y=-122.3, Z=359.7, RX=180, RY=0, RZ=90)
 
 @pytest.mark.parametrize("pose,text", [(("Righty", "Above", "NoFlip"), "0,2,4"), (("Lefty", "Below", "Flip"), "1,3,5"),
                                        (("Lefty", "Above", "Flip"), "1,2,5"), (("Righty", "Below", "NoFlip"), "0,3,4")])
-def test_move_absolute_arm_configuration_is_the_three_pose_integers(lib, pose, text):
+def test_move_absolute_arm_configuration_is_the_three_pose_integers(rig, pose, text):
     """TMscript 2.24 §13.8 PTP Syntax 2: Config1 0/1, Config2 2/3, Config3 4/5 after the precise-positioning flag."""
     values = move_abs(DataFormat="CPP_Abs", TargetPosition=CPP_TARGET, RobotPoseEnable=True,
                       RobotPose=dict(Pose1=pose[0], Pose2=pose[1], Pose3=pose[2]))
-    lib.set_struct("MoveParam", values)
-    res = command(lib, "mover", "MoveExec")
+    rig.set_struct("MoveParam", values)
+    res = command(rig, "mover", "MoveExec")
     assert res.scripts and res.scripts[0].split("\r\n")[0] == abs_call(values)[:-1] + f",{text})", res.scripts
 
 
@@ -521,9 +489,9 @@ def test_move_absolute_arm_configuration_is_the_three_pose_integers(lib, pose, t
     ("mover", "MoveParam", move_abs(ExitNode=True), "QueueTag(1)\r\nScriptExit()"),
     ("rel", "RelParam", rel(ExitNode=True, BlendingEnable=True, BlendingValue=50), "ScriptExit()"),
     ("circ", "CircParam", circ(ExitNode=True), "QueueTag(1)\r\nScriptExit()")])
-def test_exit_node_is_the_last_line_after_the_queue_tag(lib, fb, param, values, tail):
-    lib.set_struct(param, values)
-    res = command(lib, fb, {"mover": "MoveExec", "rel": "RelExec", "circ": "CircExec"}[fb])
+def test_exit_node_is_the_last_line_after_the_queue_tag(rig, fb, param, values, tail):
+    rig.set_struct(param, values)
+    res = command(rig, fb, {"mover": "MoveExec", "rel": "RelExec", "circ": "CircExec"}[fb])
     assert len(res.scripts) == 1 and res.scripts[0].split("\r\n", 1)[1] == tail, res.scripts
 
 
@@ -531,11 +499,11 @@ def test_exit_node_is_the_last_line_after_the_queue_tag(lib, fb, param, values, 
     ("mover", "MoveParam", move_abs(), abs_call(move_abs())),
     ("rel", "RelParam", rel(), rel_call(rel())),
     ("circ", "CircParam", circ(), circle_call(circ()))])
-def test_aborting_is_one_script_stop_and_clear_then_the_motion(lib, fb, param, values, call):
+def test_aborting_is_one_script_stop_and_clear_then_the_motion(rig, fb, param, values, call):
     """TMscript 2.24 §13.4: StopAndClearBuffer() first, in the same script, so nothing runs in between."""
-    lib.set_struct(param, values)
-    lib.write(f"{fb}.BufferMode", "Aborting")
-    res = command(lib, fb, {"mover": "MoveExec", "rel": "RelExec", "circ": "CircExec"}[fb])
+    rig.set_struct(param, values)
+    rig.write(f"{fb}.BufferMode", "Aborting")
+    res = command(rig, fb, {"mover": "MoveExec", "rel": "RelExec", "circ": "CircExec"}[fb])
     assert len(res.scripts) == 1 and res.scripts[0].split("\r\n")[:2] == ["StopAndClearBuffer()", call], res.scripts
     assert res.done
 
@@ -543,9 +511,9 @@ def test_aborting_is_one_script_stop_and_clear_then_the_motion(lib, fb, param, v
 @pytest.mark.parametrize("immediate,value,text", [(True, True, 'IO["ControlBox"].InstantDO[15]=1'),
                                                   (True, False, 'IO["ControlBox"].InstantDO[15]=0'),
                                                   (False, False, 'IO["ControlBox"].DO[15]=0')])
-def test_set_output_immediate_and_value(lib, immediate, value, text):
-    lib.set_struct("OutParam", dict(Module="ControlBox", Channel=15, Value=value, Immediate=immediate))
-    res = command(lib, "dout", "OutExec")
+def test_set_output_immediate_and_value(rig, immediate, value, text):
+    rig.set_struct("OutParam", dict(Module="ControlBox", Channel=15, Value=value, Immediate=immediate))
+    res = command(rig, "dout", "OutExec")
     assert res.done and res.scripts == [text], res.scripts
 
 
