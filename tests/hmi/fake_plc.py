@@ -154,3 +154,47 @@ def serving(plc, mapping):
         yield server
     finally:
         server.stop()
+
+
+class ConnectedStack:
+    """The stand-in PLC scanning every millisecond with a robot connected in its Listen node (project running, auto
+    mode, speed 100 %), and an HMI server on it; ``server_options()`` gives the server's keyword arguments at each
+    start (a test that restarts the server on the same port calls ``start_server(port)``)."""
+
+    def __init__(self, port: int = 0):
+        self.mapping = Mapping.load()
+        self.plc = FakePlc(self.mapping, command_program)
+        self.plc.vars.update(Connect_Execute=True, Connect_Connected=True, Robot_InListenNode=True,
+                             RobotStatus_Valid=True)
+        self.plc.vars["RobotStatus"].update(ProjectRunning=True, AutoMode=True, ProjectSpeed=100)
+        self.plc.executes_seen = {"Connect": True}
+        self.stop_scanning = threading.Event()
+        self.thread = threading.Thread(target=self._scan, daemon=True)
+        self.thread.start()
+        self.start_server(port)
+
+    def _scan(self) -> None:
+        while not self.stop_scanning.wait(0.001):
+            self.plc.scan()
+
+    def server_options(self) -> dict:
+        return {}
+
+    def start_server(self, port: int = 0) -> None:
+        from cbt_hmi.web.server import HmiServer
+        self.server = HmiServer(self.plc, self.mapping, port=port, **self.server_options())
+        self.server.start()
+
+    def set(self, **values) -> None:
+        """Write variables of the stand-in PLC; ``RS_<member>`` is a member of RobotStatus."""
+        with self.plc.lock:
+            for name, value in values.items():
+                if name.startswith("RS_"):
+                    self.plc.vars["RobotStatus"][name[3:]] = value
+                else:
+                    self.plc.vars[name] = value
+
+    def close(self) -> None:
+        self.server.stop()
+        self.stop_scanning.set()
+        self.thread.join(timeout=5)

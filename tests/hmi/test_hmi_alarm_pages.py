@@ -5,17 +5,13 @@ restart, #### and grey lamps within a second of the PLC going away, the operator
 robot state with the way back to the Listen node, and Play that does not speak of a stop."""
 from __future__ import annotations
 
-import threading
 import time
 
 import pytest
 from browser import Browser
-from fake_plc import FakePlc, command_program
+from fake_plc import ConnectedStack
 from panel_metrics import cut_texts, page_metrics
 from selenium.webdriver.common.by import By
-
-from cbt_hmi.web.mapping import Mapping
-from cbt_hmi.web.server import HmiServer
 
 CONTROLLER_START = time.mktime((2031, 7, 4, 21, 15, 30, 0, 0, -1))   # the controller's clock: not the browser's
 
@@ -30,40 +26,16 @@ class ControllerClock:
         return CONTROLLER_START + (time.monotonic() - self.origin)
 
 
-class Stack:
+class Stack(ConnectedStack):
+    """The stand-in PLC with its robot connected, and an HMI server keeping its alarm history in ``log_path`` on the
+    controller's clock (a new clock at each server start)."""
+
     def __init__(self, log_path, port=0):
-        self.mapping = Mapping.load()
-        self.plc = FakePlc(self.mapping, command_program)
-        self.plc.vars.update(Connect_Execute=True, Connect_Connected=True, Robot_InListenNode=True,
-                             RobotStatus_Valid=True)
-        self.plc.vars["RobotStatus"].update(ProjectRunning=True, AutoMode=True, ProjectSpeed=100)
-        self.plc.executes_seen = {"Connect": True}
         self.log_path = log_path
-        self.stop_scanning = threading.Event()
-        self.thread = threading.Thread(target=self._scan, daemon=True)
-        self.thread.start()
-        self.start_server(port)
+        super().__init__(port)
 
-    def _scan(self):
-        while not self.stop_scanning.wait(0.001):
-            self.plc.scan()
-
-    def start_server(self, port=0):
-        self.server = HmiServer(self.plc, self.mapping, port=port, alarm_log=self.log_path, clock=ControllerClock())
-        self.server.start()
-
-    def set(self, **values):
-        with self.plc.lock:
-            for name, value in values.items():
-                if name.startswith("RS_"):
-                    self.plc.vars["RobotStatus"][name[3:]] = value
-                else:
-                    self.plc.vars[name] = value
-
-    def close(self):
-        self.server.stop()
-        self.stop_scanning.set()
-        self.thread.join(timeout=5)
+    def server_options(self):
+        return {"alarm_log": self.log_path, "clock": ControllerClock()}
 
 
 @pytest.fixture(scope="module")

@@ -6,58 +6,28 @@ what the page showed, and History cutting its words in two. Screenshots: artifac
 from __future__ import annotations
 
 import json
-import threading
 
 import pytest
-from fake_plc import FakePlc, command_program
+from fake_plc import ConnectedStack
 from panel_metrics import cut_texts
 from selenium.webdriver.common.by import By
 
 from cbt_hmi import PAGES
 from cbt_hmi.web.alarms import operator_text
-from cbt_hmi.web.mapping import Mapping
-from cbt_hmi.web.server import HmiServer
 
 ERRORS = json.loads((PAGES / "errors.json").read_text(encoding="utf-8"))
 TCP = {"X": 417.5, "Y": -122.3, "Z": 359.7, "RX": 180.0, "RY": 0.0, "RZ": 90.0}
 
 
-class Stack:
-    """The stand-in PLC scanning every millisecond, a robot connected in its Listen node, and an HMI server."""
+class Stack(ConnectedStack):
+    """The stand-in PLC scanning every millisecond, a robot connected in its Listen node with its TCP position read,
+    and an HMI server."""
 
     def __init__(self):
-        self.mapping = Mapping.load()
-        self.plc = FakePlc(self.mapping, command_program)
-        self.plc.vars.update(Connect_Execute=True, Connect_Connected=True, Robot_InListenNode=True,
-                             RobotStatus_Valid=True, ReadPos_Valid=True)
-        self.plc.vars["RobotStatus"].update(ProjectRunning=True, AutoMode=True, ProjectSpeed=100)
-        self.plc.vars["ReadPos_Position"]["TCP"].update(TCP)
-        self.plc.executes_seen = {"Connect": True}
-        self.stop_scanning = threading.Event()
-        self.thread = threading.Thread(target=self._scan, daemon=True)
-        self.thread.start()
-        self.start_server()
-
-    def _scan(self):
-        while not self.stop_scanning.wait(0.001):
-            self.plc.scan()
-
-    def start_server(self, port: int = 0):
-        self.server = HmiServer(self.plc, self.mapping, port=port)
-        self.server.start()
-
-    def set(self, **values):
+        super().__init__()
+        self.set(ReadPos_Valid=True)
         with self.plc.lock:
-            for name, value in values.items():
-                if name.startswith("RS_"):
-                    self.plc.vars["RobotStatus"][name[3:]] = value
-                else:
-                    self.plc.vars[name] = value
-
-    def close(self):
-        self.server.stop()
-        self.stop_scanning.set()
-        self.thread.join(timeout=5)
+            self.plc.vars["ReadPos_Position"]["TCP"].update(TCP)
 
 
 @pytest.fixture(scope="module")
