@@ -30,7 +30,9 @@ class RobotModel:
                  stop_tags: str = "forget"):
         self.joints = list(HOME_JOINTS)
         self.bases = {"RobotBase": IDENTITY_POSE, **(bases or {})}
-        self.tools = {"NOTOOL": IDENTITY_POSE, **(tools or {})}
+        # The bare flange is a tool record of the controller under both names: "NOTOOL" (TMflow 1.x) and
+        # "RobotEndFlange", which TMscript 2.24 §15.3 (item 3) and §15.7 use in their own example packets.
+        self.tools = {"NOTOOL": IDENTITY_POSE, "RobotEndFlange": IDENTITY_POSE, **(tools or {})}
         self.base_name, self.base_pose = "RobotBase", list(IDENTITY_POSE)
         self.tool_name, self.tool_pose = "NOTOOL", list(IDENTITY_POSE)
         self.tool_mass = 0.0
