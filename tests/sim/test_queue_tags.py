@@ -142,7 +142,8 @@ def test_our_choice_stop_tags_reached_makes_dropped_tags_answer_true_without_a_p
 def test_a_script_waiting_in_queue_tag_wait_ends_when_a_priority_stop_drops_the_tag(node):
     node.send(1, sct("A", PTP_LONG + "\r\nQueueTag(2,1)"))
     node.advance(0.5)
-    assert node.send(1, sct("S", "StopAndClearBuffer(0)")) == [reply("S", "OK"), reply("A", "OK")]
+    # TMscript 2.24 §15.8 example 2: the released script's OK comes before the priority command's
+    assert node.send(1, sct("S", "StopAndClearBuffer(0)")) == [reply("A", "OK"), reply("S", "OK")]
 
 
 def test_sleep_delays_the_rest_of_the_script(node):

@@ -150,7 +150,8 @@ def test_priority_stop_0_keeps_current_script_and_releases_its_dropped_tag(node)
     node.send(1, sct("1", PTP_LONG + "\r\nQueueTag(1,1)\r\nint after = 7"))
     node.advance(1.0)
     out = node.send(1, b"$TMSCT,23,2,StopAndClearBuffer(0),*55\r\n")
-    assert out == ["$TMSCT,4,2,OK,*5F\r\n", "$TMSCT,4,1,OK,*5C\r\n"]
+    # TMscript 2.24 §15.8 example 2: the released script is answered first, then the priority command
+    assert out == ["$TMSCT,4,1,OK,*5C\r\n", "$TMSCT,4,2,OK,*5F\r\n"]
     assert node.s.variables["after"] == 7 and node.s.state == IN_NODE
     assert node.s.robot.queue_length == 0
 
@@ -339,8 +340,9 @@ def test_stop_and_clear_buffer_frees_a_script_waiting_for_room(monkeypatch):
     script = "\r\n".join(f"QueueTag({k})" for k in (1, 2, 3))
     node.s.robot.pause()                                       # nothing runs: the FIFO stays full
     assert node.send(1, sct("A", script)) == []
-    # the priority command clears the FIFO and is answered; the third tag then finds room and A ends
-    assert node.send(1, sct("P", "StopAndClearBuffer(0)")) == [frame("TMSCT", "P,OK"), frame("TMSCT", "A,OK")]
+    # the priority command clears the FIFO; the third tag then finds room and A ends, and is answered before
+    # the priority command (TMscript 2.24 §15.8 example 2: the script the stop lets finish goes first)
+    assert node.send(1, sct("P", "StopAndClearBuffer(0)")) == [frame("TMSCT", "A,OK"), frame("TMSCT", "P,OK")]
 
 
 @pytest.mark.parametrize("call,frame", [

@@ -284,6 +284,12 @@ class ListenSession:
             for dropped in self.pending:
                 self.log("discarded", conn=dropped.conn, id=dropped.id)
             self.pending.clear()
+        if arg == 0:
+            # TMscript 2.24 §15.8, example 2: the current script goes on first (a wait on a dropped tag
+            # returns), so a script the stop lets finish is answered before the priority command
+            # ("Respond 1 OK", then "Respond 2 OK"); one still blocked (example 3, WaitQueueTag(0,60000))
+            # is answered later.
+            self._resume_waits()
         self._reply(packet, "OK")
         self._pump()
 
