@@ -22,6 +22,7 @@ import xml.etree.ElementTree as ET
 
 from .. import __version__
 from ..frontend import ast as A
+from ..ladder.model import WriteError
 from ..ladder.plcopen_write import XHTML_NS, formatted, ld_body
 from ..project import Project
 from .iec61131_10 import COMPANY, PRODUCT, creation_time, to_bytes
@@ -192,11 +193,20 @@ def build(export: ExportSet, project: Project) -> ET.Element:
         _sub(_sub(ci, lang), "scaling", {"x": "1", "y": "1"})
     types = _sub(root, "types")
     data_types = _sub(types, "dataTypes")
+    refused: list[str] = []              # every construct TC6 cannot express, reported together
     for t in export.types:
-        _data_type(data_types, t, project)
+        try:
+            _data_type(data_types, t, project)
+        except ExportError as exc:
+            refused.append(str(exc))
     pous = _sub(types, "pous")
     for p in export.pous:
-        _pou(pous, p)
+        try:
+            _pou(pous, p)
+        except WriteError as exc:
+            refused.append(f"{p.path}: {p.kind} `{p.name}`: {exc}")
+    if refused:
+        raise ExportError("\n".join(refused))
     configs = _sub(_sub(root, "instances"), "configurations")
     if export.globals:
         cfg = _sub(configs, "configuration", {"name": export.name})

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from tests.vplc.export.conftest import q, run
+from tests.vplc.export.conftest import ROOT, q, run
 from vplc.api import load_plc
 
 SYSTEM_VARIABLES = """PROGRAM Main
@@ -191,3 +191,13 @@ def test_type_and_member_comments_survive_export_and_reading_back(tmp_path, caps
     code, _, err = run(capsys, "export", str(first), "-o", str(again))
     assert code == 0, err
     assert again.read_bytes() == first.read_bytes()
+
+
+def test_plcopen_export_names_every_construct_it_refuses_at_once(tmp_path, capsys):
+    # the manual-style project has two unions and a ladder FB with inline ST: one run names all three (the union
+    # refusal must not hide the inline ST one, which the project's own test looks for)
+    project = ROOT / "tests" / "vplc" / "sysmac" / "manual_project"
+    code, _, err = run(capsys, "export", str(project), "--format", "plcopen", "-o", str(tmp_path / "tc6.xml"))
+    assert code == 1 and "Traceback" not in err
+    assert "data type `uStatus` is a UNION" in err and "data type `uRealImage` is a UNION" in err
+    assert "FUNCTION_BLOCK `StartStop`: a rung holds Sysmac inline ST (smcext:InlineST)" in err
