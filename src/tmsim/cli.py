@@ -89,7 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "plus the status items; see docs/simulator.md)")
     svr.add_argument("--svr-var", action="append", default=[], metavar="NAME:TYPE[:ACCESS][=VALUE]",
                      help="a global variable of the robot's project, readable and writable through the Ethernet "
-                          "Slave (repeat for more): TYPE bool, byte, int, float or string, an array as int[4]; "
+                          "Slave (repeat for more): TYPE bool, byte, int, float or string, an array as int[4] "
+                          "(fixed size) or string[] (any number of elements, as TMscript's arrays); "
                           "ACCESS rw (default), auto (written in auto mode only) or ro; VALUE as written in string "
                           "mode, e.g. g_count:int=5, g_pos:float[3]={1,2,3}, g_name:string=\"abc\"")
     vision = parser.add_argument_group("virtual camera (TMscript manual §13.32-13.34, chapter 14)")

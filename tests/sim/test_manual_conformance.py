@@ -5,6 +5,7 @@ import pytest
 from sim_harness import Harness
 
 from tmsim.protocol import codec
+from tmsim.protocol import svr_table as table
 
 
 @pytest.fixture
@@ -113,3 +114,56 @@ def test_manual_15_8_example_5_stop_2_ends_script_1_and_discards_script_2_withou
         b"$TMSCT,4,1,OK,*5C\r\n$TMSCT,4,3,OK,*5E\r\n"
     h.run(30.0, dt=0.1)
     assert len(peer.frames) == 2 and h.robot.state()["queue_length"] == 0
+
+
+# TMscript 2.24 §17.4.2-17.4.4: the global variable g_ss is a `string[]` (no size); the manual's T2 writes two texts
+# over its three and is answered 00 OK. Before, every declared array had a fixed size and T2 got 07 ValueError.
+@pytest.fixture
+def svr():
+    harness = Harness(svr_port=0, svr_options={"period": 0, "variables": [
+        table.parse_variable('g_ss:string[]={"Hi","TM","Robot"}'), table.parse_variable("g_arr:int[]={1,2}"),
+        table.parse_variable("g_pos:float[6]")]})
+    yield harness
+    harness.close()
+
+
+def test_manual_17_4_2_binary_write_of_a_string_array_with_another_length_is_ok(svr):
+    peer = svr.connect_svr()
+    request = bytes.fromhex("24544D5356522C" "32352C" "54322C312C" "0400675F7373" "0C0048656C6C6F0000576F726C64"
+                            "2C2A30320D0A")
+    assert exchange(svr, peer, request) == b"$TMSVR,10,T2,0,00,OK,*1D\r\n"
+    assert svr.robot.svr.variables["g_ss"] == ["Hello", "World"]
+    assert exchange(svr, peer, codec.encode("TMSVR", "R1,12,g_ss")) == \
+        codec.encode("TMSVR", 'R1,12,g_ss={"Hello","World"}')
+
+
+def test_manual_17_4_4_json_write_of_the_string_array_is_ok(svr):
+    peer = svr.connect_svr()
+    assert exchange(svr, peer, b'$TMSVR,113,T9,3,[{"Item":"Ctrl_DO0","Value":1},{"Item":"Ctrl_DO1","Value":0},'
+                               b'{"Item":"g_ss","Value":["Hello","TM","Robot"]}],*7C\r\n') == \
+        b"$TMSVR,10,T9,0,00,OK,*16\r\n"
+    assert svr.robot.svr.variables["g_ss"] == ["Hello", "TM", "Robot"]
+
+
+def test_an_unsized_array_takes_any_number_of_elements_a_sized_one_keeps_its_size(svr):
+    peer = svr.connect_svr()
+    assert exchange(svr, peer, codec.encode("TMSVR", "W1,2,g_arr={1,2,3}")) == codec.encode("TMSVR", "W1,0,00,OK")
+    packed = b"\x04\x00" + (7).to_bytes(4, "little")
+    assert exchange(svr, peer, codec.encode("TMSVR", b"W2,1,\x05\x00g_arr" + packed)) == \
+        codec.encode("TMSVR", "W2,0,00,OK")
+    assert svr.robot.svr.variables["g_arr"] == [7]
+    reply = exchange(svr, peer, codec.encode("TMSVR", b"R1,11,\x05\x00g_arr"))
+    assert reply == codec.encode("TMSVR", b"R1,11,\x05\x00g_arr" + packed)
+    for bad in ("W3,2,g_arr={}", "W3,2,g_arr=5", "W3,2,g_pos={1,2,3}"):
+        name = bad.split(",")[2].split("=")[0]
+        assert exchange(svr, peer, codec.encode("TMSVR", bad)) == codec.encode("TMSVR", f"W3,0,07,ValueError;{name}")
+    odd = b"W4,1,\x05\x00g_arr\x03\x00\x01\x02\x03"                # 3 bytes: no whole int
+    assert exchange(svr, peer, codec.encode("TMSVR", odd)) == codec.encode("TMSVR", "W4,0,07,ValueError;g_arr")
+    assert svr.robot.svr.variables["g_arr"] == [7]
+
+
+@pytest.mark.parametrize("spec, words", [("g_x:int[]={}", "1..1024"), ("g_x:bool[]={1,2}", "outside 0..1"),
+                                         ("g_x:thing[]", "type 'thing'")])
+def test_an_unsized_array_declaration_names_what_is_wrong(spec, words):
+    with pytest.raises(ValueError, match=words):
+        table.parse_variable(spec)

@@ -49,6 +49,14 @@ class Item:
     low: float | None = None       # value range of a writable number (None: the type's range)
     high: float | None = None
     step: int | None = None        # written values must be multiples of this (Project_Speed)
+    # A global variable declared without a size (`string[]`, as the TMscript 2.24 manual names g_ss, §17.4.2-17.4.4)
+    # is a TMscript array: a write may give it another number of elements (the manual's T2 writes
+    # g_ss={"Hello","World"} over {"Hi","TM","Robot"}: 00 OK). ``size`` is then its initial length.
+    resizable: bool = False
+
+    @property
+    def array(self) -> bool:
+        return self.size > 1 or self.resizable
 
 
 def _items():
@@ -101,6 +109,10 @@ _PACKERS = {item.name: (_U16.pack(len(item.name.encode())) + item.name.encode(),
 # ---- checking a value against its item ------------------------------------------------------------
 def check_value(item: Item, value: Any) -> Any:
     """The value coerced to the item's type (lists for arrays); raises SvrValueError when it does not fit."""
+    if item.resizable:
+        if not isinstance(value, (list, tuple)) or not 1 <= len(value) <= SVR_ARRAY_MAX:
+            raise SvrValueError(f"{item.name} needs an array of 1..{SVR_ARRAY_MAX} values")
+        return [_scalar(item, v) for v in value]
     if item.size > 1:
         if not isinstance(value, (list, tuple)) or len(value) != item.size:
             raise SvrValueError(f"{item.name} needs {item.size} values")
@@ -150,9 +162,11 @@ def _packer(item: Item):
 
 def binary_value(item: Item, value: Any) -> bytes:
     if item.type == "string":
-        if item.size > 1:                      # §17.4.2: "two bytes, 0x00 0x00, are inserted between the elements"
+        if item.array:                         # §17.4.2: "two bytes, 0x00 0x00, are inserted between the elements"
             return b"\x00\x00".join(v.encode("utf-8") for v in value)
         return value.encode("utf-8")
+    if item.resizable:
+        return struct.pack(f"<{len(value)}{_PACK[item.type]}", *value)
     packer = _packer(item)[1]
     if item.size > 1:
         return packer.pack(*value)
@@ -201,12 +215,18 @@ def _chunk(content, pos):
 def decode_binary_value(item: Item, data: bytes) -> Any:
     if item.type == "string":
         try:
-            if item.size > 1:
+            if item.array:
                 return [part.decode("utf-8") for part in data.split(b"\x00\x00")]
             return data.decode("utf-8")
         except UnicodeDecodeError:
             raise SvrValueError(f"{item.name} is not UTF-8 text") from None
     width = _WIDTH[item.type]
+    if item.resizable:
+        count = len(data) // width
+        if not data or len(data) % width or count > SVR_ARRAY_MAX:
+            raise SvrValueError(f"{item.name} needs 1..{SVR_ARRAY_MAX} values of {width} bytes, got {len(data)} bytes")
+        values = list(struct.unpack(f"<{count}{_PACK[item.type]}", data))
+        return [float(v) for v in values] if item.type == "float" else values
     if len(data) != width * item.size:
         raise SvrValueError(f"{item.name} needs {width * item.size} bytes, got {len(data)}")
     values = list(struct.unpack(f"<{item.size}{_PACK[item.type]}", data))
@@ -217,7 +237,7 @@ def decode_binary_value(item: Item, data: bytes) -> Any:
 
 # ---- string (mode 2 / 12) --------------------------------------------------------------------------
 def string_value(item: Item, value: Any) -> str:
-    if item.size > 1:
+    if item.array:
         return "{" + ",".join(_string_scalar(item, v) for v in value) + "}"
     return _string_scalar(item, value)
 
@@ -261,9 +281,10 @@ def split_string(content: str, with_values: bool) -> list[tuple[str, str | None]
 
 def parse_string_value(item: Item, text: str) -> Any:
     """``Value`` text of mode 2 -> Python value (not yet range-checked); SvrValueError when unreadable."""
-    if item.size > 1:
+    if item.array:
         if not (text.startswith("{") and text.endswith("}")):
-            raise SvrValueError(f"{item.name} needs {{...}} with {item.size} values")
+            raise SvrValueError(f"{item.name} needs {{...}}" if item.resizable
+                                else f"{item.name} needs {{...}} with {item.size} values")
         inner = text[1:-1].strip()
         return [_parse_scalar(item, part.strip()) for part in _split_elements(inner)] if inner else []
     return _parse_scalar(item, text)
@@ -306,9 +327,9 @@ def _parse_scalar(item, text):
 # ---- JSON (mode 3 / 13) ----------------------------------------------------------------------------
 def json_value(item: Item, value: Any) -> Any:
     if item.type == "bool":
-        return [bool(v) for v in value] if item.size > 1 else bool(value)
+        return [bool(v) for v in value] if item.array else bool(value)
     if item.type == "float":
-        return [float(_float_text(v)) for v in value] if item.size > 1 else float(_float_text(value))
+        return [float(_float_text(v)) for v in value] if item.array else float(_float_text(value))
     return value
 
 
@@ -346,8 +367,9 @@ VARIABLE_TYPES = ("bool", "byte", "int", "float", "string")
 VARIABLE_ACCESS = {"rw": "MA", "auto": "A", "ro": ""}   # write in manual and auto mode / auto only / read only
 
 
-def variable_item(name: str, kind: str, size: int = 1, access: str = "rw") -> Item:
-    """The Item of a global variable; SvrValueError names what is wrong."""
+def variable_item(name: str, kind: str, size: int = 1, access: str = "rw", resizable: bool = False) -> Item:
+    """The Item of a global variable (``resizable``: an array declared without a size, ``size`` its initial
+    length); SvrValueError names what is wrong."""
     if not (isinstance(name, str) and 0 < len(name) <= 64 and name.isascii()
             and (name[0].isalpha() or name[0] == "_") and all(c.isalnum() or c == "_" for c in name)):
         raise SvrValueError(f"variable name {str(name)[:70]!r}: 1..64 letters, digits or '_', "
@@ -360,23 +382,30 @@ def variable_item(name: str, kind: str, size: int = 1, access: str = "rw") -> It
         raise SvrValueError(f"variable {name}: array size must be 1..{SVR_ARRAY_MAX}, got {size!r}")
     if access not in VARIABLE_ACCESS:
         raise SvrValueError(f"variable {name}: access {str(access)[:20]!r} is not one of {', '.join(VARIABLE_ACCESS)}")
-    return Item(name, kind, size, VARIABLE_ACCESS[access])
+    return Item(name, kind, size, VARIABLE_ACCESS[access], resizable=bool(resizable))
 
 
 def default_value(item: Item) -> Any:
     zero = "" if item.type == "string" else 0.0 if item.type == "float" else 0
-    return [zero] * item.size if item.size > 1 else zero
+    return [zero] * item.size if item.array else zero
 
 
 def parse_variable(spec: str) -> tuple[Item, object]:
-    """``NAME:TYPE[:ACCESS][=VALUE]`` (TYPE ``int``, ``float[6]`` ...; ACCESS rw, auto or ro; VALUE as in a mode 2
-    write: ``5``, ``{1,2,3}``, ``"text"``) -> (Item, value); SvrValueError names what is wrong."""
+    """``NAME:TYPE[:ACCESS][=VALUE]`` (TYPE ``int``, ``float[6]`` (fixed size), ``string[]`` (any number of
+    elements, initially VALUE's) ...; ACCESS rw, auto or ro; VALUE as in a mode 2 write: ``5``, ``{1,2,3}``,
+    ``"text"``) -> (Item, value); SvrValueError names what is wrong."""
     head, eq, text = spec.partition("=")
     parts = head.split(":")
     if len(parts) not in (2, 3):
         raise SvrValueError(f"variable {spec[:60]!r}: expected NAME:TYPE[:ACCESS][=VALUE]")
     name, kind = parts[0].strip(), parts[1].strip()
     size = 1
+    if kind.endswith("[]"):
+        kind = kind[:-2].strip()
+        access = parts[2].strip() if len(parts) == 3 else "rw"
+        item = variable_item(name, kind, 1, access, resizable=True)
+        value = check_value(item, parse_string_value(item, text.strip())) if eq else default_value(item)
+        return variable_item(name, kind, len(value), access, resizable=True), value
     if kind.endswith("]") and "[" in kind:
         kind, _, count = kind[:-1].partition("[")
         if not count.isdigit():
