@@ -11,13 +11,10 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import FrameType
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 from ..frontend import types as T
 from .faults import GEN_FILE
-
-if TYPE_CHECKING:
-    from .engine import Engine
 
 
 @dataclass
@@ -44,6 +41,16 @@ class Collector:
 
     def order(self) -> list[TestCase]:
         return list(self.tests.values())
+
+
+class Engine(Protocol):
+    """What the test functions use of the engine that runs them (runtime/engine.py's Engine, which holds the
+    collector): declared here so that this module does not import the engine that imports it."""
+
+    tests: Collector | None
+
+    @property
+    def module(self) -> Any: ...
 
 
 def _where(rt: Engine) -> tuple[str, int, str]:
