@@ -81,26 +81,25 @@ function drawBanner() {
   const banner = document.getElementById("alarm-banner");
   if (!banner) return;
   const text = banner.querySelector(".text"), ack = banner.querySelector("button");
-  if (!live.online && !live.fault && live.lostAt) {
-    banner.hidden = false;
-    banner.dataset.priority = "high";
-    ack.hidden = true;
-    const shown = `${live.clock ? live.clock.slice(0, 19) : "—"}  High  PLC communication lost: no answer from the PLC ` +
-      "— check the PLC and the network cable; the values shown as #### are not valid.";
-    if (text.textContent !== shown) text.textContent = shown;
+  if (!live.online && !live.fault && live.lostAt) {      // every write compares first (hmi.js, setText …)
+    setHidden(banner, false);
+    setData(banner, "priority", "high");
+    setHidden(ack, true);
+    setText(text, `${live.clock ? live.clock.slice(0, 19) : "—"}  High  PLC communication lost: no answer from the ` +
+      "PLC — check the PLC and the network cable; the values shown as #### are not valid.");
     return;
   }
   const open = alarms.list.filter((a) => a.state.endsWith("unacknowledged"));
-  banner.hidden = open.length === 0;
-  ack.hidden = false;
+  setHidden(banner, open.length === 0);
+  setHidden(ack, false);
   if (!open.length) return;
   const a = open[0];
-  banner.dataset.priority = a.priority;
-  banner.dataset.number = a.number;
+  setData(banner, "priority", a.priority);
+  setData(banner, "number", a.number);
   const shown = `${a.time.slice(0, 19)}  ${PRIORITY_SHOWN[a.priority]}  ${alarmLine(a)}` +
     (a.remedy ? ` — ${a.remedy}` : "") + (a.details.length ? `  [${a.details.length} consequence` +
     `${a.details.length > 1 ? "s" : ""}]` : "") + (open.length > 1 ? `  (+${open.length - 1} more)` : "");
-  if (text.textContent !== shown) text.textContent = shown;
+  setText(text, shown);
 }
 
 function drawAlarms() {
@@ -231,10 +230,10 @@ function drawRobotTile() {
   const v = live.values, rs = v.RobotStatus, valid = v.RobotStatus_Valid === true && rs;
   const set = (id, text, bad) => {
     const el = document.getElementById(id);
-    if (el.textContent !== text) el.textContent = text;
-    el.className = bad ? "bad" : "";
+    setText(el, text);
+    setClass(el, bad ? "bad" : "");
   };
-  document.getElementById("btn-back-to-node").hidden = live.robot !== "left the Listen node";
+  setHidden(document.getElementById("btn-back-to-node"), live.robot !== "left the Listen node");
   if (!live.online && !live.fault) {
     for (const id of ["robot-project", "robot-error", "robot-safety", "robot-link"]) set(id, "####", false);
     return;

@@ -58,8 +58,41 @@ const readVars = (names) => api("/api/read?names=" + names.map(encodeURIComponen
 
 function message(text, kind = "") {
   const el = document.getElementById("message");
-  el.textContent = text;
-  el.className = kind;
+  setText(el, text);
+  setClass(el, kind);
+}
+
+/* ---------- writing the page ---------- */
+/* Every poll (20 a second) runs the page's listeners, and most of what they show has not changed since the last
+   one. A write into the page costs the panel's browser a new frame (style, layout, paint) even when it writes the
+   value already there, so the listeners write through these helpers: each one compares first and writes only a
+   change (docs/hmi.md, Performance). A changed value still shows at the next poll. */
+function setText(el, text) {
+  const t = String(text);
+  if (el.textContent !== t) el.textContent = t;
+}
+/* an attribute; null or undefined removes it */
+function setAttr(el, name, value) {
+  if (value === null || value === undefined) {
+    if (el.hasAttribute(name)) el.removeAttribute(name);
+    return;
+  }
+  const v = String(value);
+  if (el.getAttribute(name) !== v) el.setAttribute(name, v);
+}
+function setData(el, key, value) {
+  const v = String(value);
+  if (el.dataset[key] !== v) el.dataset[key] = v;
+}
+/* the whole class attribute (HTML and SVG elements alike) */
+function setClass(el, cls) {
+  if ((el.getAttribute("class") || "") !== cls) el.setAttribute("class", cls);
+}
+function setHidden(el, flag) {
+  if (el.hidden !== Boolean(flag)) el.hidden = Boolean(flag);
+}
+function setDisabled(el, flag) {
+  if (el.disabled !== Boolean(flag)) el.disabled = Boolean(flag);
 }
 
 /* ---------- the variable table ---------- */
@@ -293,22 +326,22 @@ function showStatus() {
   for (const cell of document.querySelectorAll("[data-status]")) {
     if (invalid) {
       if (cell.classList.contains("lamp") || cell.querySelector(".led")) {
-        cell.dataset.value = "invalid";
+        setData(cell, "value", "invalid");
         const led = cell.querySelector(".led");
-        if (led) led.classList.remove("on");
-      } else if (cell.textContent !== "####") cell.textContent = "####";
+        if (led) led.classList.toggle("on", false);      // toggle with its force writes only a change
+      } else setText(cell, "####");
       continue;
     }
     const v = live.values[cell.dataset.status];
-    if (cell.classList.contains("lamp")) { cell.dataset.value = String(v === true); continue; }
+    if (cell.classList.contains("lamp")) { setData(cell, "value", v === true); continue; }
     const led = cell.querySelector(".led");
-    if (led) { led.classList.toggle("on", v === true); cell.dataset.value = String(v === true); continue; }
+    if (led) { led.classList.toggle("on", v === true); setData(cell, "value", v === true); continue; }
     let text = v === undefined || v === null ? "" : String(v);
     if (cell.dataset.status === "PnP_Segment" && typeof v === "number" && PNP_SEGMENTS[v])
       text = `${v + 1} ${PNP_SEGMENTS[v]}`;            // the drawing numbers segments from 1
     if (cell.dataset.status.endsWith("ErrorID") && typeof v === "number")
       text = "16#" + v.toString(16).toUpperCase().padStart(4, "0");
-    if (cell.textContent !== text) cell.textContent = text;
+    setText(cell, text);
   }
 }
 
@@ -325,13 +358,13 @@ const ROBOT_PILL = { ready: ["Robot ready", ""], connected: ["Robot connected", 
 function showPlcState(pillPlc, pillRobot) {
   const fault = live.fault, lost = !live.online && !fault;
   const what = fault ? (fault.what.length > 40 ? fault.what.slice(0, 39) + "…" : fault.what) : "";
-  pillPlc.textContent = fault ? `PLC fault — ${what}` : live.online ? "PLC online" : "PLC offline";
-  pillPlc.title = fault ? fault.message : "";
-  pillPlc.className = "pill " + (live.online ? "" : "alarm");
+  setText(pillPlc, fault ? `PLC fault — ${what}` : live.online ? "PLC online" : "PLC offline");
+  setAttr(pillPlc, "title", fault ? fault.message : "");
+  setClass(pillPlc, "pill " + (live.online ? "" : "alarm"));
   const [text, kind] = fault ? ["Robot link closed", "alarm"] : lost ? ["Robot ####", ""] :
     ROBOT_PILL[live.robot] || ROBOT_PILL.unknown;
-  if (pillRobot.textContent !== text) pillRobot.textContent = text;
-  pillRobot.className = "pill " + kind;
+  setText(pillRobot, text);
+  setClass(pillRobot, "pill " + kind);
   const panel = document.querySelector(".panel");
   if (lost !== panel.classList.contains("plc-offline")) {
     panel.classList.toggle("plc-offline", lost);

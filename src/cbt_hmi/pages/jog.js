@@ -105,7 +105,7 @@ function jogShow() {
     let text = "####";
     if (valid && pos) text = jog.frame === "JogJoint" ? pos.Joints[i].toFixed(2) :
       pos.TCP[["X", "Y", "Z", "RX", "RY", "RZ"][i]].toFixed(2);
-    if (cell.textContent !== text) cell.textContent = text;
+    setText(cell, text);                          // every write compares first (hmi.js, setText …)
   }
   const table = v.TeachTable, body = document.getElementById("teach-points");
   if (Array.isArray(table) && body) {
@@ -116,8 +116,8 @@ function jogShow() {
       if (row.dataset.text !== text) {
         row.dataset.text = text;
         const [name, xyz] = text.split("|");
-        row.cells[1].textContent = name;
-        row.cells[2].textContent = xyz;
+        setText(row.cells[1], name);
+        setText(row.cells[2], xyz);
       }
       row.classList.toggle("sel", i + 1 === index);
     });

@@ -8,6 +8,7 @@
 
 let pnpParams = null;
 let pnpGeometry = null;
+let pnpTrailShown = { el: null, seq: -1 };         // the trail polyline and the trail it shows (updatePnP)
 
 /* the segments and the preset cycle (same as the initial values in examples/GlobalVariables.st); the PnP page
    stays hand-written: a path drawing with six editable segments is more than a page description says */
@@ -70,10 +71,10 @@ function showPnPState() {
   const { state, text, enabled } = pnpOptions();
   if (state === "Faulted" && box.dataset.state !== "Faulted")      // the line no longer says "Start: … Running"
     message(`Cycle: Faulted – ${text}`, "error");
-  box.dataset.state = state || "";
-  document.getElementById("pnp-state-name").textContent = state ? `Cycle: ${state}` : "Cycle: –";
-  document.getElementById("pnp-state-text").textContent = text;
-  for (const [id, on] of Object.entries(enabled)) document.getElementById(id).disabled = !on;
+  setData(box, "state", state || "");                 // every write compares first (hmi.js, setText …)
+  setText(document.getElementById("pnp-state-name"), state ? `Cycle: ${state}` : "Cycle: –");
+  setText(document.getElementById("pnp-state-text"), text);
+  for (const [id, on] of Object.entries(enabled)) setDisabled(document.getElementById(id), !on);
 }
 
 function buildPnP() {
@@ -195,12 +196,17 @@ function updatePnP() {
     document.getElementById(`seg-${i}`).classList.toggle("active", i === active);
     document.getElementById(`edit-${i}`).classList.toggle("active", i === active);
   }
-  const pts = VIEW.trail.map(([x, y, z]) => ({ X: x, Y: y, Z: z }));
-  document.getElementById("pnp-trail").setAttribute("points", pts.map((p) => `${X(p)},${Y(p)}`).join(" "));
+  /* the trail's points are worked out again only when the server sent new ones (robotview.js, VIEW.trailSeq) */
+  const trail = document.getElementById("pnp-trail");
+  if (pnpTrailShown.el !== trail || pnpTrailShown.seq !== VIEW.trailSeq) {     // drawPnP makes a new polyline
+    const pts = VIEW.trail.map(([x, y, z]) => ({ X: x, Y: y, Z: z }));
+    setAttr(trail, "points", pts.map((p) => `${X(p)},${Y(p)}`).join(" "));
+    pnpTrailShown = { el: trail, seq: VIEW.trailSeq };
+  }
   const tcp = live.values.ReadPos_Valid && live.values.ReadPos_Position ? live.values.ReadPos_Position.TCP : null;
   if (tcp) {
     const dot = document.getElementById("pnp-tcp");
-    dot.setAttribute("cx", X(tcp)); dot.setAttribute("cy", Y(tcp));
+    setAttr(dot, "cx", X(tcp)); setAttr(dot, "cy", Y(tcp));
   }
 }
 

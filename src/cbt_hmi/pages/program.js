@@ -82,7 +82,7 @@ const overlaps = (a, b) => a.left < b.right - 0.5 && b.left < a.right - 0.5 && a
 function showValue(t, text, fixed) {
   if (t.dataset.full === text) return;
   t.dataset.full = text;
-  t.textContent = text;
+  setText(t, text);                     // after a scroll or a zoom the value is worked out again, often the same
   if (!text) return;
   const others = fixed.get(t.closest("g.rung"));
   const vals = [...t.closest("g.rung").querySelectorAll("text.val")].filter((v) => v !== t && v.textContent);

@@ -7,7 +7,8 @@
    when the TM5-700 cannot reach it (reachRefusal: the page refuses to send it). */
 "use strict";
 
-const VIEW = { trail: [], next: 0, preview: null, zoom: Number(sessionStorage.getItem("hmi.zoom")) || 1 };
+/* trailSeq counts the changes of the trail: a drawing of it is redone only when it changed */
+const VIEW = { trail: [], trailSeq: 0, next: 0, preview: null, zoom: Number(sessionStorage.getItem("hmi.zoom")) || 1 };
 
 /* The side view's horizontal axis, the same on every page (the PnP page included): Y by default — the robot as
    the operator facing it from the front (+X) sees it, Y to the right, Z up, the direction the PnP example's cycle
@@ -309,27 +310,38 @@ function robotView(container, preview) {
     <span class="zoom"><button type="button" id="side-axis"></button>
     <button type="button" id="zoom-out" aria-label="Zoom out" title="Zoom out">−</button>
     <span id="zoom-level"></span><button type="button" id="zoom-in" aria-label="Zoom in" title="Zoom in">+</button></span></div>`;
+  /* what the two canvases show, as last drawn: a poll that changes none of it draws nothing (docs/hmi.md,
+     Performance); the canvases' sizes are part of it, so a resized view is drawn again */
+  let drawn = "";
   const redraw = () => {
     VIEW.preview = preview ? preview() : null;
     const pos = live.values.ReadPos_Valid && live.values.ReadPos_Position ? live.values.ReadPos_Position : null;
     const p = pos ? pos.TCP : null;
     const arm = readJoints() && ARM.data ? armPoints(readJoints(), [p.X, p.Y, p.Z]) : null;
-    drawProjection(container.querySelector("#view-top"), "X", "Y", "Top", p, arm);
-    drawProjection(container.querySelector("#view-side"), sideAxis(), "Z", "Side", p, arm);
+    const top = container.querySelector("#view-top"), side = container.querySelector("#view-side");
+    const size = (c) => { const r = c.getBoundingClientRect(); return [Math.round(r.width), Math.round(r.height)]; };
+    const scene = JSON.stringify([VIEW.preview, p, arm, VIEW.trailSeq, VIEW.zoom, sideAxis(), Boolean(ARM.data),
+      size(top), size(side)]);
+    if (scene !== drawn) {
+      drawProjection(top, "X", "Y", "Top", p, arm);
+      drawProjection(side, sideAxis(), "Z", "Side", p, arm);
+      drawn = scene;
+    }
     const other = sideAxis() === "X" ? "Y" : "X", toggle = container.querySelector("#side-axis");
-    toggle.textContent = `${other}–Z view`;
-    toggle.title = toggle.ariaLabel = `Show the side view ${other}–Z (on every page)`;
+    setText(toggle, `${other}–Z view`);
+    setAttr(toggle, "title", `Show the side view ${other}–Z (on every page)`);
+    setAttr(toggle, "aria-label", `Show the side view ${other}–Z (on every page)`);
     // without the PLC the last position is no longer valid (####, as every value); a short text when the robot gives
     // none, so the preview's note beside it keeps its room at 800x480
-    container.querySelector("#tcp-pos").textContent = !live.online && !live.fault ? "TCP ####" : p ?
-      `TCP X ${p.X.toFixed(1)} Y ${p.Y.toFixed(1)} Z ${p.Z.toFixed(1)}` : "TCP not valid";
+    setText(container.querySelector("#tcp-pos"), !live.online && !live.fault ? "TCP ####" : p ?
+      `TCP X ${p.X.toFixed(1)} Y ${p.Y.toFixed(1)} Z ${p.Z.toFixed(1)}` : "TCP not valid");
     const note = container.querySelector("#view-note"), pv = VIEW.preview;
-    note.textContent = pv && pv.refused ? `✕ ${pv.refused.short}` : (pv && pv.note) || "";
-    note.title = pv && pv.refused ? pv.refused.reason : "";
+    setText(note, pv && pv.refused ? `✕ ${pv.refused.short}` : (pv && pv.note) || "");
+    setAttr(note, "title", pv && pv.refused ? pv.refused.reason : "");
     note.classList.toggle("refused", Boolean(pv && pv.refused));
-    container.querySelector("#zoom-level").textContent = `${VIEW.zoom}×`;
-    container.querySelector("#zoom-out").disabled = VIEW.zoom === ZOOMS[0];
-    container.querySelector("#zoom-in").disabled = VIEW.zoom === ZOOMS[ZOOMS.length - 1];
+    setText(container.querySelector("#zoom-level"), `${VIEW.zoom}×`);
+    setDisabled(container.querySelector("#zoom-out"), VIEW.zoom === ZOOMS[0]);
+    setDisabled(container.querySelector("#zoom-in"), VIEW.zoom === ZOOMS[ZOOMS.length - 1]);
   };
   const zoomBy = (d) => {
     const i = Math.max(0, Math.min(ZOOMS.length - 1, ZOOMS.indexOf(VIEW.zoom) + d));
@@ -354,8 +366,12 @@ async function fetchTrail() {
   trailBusy = true;
   try {
     const data = await api(`/api/trail?since=${VIEW.next}`);
-    VIEW.trail = data.complete ? VIEW.trail.concat(data.points) : data.points;
-    if (VIEW.trail.length > 2000) VIEW.trail = VIEW.trail.slice(-2000);
+    const changed = data.complete ? data.points.length > 0 : JSON.stringify(data.points) !== JSON.stringify(VIEW.trail);
+    if (changed) {
+      VIEW.trail = data.complete ? VIEW.trail.concat(data.points) : data.points;
+      if (VIEW.trail.length > 2000) VIEW.trail = VIEW.trail.slice(-2000);
+      VIEW.trailSeq += 1;
+    }
     VIEW.next = data.next;
   } catch (e) { /* the trail is a nicety: the next poll tries again */ }
   trailBusy = false;
