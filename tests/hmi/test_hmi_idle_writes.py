@@ -10,6 +10,7 @@ from collections import Counter
 
 import pytest
 from browser import chromium_paths
+from fake_plc import ConnectedStack
 from hmi_system import System
 
 pytestmark = pytest.mark.skipif(chromium_paths() is None, reason="chromium/chromedriver: run `make browser`")
@@ -22,7 +23,8 @@ MIN_POLLS = 5          # the window saw the page's listeners run, whatever the m
 # removed read the same as those it added (textContent = the same text).
 OBSERVE = """
 const seen = [];
-window.__idle = { records: seen, polls: live.polls };
+window.__idle = { records: seen, ticks: 0 };
+live.listeners.push(() => { window.__idle.ticks += 1; });     // every poll, answered or not
 window.__idleObserver = new MutationObserver((list) => { for (const m of list) seen.push(m); });
 window.__idleObserver.observe(document.body, { subtree: true, childList: true, attributes: true, characterData: true,
   attributeOldValue: true, characterDataOldValue: true });
@@ -47,7 +49,7 @@ records.forEach((m, i) => {
   else now = m.type === 'attributes' ? m.target.getAttribute(m.attributeName) : m.target.data;
   if (now === m.oldValue) same.push(m.type === 'attributes' ? name(m.target) + '@' + m.attributeName : name(m.target));
 });
-return { same, writes: records.length, polls: live.polls - idle.polls };
+return { same, writes: records.length, polls: idle.ticks };
 """
 
 
@@ -98,3 +100,44 @@ def test_an_idle_page_writes_no_value_it_already_shows(system, page):
     result = watch(browser)
     assert result["polls"] >= MIN_POLLS, result
     assert result["same"] == [], f"{page}: written with the value already there (times): {Counter(result['same'])}"
+
+
+@pytest.fixture(scope="module")
+def stack(chromium):
+    """The stand-in PLC with its robot connected: states the idle demo does not show, held still."""
+    s = ConnectedStack()
+    yield s
+    s.close()
+
+
+def test_a_page_with_an_alarm_and_the_robot_out_of_its_listen_node_writes_nothing_twice(stack, chromium):
+    """The robot outside its Listen node: the banner shown (its priority and number), the header's alarm pill, the
+    Robot tile's red link and Back to Listen Node, each held for a second of polls."""
+    stack.set(Robot_InListenNode=False)
+    try:
+        chromium.open(stack.server.page_url("index", "operator"))
+        chromium.wait_for(lambda d: "The robot left the Listen node" in chromium.banner(), "the alarm in the banner")
+        chromium.wait_for(lambda d: d.find_element("id", "btn-back-to-node").is_displayed(), "Back to Listen Node")
+        settle(chromium)
+        result = watch(chromium)
+        assert result["polls"] >= MIN_POLLS, result
+        assert result["same"] == [], f"written with the value already there (times): {Counter(result['same'])}"
+    finally:
+        stack.set(Robot_InListenNode=True)
+        stack.server.alarms.acknowledge(None, "engineer")
+
+
+def test_a_page_without_its_plc_writes_nothing_twice(stack, chromium):
+    """No answer from the HMI server: ####, grey lamps and the communication alarm, held while the polls fail."""
+    chromium.open(stack.server.page_url("moveabs", "operator"))
+    port = stack.server.port
+    stack.server.stop()
+    try:
+        chromium.wait_for(lambda d: chromium.status("MoveAbs_ErrorID") == "####", "#### in place of the value")
+        chromium.wait_for(lambda d: "PLC communication lost" in chromium.banner(), "the communication alarm")
+        result = watch(chromium)
+        assert result["polls"] >= MIN_POLLS, result
+        assert result["same"] == [], f"written with the value already there (times): {Counter(result['same'])}"
+    finally:
+        stack.start_server(port)
+        chromium.wait_for(lambda d: chromium.status("MoveAbs_ErrorID") == "16#0000", "valid values again")
