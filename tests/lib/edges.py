@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from rig import ROOT, Rig, move_abs
@@ -117,6 +118,15 @@ def refused(res: Outcome, code: int) -> None:
     assert res.error and not res.done, res
     assert res.error_id == code, f"ErrorID {res.error_id:#06x}, expected {code:#06x}: {res.descrip}"
     assert res.descrip == ERRORS[code][:80], res.descrip
+
+
+def refused_or_sent(res: Outcome, code: int | None, call: Callable[[], str], motion: bool = False) -> None:
+    """``refused(res, code)`` when a code is expected, else ``sent`` with the command line ``call()`` gives (called
+    only then: a refused value may have no text)."""
+    if code is not None:
+        refused(res, code)
+    else:
+        sent(res, call(), motion)
 
 
 def sent(res: Outcome, call: str, motion: bool = False) -> str:

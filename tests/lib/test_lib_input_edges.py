@@ -32,6 +32,7 @@ from edges import (
     past,
     pose_text,
     refused,
+    refused_or_sent,
     rel_call,
     script_frames,
     sent,
@@ -86,10 +87,7 @@ MOVE_ABS_CASES = [
 def test_move_absolute_numbers(rig, values, code):
     rig.set_struct("MoveParam", values)
     res = command(rig, "mover", "MoveExec")
-    if code is not None:
-        refused(res, code)
-    else:
-        sent(res, abs_call(values), motion=not values["BlendingEnable"])
+    refused_or_sent(res, code, lambda: abs_call(values), motion=not values["BlendingEnable"])
 
 
 @pytest.mark.parametrize("member,raw,code", [
@@ -135,10 +133,7 @@ REL_CASES = [
 def test_move_relative_numbers(rig, values, code):
     rig.set_struct("RelParam", values)
     res = command(rig, "rel", "RelExec")
-    if code is not None:
-        refused(res, code)
-    else:
-        sent(res, rel_call(values), motion=not values["BlendingEnable"])
+    refused_or_sent(res, code, lambda: rel_call(values), motion=not values["BlendingEnable"])
 
 
 @pytest.mark.parametrize("member,raw,code", [
@@ -174,10 +169,7 @@ CIRCLE_CASES = [
 def test_move_circle_numbers(rig, values, code):
     rig.set_struct("CircParam", values)
     res = command(rig, "circ", "CircExec")
-    if code is not None:
-        refused(res, code)
-    else:
-        sent(res, circle_call(values), motion=not values["BlendingEnable"])
+    refused_or_sent(res, code, lambda: circle_call(values), motion=not values["BlendingEnable"])
 
 
 @pytest.mark.parametrize("member,raw,code", [("DataFormat", 3, 0x101C), ("DataFormat", 4, 0x101C),
