@@ -87,15 +87,10 @@ class ServerLock:
             raise
 
     def __enter__(self) -> bool:
-        self._lock.acquire()
-        self._depth += 1
-        return True
+        return self.acquire()
 
     def __exit__(self, *_exc: object) -> None:
-        self._depth -= 1
-        if not self._depth:
-            self._on_release()
-        self._lock.release()
+        self.release()
 
 
 class SimServer:
