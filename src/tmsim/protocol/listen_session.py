@@ -24,7 +24,7 @@ from typing import Any
 
 from tmsim.limits import NODE_TIMEOUT_MAX_S, WORK_CHAR, WORK_LINE, WORK_LOG_BYTES, WORK_TOKEN, TurnBudget
 from tmsim.protocol import codec
-from tmsim.protocol.listen_protocol import PROTOCOL_SETTINGS, Client, ListenProtocol, check_settings, outgoing
+from tmsim.protocol.listen_protocol import PROTOCOL_SETTINGS, Client, ListenProtocol, outgoing
 from tmsim.robot.faults import check_params as check_fault_params
 from tmsim.robot.model import RobotModel
 from tmsim.tmscript.interp import Context, ScriptRuntimeError, run_script, variable_memory
@@ -591,9 +591,9 @@ class ListenSession:
         if not isinstance(profile, Profile):
             raise ValueError(f"setting 'profile' of the Listen node must be a tmsim.tmscript.profiles.Profile, "
                              f"got {profile!r}")
-        protocol_settings = {name: settings[name] for name in PROTOCOL_SETTINGS if name in settings}
-        check_settings("Listen node protocol", protocol_settings, PROTOCOL_SETTINGS)
-        self.protocol.configure(**protocol_settings)
+        # the protocol checks its settings before it changes any, and the node's are checked above: a bad one
+        # leaves everything as it was
+        self.protocol.configure(**{name: settings[name] for name in PROTOCOL_SETTINGS if name in settings})
         for name, seconds in timeouts.items():
             setattr(self, name, seconds)
         self.profile = profile
