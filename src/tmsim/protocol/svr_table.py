@@ -221,18 +221,16 @@ def decode_binary_value(item: Item, data: bytes) -> Any:
         except UnicodeDecodeError:
             raise SvrValueError(f"{item.name} is not UTF-8 text") from None
     width = _WIDTH[item.type]
+    count = len(data) // width if item.resizable else item.size     # (resizable: as many as the bytes hold)
     if item.resizable:
-        count = len(data) // width
         if not data or len(data) % width or count > SVR_ARRAY_MAX:
             raise SvrValueError(f"{item.name} needs 1..{SVR_ARRAY_MAX} values of {width} bytes, got {len(data)} bytes")
-        values = list(struct.unpack(f"<{count}{_PACK[item.type]}", data))
-        return [float(v) for v in values] if item.type == "float" else values
-    if len(data) != width * item.size:
-        raise SvrValueError(f"{item.name} needs {width * item.size} bytes, got {len(data)}")
-    values = list(struct.unpack(f"<{item.size}{_PACK[item.type]}", data))
+    elif len(data) != width * count:
+        raise SvrValueError(f"{item.name} needs {width * count} bytes, got {len(data)}")
+    values = list(struct.unpack(f"<{count}{_PACK[item.type]}", data))
     if item.type == "float":
         values = [float(v) for v in values]
-    return values if item.size > 1 else values[0]
+    return values if item.array else values[0]
 
 
 # ---- string (mode 2 / 12) --------------------------------------------------------------------------
