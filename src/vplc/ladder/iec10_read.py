@@ -149,7 +149,10 @@ def type_text(t: ET.Element | None, where: str) -> str:
 
 def _array(spec: ET.Element, where: str) -> str:
     dims = []
-    for ds in spec.iterfind("DimensionSpec"):
+    # dimensionNumber (xsd:unsignedInt, required) says which dimension a DimensionSpec is: read in that order,
+    # not in the document's, so ARRAY[1..2, 1..5] never comes back as ARRAY[1..5, 1..2]
+    numbered = [(_count(ds, "dimensionNumber", n, where), ds) for n, ds in enumerate(spec.iterfind("DimensionSpec"), 1)]
+    for _number, ds in sorted(numbered, key=lambda p: p[0]):
         r = ds.find("IndexRange")
         if r is None and ds.find("VariableLength") is None:
             _old(where, "an open array dimension is an empty DimensionSpec; the schema needs IndexRange or "
@@ -194,8 +197,9 @@ def _var(v: ET.Element, where: str) -> VarText:
 
 
 def _list(kind: str, lst: ET.Element, where: str) -> SectionText:
+    # constant / retain are xsd:boolean: "1" is as true as "true" (IEC61131_10_Ed1_0_Spc1_0.xsd, VarList)
     return SectionText(kind, [_var(v, where) for v in lst.iterfind("Variable")],
-                       constant=lst.get("constant") == "true", retain=lst.get("retain") == "true")
+                       constant=_flag(lst, "constant", where), retain=_flag(lst, "retain", where))
 
 
 def _data_type(dt: ET.Element) -> TypeText:
@@ -218,7 +222,7 @@ def _data_type(dt: ET.Element) -> TypeText:
         raise FormatError(where, "data type specification `?` is not supported")
     if kind == "StructTypeSpec":
         # overlap="true": Sysmac's union, the members sharing one memory image (W501 6-3-6)
-        word = "UNION" if spec.get("overlap", "false") in ("true", "1") else "STRUCT"
+        word = "UNION" if _flag(spec, "overlap", where) else "STRUCT"
         fields = "".join(f"    {_line(m_var)}{_trailing(m_var.comment)}\n"
                          for m_var in (_var(m, where) for m in spec.iterfind("Member")))
         text = f"{word}\n{fields}END_{word}"
@@ -277,14 +281,14 @@ def _pou(el: ET.Element) -> PouText:
                 continue
             if lst.tag == "InOutVars":
                 _old(name, "<InOutVars> is spelt InoutVars in the schema")
-            if lst.get("constant") == "true":
+            if _flag(lst, "constant", name):
                 _old(name, f"<{lst.tag} constant=\"true\">: the schema marks a constant parameter per variable "
                            "(smcext:ParameterSetVariableAdditionalProperties constant=\"true\")")
             for v in lst.iterfind("Variable"):
                 props = _add_data(v, f"{name}:variable {v.get('name', '')}").get(
                     "ParameterSetVariableAdditionalProperties")
-                constant = lst.get("constant") == "true" or (
-                    props is not None and props.get("constant", "false") in ("true", "1"))
+                constant = _flag(lst, "constant", name) or (
+                    props is not None and _flag(props, "constant", f"{name}:variable {v.get('name', '')}"))
                 order = _count(v, "orderWithinParamSet", len(params), f"{name}:variable {v.get('name', '')}")
                 params.append((order, PARAMS[lst.tag], lst, v, constant))
     params.sort(key=lambda p: p[0])
@@ -293,7 +297,7 @@ def _pou(el: ET.Element) -> PouText:
     holder_of = None
     for _order, kind, lst, v, constant in params:        # declaration order; one section per source section
         if not out.sections or holder_of is not lst or out.sections[-1].constant != constant:
-            out.sections.append(SectionText(kind, constant=constant, retain=lst.get("retain") == "true"))
+            out.sections.append(SectionText(kind, constant=constant, retain=_flag(lst, "retain", name)))
             holder_of = lst
         out.sections[-1].vars.append(_var(v, name))
     for lst in el:

@@ -390,3 +390,37 @@ def test_a_negated_in_out_drawn_on_both_sides_is_refused_by_name(tmp_path):
     write(tmp_path, iec10_program({"B": "BOOL", "Q": "BOOL"}, rungs))
     err = refused(tmp_path / "sysmac.xml", "rung 1", "block Toggle", "in-out `X`", "negated")
     assert err.severity == "error"
+
+
+def _fb_section(fb_name: str, proj, kind: str) -> list:
+    fb = next(i for u in proj.units for i in getattr(u, "items", []) if getattr(i, "name", "") == fb_name)
+    return [s for s in fb.sections if s.kind == kind]
+
+
+def test_list_and_member_booleans_are_xsd_booleans_1_as_true(tmp_path):
+    # retain, constant and overlap are xsd:boolean: "1" means true (read as false before: RETAIN lost silently)
+    proj = load_project([str(write(tmp_path, doc(_param_fb("", ' retain="1"'))))])
+    assert not proj.has_errors, proj.render_diagnostics()
+    assert [s.retain for s in _fb_section("Fb", proj, "VAR_INPUT")] == [True, False]
+    props = (f'<AddData><Data {SMC}><smcext:ParameterSetVariableAdditionalProperties constant="1"/></Data>'
+             '</AddData>')
+    refused(write(tmp_path, doc(_param_fb(props)), "const.xml"), "`Limit` is a CONSTANT and cannot be written")
+    refused(write(tmp_path, doc(_param_fb("", ' retain="yes"')), "bad.xml"),
+            "Fb", 'retain="yes" is not a boolean')
+
+
+def test_array_dimensions_are_read_by_their_dimension_number(tmp_path):
+    # DimensionSpec dimensionNumber names the dimension; a file listing dimension 2 first is still ARRAY[1..2, 0..4]
+    from vplc.export.model import type_text
+    fb = ('<FunctionBlock name="Grid"><Vars accessSpecifier="private"><Variable name="Cells"><Type>'
+          '<InstantlyDefinedType xsi:type="ArrayTypeSpec"><BaseType><TypeName>INT</TypeName></BaseType>'
+          '<DimensionSpec dimensionNumber="2"><IndexRange lower="0" upper="4"/></DimensionSpec>'
+          '<DimensionSpec dimensionNumber="1"><IndexRange lower="1" upper="2"/></DimensionSpec>'
+          '</InstantlyDefinedType></Type></Variable></Vars>'
+          '<MainBody><BodyContent xsi:type="ST"><ST>Cells[2, 4] := 1;</ST></BodyContent></MainBody></FunctionBlock>')
+    proj = load_project([str(write(tmp_path, doc(fb)))])
+    assert not proj.has_errors, proj.render_diagnostics()
+    [cells] = _fb_section("Grid", proj, "VAR")[0].vars
+    assert type_text(cells.type).replace(" ", "") == "ARRAY[1..2,0..4]OFINT"
+    refused(write(tmp_path, doc(fb.replace('dimensionNumber="1"', 'dimensionNumber="one"')), "bad.xml"),
+            "Grid", 'dimensionNumber="one" is not an integer')
