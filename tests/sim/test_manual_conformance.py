@@ -167,3 +167,39 @@ def test_an_unsized_array_takes_any_number_of_elements_a_sized_one_keeps_its_siz
 def test_an_unsized_array_declaration_names_what_is_wrong(spec, words):
     with pytest.raises(ValueError, match=words):
         table.parse_variable(spec)
+
+
+# The manual's ambiguous or misprinted points, as docs/simulator.md "Choices" answers them.
+def test_manual_15_5_f1_example_with_its_misprinted_checksum_is_a_checksum_error(h):
+    # §15.5 prints `$TMSCT,25,1,ChangeBase("RobotBase"),*0D` as its F1 example; the checksum of those bytes is
+    # *08 (the 15.7 example above), and the frame is checked before its content: CPERR 02
+    assert codec.encode("TMSCT", '1,ChangeBase("RobotBase")').endswith(b",*08\r\n")
+    peer = h.connect()
+    assert exchange(h, peer, b'$TMSCT,25,1,ChangeBase("RobotBase"),*0D\r\n') == b"$CPERR,2,02,*4A\r\n"
+
+
+@pytest.mark.parametrize("data", ["90", "95,x", "99"])
+def test_manual_15_4_tmsta_90_to_99_from_a_client_is_a_data_error(h, data):
+    # §15.4: sub-commands 90-99 go from the robot to the client only ("Receive: None")
+    peer = h.connect()
+    assert exchange(h, peer, codec.encode("TMSTA", data)) == b"$CPERR,2,04,*4C\r\n"
+
+
+def test_manual_17_4_a_tmsvr_packet_without_a_mode_is_a_data_error(svr):
+    peer = svr.connect_svr()
+    assert exchange(svr, peer, codec.encode("TMSVR", "S6")) == b"$CPERR,2,04,*4C\r\n"
+
+
+def test_manual_17_4_3_and_17_4_6_examples_with_their_misprinted_length(svr):
+    # The printed checksums are those of the right lengths (27 and 26, not 15 and 28)
+    write = codec.encode("TMSVR", "T2,2,Ctrl_DO0=0\r\nCtrl_DO1=1")
+    read = codec.encode("TMSVR", "Q2,12,Robot_Link\r\nTCP_Mass")
+    assert (write, read) == (b"$TMSVR,27,T2,2,Ctrl_DO0=0\r\nCtrl_DO1=1,*34\r\n",
+                             b"$TMSVR,26,Q2,12,Robot_Link\r\nTCP_Mass,*0E\r\n")
+    peer = svr.connect_svr()
+    # as printed (length 15), the length field does not end at the data's end: CPERR 01 (§15.5's rule)
+    assert exchange(svr, peer, b"$TMSVR,15,T2,2,Ctrl_DO0=0\r\nCtrl_DO1=1,*34\r\n") == b"$CPERR,2,01,*49\r\n"
+    # with the right length, the manual's replies (§17.4.6 prints Robot_Link=0: its robot is not connected)
+    assert exchange(svr, peer, write) == b"$TMSVR,10,T2,0,00,OK,*1D\r\n"
+    assert exchange(svr, peer, read) == codec.encode("TMSVR", "Q2,12,Robot_Link=1\r\nTCP_Mass=0")
+    assert codec.encode("TMSVR", "Q2,12,Robot_Link=0\r\nTCP_Mass=0").endswith(b",*09\r\n")    # the printed reply

@@ -237,7 +237,7 @@ class ListenSession:
             except ValueError:
                 tag = None
             reply = f"01,{param},{self.robot.tag_status(tag) if tag is not None else 'none'}"
-        else:
+        else:       # TMscript 2.24 §15.4: a client asks 00 and 01 only (90-99 go robot -> client, "Receive: None")
             self.protocol.send(conn, "CPERR", codec.CPERR_DATA)
             return
         self.protocol.send(conn, "TMSTA", reply)
