@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..frontend import codes
-from .model import LadderBody
+from .model import Element, LadderBody
 
 
 @dataclass
@@ -67,3 +67,12 @@ class FormatError(Exception):
         self.where = where
         self.message = message
         self.code = code
+
+
+def join_inouts(e: Element, where: str) -> None:
+    """Both readers: a block's input and output of the same name are its in-out (``Element``'s method says why);
+    a negated or edge-detected one is refused at ``where``."""
+    bad = e.join_inouts_drawn_on_both_sides()
+    if bad is not None:
+        raise FormatError(where, f"in-out `{bad}` (an input and an output of the same name) is negated or "
+                                 "edge-detected; an in-out passes the variable itself")

@@ -23,7 +23,7 @@ from ..frontend import ast as A
 from ..frontend.diagnostics import DiagnosticBag
 from ..frontend.parser import parse
 from ..frontend.source import SourceFile
-from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit
+from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit, join_inouts
 from .model import EDGES, STORAGES, Conn, Element, LadderBody, Pin, Rung
 from .xmlsafe import XSI_TYPE, text_of, xsi_type
 
@@ -443,7 +443,7 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
                 e.inouts.append(Pin(v.get("parameterName", ""), _point_ins(v, outs)))
             for v in obj.iterfind("OutputVariables/OutputVariable"):
                 e.outputs.append(Pin(v.get("parameterName", ""), negated=_flag(v, "negated", where)))
-            _join_inouts(e, where)
+            join_inouts(e, where)
         if e.kind != "block" and e.kind not in ("left_rail", "in_var", "label"):
             e.inputs = [Pin("", _point_ins(obj, outs))]
         if e.kind == "label":
@@ -451,14 +451,6 @@ def _rung(r: ET.Element, pou: str, number: int) -> Rung:
             continue
         rung.elements.append(e)
     return rung
-
-
-def _join_inouts(e: Element, where: str) -> None:
-    """An in-out written as an input and an output of the same name is the in-out (Element's method)."""
-    bad = e.join_inouts_drawn_on_both_sides()
-    if bad is not None:
-        raise FormatError(where, f"in-out `{bad}` (an input and an output of the same name) is negated or "
-                                 "edge-detected; an in-out passes the variable itself")
 
 
 def _flag(el: ET.Element, name: str, where: str, true=("true", "1")) -> bool:

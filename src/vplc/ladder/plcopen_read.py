@@ -14,7 +14,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from ..frontend import codes
-from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit
+from .decls import FormatError, PouText, SectionText, TypeText, VarText, XmlUnit, join_inouts
 from .model import EDGES, STORAGES, Conn, Element, LadderBody, Pin, Rung
 from .xmlsafe import text_of
 
@@ -219,10 +219,7 @@ def _element(el: ET.Element, pou: str) -> Element:
             e.inouts.append(Pin(v.get("formalParameter", ""), _conns(v.find("connectionPointIn"))))
         for v in el.iterfind("outputVariables/variable"):
             e.outputs.append(Pin(v.get("formalParameter", ""), negated=_flag(v, "negated")))
-        bad = e.join_inouts_drawn_on_both_sides()
-        if bad is not None:
-            raise FormatError(where, f"in-out `{bad}` (an input and an output of the same name) is negated or "
-                                     "edge-detected; an in-out passes the variable itself")
+        join_inouts(e, where)
     return e
 
 
