@@ -391,8 +391,8 @@ def _flatten_names(root: ET.Element, export: ExportSet) -> None:
     namespace too: type names, initial values (``ns\\eMode#Idle``), ladder block types and the ST bodies. Only
     the namespaces of the exported objects are removed (a name of another namespace is left to the checker);
     comments and string literals are not touched. Two objects that would get the same name are refused."""
-    spaces = {ns.upper() for ns in export.namespaces}
-    spaces |= {ns.upper().rsplit("\\", i)[0] for ns in export.namespaces for i in range(ns.count("\\") + 1)}
+    # each exported namespace and every namespace enclosing it (rsplit with 0 splits is the namespace itself)
+    spaces = {ns.upper().rsplit("\\", i)[0] for ns in export.namespaces for i in range(ns.count("\\") + 1)}
     seen: dict[str, str] = {}
     for item in export.items:
         full = f"{item.namespace}\\{item.name}" if item.namespace else item.name

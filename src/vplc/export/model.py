@@ -118,8 +118,7 @@ class _Comments:
 
     def trailing(self, end: int) -> str:
         """The comments on the rest of the line after offset ``end`` (a declaration's line comment)."""
-        line_end = self.text.find("\n", end)
-        line_end = len(self.text) if line_end < 0 else line_end
+        line_end = self.line_end(end)
         parts = []
         for s, e in self.spans:
             if end <= s < line_end and not self.text[end:s].strip(" \t,;\r"):
