@@ -23,9 +23,15 @@ _SAFE_OPS = {"OR", "XOR", "AND", "=", "<>", "<", ">", "<=", ">=", "+", "-", "*",
 _INLINE_NATIVES = {"VPLC_ScanTime"}
 
 
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}     # node class -> its dataclass fields' names (fields() is slow)
+
+
 def _children(node: A.Node) -> Iterator[A.Node]:
-    for f in fields(node):
-        value = getattr(node, f.name)
+    names = _FIELD_NAMES.get(type(node))
+    if names is None:
+        names = _FIELD_NAMES[type(node)] = tuple(f.name for f in fields(node))
+    for name in names:
+        value = getattr(node, name)
         if isinstance(value, A.Node):
             yield value
         elif isinstance(value, list):
