@@ -4,12 +4,13 @@ FB page, drawn from that page's own "## Example" program, plus the blended and e
     make traces          (or: PYTHONPATH=tests/lib .venv/bin/python docs/library/make_traces.py)
 """
 import re
+import tempfile
 from pathlib import Path
 
-from doc_steps import STEPS, example_of, on_simulator, simulator
-from rig import LIB, SEC, Rig, move_abs
+from doc_steps import STEPS, Examples
+from rig import SEC, Rig, move_abs
 
-from vplc.api import PathError, load_plc
+from vplc.api import PathError
 from vplc.trace.recorder import Recorder, write_trace
 
 HERE = Path(__file__).resolve().parent
@@ -39,16 +40,12 @@ def trace_name(page: str) -> str:
     return f"{slug(page)}.svg"
 
 
-def page_trace(page: str, out: Path) -> None:
+def page_trace(page: str, out: Path, examples: Examples) -> None:
     """Run the page's example as the library tests do and record its trigger inputs and the FB's pins."""
-    code, _ = example_of(page)
-    program = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
-    srv = simulator()
-    srv.start()
-    source = out / f".{page}_example.st"
+    program = examples.names[page]
+    srv = examples.servers[page]
     try:
-        source.write_text(on_simulator(code, srv), encoding="utf-8")
-        plc = load_plc([str(LIB), str(source)], task="Main@1ms")
+        plc = examples.plc(page)
         read = lambda name: plc.read(f"{program}.{name}")   # noqa: E731
         pump = lambda now_ns: srv.poll(now_ns / 1e9)        # noqa: E731
         steps = STEPS[page]
@@ -82,7 +79,6 @@ def page_trace(page: str, out: Path) -> None:
         write_trace(rec, str(out / trace_name(page)))
         plc.close()
     finally:
-        source.unlink(missing_ok=True)
         srv.close()
 
 
@@ -131,8 +127,13 @@ def move_absolute_aborting(out: Path) -> None:
 def main(out: Path = OUT) -> None:
     """Write every diagram into ``out`` (the drift test writes them into a temporary folder and compares)."""
     out.mkdir(exist_ok=True)
-    for page in sorted(STEPS):
-        page_trace(page, out)
+    with tempfile.TemporaryDirectory() as sources:      # the examples, pointed at their simulators
+        examples = Examples(Path(sources))
+        try:
+            for page in sorted(STEPS):
+                page_trace(page, out, examples)
+        finally:
+            examples.close()
     move_absolute_cases(out)
     move_absolute_aborting(out)
 

@@ -3,12 +3,14 @@ other once connected, and the output that ends each step. test_lib_doc_examples.
 test_lib_doc_traces.py draws their timing diagrams; the robot both run the examples against, and the example
 taken from a page."""
 import re
+from pathlib import Path
 
-from rig import ROOT
+from rig import LIB, ROOT
 
 from tmsim.net.server import SimServer
 from tmsim.protocol.svr_table import parse_variable
 from tmsim.robot.camera import camera_of
+from vplc.api import LoadError, Plc, compile_program, load_plc
 
 # page -> (BOOL inputs raised one after the other once connected, output that ends each step)
 STEPS = {
@@ -66,3 +68,40 @@ def on_simulator(code: str, srv) -> str:
     """The example as the page shows it, pointed at the simulator's robot and Ethernet Slave on loopback."""
     return (code.replace("'192.168.1.10'", "'127.0.0.1'").replace("IPPort := 5890", f"IPPort := {srv.ports[0]}")
             .replace("SvrPort := 5891", f"SvrPort := {srv.robots[0].svr_port}"))
+
+
+class Examples:
+    """The examples of ``pages``, each pointed at a simulator of its own (started, not yet polled), written into
+    ``folder`` and compiled with the library as one program: the library, most of the work, is compiled once
+    for all pages instead of once per page. The examples are PROGRAMs of distinct names; ``plc(page)`` runs
+    only its page's, in a PLC instance of its own. Should they not check clean together, each page is compiled
+    alone with the library, so its own diagnostics are what its run reports."""
+
+    def __init__(self, folder: Path, pages=None) -> None:
+        self.servers: dict[str, SimServer] = {}
+        self.sources: dict[str, Path] = {}
+        self.names: dict[str, str] = {}          # page -> its example's PROGRAM
+        try:
+            for page in pages or sorted(STEPS):
+                srv = self.servers[page] = simulator()
+                srv.start()
+                code, _ = example_of(page)
+                self.names[page] = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
+                self.sources[page] = folder / f"{page}_example.st"
+                self.sources[page].write_text(on_simulator(code, srv), encoding="utf-8")
+            try:
+                self.compiled = compile_program([str(LIB), *map(str, self.sources.values())])
+            except LoadError:
+                self.compiled = None
+        except BaseException:
+            self.close()
+            raise
+
+    def plc(self, page: str) -> Plc:
+        if self.compiled is None:
+            return load_plc([str(LIB), str(self.sources[page])], task="Main@1ms")
+        return Plc(self.compiled, "Main@1ms", [self.names[page]])
+
+    def close(self) -> None:
+        for srv in self.servers.values():
+            srv.close()

@@ -6,10 +6,8 @@ from __future__ import annotations
 import re
 
 import pytest
-from doc_steps import DOCS, STEPS, example_of, on_simulator, simulator
-from rig import LIB, SEC
-
-from vplc.api import load_plc
+from doc_steps import DOCS, STEPS, Examples, example_of
+from rig import SEC
 
 
 def test_every_fb_page_has_a_runnable_example():
@@ -17,16 +15,21 @@ def test_every_fb_page_has_a_runnable_example():
     assert pages == set(STEPS), "a page was added or removed: give its example steps in STEPS"
 
 
+@pytest.fixture(scope="module")
+def examples(tmp_path_factory):
+    """Every page's example with its own simulator, the library compiled once for all of them."""
+    found = Examples(tmp_path_factory.mktemp("examples"))
+    yield found
+    found.close()
+
+
 @pytest.mark.parametrize("page", sorted(STEPS))
-def test_page_example_runs_against_the_simulator(page, tmp_path):
+def test_page_example_runs_against_the_simulator(page, examples):
     code, promised = example_of(page)
     program = re.search(r"^PROGRAM (\w+)", code, re.M).group(1)
-    srv = simulator()
-    srv.start()
+    srv = examples.servers[page]
     try:
-        source = tmp_path / f"{page}_example.st"
-        source.write_text(on_simulator(code, srv), encoding="utf-8")
-        plc = load_plc([str(LIB), str(source)], task="Main@1ms")
+        plc = examples.plc(page)
         read = lambda name: plc.read(f"{program}.{name}")  # noqa: E731
         pump = lambda now_ns: srv.poll(now_ns / 1e9)  # noqa: E731
         if page != "CBT_Connect":
