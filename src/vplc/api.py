@@ -98,7 +98,7 @@ def compile_program(paths: SourcePaths, *, dialect: str = "sysmac", count_statem
 
     Programs are kept by a fingerprint of every source file's name and bytes (prelude included), so loading
     unchanged sources again costs a file read, and an edited file is always compiled afresh."""
-    from .project import load_project
+    from .project import gc_paused, load_project
     if isinstance(paths, str):
         paths = [paths]
     paths = list(paths)
@@ -111,7 +111,8 @@ def compile_program(paths: SourcePaths, *, dialect: str = "sysmac", count_statem
     if proj.has_errors:
         raise LoadError(proj.render_diagnostics())
     try:
-        program = CodeGen(proj, count_statements).generate()
+        with gc_paused():
+            program = CodeGen(proj, count_statements).generate()
     except (NotImplementedError, RecursionError, SyntaxError, MemoryError) as exc:
         raise LoadError(f"error: the runtime cannot compile this program: {getattr(exc, 'msg', None) or exc}") from None
     except Exception as exc:    # noqa: BLE001 - a code generator defect must not show a traceback

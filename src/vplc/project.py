@@ -4,7 +4,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 from .checker import calls, recursion, sysmac_identifiers
@@ -135,12 +135,19 @@ def load_project(paths: Paths, *, dialect: str = "sysmac", include_prelude: bool
                  portable: bool = False) -> Project:
     """Read, parse and check ``paths`` (files or folders, recursively ``*.st`` and ``*.xml``: PLCopen XML and
     IEC 61131-10 projects, see :mod:`vplc.ladder`) plus the prelude."""
-    # The front end allocates many small long-lived objects and frees almost nothing: the cyclic garbage
-    # collector would only re-scan them (making large files quadratic-ish), so it is paused while loading.
+    with gc_paused():
+        return _load(paths, dialect, include_prelude, portable)
+
+
+@contextlib.contextmanager
+def gc_paused() -> Iterator[None]:
+    """The cyclic garbage collector paused for the block. The front end and the code generator allocate many
+    small long-lived objects and free almost nothing: the collector would only re-scan them (making large files
+    quadratic-ish, and a compile in a process that already holds compiled programs 15-40 % slower)."""
     was_enabled = gc.isenabled()
     gc.disable()
     try:
-        return _load(paths, dialect, include_prelude, portable)
+        yield
     finally:
         if was_enabled:
             gc.enable()
