@@ -3,10 +3,11 @@ PLCopen XML TC6 with <LD>), and loading the export gives the same program: the s
 of a 1,000-scan run. ST POUs are written unchanged."""
 from __future__ import annotations
 
+import functools
 import re
 
 import pytest
-from ld_trace import ROOT, first_difference, trace
+from ld_trace import ROOT, example_trace, first_difference, trace
 from ld_xml import ALL_BODY, ALL_KINDS, program
 
 from vplc.cli.main import main
@@ -26,15 +27,22 @@ def export(tmp_path, fmt, *paths) -> str:
     return out
 
 
+@pytest.fixture(scope="module")
+def example_export(tmp_path_factory):
+    """`vplc export` of the library with the example project, run once per format for the tests that read it."""
+    folder = tmp_path_factory.mktemp("example_export")
+    return functools.cache(lambda fmt: export(folder, fmt, LIB, ROOT / "examples"))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("fmt", FORMATS)
-def test_exported_example_project_runs_the_same_1000_scans(tmp_path, fmt):
-    out = export(tmp_path, fmt, LIB, ROOT / "examples")
+def test_exported_example_project_runs_the_same_1000_scans(example_export, fmt):
+    out = example_export(fmt)
     text = out.read_text(encoding="utf-8")
     assert ("smcext:LdSection" in text) if fmt == "iec61131-10" else ("<LD>" in text)
     assert "_ldP" not in text and "_ldM" not in text, "the translation's helper variables are not exported"
     programs = configured_programs(ROOT / "examples" / "Examples_Configuration.st")    # an export has no configuration
-    original = trace([LIB, ROOT / "examples"])
+    original = example_trace()
     again = trace([out], programs=programs)
     assert first_difference(original, again) is None
 
@@ -56,8 +64,8 @@ def test_every_element_kind_survives_the_round_trip(tmp_path, fmt):
     assert any(r["Main.Mid"] for r in original) and not all(r["Main.Mid"] == r["Main.A"] for r in original)
 
 
-def test_st_pous_are_written_unchanged_next_to_ladders(tmp_path):
-    out = export(tmp_path, "plcopen", LIB, ROOT / "examples")
+def test_st_pous_are_written_unchanged_next_to_ladders(example_export):
+    out = example_export("plcopen")
     text = out.read_text(encoding="utf-8")
     body = (ROOT / "examples" / "PnP_Example.st").read_text(encoding="utf-8")
     assert "PnP_Segment := PnP_Segment + 1;" in body
