@@ -7,8 +7,8 @@ for a program, the same values of its variables in every scan of a run in virtua
 
 The fixtures are found by globbing, so a new fixture is covered the day it is added. Fixtures that use the
 library (tests/lib/st_unit, tests/hmi/user_*, tests/examples/*, the example folders) compile the library with them
-and are marked slow; the others take well under a second each. An original is compiled once for its
-signature and its trace (``vplc.api.compile_program`` keeps compiled programs)."""
+and are marked slow; the others take well under a second each. An original is loaded and compiled once for its
+signature, its trace and both exports (``vplc.api.compile_program`` keeps compiled programs)."""
 from __future__ import annotations
 
 import os
@@ -20,7 +20,7 @@ import pytest
 from vplc.api import LoadError, Plc, compile_program
 from vplc.compiler.codegen import CodeGen
 from vplc.export.iec61131_10 import render as render_iec61131_10
-from vplc.export.model import ExportError, collect, enum_values, expr_text, type_text
+from vplc.export.model import ExportError, ExportSet, collect, enum_values, expr_text, type_text
 from vplc.export.plcopen import render as render_plcopen
 from vplc.frontend import ast as A
 from vplc.frontend import printer
@@ -103,10 +103,11 @@ def _sections(pou_kind: str, sections: list[A.VarSection], helpers: frozenset[st
                              d.at) for d in s.vars if d.name.upper() not in helpers]) for s in sections]
 
 
-def signature(project: Project, skip_namespace: str | None = None) -> dict:
+def signature(project: Project, skip_namespace: str | None = None, ex: ExportSet | None = None) -> dict:
     """What an export must keep, by kind and name; ``skip_namespace``: leave out the library's own objects
-    (exported and compared once by test_export_sysmac_xsd / test_ld_export)."""
-    ex = collect(project)
+    (exported and compared once by test_export_sysmac_xsd / test_ld_export); ``ex``: ``collect(project)`` when
+    the caller has it already."""
+    ex = ex or collect(project)
     out: dict = {}
     for t in ex.types:
         if t.namespace != skip_namespace or skip_namespace is None:
@@ -203,7 +204,11 @@ def test_fixture_exports_validate_and_load_back_the_same(paths, tmp_path, schema
         pytest.skip("the fixture does not check clean (a test of diagnostics)")
     warned = {(d.code, d.message) for d in original.project.diagnostics if d.severity == "warning"}
     library = LIB in paths
-    before = signature(original.project, "CBT_Commands_Lib" if library else None)
+    # what `vplc export` loads and collects: compile_program's load_project of the same files (the code generator
+    # only reads the project), collected once for the signature and both formats
+    sources = original.project
+    exported = collect(sources)
+    before = signature(sources, "CBT_Commands_Lib" if library else None, exported)
     progs = configured(paths)
     runs = any(isinstance(i, A.Pou) and i.kind == "PROGRAM" for u in original.project.units
                if not getattr(u, "in_prelude", False) for i in u.items)
@@ -213,11 +218,10 @@ def test_fixture_exports_validate_and_load_back_the_same(paths, tmp_path, schema
                           stimulus=stimulus) if runs \
         else ([], 0)
     missing = []
-    sources = load_project([str(p) for p in paths])     # what `vplc export` loads, once for both formats
     for fmt in FORMATS:
         out = tmp_path / f"export.{fmt}.xml"
         try:
-            out.write_bytes(RENDER[fmt](collect(sources), sources))
+            out.write_bytes(RENDER[fmt](exported, sources))
         except (ExportError, WriteError) as exc:
             assert any(d in str(exc) for d in DOCUMENTED_REFUSALS[fmt]), f"{fmt}: {exc}"
             continue                             # a construct the format cannot express, refused by name
