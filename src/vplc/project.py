@@ -18,7 +18,7 @@ from .frontend import ast as A
 from .frontend import codes
 from .frontend import types as T
 from .frontend.diagnostics import Diagnostic, DiagnosticBag, render_all, sort_key
-from .frontend.parser import parse
+from .frontend.parser import parse, parse_kept
 from .frontend.source import SourceFile, Span
 from .ladder.load import attach_ladders, check_operands, is_project_xml, is_xml, read_xml
 
@@ -174,9 +174,10 @@ def _load(paths: Paths, dialect: str, include_prelude: bool, portable: bool) -> 
         source = read_source(path, diags)
         if source is None:
             continue
-        unit = parse(source, diags)
-        unit.namespace = None if os.path.abspath(path) in prelude_abs else namespace_of(path)
-        unit.in_prelude = os.path.abspath(path) in prelude_abs
+        in_prelude = os.path.abspath(path) in prelude_abs
+        unit = parse_kept(source, diags) if in_prelude else parse(source, diags)
+        unit.namespace = None if in_prelude else namespace_of(path)
+        unit.in_prelude = in_prelude
         unit.vendor = unit.in_prelude and os.path.basename(path) in VENDOR_PRELUDE
         proj.units.append(unit)
     check_units(ctx, proj)

@@ -523,10 +523,35 @@ class Parser:
 
 def parse(src: SourceFile, diags: DiagnosticBag) -> A.CompilationUnit:
     """Parse one file. Syntax errors are added to ``diags``; the returned AST holds what could be read."""
-    if sys.getrecursionlimit() < 20000:
-        sys.setrecursionlimit(20000)
     comments: list = []
     tokens = tokenize(src, diags, comments)
+    return _parse_tokens(src, tokens, comments, diags)
+
+
+# path -> (text, tokens, comments) of the files parse_kept has tokenized (the prelude: a few hundred kB at most)
+_KEPT_TOKENS: dict[str, tuple[str, list[Token], list]] = {}
+
+
+def parse_kept(src: SourceFile, diags: DiagnosticBag) -> A.CompilationUnit:
+    """``parse`` for a file every project loads again unchanged (the prelude): its tokens are kept by path and
+    used again while its text is the same, so it is tokenized once per process (a third of its parse time). The
+    parser only reads tokens. A file whose tokenizing reports a problem is not kept: ``parse`` reads it."""
+    kept = _KEPT_TOKENS.get(src.path)
+    if kept is not None and kept[0] == src.text:
+        _text, tokens, comments = kept
+    else:
+        comments = []
+        problems = DiagnosticBag()
+        tokens = tokenize(src, problems, comments)
+        if problems.items:
+            return parse(src, diags)
+        _KEPT_TOKENS[src.path] = (src.text, tokens, comments)
+    return _parse_tokens(src, tokens, list(comments), diags)
+
+
+def _parse_tokens(src: SourceFile, tokens: list[Token], comments: list, diags: DiagnosticBag) -> A.CompilationUnit:
+    if sys.getrecursionlimit() < 20000:
+        sys.setrecursionlimit(20000)
     unit = Parser.for_tokens(src, tokens, diags).unit()
     unit.comments = comments
     return unit

@@ -171,3 +171,31 @@ def test_object_oriented_and_pointer_extensions_are_refused_clearly():
     assert diags[0].code == "ST0207"
     _, diags = parse_text(program("", "p : POINTER TO INT;"))
     assert diags[0].code == "ST0207"
+
+
+def test_kept_tokens_give_the_tree_parse_gives_and_follow_a_changed_text(tmp_path):
+    """parse_kept (the prelude: tokenized once per process, its tokens used again by every load) gives the tree and
+    comments parse gives, each time; the same path with another text is tokenized again, and a text with a lexical
+    problem reports it as parse does."""
+    import os
+
+    from vplc.frontend.diagnostics import DiagnosticBag
+    from vplc.frontend.parser import parse, parse_kept
+    from vplc.frontend.source import SourceFile
+    from vplc.project import PRELUDE_DIR
+    for name in sorted(n for n in os.listdir(PRELUDE_DIR) if n.endswith(".st")):
+        path = os.path.join(PRELUDE_DIR, name)
+        with open(path, encoding="utf-8") as fh:
+            src = SourceFile(path, fh.read())
+        fresh, first, again = (parse(src, DiagnosticBag()), parse_kept(src, DiagnosticBag()),
+                               parse_kept(src, DiagnosticBag()))
+        assert fresh == first == again and fresh.comments == again.comments and again.comments is not first.comments
+    path = str(tmp_path / "kept.st")
+    one = parse_kept(SourceFile(path, "FUNCTION F : INT\nF := 1;\nEND_FUNCTION\n"), DiagnosticBag())
+    two = parse_kept(SourceFile(path, "FUNCTION G : INT\nG := 2; (* two *)\nEND_FUNCTION\n"), DiagnosticBag())
+    assert (one.items[0].name, two.items[0].name, len(two.comments)) == ("F", "G", 1)
+    bad = SourceFile(path, "FUNCTION H : INT\nH := 3 ` ;\nEND_FUNCTION\n")
+    kept, plain = DiagnosticBag(), DiagnosticBag()
+    parse_kept(bad, kept)
+    parse(bad, plain)
+    assert [d.render() for d in kept.items] == [d.render() for d in plain.items] != []
