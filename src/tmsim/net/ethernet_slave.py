@@ -108,8 +108,9 @@ class EthernetSlave:
             service = self._services.get(robot.index)
             if service is None:
                 continue
-            if service.listener is not None:
-                service.listener.tick(now)
+            listener = service.listener
+            if listener is not None and listener.paused_until is not None:
+                listener.tick(now)
             if service.session.clients:
                 service.session.advance(now)
                 self._flush(robot)

@@ -371,33 +371,74 @@ class SimServer:
         time (nothing of theirs is due) and the sockets are served at once."""
         self._slice_start = time.perf_counter()
         self._poll_end = self._slice_start + POLL_BUDGET_S
-        if advance:
-            self._now = max(self._now, now_s)
-            for robot in self.robots:
-                session = robot.session
-                if robot.listener is not None:
-                    robot.listener.tick(self._now)
-                self._advance(robot)
-                if session.has_output() and not robot.faults.active:
-                    self.flush(robot)            # pushes (tag reached) leave at once; faulty output once a poll
-                self.breathe()
-            if self.svr is not None:
-                self.svr.poll(self._now)
-            if self.control is not None:
-                self.control.tick(self._now)
-        served = self._serve(0.0 if self._has_work() else timeout, selected=ready)
-        self.fair.serve_backlog()
+        settled = advance and self._advance_all(max(self._now, now_s))
+        if timeout and self._has_work():        # work left over from a turn: the sockets are not waited for
+            timeout = 0.0
+        served = self._serve(timeout, selected=ready)
+        if settled and not served and not self._touched and not self.fair.has_backlog and \
+                (self.control is None or not self.control.backlog):
+            # the usual poll of a virtual-time rig (one per 1 ms PLC scan): no socket was ready, nothing is left
+            # over, and every robot was settled after advancing - the steps below would find nothing to do
+            if self.manage_gc:
+                _collect_garbage(idle=True)
+            return
+        if self.fair.has_backlog:
+            self.fair.serve_backlog()
         if self.control is not None and self.control.backlog:
             self.control.serve_backlog()
-        self._start_touched()
+        if self._touched:
+            self._start_touched()
         for robot in self.robots:
-            self.flush(robot)
-            if not robot.session.project_running() and (robot.listener is not None or robot.conns):
-                self.close_robot_sockets(robot, "project stopped: " + (robot.session.last_error or "stopped"))
+            if robot.conns:
+                self.flush(robot)
+            session = robot.session
+            if (robot.listener is not None or robot.conns) and not session.project_running():
+                self.close_robot_sockets(robot, "project stopped: " + (session.last_error or "stopped"))
             if robot.reading_paused and not self.fair.buffer_full(robot, 0.5):
                 self._set_reading(robot, True)
         if self.manage_gc:
             _collect_garbage(idle=not served)
+
+    def _advance_all(self, now: float) -> bool:
+        """The robots, the Ethernet Slave and the control channel to ``now``: every robot's session advances
+        (its clock and its turn's work meter move on even when nothing is due); what it pushed leaves at once.
+        Returns whether every robot is settled: no output held or left to write, no client that closed its side
+        or left the session, its project running while it has sockets, its clients read. Then the end of the
+        poll has nothing to do unless a socket was ready or work is left over (``_poll``)."""
+        self._now = now
+        clock = time.perf_counter
+        settled = True
+        for robot in self.robots:
+            listener = robot.listener
+            if listener is not None and listener.paused_until is not None:
+                listener.tick(now)
+            self._advance(robot)
+            session = robot.session
+            conns = robot.conns
+            if conns:
+                faulty = robot.faults.active
+                if session.has_output():
+                    settled = False
+                    if not faulty:
+                        self.flush(robot)    # pushes (tag reached) leave at once; faulty output once a poll
+                elif faulty:
+                    settled = False
+                elif settled:
+                    for conn in conns.values():
+                        if conn.wbuf or conn.eof or not session.is_connected(conn.id):
+                            settled = False
+                            break
+            if settled and (robot.reading_paused or
+                            ((robot.listener is not None or robot.conns) and not session.project_running())):
+                settled = False
+            if clock() - self._slice_start > IO_SLICE_S:
+                self.breathe()
+                settled = False
+        if self.svr is not None:
+            self.svr.poll(now)
+        if self.control is not None:
+            self.control.tick(now)
+        return settled
 
     def _has_work(self) -> bool:
         """Work is left over from earlier turns (client input, control requests): the next poll must not wait."""
@@ -457,6 +498,8 @@ class SimServer:
         polled again for the others' new requests (``quick_only``: serve only those). ``selected``: the
         sockets found ready already (no select)."""
         ready = self.selector.select(timeout) if selected is None else selected
+        if not ready:
+            return 0
         ready.sort(key=_is_greedy)
         checked = time.perf_counter()
         for key, _mask in ready:
@@ -562,7 +605,12 @@ class SimServer:
         faulty = robot.faults.active
         waiting = 0
         session = robot.session
-        conns = list(robot.conns.values()) if only is None else [only]
+        if only is not None:
+            conns = [only]
+        elif faulty or session.has_output():
+            conns = list(robot.conns.values())
+        else:                   # no frame to hand out: only a socket with bytes waiting or a closed side has work
+            conns = [conn for conn in robot.conns.values() if conn.wbuf or conn.eof]
         for conn in conns:
             conn_id = conn.id
             if not session.is_connected(conn_id):
@@ -591,7 +639,7 @@ class SimServer:
                 self.drop(robot, conn, "peer closed its side")
         if only is not None:
             return
-        for conn in [c for c in robot.conns.values() if not robot.session.is_connected(c.id)]:
+        for conn in [c for c in robot.conns.values() if not session.is_connected(c.id)]:
             self.drop(robot, conn, "session ended")
         while waiting > OUTBOX_TOTAL_MAX:             # e.g. a large ListenSend to many clients that do not read
             laziest = max(robot.conns.values(), key=lambda c: len(c.wbuf))

@@ -131,7 +131,8 @@ class FaultState:
     def active(self) -> bool:
         """True while any output fault is armed or output is still held back."""
         return bool(self.delay or self.split or self.glue or self.corrupt or self.close_mid or self.black_hole
-                    or any(self._queues.values()) or any(self._partial.values()))
+                    or (self._queues and any(self._queues.values()))
+                    or (self._partial and any(self._partial.values())))
 
     def describe(self) -> dict:
         return {"reply_delay": self.delay, "split_replies": self.split, "glue_replies": self.glue,
