@@ -55,7 +55,7 @@ def browser(chromium, stack):
 
 
 def text(browser, element_id):
-    return browser.driver.find_element(By.ID, element_id).text
+    return browser.text(element_id)
 
 
 def test_an_alarm_goes_through_its_states_on_the_page(browser, stack):
@@ -118,9 +118,7 @@ def test_alarm_rows_are_touch_targets_and_main_cuts_no_text_while_alarms_stand(b
     (they were 18 px), and the robot tile's state and the list's texts read whole with an E-stop, a robot error, a
     lost link and a failed command standing."""
     d = browser.driver
-    dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
-    d.set_window_size(size[0] + dw, size[1] + dh)
-    d.get("about:blank")
+    browser.size(*size)
     browser.open(stack.server.page_url("index", "operator"))
     stack.set(MoveAbs_Error=True, MoveAbs_ErrorID=0x3001,
               MoveAbs_ErrorDescrip="No reply from robot within ReplyTimeout")

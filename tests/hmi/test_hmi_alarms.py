@@ -20,7 +20,7 @@ def system(chromium):
 
 
 def text(browser, element_id):
-    return browser.driver.find_element(By.ID, element_id).text
+    return browser.text(element_id)
 
 
 

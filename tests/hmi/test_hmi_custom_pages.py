@@ -54,10 +54,7 @@ def browser(chromium):
 
 
 def sized(browser, size):
-    d = browser.driver
-    dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
-    d.set_window_size(size[0] + dw, size[1] + dh)
-    d.get("about:blank")
+    browser.size(*size)
 
 
 @needs_chromium

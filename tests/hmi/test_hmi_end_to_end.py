@@ -60,8 +60,8 @@ def execute_and_wait_done(system, browser, group: str) -> None:
 
 def test_main_page_shows_the_live_tcp_position(connected):
     browser = connected.open("index")
-    browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text.startswith("TCP X "), "the TCP position")
-    x = float(browser.driver.find_element(By.ID, "tcp-pos").text.split()[2])
+    browser.wait_for(lambda d: browser.text("tcp-pos").startswith("TCP X "), "the TCP position")
+    x = float(browser.text("tcp-pos").split()[2])
     assert abs(x - connected.robot_state()["tcp"][0]) < 1.0
     browser.wait_status("Robot_InListenNode", "true")                     # the robot status strip
     assert browser.status("Robot_Stopping") == "false" and browser.status("Robot_LastErrorID").startswith("16#")
@@ -247,8 +247,11 @@ def press_stop_motion(system) -> Browser:
 
 
 def pnp_page_offers(browser) -> dict:
-    return {name: browser.driver.find_element(By.ID, f"btn-{name}").is_enabled()
-            for name in ("execute", "stop", "reset")}
+    """Which of the PnP page's Execute, Stop and Reset keys are enabled (not :disabled, as WebDriver's is_enabled
+    tells), read in one round trip."""
+    return browser.driver.execute_script(
+        "return Object.fromEntries(arguments[0].map((name) => "
+        "[name, !document.getElementById(`btn-${name}`).matches(':disabled')]))", ["execute", "stop", "reset"])
 
 
 @pytest.mark.slow
@@ -277,8 +280,8 @@ def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(co
     assert connected.events("motion_start", mark) == [], "the robot moved again by itself"
     assert connected.read("PnP_State") == "Stopped" and connected.read("PnP_Example_Execute") is True
     browser = connected.open("pnp")
-    browser.wait_for(lambda d: "Cycle: Stopped" in d.find_element(By.ID, "pnp-state").text, "Stopped on the page")
-    assert "Nothing moves until you press Start" in browser.driver.find_element(By.ID, "pnp-state").text
+    browser.wait_for(lambda d: "Cycle: Stopped" in browser.text("pnp-state"), "Stopped on the page")
+    assert "Nothing moves until you press Start" in browser.text("pnp-state")
     assert pnp_page_offers(browser) == {"execute": True, "stop": False, "reset": False}
     assert browser.viewport_overflow() == []
     browser.screenshot("e2e_pnp_stopped_dwelling")
@@ -296,7 +299,7 @@ def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(co
     assert connected.events("motion_start", mark) == [], "the robot moved again by itself"
     assert not connected.robot_state()["moving"] and connected.read("PnP_State") == "Stopped"
     browser = connected.open("pnp")
-    browser.wait_for(lambda d: "Cycle: Stopped" in d.find_element(By.ID, "pnp-state").text, "Stopped on the page")
+    browser.wait_for(lambda d: "Cycle: Stopped" in browser.text("pnp-state"), "Stopped on the page")
     assert pnp_page_offers(browser) == {"execute": True, "stop": False, "reset": False}
     browser.screenshot("e2e_pnp_stopped_mid_move")
     with connected.plc.lock:
@@ -334,8 +337,8 @@ def test_pnp_fault_with_an_unknown_outcome_is_reset_on_the_page_and_the_move_is_
     cut = connected.event_count()
     connected.wait(lambda: connected.read("PnP_State") == "Faulted", "the fault")
     assert connected.read("PnP_MoveErrorID") == 0x200B and connected.read("PnP_OutcomeUnknown") is True
-    browser.wait_for(lambda d: "Cycle: Faulted" in d.find_element(By.ID, "pnp-state").text, "Faulted on the page")
-    text = browser.driver.find_element(By.ID, "pnp-state").text
+    browser.wait_for(lambda d: "Cycle: Faulted" in browser.text("pnp-state"), "Faulted on the page")
+    text = browser.text("pnp-state")
     assert "16#200B" in text and "Press Reset, then Start" in text and "may have run" in text
     assert pnp_page_offers(browser) == {"execute": False, "stop": False, "reset": True}
     browser.screenshot("e2e_pnp_faulted_outcome_unknown")
@@ -367,7 +370,7 @@ def test_connection_loss_shows_on_the_connect_page(connected):
     browser.wait_status("Connect_Connected", "false")
     browser.wait_status("Connect_Reconnecting", "true")
     browser.wait_for(lambda d: browser.status("Connect_LastLostTime") != lost_before, "LastLostTime to change")
-    browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot not connected", "the pill")
+    browser.wait_for(lambda d: browser.text("pill-robot") == "Robot not connected", "the pill")
     browser.screenshot("e2e_connect_lost")
     with connected.sim.lock:
         connected.robot.clear_faults()                          # back: CBT_Connect reconnects by itself

@@ -59,7 +59,7 @@ def system(chromium):
     with stack.plc.lock:
         stack.plc.write("Connect_Execute", True)
     stack.open("index")
-    chromium.wait_for(lambda d: chromium.driver.find_element("id", "pill-robot").text == "Robot ready",
+    chromium.wait_for(lambda d: chromium.text("pill-robot") == "Robot ready",
                       "the robot connected in its Listen node")
     yield stack
     stack.close()

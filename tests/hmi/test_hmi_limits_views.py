@@ -119,8 +119,9 @@ def test_format_the_fb_refuses_for_the_motion_command_is_refused_on_the_page(pag
 def test_active_paused_and_stopping_lamps_show_the_plc_state(page):
     plc, _, open_page = page
     b = open_page("moveabs")
-    def lamps():
-        return [e.get_attribute("data-value") for e in b.driver.find_elements(By.CSS_SELECTOR, ".indicators .lamp")]
+    def lamps():        # the three lamps' data-value in one round trip
+        return b.driver.execute_script(
+            "return [...document.querySelectorAll('.indicators .lamp')].map((e) => e.getAttribute('data-value'))")
     b.wait_for(lambda d: lamps() == ["false"] * 3, "the lamps off")
     with plc.lock:
         plc.vars["MoveAbs_Active"] = True

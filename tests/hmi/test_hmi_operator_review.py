@@ -91,12 +91,12 @@ def test_a_pnp_fault_says_what_to_do_and_replaces_the_start_message(browser, sta
     state box gives the operator remedy (Play on the Main screen) instead of "code and text in CBT_RobotStatus"."""
     open_page(browser, stack, "pnp")
     stack.set(PnP_State=1)
-    browser.wait_for(lambda d: "Cycle: Running" in d.find_element(By.ID, "pnp-state").text, "Running")
+    browser.wait_for(lambda d: "Cycle: Running" in browser.text("pnp-state"), "Running")
     browser.driver.execute_script("message('Start: the cycle is Running.', 'ok')")
     stack.set(PnP_State=4, PnP_MoveError=True, PnP_MoveErrorID=0x4006,
               PnP_MoveErrorDescrip="Robot error stopped the project: code and text in CBT_RobotStatus")
-    browser.wait_for(lambda d: "Cycle: Faulted" in d.find_element(By.ID, "pnp-state").text, "Faulted")
-    state = browser.driver.find_element(By.ID, "pnp-state-text").text
+    browser.wait_for(lambda d: "Cycle: Faulted" in browser.text("pnp-state"), "Faulted")
+    state = browser.text("pnp-state-text")
     assert "CBT_" not in state and "press Play on the Main screen" in state and state.endswith(
         "Here: press Reset, then Start."), state
     browser.wait_for(lambda d: browser.message().startswith("Cycle: Faulted – Fault 16#4006"), "the fault's message")
@@ -107,8 +107,8 @@ def test_a_pnp_fault_says_what_to_do_and_replaces_the_start_message(browser, sta
 def test_pnp_says_the_plc_reconnects_by_itself_when_the_link_is_down(browser, stack):
     open_page(browser, stack, "pnp")
     stack.set(Connect_Connected=False)
-    browser.wait_for(lambda d: "reconnecting" in d.find_element(By.ID, "pnp-state-text").text, "the reconnect text")
-    assert "wait for Robot ready in the header" in browser.driver.find_element(By.ID, "pnp-state-text").text
+    browser.wait_for(lambda d: "reconnecting" in browser.text("pnp-state-text"), "the reconnect text")
+    assert "wait for Robot ready in the header" in browser.text("pnp-state-text")
     assert not browser.driver.find_element(By.ID, "btn-execute").is_enabled()
 
 
@@ -120,7 +120,7 @@ def test_the_robot_views_note_stays_whole_while_the_robot_is_not_connected(brows
     p…" at 800x480."""
     stack.set(ReadPos_Valid=False, Connect_Connected=False)
     open_page(browser, stack, page)
-    browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text == "TCP not valid", "the invalid position")
+    browser.wait_for(lambda d: browser.text("tcp-pos") == "TCP not valid", "the invalid position")
     browser.wait_for(lambda d: cut_texts(browser) == [], f"every text whole: {cut_texts(browser)}")
     if page == "moverel":
         note = browser.driver.find_element(By.ID, "view-note")
@@ -132,11 +132,11 @@ def test_without_the_plc_the_tcp_reads_invalid_and_no_key_looks_usable(browser, 
     """The view's TCP line kept "TCP X 417.5 …" and Execute, Preset Values looked live while the line said that
     nothing can be sent; the header's Stop key stays (it is tried whatever the page believes)."""
     open_page(browser, stack, "moveabs")
-    browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text.startswith("TCP X 417.5"), "the position")
+    browser.wait_for(lambda d: browser.text("tcp-pos").startswith("TCP X 417.5"), "the position")
     port = stack.server.port
     stack.server.stop()
     try:
-        browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text == "TCP ####", "#### for the position")
+        browser.wait_for(lambda d: browser.text("tcp-pos") == "TCP ####", "#### for the position")
         looks = browser.driver.execute_script("""
             return ['btn-execute', 'btn-preset', 'zoom-in', 'hdr-stop'].map((id) => {
               const s = getComputedStyle(document.getElementById(id));
@@ -147,7 +147,7 @@ def test_without_the_plc_the_tcp_reads_invalid_and_no_key_looks_usable(browser, 
         browser.screenshot("review_offline_moveabs")
     finally:
         stack.start_server(port)
-    browser.wait_for(lambda d: d.find_element(By.ID, "tcp-pos").text.startswith("TCP X 417.5"), "valid again")
+    browser.wait_for(lambda d: browser.text("tcp-pos").startswith("TCP X 417.5"), "valid again")
     assert browser.driver.execute_script(
         "return getComputedStyle(document.getElementById('btn-execute')).pointerEvents") == "auto"
 
@@ -262,8 +262,8 @@ def test_the_monitor_address_offers_no_pnp_key_and_reads_the_segment_names(brows
     stack.set(PnP_State=0)
     browser.fresh()              # a tab without the key an earlier test's address left in its sessionStorage
     browser.open(f"{stack.server.url}pnp.html")                  # no key: the monitor
-    assert browser.driver.find_element(By.ID, "pill-role").text == "Monitor"
-    browser.wait_for(lambda d: "Cycle: Idle" in d.find_element(By.ID, "pnp-state").text, "the cycle's state")
+    assert browser.text("pill-role") == "Monitor"
+    browser.wait_for(lambda d: "Cycle: Idle" in browser.text("pnp-state"), "the cycle's state")
     keys = browser.driver.execute_script(
         "return [...document.querySelectorAll('.side .buttons button')].map((b) => [b.id, b.disabled])")
     assert keys and all(disabled for _, disabled in keys), keys
@@ -282,8 +282,7 @@ def test_the_pnp_segment_names_sit_inside_the_drawing_and_beside_their_paths(bro
     """At 800x480 the boxes of "2 Pick" and "5 Place" ran off the drawing's edges, and every column's names (172 px
     boxes centred 78 px out) covered its down and up paths."""
     d = browser.driver
-    dw, dh = d.execute_script("return [outerWidth - innerWidth, outerHeight - innerHeight]")
-    d.set_window_size(size[0] + dw, size[1] + dh)
+    browser.size(*size)
     try:
         open_page(browser, stack, "pnp")
         browser.click("btn-preset")

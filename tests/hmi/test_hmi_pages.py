@@ -134,10 +134,10 @@ def test_connect_and_disconnect_update_the_connection_status(page):
     browser.click("btn-preset")
     browser.click("btn-execute")
     browser.wait_status("Connect_Connected", "true")
-    browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the header pill")
+    browser.wait_for(lambda d: browser.text("pill-robot") == "Robot connected", "the header pill")
     browser.click("btn-disconnect")
     browser.wait_status("Connect_Connected", "false")
-    browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot not connected", "the header pill")
+    browser.wait_for(lambda d: browser.text("pill-robot") == "Robot not connected", "the header pill")
 
 
 def test_pnp_segment_edit_writes_only_that_segment(page):
@@ -215,7 +215,7 @@ def test_a_first_connect_retried_is_not_called_a_lost_connection(page, stack):
         with plc.lock:
             plc.vars.update(Connect_Connected=True, Connect_Reconnecting=False, Connect_Error=False,
                             Connect_ErrorID=0, Connect_ErrorDescrip="")
-        browser.wait_for(lambda d: d.find_element(By.ID, "pill-robot").text == "Robot connected", "the link up")
+        browser.wait_for(lambda d: browser.text("pill-robot") == "Robot connected", "the link up")
         browser.wait_for(lambda d: browser.alarm_rows()[0].endswith("returned, unack."), "the retry alarm back")
         with plc.lock:
             plc.vars.update(Connect_Connected=False, Connect_Reconnecting=True, Connect_RetryCount=0,

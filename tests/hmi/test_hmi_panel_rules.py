@@ -5,6 +5,7 @@ The screenshots go to artifacts/screenshots/panel_<page>_<role>_<size>.png."""
 from __future__ import annotations
 
 import pytest
+from browser import SHOWN_TEXT
 from fake_plc import FakePlc, command_program, scanning, serving
 from panel_metrics import cut_texts, page_metrics
 
@@ -48,15 +49,15 @@ def stack(chromium):
 
 
 def open_sized(stack, name: str, role: str, size):
+    """``name`` loaded afresh (Browser.open) as ``role`` in a viewport of ``size``."""
     _, server, browser = stack
     d = browser.driver
-    dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
-    d.set_window_size(size[0] + dw, size[1] + dh)
-    d.get("about:blank")            # a new load: an address differing only in its #key= would not reload the page
+    browser.size(*size)
     browser.open(server.page_url(name, role))
-    role_shown = d.find_element("id", "pill-role").text
+    role_shown, *viewport = d.execute_script(SHOWN_TEXT + "return [shown(document.getElementById('pill-role')), "
+                                                          "innerWidth, innerHeight]")
     assert role_shown == role.capitalize(), role_shown
-    assert d.execute_script("return [innerWidth, innerHeight]") == list(size)
+    assert viewport == list(size)
     return browser
 
 
@@ -92,7 +93,7 @@ def test_normal_states_are_grey(stack, name):
     """Robot connected and in its Listen node, PLC online, operator logged in, a command done: nothing is coloured
     (ISA-101). Only the header's Stop key keeps its red."""
     browser = open_sized(stack, name, "operator", (800, 480))
-    browser.wait_for(lambda d: browser.driver.find_element("id", "pill-robot").text == "Robot ready", "the robot state")
+    browser.wait_for(lambda d: browser.text("pill-robot") == "Robot ready", "the robot state")
     browser.driver.execute_script("message('Move Absolute: Done – the robot arrived at the target.', 'ok')")
     assert browser.driver.execute_script(COLOURS, NORMAL_STATE_ELEMENTS, GREY_CHROMA) == []
 
@@ -164,7 +165,7 @@ def test_the_ladder_drawing_reads_at_the_panels_body_text_size(ladder_stack, siz
     browser.driver.refresh()
     browser.wait_for(lambda d: d.execute_script("return document.querySelector('.ladder svg') !== null"),
                      "the ladder drawing")
-    assert browser.driver.find_element("id", "ladder-zoom").text == "100 %"
+    assert browser.text("ladder-zoom") == "100 %"
     browser.screenshot(f"panel_program_100_{size[0]}x{size[1]}")
     found = page_metrics(browser)
     assert found == {"small": [], "text": [], "contrast": []}, found

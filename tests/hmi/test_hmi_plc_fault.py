@@ -88,9 +88,9 @@ def test_the_page_header_shows_the_fault_and_no_robot_link(chromium, mapping):
     with scanning(FakePlc(mapping)) as plc, serving(plc, mapping) as server:      # no program: the link stays up
         plc.vars["Connect_Connected"] = True
         chromium.open(server.page_url("stop", "operator"))
-        chromium.wait_for(lambda d: d.find_element("id", "pill-robot").text == "Robot connected", "the robot link")
+        chromium.wait_for(lambda d: chromium.text("pill-robot") == "Robot connected", "the robot link")
         fault(plc)
-        chromium.wait_for(lambda d: d.find_element("id", "pill-plc").text.startswith("PLC fault — "), "the fault")
+        chromium.wait_for(lambda d: chromium.text("pill-plc").startswith("PLC fault — "), "the fault")
         driver = chromium.driver
         assert driver.find_element("id", "pill-plc").text == "PLC fault — integer division by zero (100 / 0)"
         assert driver.find_element("id", "pill-plc").get_attribute("title") == FAULT

@@ -104,8 +104,7 @@ def text_overlaps(browser) -> list:
 def test_ladder_monitor_rung_list_zoom_whole_comments_hex_values_and_no_overlap(system, size):
     plc, hmi, browser = system
     d = browser.driver
-    dw, dh = d.execute_script("return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
-    d.set_window_size(size[0] + dw, size[1] + dh)
+    browser.size(*size)
     try:
         browser.open(f"{hmi.url}program.html")
         browser.wait_for(lambda _d: int(d.find_element(By.CSS_SELECTOR, "section[data-pou]").get_attribute("data-polls")

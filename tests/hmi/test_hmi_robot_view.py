@@ -53,10 +53,7 @@ def page(stack):
         plc.vars["ReadPos_Position"]["Joints"] = list(JOINTS)
 
     def open_page(name: str, size=(800, 480)):
-        d = browser.driver
-        dw, dh = d.execute_script(
-            "return [window.outerWidth - window.innerWidth, window.outerHeight - window.innerHeight]")
-        d.set_window_size(size[0] + dw, size[1] + dh)
+        browser.size(*size)
         browser.open(server.page_url(name, "engineer"))
         browser.wait_for(lambda _d: _d.execute_script("return ARM.data !== null"), "the arm data")
         return browser
@@ -91,20 +88,20 @@ def test_the_browser_reach_check_agrees_with_the_simulator(page):
     poses = [[2000, 0, 300, 180, 0, 90], [0, 0, 1200, 180, 0, 0], [30, 20, 400, 180, 0, 90]]
     poses += [[rng.uniform(-950, 950), rng.uniform(-950, 950), rng.uniform(-600, 1100),
                rng.uniform(-180, 180), rng.uniform(-90, 90), rng.uniform(-180, 180)] for _ in range(150)]
+    # every pose checked by the page in one round trip
+    results = js(b, "return arguments[0].map((p) => reachCheck({X: p[0], Y: p[1], Z: p[2], RX: p[3], RY: p[4], "
+                    "RZ: p[5]}))", poses)
     agree = 0
-    for pose in poses:
+    for pose, result in zip(poses, results, strict=True):
         try:
             kinematics.inverse_kinematics(kinematics.pose_to_matrix(pose))
             reachable = True
         except kinematics.KinematicsError:
             reachable = False
-        result = js(b, "const p = arguments[0]; return reachCheck({X: p[0], Y: p[1], Z: p[2], RX: p[3], RY: p[4], "
-                       "RZ: p[5]})", pose)
         assert ("reason" not in result) == reachable, (pose, result)
         agree += 1
     assert agree == len(poses)
-    assert sum(1 for p in poses if "reason" in js(b, "const p = arguments[0]; return reachCheck({X: p[0], Y: p[1], "
-                                                     "Z: p[2], RX: p[3], RY: p[4], RZ: p[5]})", p)) > 10
+    assert sum(1 for result in results if "reason" in result) > 10
 
 
 def red_pixels(b, canvas_id):
@@ -290,5 +287,5 @@ def test_the_view_controls_fit_a_finger_and_read_on_the_panel(page, size):
                                     "parseFloat(getComputedStyle(document.getElementById(id)).fontSize))")
     assert min(texts) >= 14
     b = open_page("pnp", size)
-    b.wait_for(lambda _d: b.driver.find_element(By.ID, "pnp-side").text, "the PnP drawing")
+    b.wait_for(lambda _d: b.text("pnp-side"), "the PnP drawing")
     check_controls(b, ["pnp-side"])

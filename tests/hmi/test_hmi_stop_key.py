@@ -118,7 +118,7 @@ def test_the_stop_key_latches_the_pnp_cycle(connected):
     time.sleep(2.0)                                                          # 8 s of robot time after the release
     assert connected.events("motion_start", mark) == [], "the robot moved again by itself"
     assert not connected.robot_state()["moving"] and connected.read("PnP_State") == "Stopped"
-    browser.wait_for(lambda d: "Cycle: Stopped" in d.find_element("id", "pnp-state").text, "Stopped on the page")
+    browser.wait_for(lambda d: "Cycle: Stopped" in browser.text("pnp-state"), "Stopped on the page")
     browser.screenshot("stopkey_pnp_stopped_operator")
     with connected.plc.lock:
         connected.plc.write("PnP_MoveParameters[4].Speed", 30)
