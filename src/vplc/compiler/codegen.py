@@ -374,14 +374,36 @@ class CodeGen:
                           f"{abi.WATCHDOG}('still copying large arrays or structures')")
 
     def moves_bulk(self, st: A.Stmt) -> bool:
-        """Whether a statement reads, writes or passes a structured value of at least BULK_CELLS cells (a copy
-        of it takes long enough to matter to the watchdog)."""
+        """Whether a statement copies a structured value of at least BULK_CELLS cells (a copy of it takes long
+        enough to matter to the watchdog): a value it reads whole, assigns, passes into an input or takes from an
+        output. What it only reaches through (``big.x``, ``big[i]``), the FB instance it calls and an in-out of a
+        POU it hands over (a reference; the callee's statements carry their own checks) are not copied. An array
+        element given to an array input, or to any argument of a builtin or native POU, stands for its array from
+        that element on: the array counts; a native POU's in-outs count whole."""
         memo = self._cells_memo
-        for node in A.walk(st):
-            ty = getattr(node, "ty", None)
-            if isinstance(node, A.Expr) and ty is not None and not is_scalar(ty) and \
-                    T.value_cells(ty, BULK_CELLS, memo) >= BULK_CELLS:
-                return True
+        through: set[int] = set()           # nodes only reached through or handed over by reference
+        from_element: set[int] = set()      # Index nodes standing for their array from that element on
+        stack: list[A.Node] = [st]
+        while stack:
+            node = stack.pop()
+            if isinstance(node, A.Expr) and id(node) not in through:
+                ty = node.ty
+                if ty is not None and not is_scalar(ty) and T.value_cells(ty, BULK_CELLS, memo) >= BULK_CELLS:
+                    return True
+            if isinstance(node, (A.Member, A.Index, A.BitAccess)) and id(node) not in from_element:
+                through.add(id(node.base))
+            elif isinstance(node, A.Call) and node.binding is not None:
+                b = node.binding
+                foreign = b.kind == "builtin" or b.pou is None or b.pou.native
+                through.add(id(node.callee))
+                if b.instance is not None:
+                    through.add(id(b.instance))
+                for ba in b.args:
+                    if ba.param.direction == "inout" and not foreign:
+                        through.add(id(ba.expr))
+                    elif ba.from_element or (foreign and isinstance(ba.expr, A.Index)):
+                        from_element.add(id(ba.expr))
+            stack.extend(A.iter_children(node))
         return False
 
     def st_Empty(self, st: A.Empty) -> None:

@@ -37,6 +37,57 @@ def test_only_statements_moving_large_values_carry_the_watchdog_check(tmp_path):
     assert code.count("still copying large arrays or structures") == 1
 
 
+
+_BIG_POUS = """
+TYPE stBig : STRUCT x : INT; arr : ARRAY[0..2047] OF INT; END_STRUCT; END_TYPE
+FUNCTION_BLOCK FbRef
+VAR_IN_OUT Big : stBig; END_VAR
+VAR_INPUT Small : INT; END_VAR
+VAR_OUTPUT Seen : INT; END_VAR
+Seen := Big.x + Small;
+END_FUNCTION_BLOCK
+FUNCTION FnRef : INT
+VAR_IN_OUT Big : stBig; END_VAR
+FnRef := Big.arr[1];
+END_FUNCTION
+FUNCTION FnArr : INT
+VAR_INPUT In : ARRAY[0..1023] OF INT; END_VAR
+FnArr := In[0];
+END_FUNCTION
+FUNCTION_BLOCK FbVal
+VAR_INPUT BigIn : stBig; END_VAR
+VAR_OUTPUT BigOut : stBig; END_VAR
+BigOut.x := BigIn.x;
+END_FUNCTION_BLOCK
+"""
+
+
+@pytest.mark.parametrize("body, checked", [
+    ("c.x := 1;", False), ("y := c.arr[3];", False), ("c.arr[4] := y;", False),   # reached through, not copied
+    ("r(Big := c, Small := 3);", False), ("y := FnRef(Big := c);", False),          # in-outs: references
+    ("d := c;", True), ("v(BigIn := c);", True), ("v(BigOut => d);", True),         # whole values moved
+    ("y := FnArr(In := k[5]);", True), ("y := FnArr(In := c.arr[5]);", True),       # the array from that element
+])
+def test_the_large_copy_check_follows_what_a_statement_copies_not_what_it_reaches_through(tmp_path, body, checked):
+    src = tmp_path / "m.st"
+    src.write_text("PROGRAM Main\nVAR c, d : stBig; y : INT; r : FbRef; v : FbVal; k : ARRAY[0..1999] OF INT; "
+                   f"END_VAR\n{body}\nEND_PROGRAM\n{_BIG_POUS}", encoding="utf-8")
+    code = compile_program([str(src)]).source
+    assert code.count("still copying large arrays or structures") == int(checked)
+
+
+def test_large_copies_inside_a_function_block_given_large_in_outs_are_stopped_by_the_watchdog(tmp_path):
+    # the call hands the arrays over by reference (no check after it); the copies in the body carry their own
+    churn = ("FUNCTION_BLOCK Churn\nVAR_IN_OUT a, b : ARRAY[0..499999] OF DINT; END_VAR\n"
+             + "a := b; b := a;\n" * 100 + "END_FUNCTION_BLOCK\n")
+    plc = plc_from(tmp_path, "ch(a := x, b := z);\n" * 2, "x, z : ARRAY[0..499999] OF DINT; ch : Churn;",
+                   extra=churn, watchdog_ms=5)
+    with pytest.raises(PlcFault) as exc:
+        plc.scan(0)
+    assert exc.value.kind == "watchdog"
+    assert "watchdog: scan exceeded 5 ms (still copying large arrays or structures)" in str(exc.value)
+    assert exc.value.instance is not None and "ch" in exc.value.instance.lower()
+
 def test_whole_array_assignment_copies_every_element(tmp_path):
     plc = plc_from(tmp_path, """
         b[7] := 7; b[99999] := -1; a := b;
