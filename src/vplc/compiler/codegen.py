@@ -24,6 +24,7 @@ from .inline import constant_bounds, constant_step, inlinable, kept_inputs, loop
 
 BULK_CELLS = 1024         # a statement copying a structured value this large checks the watchdog after it
 CASE_CHAIN = 200          # CASE branches per if/elif chain (Python compiles an elif one level deeper)
+LEAF_FIELDS = 16          # a structure field of at most this many plain fields: copied in its parent's assigner
 
 Branch = TypeVar("Branch", A.IfBranch, A.CaseBranch)
 Binding = Any              # the checker's call binding (checker/symbols.py), read without importing it
@@ -178,7 +179,16 @@ class CodeGen:
             self.out.emit("pass")
         for f in t.fields.values():
             a = attr(f.name)
-            self.out.emit(self.field_assign(f"o.{a}", f"v.{a}", f.type))
+            leaf = _leaf_struct(f.type)
+            if leaf is None:
+                self.out.emit(self.field_assign(f"o.{a}", f"v.{a}", f.type))
+                continue
+            # a small structure of plain fields is copied here, as its assigner would (same reads and writes,
+            # same order), without the call
+            self.out.emit(f"o_, v_ = o.{a}, v.{a}")
+            for g in leaf.fields.values():
+                b = attr(g.name)
+                self.out.emit(self.field_assign(f"o_.{b}", f"v_.{b}", g.type))
         self.out.ind -= 1
 
     def gen_union(self, t: T.StructType) -> None:
@@ -696,6 +706,19 @@ class CodeGen:
             if ba.negated:
                 code = f"(not {code})"
             self.store(ba.expr, code, None, src_type=ba.param.type)
+
+
+def _leaf_struct(t: T.Type) -> T.StructType | None:
+    """``t`` when it is a structure (not a union) of 1..LEAF_FIELDS fields that are all elementary values, strings
+    or fixed arrays of them (copied without a call), else None."""
+    u = T.unalias(t)
+    if not isinstance(u, T.StructType) or u.kind == "union" or not 0 < len(u.fields) <= LEAF_FIELDS:
+        return None
+    for f in u.fields.values():
+        ft = T.unalias(f.type)
+        if not (is_scalar(ft) or isinstance(ft, T.ArrayType) and not ft.open and is_scalar(T.unalias(ft.element))):
+            return None
+    return u
 
 
 def _task_number(td: A.TaskDecl, prop: str, default: int) -> int:

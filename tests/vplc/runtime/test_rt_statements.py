@@ -74,6 +74,38 @@ def test_struct_assignment_copies_values(tmp_path):
     assert plc.read("Main.b") == {"X": 9.0, "Y": 2.0}
 
 
+
+NESTED = """
+TYPE
+    stPose : STRUCT X, Y : REAL; Tag : STRING[8]; J : ARRAY[0..2] OF INT; END_STRUCT;
+    stCmd : STRUCT Speed : INT; Target : stPose; Via : stPose; Done : BOOL; END_STRUCT;
+END_TYPE
+FUNCTION_BLOCK Mover
+VAR_INPUT P : stCmd; END_VAR
+VAR_OUTPUT Seen : stCmd; END_VAR
+Seen := P;
+P.Target.X := P.Target.X + 100.0;
+END_FUNCTION_BLOCK
+"""
+
+
+def test_nested_structures_are_copied_by_value_through_assignments_and_fb_inputs(tmp_path):
+    # the small inner structures are copied inside the outer one's assigner: values, never the inner objects
+    plc = run1(tmp_path, """
+        a.Speed := 5; a.Target.X := 1.0; a.Target.Tag := 'T'; a.Target.J[2] := 7; a.Via.Y := 2.0; a.Done := TRUE;
+        b := a; b.Target.X := 9.0; b.Target.J[2] := 8;
+        a := a;
+        m(P := a); a.Target.X := 3.0;
+        m2(P := a, Seen => c);
+        """, "a, b, c : stCmd; m, m2 : Mover;", NESTED)
+    assert plc.read("Main.b.Speed") == 5 and plc.read("Main.b.Via.Y") == 2.0 and plc.read("Main.b.Done") is True
+    assert plc.read("Main.b.Target.Tag") == "T"
+    assert plc.read("Main.a.Target.X") == 3.0 and plc.read("Main.a.Target.J[2]") == 7     # b's writes stay in b
+    assert plc.read("Main.m.Seen.Target.X") == 1.0 and plc.read("Main.m.P.Target.X") == 101.0
+    assert plc.read("Main.c.Target.X") == 3.0 and plc.read("Main.m2.P.Target.X") == 103.0
+    plc.write("Main.m2.Seen.Via.Y", 5.0)
+    assert plc.read("Main.c.Via.Y") == 2.0 and plc.read("Main.a.Via.Y") == 2.0
+
 def test_arrays_of_structs_and_of_fb_instances(tmp_path):
     plc = plc_from(tmp_path, """FOR i := 1 TO 3 DO
             pts[i].X := INT_TO_REAL(i);
