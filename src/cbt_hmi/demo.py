@@ -299,7 +299,10 @@ class Demo:
         from vplc.api import PlcFault
         plc, _, _ = self._started()
         try:
-            plc.run_realtime(self.stop_event)
+            # sleep to each due time instead of spinning its last 0.3 ms (run_realtime's default, for the lowest
+            # lateness): the demo is a desk tool, and a scan ~0.1 ms late costs nothing here; idle, the demo
+            # process uses ~5 % of a core instead of ~17 %
+            plc.run_realtime(self.stop_event, spin_ns=0)
         except PlcFault as exc:
             self.fault = f"PLC major fault - the virtual PLC stopped:\n{exc}"
 
