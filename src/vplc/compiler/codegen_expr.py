@@ -328,7 +328,9 @@ class ExprGen:
             if isinstance(first, (A.Name, A.Member)) and _plain(idx[0]):   # cheap to read twice: check inline
                 return f"{base}[{_offset(idx[0], lo)} if {lo} <= {idx[0]} <= {hi} " \
                        f"else {abi.IX1}({idx[0]}, {lo}, {hi}, {what})]"
-            return f"{base}[{abi.IX1}({idx[0]}, {lo}, {hi}, {what})]"
+            z = self.out.tmp("_z")         # any other index: computed once, checked inline (a call only to fault)
+            return f"{base}[{_offset(z, lo)} if {lo} <= ({z} := {idx[0]}) <= {hi} " \
+                   f"else {abi.IX1}({z}, {lo}, {hi}, {what})]"
         dims = self.const(tuple(at.dims), "_d")
         return f"{base}[{abi.IXN}(({', '.join(idx)},), {dims}, {what})]"
 

@@ -29,6 +29,18 @@ def test_index_out_of_range_reports_index_and_bounds(tmp_path):
         plc.scan(0)
 
 
+
+def test_a_computed_index_is_evaluated_once_and_out_of_range_reports_its_value(tmp_path):
+    extra = "FUNCTION Next : INT\nVAR_IN_OUT n : INT; END_VAR\nn := n + 1; Next := n;\nEND_FUNCTION\n"
+    plc = plc_from(tmp_path, "a[i + 1] := a[Next(k) - 1] + 10; IF go THEN b := a[i * 3]; END_IF;",
+                   "a : ARRAY[1..4] OF INT := [1, 2, 3, 4]; b, i : INT := 1; k : INT := 2; go : BOOL;", extra=extra)
+    plc.scan(0)
+    assert plc.read("Main.a") == [1, 12, 3, 4] and plc.read("Main.k") == 3     # Next ran once: a[2] read
+    plc.write("Main.go", True)
+    plc.write("Main.i", 2)
+    with pytest.raises(PlcFault, match=r"index 6 out of range 1\.\.4 of a"):
+        plc.scan(1_000_000)
+
 def test_endless_while_trips_the_watchdog(tmp_path):
     plc = plc_from(tmp_path, "WHILE TRUE DO n := n + 1; END_WHILE;", "n : DINT;", watchdog_ms=50)
     with pytest.raises(PlcFault, match="watchdog") as ei:
