@@ -386,10 +386,11 @@ class CodeGen:
     def moves_bulk(self, st: A.Stmt) -> bool:
         """Whether a statement copies a structured value of at least BULK_CELLS cells (a copy of it takes long
         enough to matter to the watchdog): a value it reads whole, assigns, passes into an input or takes from an
-        output. What it only reaches through (``big.x``, ``big[i]``), the FB instance it calls and an in-out of a
-        POU it hands over (a reference; the callee's statements carry their own checks) are not copied. An array
-        element given to an array input, or to any argument of a builtin or native POU, stands for its array from
-        that element on: the array counts; a native POU's in-outs count whole."""
+        output. What it only reaches through (``big.x``, ``big[i]``; not ``f().x``, whose call builds the whole
+        result), the FB instance it calls and an in-out of a POU it hands over (a reference; the callee's
+        statements carry their own checks) are not copied. An array element given to an array input, or to any
+        argument of a builtin or native POU, stands for its array from that element on: the array counts; a
+        native POU's in-outs count whole."""
         memo = self._cells_memo
         through: set[int] = set()           # nodes only reached through or handed over by reference
         from_element: set[int] = set()      # Index nodes standing for their array from that element on
@@ -400,7 +401,8 @@ class CodeGen:
                 ty = node.ty
                 if ty is not None and not is_scalar(ty) and T.value_cells(ty, BULK_CELLS, memo) >= BULK_CELLS:
                     return True
-            if isinstance(node, (A.Member, A.Index, A.BitAccess)) and id(node) not in from_element:
+            if isinstance(node, (A.Member, A.Index, A.BitAccess)) and id(node) not in from_element and \
+                    not isinstance(node.base, A.Call):      # a function's result is built by the call: a copy
                 through.add(id(node.base))
             elif isinstance(node, A.Call) and node.binding is not None:
                 b = node.binding

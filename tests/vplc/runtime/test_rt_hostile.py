@@ -88,6 +88,22 @@ def test_large_copies_inside_a_function_block_given_large_in_outs_are_stopped_by
     assert "watchdog: scan exceeded 5 ms (still copying large arrays or structures)" in str(exc.value)
     assert exc.value.instance is not None and "ch" in exc.value.instance.lower()
 
+def test_a_member_of_a_large_function_result_is_a_copy_the_watchdog_checks(tmp_path):
+    # MkBig(3).x builds the whole 100,000-cell result in every call: not a stored value reached through
+    make = ("TYPE stHuge : STRUCT x : INT; arr : ARRAY[0..99999] OF INT; END_STRUCT; END_TYPE\n"
+            "FUNCTION MkBig : stHuge\nVAR_INPUT v : INT; END_VAR\nMkBig.x := v;\nEND_FUNCTION\n"
+            "FUNCTION MkArr : ARRAY[0..99999] OF INT\nVAR_INPUT v : INT; END_VAR\nMkArr[0] := v;\nEND_FUNCTION\n")
+    src = tmp_path / "m.st"
+    src.write_text(f"PROGRAM Main\nVAR y : INT; END_VAR\ny := MkBig(3).x;\ny := MkArr(4)[0];\nEND_PROGRAM\n{make}",
+                   encoding="utf-8")
+    assert compile_program([str(src)]).source.count("still copying large arrays or structures") == 2
+    plc = plc_from(tmp_path, "y := MkBig(3).x;\ny := MkArr(4)[0];\n" * 300, "y : INT;", extra=make, watchdog_ms=5)
+    with pytest.raises(PlcFault) as exc:
+        plc.scan(0)
+    assert exc.value.kind == "watchdog"
+    assert "watchdog: scan exceeded 5 ms (still copying large arrays or structures)" in str(exc.value)
+
+
 def test_whole_array_assignment_copies_every_element(tmp_path):
     plc = plc_from(tmp_path, """
         b[7] := 7; b[99999] := -1; a := b;
