@@ -300,11 +300,12 @@ class CodeGen:
         self.out.at(pou.span)
         self.out.emit(f"def {bname}(s):")
         self.out.ind += 1
-        for sec in pou.sections:
-            if sec.kind == "VAR_TEMP":
-                for d in sec.vars:
-                    self.out.at(d.span)
-                    self.init_var(sec.kind, d)
+        temps = [d for sec in pou.sections if sec.kind == "VAR_TEMP" for d in sec.vars]
+        for d in temps:
+            self.out.at(d.span)
+            self.init_var("VAR_TEMP", d)
+        if pt.kind != "function" and self.builds_bulk(temps):
+            self.check_bulk()
         self.block(pou.body)
         self.out.emit("return")
         self.out.ind -= 1
@@ -352,6 +353,9 @@ class CodeGen:
                     self.out.emit(f"s.{a} = {n}")
         if pt.ret is not None and pt.ret is not T.VOID:
             self.out.emit(f"s.{attr(pt.name)} = {self.ex.default(pt.ret, None, 'path')}")
+        built = [d for sec in pt.pou.sections if sec.kind not in ("VAR_INPUT", "VAR_IN_OUT") for d in sec.vars]
+        if self.builds_bulk(built, pt.ret if pt.ret is not T.VOID else None):
+            self.check_bulk()            # a fresh frame per call: its large variables are built as a copy is
         self.out.emit(f"{bname}(s)")
         for p, n in names.values():
             if p.direction == "out":
@@ -379,18 +383,35 @@ class CodeGen:
         m(st)
         self.ex.spill_ok = False
         if isinstance(st, (A.Assign, A.CallStmt)) and self.moves_bulk(st):
-            # a scan of large copies and no loop still meets the watchdog
-            self.out.emit(f"if {abi.PERF_COUNTER}() > {abi.DEADLINE}[0]: "
-                          f"{abi.WATCHDOG}('still copying large arrays or structures')")
+            self.check_bulk()           # a scan of large copies and no loop still meets the watchdog
+
+    def check_bulk(self) -> None:
+        """The watchdog check after work as long as a large copy."""
+        self.out.emit(f"if {abi.PERF_COUNTER}() > {abi.DEADLINE}[0]: "
+                      f"{abi.WATCHDOG}('still copying large arrays or structures')")
+
+    def builds_bulk(self, decls: list[A.VarDecl], ret: T.Type | None = None) -> bool:
+        """Whether a call builds variables of its own (a function's locals, outputs and result, an FB's
+        VAR_TEMP) of at least BULK_CELLS cells together: every call does that work afresh, though the statements
+        only reach through them. (Inputs are the caller's: a copy into one is checked after the calling statement.)"""
+        memo = self._cells_memo
+        types = [d.sym.type for d in decls if d.sym is not None] + ([ret] if ret is not None else [])
+        cells = 0
+        for t in types:
+            if not is_scalar(t):
+                cells += T.value_cells(t, BULK_CELLS, memo)
+                if cells >= BULK_CELLS:
+                    return True
+        return False
 
     def moves_bulk(self, st: A.Stmt) -> bool:
         """Whether a statement copies a structured value of at least BULK_CELLS cells (a copy of it takes long
         enough to matter to the watchdog): a value it reads whole, assigns, passes into an input or takes from an
-        output. What it only reaches through (``big.x``, ``big[i]``; not ``f().x``, whose call builds the whole
-        result), the FB instance it calls and an in-out of a POU it hands over (a reference; the callee's
-        statements carry their own checks) are not copied. An array element given to an array input, or to any
-        argument of a builtin or native POU, stands for its array from that element on: the array counts; a
-        native POU's in-outs count whole."""
+        output. What it only reaches through (``big.x``, ``big[i]``, ``f().x``: ``builds_bulk`` checks a call
+        that builds large variables of its own), the FB instance it calls and an in-out of a POU it hands over (a
+        reference; the callee's statements carry their own checks) are not copied. An array element given to an
+        array input, or to any argument of a builtin or native POU, stands for its array from that element on:
+        the array counts; a native POU's in-outs count whole."""
         memo = self._cells_memo
         through: set[int] = set()           # nodes only reached through or handed over by reference
         from_element: set[int] = set()      # Index nodes standing for their array from that element on
@@ -401,8 +422,7 @@ class CodeGen:
                 ty = node.ty
                 if ty is not None and not is_scalar(ty) and T.value_cells(ty, BULK_CELLS, memo) >= BULK_CELLS:
                     return True
-            if isinstance(node, (A.Member, A.Index, A.BitAccess)) and id(node) not in from_element and \
-                    not isinstance(node.base, A.Call):      # a function's result is built by the call: a copy
+            if isinstance(node, (A.Member, A.Index, A.BitAccess)) and id(node) not in from_element:
                 through.add(id(node.base))
             elif isinstance(node, A.Call) and node.binding is not None:
                 b = node.binding

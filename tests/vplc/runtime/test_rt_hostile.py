@@ -89,7 +89,7 @@ def test_large_copies_inside_a_function_block_given_large_in_outs_are_stopped_by
     assert exc.value.instance is not None and "ch" in exc.value.instance.lower()
 
 def test_a_member_of_a_large_function_result_is_a_copy_the_watchdog_checks(tmp_path):
-    # MkBig(3).x builds the whole 100,000-cell result in every call: not a stored value reached through
+    # MkBig(3).x builds the whole 100,000-cell result in every call: the functions' frames carry the check
     make = ("TYPE stHuge : STRUCT x : INT; arr : ARRAY[0..99999] OF INT; END_STRUCT; END_TYPE\n"
             "FUNCTION MkBig : stHuge\nVAR_INPUT v : INT; END_VAR\nMkBig.x := v;\nEND_FUNCTION\n"
             "FUNCTION MkArr : ARRAY[0..99999] OF INT\nVAR_INPUT v : INT; END_VAR\nMkArr[0] := v;\nEND_FUNCTION\n")
@@ -98,6 +98,24 @@ def test_a_member_of_a_large_function_result_is_a_copy_the_watchdog_checks(tmp_p
                    encoding="utf-8")
     assert compile_program([str(src)]).source.count("still copying large arrays or structures") == 2
     plc = plc_from(tmp_path, "y := MkBig(3).x;\ny := MkArr(4)[0];\n" * 300, "y : INT;", extra=make, watchdog_ms=5)
+    with pytest.raises(PlcFault) as exc:
+        plc.scan(0)
+    assert exc.value.kind == "watchdog"
+    assert "watchdog: scan exceeded 5 ms (still copying large arrays or structures)" in str(exc.value)
+
+
+@pytest.mark.parametrize("call, decls, pou", [
+    ("y := FnLocal(1);", "y : INT;",
+     "FUNCTION FnLocal : INT\nVAR_INPUT v : INT; END_VAR\n"
+     "VAR tmp : ARRAY[0..99999] OF INT; END_VAR\nFnLocal := tmp[v] + v;\nEND_FUNCTION\n"),
+    ("f(v := 1);", "f : FbTemp;",
+     "FUNCTION_BLOCK FbTemp\nVAR_INPUT v : INT; END_VAR\nVAR_OUTPUT o : INT; END_VAR\n"
+     "VAR_TEMP tmp : ARRAY[0..99999] OF INT; END_VAR\no := tmp[v] + v;\nEND_FUNCTION_BLOCK\n"),
+])
+def test_a_call_that_builds_large_variables_of_its_own_is_checked_by_the_watchdog(tmp_path, call, decls, pou):
+    # a function's variables and an FB's VAR_TEMP are built afresh by every call (100,000 cells here), though the
+    # statements only reach through them: the call's frame carries the check
+    plc = plc_from(tmp_path, (call + "\n") * 300, decls, extra=pou, watchdog_ms=5)
     with pytest.raises(PlcFault) as exc:
         plc.scan(0)
     assert exc.value.kind == "watchdog"
