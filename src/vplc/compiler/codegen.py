@@ -407,11 +407,12 @@ class CodeGen:
     def moves_bulk(self, st: A.Stmt) -> bool:
         """Whether a statement copies a structured value of at least BULK_CELLS cells (a copy of it takes long
         enough to matter to the watchdog): a value it reads whole, assigns, passes into an input or takes from an
-        output. What it only reaches through (``big.x``, ``big[i]``, ``f().x``: ``builds_bulk`` checks a call
-        that builds large variables of its own), the FB instance it calls and an in-out of a POU it hands over (a
-        reference; the callee's statements carry their own checks) are not copied. An array element given to an
-        array input, or to any argument of a builtin or native POU, stands for its array from that element on:
-        the array counts; a native POU's in-outs count whole."""
+        output, or a large input a function call leaves out (its default is built). What it only reaches through
+        (``big.x``, ``big[i]``, ``f().x``: ``builds_bulk`` checks a call that builds large variables of its own),
+        the FB instance it calls and an in-out of a POU it hands over (a reference; the callee's statements carry
+        their own checks) are not copied. An array element given to an array input, or to any argument of a
+        builtin or native POU, stands for its array from that element on: the array counts; a native POU's
+        in-outs count whole."""
         memo = self._cells_memo
         through: set[int] = set()           # nodes only reached through or handed over by reference
         from_element: set[int] = set()      # Index nodes standing for their array from that element on
@@ -435,8 +436,17 @@ class CodeGen:
                         through.add(id(ba.expr))
                     elif ba.from_element or (foreign and isinstance(ba.expr, A.Index)):
                         from_element.add(id(ba.expr))
+                if not foreign and b.pou.kind == "function" and self.omits_bulk(b):
+                    return True
             stack.extend(A.iter_children(node))
         return False
+
+    def omits_bulk(self, b: Binding) -> bool:
+        """Whether a function call leaves out inputs of at least BULK_CELLS cells: the call builds their
+        defaults (an FB's input left out keeps its value)."""
+        given = {ba.param.name.upper() for ba in b.args}
+        left = [p.type for p in b.pou.params if p.direction == "in" and p.name.upper() not in given]
+        return sum(T.value_cells(t, BULK_CELLS, self._cells_memo) for t in left if not is_scalar(t)) >= BULK_CELLS
 
     def st_Empty(self, st: A.Empty) -> None:
         self.out.emit("pass")

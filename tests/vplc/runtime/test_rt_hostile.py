@@ -111,10 +111,13 @@ def test_a_member_of_a_large_function_result_is_a_copy_the_watchdog_checks(tmp_p
     ("f(v := 1);", "f : FbTemp;",
      "FUNCTION_BLOCK FbTemp\nVAR_INPUT v : INT; END_VAR\nVAR_OUTPUT o : INT; END_VAR\n"
      "VAR_TEMP tmp : ARRAY[0..99999] OF INT; END_VAR\no := tmp[v] + v;\nEND_FUNCTION_BLOCK\n"),
+    ("y := FnOmit(v := 1);", "y : INT;",                  # an input the call leaves out: its default is built
+     "FUNCTION FnOmit : INT\nVAR_INPUT v : INT; In : ARRAY[0..99999] OF INT; END_VAR\nFnOmit := In[v];\n"
+     "END_FUNCTION\n"),
 ])
 def test_a_call_that_builds_large_variables_of_its_own_is_checked_by_the_watchdog(tmp_path, call, decls, pou):
     # a function's variables and an FB's VAR_TEMP are built afresh by every call (100,000 cells here), though the
-    # statements only reach through them: the call's frame carries the check
+    # statements only reach through them: the call's frame, or the call leaving out a large input, carries the check
     plc = plc_from(tmp_path, (call + "\n") * 300, decls, extra=pou, watchdog_ms=5)
     with pytest.raises(PlcFault) as exc:
         plc.scan(0)
