@@ -382,7 +382,8 @@ class CodeGen:
         self.ex.spill_ok = isinstance(st, (A.Assign, A.CallStmt, A.Case, A.For))
         m(st)
         self.ex.spill_ok = False
-        if isinstance(st, (A.Assign, A.CallStmt)) and self.moves_bulk(st):
+        if isinstance(st, (A.Assign, A.CallStmt)) and self.moves_bulk(st) or \
+                any(self.moves_bulk(e) for e in _tested(st)):
             self.check_bulk()           # a scan of large copies and no loop still meets the watchdog
 
     def check_bulk(self) -> None:
@@ -404,15 +405,15 @@ class CodeGen:
                     return True
         return False
 
-    def moves_bulk(self, st: A.Stmt) -> bool:
-        """Whether a statement copies a structured value of at least BULK_CELLS cells (a copy of it takes long
-        enough to matter to the watchdog): a value it reads whole, assigns, passes into an input or takes from an
-        output, or a large input a function call leaves out (its default is built). What it only reaches through
-        (``big.x``, ``big[i]``, ``f().x``: ``builds_bulk`` checks a call that builds large variables of its own),
-        the FB instance it calls and an in-out of a POU it hands over (a reference; the callee's statements carry
-        their own checks) are not copied. An array element given to an array input, or to any argument of a
-        builtin or native POU, stands for its array from that element on: the array counts; a native POU's
-        in-outs count whole."""
+    def moves_bulk(self, st: A.Node) -> bool:
+        """Whether a statement (or a condition) copies a structured value of at least BULK_CELLS cells (a copy
+        of it takes long enough to matter to the watchdog): a value it reads whole, assigns, passes into an input
+        or takes from an output, or a large input a function call leaves out (its default is built). What it only
+        reaches through (``big.x``, ``big[i]``, ``f().x``: ``builds_bulk`` checks a call that builds large
+        variables of its own), the FB instance it calls and an in-out of a POU it hands over (a reference; the
+        callee's statements carry their own checks) are not copied. An array element given to an array input, or
+        to any argument of a builtin or native POU, stands for its array from that element on: the array counts;
+        a native POU's in-outs count whole."""
         memo = self._cells_memo
         through: set[int] = set()           # nodes only reached through or handed over by reference
         from_element: set[int] = set()      # Index nodes standing for their array from that element on
@@ -738,6 +739,18 @@ class CodeGen:
             if ba.negated:
                 code = f"(not {code})"
             self.store(ba.expr, code, None, src_type=ba.param.type)
+
+
+def _tested(st: A.Stmt) -> list[A.Expr]:
+    """The conditions and the selector an IF, CASE, WHILE or REPEAT evaluates (a call in them may copy a large
+    input; the statements of the branches carry their own checks)."""
+    if isinstance(st, A.If):
+        return [b.cond for b in st.branches]
+    if isinstance(st, A.Case):
+        return [st.selector]
+    if isinstance(st, (A.While, A.Repeat)):
+        return [st.cond]
+    return []
 
 
 def _leaf_struct(t: T.Type) -> T.StructType | None:

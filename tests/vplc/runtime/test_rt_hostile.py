@@ -125,6 +125,22 @@ def test_a_call_that_builds_large_variables_of_its_own_is_checked_by_the_watchdo
     assert "watchdog: scan exceeded 5 ms (still copying large arrays or structures)" in str(exc.value)
 
 
+@pytest.mark.parametrize("statement", [
+    "IF FnW(In := k) > 0 THEN n := 5; END_IF;", "CASE FnW(In := k) OF 1: n := 5; END_CASE;",
+    "WHILE FnW(In := k) < 0 DO n := 5; END_WHILE;",             # (no iteration: no loop check)
+])
+def test_a_large_copy_in_a_condition_is_checked_by_the_watchdog(tmp_path, statement):
+    # FnW writes its input: every call copies the 100,000-cell array into it
+    fn = ("FUNCTION FnW : INT\nVAR_INPUT In : ARRAY[0..99999] OF INT; END_VAR\n"
+          "In[0] := In[0] + 1; FnW := In[0];\nEND_FUNCTION\n")
+    plc = plc_from(tmp_path, (statement + "\n") * 300, "n, i : INT; k : ARRAY[0..99999] OF INT;", extra=fn,
+                   watchdog_ms=5)
+    with pytest.raises(PlcFault) as exc:
+        plc.scan(0)
+    assert exc.value.kind == "watchdog"
+    assert "watchdog: scan exceeded 5 ms (still copying large arrays or structures)" in str(exc.value)
+
+
 def test_whole_array_assignment_copies_every_element(tmp_path):
     plc = plc_from(tmp_path, """
         b[7] := 7; b[99999] := -1; a := b;
