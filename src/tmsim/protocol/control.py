@@ -31,7 +31,7 @@ from tmsim.limits import (
     CONTROL_TURN_REQUESTS,
 )
 from tmsim.protocol.clients import Clients
-from tmsim.protocol.port_events import PortEvents
+from tmsim.protocol.port_events import EventPort
 
 
 class RequestError(ValueError):
@@ -183,7 +183,7 @@ class _Client:
     pieces: list[str] = field(default_factory=list)         # ... and those encoded so far
 
 
-class ControlProtocol:
+class ControlProtocol(EventPort):
     """The clients of the control channel and their bytes (see the module docstring). ``log(kind, **fields)``
     receives the channel's events (``control_closed`` with its ``reason``); built without it, the protocol keeps
     them for ``events()`` (tmsim/protocol/port_events.py).
@@ -194,21 +194,10 @@ class ControlProtocol:
     of tmsim/limits.py, the same for every channel: ``configure`` with any setting raises ValueError)."""
 
     def __init__(self, log: Callable[..., None] | None = None):
-        self._events = PortEvents()
-        self.log: Callable[..., None] = self._events.record if log is None else log
+        super().__init__(log)
         self.clients: Clients[_Client] = Clients()
 
     # ---- events, faults and settings ----------------------------------------------------------
-    def events(self) -> list[dict[str, Any]]:
-        """The events produced since the last call, oldest first, each ``{"kind": ..., **fields}``; they are
-        forgotten. Empty when the protocol was built with a ``log`` callback (it got them as they happened)."""
-        return self._events.take()
-
-    @property
-    def events_dropped(self) -> int:
-        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
-        return self._events.dropped
-
     def inject(self, fault: str, **params: Any) -> None:
         """The control channel has no faults: always ValueError naming ``fault`` (the robots' faults are
         injected with the request ``inject`` / ``svr_inject`` it carries, on the robot's ports)."""

@@ -24,7 +24,7 @@ from typing import Any, Protocol
 from tmsim.limits import CPERR_BURST, CPERR_PER_S, CPERR_SETTING_MAX, RECEIVE_TURN, TurnBudget
 from tmsim.protocol import codec
 from tmsim.protocol.clients import Clients
-from tmsim.protocol.port_events import PortEvents
+from tmsim.protocol.port_events import EventPort
 from tmsim.robot.eventlog import text as _text
 from tmsim.tmscript.work import WorkMeter
 
@@ -84,28 +84,17 @@ class Node(Protocol):
         ...
 
 
-class ListenProtocol:
+class ListenProtocol(EventPort):
     """The clients of one robot's Listen node and their bytes (see the module docstring)."""
 
     def __init__(self, node: Node, log: Callable[..., None] | None = None):
+        super().__init__(log)
         self._node = node
-        self._events = PortEvents()
-        self.log: Callable[..., None] = self._events.record if log is None else log
         self.clients: Clients[Client] = Clients()
         self.cperr_burst = CPERR_BURST      # CPERR answers to bad packets a client gets at once ...
         self.cperr_per_s = CPERR_PER_S      # ... then at most this many per second of robot clock
 
     # ---- events and settings ------------------------------------------------------------------
-    def events(self) -> list[dict[str, Any]]:
-        """The events produced since the last call, oldest first, each ``{"kind": ..., **fields}``; they are
-        forgotten. Empty when the protocol was built with a ``log`` callback (it got them as they happened)."""
-        return self._events.take()
-
-    @property
-    def events_dropped(self) -> int:
-        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
-        return self._events.dropped
-
     def configure(self, **settings: Any) -> None:
         """Set the CPERR limit on bad packets: ``cperr_burst`` (1..CPERR_SETTING_MAX) answers at once, then
         ``cperr_per_s`` (0..CPERR_SETTING_MAX) per second of robot clock; a connected client keeps the answers it

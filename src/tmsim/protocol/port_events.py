@@ -14,6 +14,7 @@ frame's text, up to 64 KiB).
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Callable
 from typing import Any
 
 from tmsim.limits import PORT_EVENTS_MAX
@@ -50,3 +51,24 @@ class PortEvents:
 
     def __len__(self) -> int:
         return len(self._kept)
+
+
+class EventPort:
+    """What every port protocol offers for its events (the Listen node's protocol, the Ethernet Slave's session,
+    the control channel): ``log(kind, **fields)``, the callback the protocol reports through (the one it was built
+    with, else this port's own PortEvents), and ``events()`` / ``events_dropped`` for a caller that reads them."""
+
+    def __init__(self, log: Callable[..., None] | None = None):
+        self._events = PortEvents()
+        self.log: Callable[..., None] = self._events.record if log is None else log
+
+    def events(self) -> list[dict[str, Any]]:
+        """The events produced since the last call, oldest first, each ``{"kind": ..., **fields}`` (the kinds of
+        docs/simulator.md "Event log"); they are forgotten. Empty when the port was built with a ``log`` callback
+        (it got them as they happened)."""
+        return self._events.take()
+
+    @property
+    def events_dropped(self) -> int:
+        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
+        return self._events.dropped

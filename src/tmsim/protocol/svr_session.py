@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from tmsim.protocol import codec
 from tmsim.protocol import svr_table as table
-from tmsim.protocol.port_events import PortEvents
+from tmsim.protocol.port_events import EventPort
 from tmsim.protocol.svr_table import ITEMS, Item, SvrContentError, SvrValueError
 
 if TYPE_CHECKING:
@@ -68,13 +68,12 @@ class Client:
     rbuf: bytearray = field(default_factory=bytearray)      # received bytes of an incomplete frame
 
 
-class SvrSession:
+class SvrSession(EventPort):
     def __init__(self, source: RobotDataSource, log: Callable[..., None] | None = None,
                  stream_items: Iterable[str] = DEFAULT_STREAM, stream_mode: int = 1, period: float = 0.1,
                  write_permission: bool = True, variables: Iterable = ()):
         self.source = source
-        self._events = PortEvents()
-        self.log: Callable[..., None] = self._events.record if log is None else log
+        super().__init__(log)
         self.items: dict[str, Item] = dict(ITEMS)   # the predefined items and the declared global variables
         self.variables: dict[str, object] = {}      # value of every declared global variable
         for variable in variables:
@@ -113,17 +112,6 @@ class SvrSession:
         self.stream_mode, self.period = mode, period
         if write_permission is not None:
             self.write_permission = bool(write_permission)
-
-    def events(self) -> list[dict[str, Any]]:
-        """The events produced since the last call, oldest first, each ``{"kind": ..., **fields}`` (``svr_*``,
-        docs/simulator.md); they are forgotten. Empty when the session was built with a ``log`` callback (it got
-        them as they happened)."""
-        return self._events.take()
-
-    @property
-    def events_dropped(self) -> int:
-        """Events not taken by ``events()`` and dropped (PORT_EVENTS_MAX, tmsim/limits.py)."""
-        return self._events.dropped
 
     def config(self) -> dict:
         """What ``configure`` set: the streamed items in order, the mode, the period and the write permission."""
