@@ -1,8 +1,9 @@
 """Contract A queries for tools that judge or sample a variable: ``Plc.type_of`` (the declared type) and
 ``Plc.lasting_slot`` (where a directly declared variable's value lives), with the errors ``read`` gives."""
 import pytest
+from rt_helpers import plc_of
 
-from vplc.api import PathError, T, load_plc
+from vplc.api import PathError, T
 
 SOURCE = """
 TYPE eMode : (Off, Auto); stP : STRUCT X : REAL; Name : STRING[8]; END_STRUCT; END_TYPE
@@ -20,9 +21,7 @@ END_PROGRAM
 
 @pytest.fixture
 def plc(tmp_path):
-    path = tmp_path / "main.st"
-    path.write_text(SOURCE, encoding="utf-8")
-    with load_plc([str(path)]) as p:
+    with plc_of(tmp_path, SOURCE) as p:
         yield p
 
 

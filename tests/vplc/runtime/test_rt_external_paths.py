@@ -1,8 +1,9 @@
 """A program's (or function block's) VAR_EXTERNAL is the global it names (W501, external variables): its path
 reads and writes that global through the API, the CLI and traces (issue 27, defect D1 of a new user's cell)."""
 import pytest
+from rt_helpers import plc_of
 
-from vplc.api import PathError, load_plc
+from vplc.api import PathError
 
 SOURCE = """
 TYPE stPos : STRUCT X : INT; Flags : WORD; END_STRUCT; END_TYPE
@@ -29,9 +30,7 @@ END_PROGRAM
 
 @pytest.fixture
 def plc(tmp_path):
-    path = tmp_path / "main.st"
-    path.write_text(SOURCE, encoding="utf-8")
-    with load_plc([str(path)]) as p:
+    with plc_of(tmp_path, SOURCE) as p:
         yield p
 
 
