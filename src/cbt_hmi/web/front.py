@@ -3,7 +3,8 @@
 One thread owns every socket and reads requests without blocking; a request is answered only when its header
 and its body have arrived whole, so a client that sends slowly or not at all holds no thread, only one of a
 bounded number of connections until its deadline (docs/hmi.md, "Serving every client"). What a request means
-is the handler's business (cbt_hmi.web.server); this module only moves bytes.
+is the handler's business (cbt_hmi.web.server); this module only moves bytes. An answer may go on (a Stream):
+after it the same thread sends the stream's next part every period for as long as the client takes them.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import selectors
 import socket
 import sys
 import time
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from http import HTTPStatus
@@ -58,8 +60,20 @@ class HttpLimits:
             raise ValueError("HttpLimits: 1 <= per_client <= connections")
 
 
-# states of a connection in the front end
-_IDLE, _HEAD, _BODY, _BUSY, _SEND, _LINGER = range(6)
+@dataclass(frozen=True)
+class Stream:
+    """An answer that goes on. A handler that sets ``stream`` on itself leaves its connection open after its answer:
+    the front-end thread calls ``next()`` ``period_s`` seconds after the client took the last part and sends what it
+    returns, until it returns None (the answer ends: the connection is closed, as an HTTP/1.0 body without a length
+    ends) or raises. A part the client does not take within the send deadline closes the connection; no part is
+    made while the last one waits, so a client that reads slowly gets fewer parts, never a growing queue."""
+
+    next: Callable[[], bytes | None]
+    period_s: float
+
+
+# states of a connection in the front end (_STREAM: between two parts of a Stream)
+_IDLE, _HEAD, _BODY, _BUSY, _SEND, _LINGER, _STREAM = range(7)
 
 
 def _head_end(data: bytearray) -> int:
@@ -90,7 +104,8 @@ def _answer(status: HTTPStatus, message: str) -> bytes:
 class _Connection:
     """One client connection and what the front end knows of its current request."""
 
-    __slots__ = ("sock", "peer", "client", "data", "state", "since", "deadline", "need", "whole", "out", "events")
+    __slots__ = ("sock", "peer", "client", "data", "state", "since", "deadline", "need", "whole", "out", "events",
+                 "stream")
 
     def __init__(self, sock, peer, now: float, idle_s: float):
         self.sock, self.peer, self.client = sock, peer, peer[0]
@@ -100,6 +115,7 @@ class _Connection:
         self.whole = False             # the request was read to its end and nothing may follow: close at once
         self.out = memoryview(b"")
         self.events = 0                # what the selector watches for
+        self.stream: Stream | None = None
 
 
 class HttpFront:
@@ -279,7 +295,7 @@ class HttpFront:
         except OSError:
             self._close(connection)
             return
-        if connection.state == _LINGER:               # the answer is sent: what still comes is dropped
+        if connection.state in (_LINGER, _STREAM):    # the answer is sent (or goes on): what comes is dropped
             if not chunk:
                 self._close(connection)
             return
@@ -324,7 +340,7 @@ class HttpFront:
         connection.state = _BUSY
         self._watch(connection, 0)
         if self.at_once(request):
-            self._finish(connection, self._answer(connection, request, late))
+            self._finish(connection, *self._answer(connection, request, late))
         else:
             self._pool.submit(self._work, connection, request, late)
 
@@ -344,7 +360,9 @@ class HttpFront:
             elif connection.deadline < self._next_due:
                 self._next_due = connection.deadline
         for connection in due:
-            if connection.state == _HEAD:
+            if connection.state == _STREAM:
+                self._next_part(connection)                    # the stream's next part is due
+            elif connection.state == _HEAD:
                 self._refuse(connection, HTTPStatus.REQUEST_TIMEOUT,
                              f"the request header did not arrive within {self.limits.header_s:g} s")
             elif connection.state == _BODY:
@@ -355,14 +373,17 @@ class HttpFront:
     # --- answers ---------------------------------------------------------------------------------------------
     def _work(self, connection: _Connection, request: bytes, late: bool) -> None:
         """In a worker thread: answer one request, hand the connection back to the front-end thread."""
-        self._answers.put((connection, self._answer(connection, request, late)))
+        self._answers.put((connection, *self._answer(connection, request, late)))
         self._wake()
 
-    def _answer(self, connection: _Connection, request: bytes, late: bool) -> bytes | None:
-        """The answer to one complete request. What the socket takes at once is sent here without waiting (the
-        front-end thread leaves a connection alone while it is answered); returns the rest, None to close."""
+    def _answer(self, connection: _Connection, request: bytes, late: bool) -> tuple[bytes | None, Stream | None]:
+        """The answer to one complete request and the Stream that goes on after it, if any. What the socket takes
+        at once is sent here without waiting (the front-end thread leaves a connection alone while it is
+        answered); returns the rest (None to close) and the stream."""
+        stream = None
         try:
-            answer = self.handler(request, connection.peer, late).wfile.getvalue()
+            handled = self.handler(request, connection.peer, late)
+            answer, stream = handled.wfile.getvalue(), getattr(handled, "stream", None)
         except Exception:          # noqa: BLE001 - one broken request must never stop the server
             self.handle_error(None, connection.peer)
             answer = b""
@@ -375,22 +396,35 @@ class HttpFront:
             except OSError:
                 self.handle_error(None, connection.peer)
                 rest = None
-        return rest
+        return rest, stream
 
     def _take_answers(self) -> None:
         while True:
             try:
-                connection, rest = self._answers.get_nowait()
+                connection, rest, stream = self._answers.get_nowait()
             except queue.Empty:
                 return
             if connection in self._connections:       # else closed at shutdown meanwhile
-                self._finish(connection, rest)
+                self._finish(connection, rest, stream)
 
-    def _finish(self, connection: _Connection, rest: bytes | None) -> None:
+    def _finish(self, connection: _Connection, rest: bytes | None, stream: Stream | None = None) -> None:
         if rest is None:
             self._close(connection)
         else:
+            connection.stream = stream
             self._start_sending(connection, rest)     # what could not be sent at once (often nothing)
+
+    def _next_part(self, connection: _Connection) -> None:
+        """Send the next part of the connection's stream; close the connection when the stream ends."""
+        try:
+            part = connection.stream.next() if connection.stream is not None else None
+        except Exception:          # noqa: BLE001 - one broken stream must never stop the server
+            self.handle_error(None, connection.peer)
+            part = None
+        if part is None:
+            self._close(connection)
+        else:
+            self._start_sending(connection, part)
 
     def _start_sending(self, connection: _Connection, answer: bytes) -> None:
         connection.out = memoryview(answer)
@@ -410,6 +444,13 @@ class HttpFront:
         connection.out = connection.out[sent:]
         if connection.out:
             self._watch(connection, selectors.EVENT_WRITE)
+            return
+        if connection.stream is not None:          # taken: the next part after the stream's period
+            now = time.monotonic()
+            connection.state, connection.since = _STREAM, now
+            connection.deadline = now + connection.stream.period_s
+            self._next_due = min(self._next_due, connection.deadline)
+            self._watch(connection, selectors.EVENT_READ)      # to see the client leave
             return
         if connection.whole:
             self._close(connection)

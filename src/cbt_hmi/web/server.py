@@ -11,6 +11,8 @@ API (all answers are JSON objects with "ok"):
   GET  /api/session                         {"ok", "role"}: the role the request's X-HMI-Key grants
   GET  /api/read?names=A,B.C,...            {"ok", "time_ns", "clock", "plc": "run"|"fault", ["fault",] "alarms",
                                             "robot", "values": {...}}: "alarms" changes with the alarm list
+  GET  /api/stream?names=A,B.C,...          the same answer every STREAM_PERIOD_S on one connection, one JSON
+                                            object a line (application/x-ndjson), until the client leaves
   GET  /api/alarms[?history=N]              the alarm list and the newest N history entries (cbt_hmi.web.alarms)
   POST /api/alarms/ack {"alarms": [n, ...]} | {"all": true}   acknowledge (operator or engineer)
   GET  /api/program[/state?pou=NAME]        ladder drawings and their live power flow (cbt_hmi.web.program)
@@ -42,7 +44,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
 from .alarms import HISTORY, AlarmSystem, plc_fault, stamp
-from .front import MAX_BODY, HttpFront, HttpLimits
+from .front import MAX_BODY, HttpFront, HttpLimits, Stream
 from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, validate
 from .trail import Trail
 
@@ -52,6 +54,7 @@ if TYPE_CHECKING:
 MAX_DIGITS = 40                    # digits of one number in a request body (a LINT has 19, an LREAL 17)
 MAX_NAMES = 400
 SCAN_WAIT_S = 1.0
+STREAM_PERIOD_S = 0.05             # /api/stream: a new answer every 50 ms, the pages' 20 updates a second
 
 log = logging.getLogger("cbt_hmi.web")
 
@@ -66,6 +69,11 @@ def _number_digits(text: str) -> str:
     if sum(c.isdigit() for c in mantissa) > MAX_DIGITS:
         raise RequestError(f"a number in the request has more than {MAX_DIGITS} digits")
     return text
+
+
+def _line(answer: dict) -> bytes:
+    """One answer of /api/stream: a JSON object on a line of its own."""
+    return json.dumps(answer).encode("utf-8") + b"\n"
 
 
 def _json_body(raw: bytes):
@@ -313,6 +321,7 @@ class _Handler(BaseHTTPRequestHandler):
 
     hmi: HmiServer
     server_version = "CBT-HMI/1.0"
+    stream: Stream | None = None       # set by an answer that goes on (/api/stream)
 
     def __init__(self, request: bytes, client_address, body_late: bool = False):  # noqa: D107
         self.client_address = client_address
@@ -371,9 +380,9 @@ class _Handler(BaseHTTPRequestHandler):
             elif url.path == "/api/session":
                 self._json(HTTPStatus.OK, {"ok": True, "role": self.hmi.access.role_of(self.headers)})
             elif url.path == "/api/read":
-                query = parse_qs(url.query, max_num_fields=MAX_NAMES)
-                names = [n for part in query.get("names", []) for n in part.split(",") if n]
-                self._json(HTTPStatus.OK, self.hmi.read(names))
+                self._json(HTTPStatus.OK, self.hmi.read(self._names(url)))
+            elif url.path == "/api/stream":
+                self._stream(self._names(url))
             elif url.path in ("/api/program", "/api/program/state"):
                 self._program(url)
             elif url.path == "/api/trail" and self.hmi.trail is not None:
@@ -398,6 +407,30 @@ class _Handler(BaseHTTPRequestHandler):
             self._fail(RequestError(f"malformed address: {exc}"))
 
     do_HEAD = do_GET
+
+    @staticmethod
+    def _names(url) -> list[str]:
+        query = parse_qs(url.query, max_num_fields=MAX_NAMES)
+        return [n for part in query.get("names", []) for n in part.split(",") if n]
+
+    def _stream(self, names: list[str]) -> None:
+        """The /api/read answer of ``names`` now and then every STREAM_PERIOD_S, a line each, on this connection
+        (the front end sends the parts: cbt_hmi.web.front.Stream). A name the table does not allow is refused
+        before anything is streamed, as by /api/read."""
+        first = self.hmi.read(names)
+        self.send_response(HTTPStatus.OK)
+        self.send_header("Content-Type", "application/x-ndjson")
+        self.send_header("Cache-Control", "no-store")
+        self.send_header("X-Content-Type-Options", "nosniff")
+        self.send_header("X-Frame-Options", "DENY")
+        self.send_header("Referrer-Policy", "no-referrer")
+        self.send_header("X-Accel-Buffering", "no")          # a reverse proxy passes each part on at once
+        self.end_headers()
+        if self.command == "HEAD":
+            return
+        read = self.hmi.read
+        self.wfile.write(_line(first))
+        self.stream = Stream(lambda: _line(read(names)), STREAM_PERIOD_S)
 
     def _program(self, url) -> None:
         """The Program page's ladder drawings and their live state (cbt_hmi.web.program)."""
