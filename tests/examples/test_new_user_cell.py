@@ -26,6 +26,9 @@ PRESS_IN, PRESS_OUT = (450, 150, 220), (450, 150, 320)
 PART = [SHUTTLE_UP, SHUTTLE_DOWN, SHUTTLE_UP, PRESS_IN, PRESS_OUT]   # the five Line moves of one part
 
 
+SLEEP_TO_DUE = ["--spin-us", "0"]     # no busy wait before each scan: the cell is checked here, not the lateness
+
+
 class Simulator:
     """`tmflow-sim` in its own process, as a user starts it; ports read from what it prints."""
 
@@ -74,7 +77,8 @@ def vplc_run(sim: Simulator, program: pathlib.Path = CELL) -> subprocess.Complet
                            "--axes", str(program / "press_axes.toml"), "--scenario", str(program / "press.scn"),
                            "--sim-control", f"127.0.0.1:{sim.control}", f"--set=PressCell.Port={sim.port}",
                            f"--set=PressCell.SvrPort={sim.svr_port}",
-                           "--watch", "PressCell.Parts,PressCell.Alarm,Tm.Connected,MC_Shuttle.Status.Stopping"],
+                           "--watch", "PressCell.Parts,PressCell.Alarm,Tm.Connected,MC_Shuttle.Status.Stopping",
+                           *SLEEP_TO_DUE],
                           capture_output=True, text=True, timeout=300)
 
 

@@ -16,6 +16,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "palletizer"
 
 
+SLEEP_TO_DUE = ["--spin-us", "0"]     # no busy wait before each scan: the cell is checked here, not the lateness
+
+
 @pytest.fixture
 def robots():
     sim = SimServer(port=0, robots=2, speedup=20)
@@ -27,7 +30,7 @@ def robots():
 def vplc_run(sim, *extra):
     ports = [f"--set=Palletizer.Port[{i + 1}]={port}" for i, port in enumerate(sim.ports)]
     return subprocess.run([sys.executable, "-m", "vplc", "run", str(ROOT / "lib" / "CBT_Commands_Lib"), str(EXAMPLE),
-                           "--scenario", str(EXAMPLE / "commissioning.scn"), *ports, *extra],
+                           "--scenario", str(EXAMPLE / "commissioning.scn"), *ports, *extra, *SLEEP_TO_DUE],
                           capture_output=True, text=True, timeout=300)
 
 
