@@ -12,6 +12,7 @@ import time
 
 import pytest
 from browser import chromium_paths
+from fake_plc import FakePlc, scanning, serving
 
 from cbt_hmi.web.front import HttpFront, HttpLimits, Stream
 
@@ -218,3 +219,37 @@ def test_a_command_opens_a_new_stream_so_its_answer_is_read_after_it(chromium, s
     chromium.click("btn-execute")
     chromium.wait_for(lambda d: "Stop Motion: Done" in chromium.message(), "Done on the message line")
     assert len(openings) > streams, "no new stream after the command"
+
+
+def refusing_stop(plc: FakePlc) -> None:
+    """A stand-in CBT_Stop that refuses every command (16#200C, robot not connected) and clears its Error when
+    Execute falls, as the FB does."""
+    execute = plc.vars["Stop_Execute"]
+    if execute and not plc.executes_seen.get("Stop"):
+        plc.vars.update(Stop_Error=True, Stop_ErrorID=0x200C, Stop_ErrorDescrip="Robot not connected")
+    elif not execute:
+        plc.vars.update(Stop_Error=False, Stop_ErrorID=0, Stop_ErrorDescrip="")
+    plc.executes_seen["Stop"] = execute
+
+
+@pytestmark_browser
+def test_a_refused_command_is_reported_refused_though_its_release_clears_the_error(chromium, mapping, monkeypatch):
+    """The page releases Execute after the FB answered; the polls that follow show Error FALSE again. The message
+    must be the answer the page judged (it once read the values anew after the release and said Done), here with
+    the release's answer held back until such polls have come."""
+    from cbt_hmi.web.server import HmiServer
+    write = HmiServer.write
+
+    def slow_write(server, body, role):
+        answer = write(server, body, role)
+        time.sleep(0.3)                       # the stream's answers of the released FB reach the page first
+        return answer
+
+    monkeypatch.setattr(HmiServer, "write", slow_write)
+    with scanning(FakePlc(mapping, refusing_stop)) as plc, serving(plc, mapping) as server:
+        chromium.open(server.page_url("stop", "engineer"))
+        chromium.click("btn-execute")
+        chromium.wait_for(lambda d: plc.read("Stop_Execute") is False and "Stop Motion:" in chromium.message()
+                          and "…" not in chromium.message(), "the command released and its answer shown")
+        time.sleep(0.2)
+        assert "Error 16#200C" in chromium.message() and "Done" not in chromium.message(), chromium.message()

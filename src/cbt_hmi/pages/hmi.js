@@ -578,7 +578,9 @@ const HOLD_DONE_MS = 1500;
 function releaseWhenFinished(group, what, doneText) {
   const deadline = Date.now() + 10000, firstPoll = live.polls + 2;   // values read after the command was sent
   const check = async () => {
-    const v = live.values;
+    // the values judged, kept: the answer reported after the release below is the one the FB gave, whatever the
+    // polls show meanwhile (Execute FALSE clears Done and Error)
+    const v = { ...live.values };
     const finished = live.polls >= firstPoll && (v[`${group}_Done`] === true || v[`${group}_Error`] === true);
     if (!finished && Date.now() < deadline) { setTimeout(check, POLL_MS); return; }
     if (finished && v[`${group}_Done`] === true) {
