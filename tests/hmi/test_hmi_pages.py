@@ -4,7 +4,7 @@ from __future__ import annotations
 import threading
 
 import pytest
-from fake_plc import FakePlc, command_program
+from fake_plc import FakePlc, command_program, scan_every
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
@@ -20,11 +20,7 @@ def stack(chromium):
     plc = FakePlc(mapping, command_program)
     stop = threading.Event()
 
-    def scanning():
-        while not stop.wait(0.001):
-            plc.scan()
-
-    thread = threading.Thread(target=scanning, daemon=True)
+    thread = threading.Thread(target=scan_every, args=(plc, stop), daemon=True)
     thread.start()
     server = HmiServer(plc, mapping, port=0)
     server.start()
