@@ -383,13 +383,13 @@ function showPlcState(pillPlc, pillRobot) {
 /* ---------- polling ---------- */
 /* The page's values come on one streamed answer, GET /api/stream: the server sends the /api/read answer of the
    page's variables every 50 ms on one connection (docs/hmi.md, Updates); each answer is a poll, as each read was.
-   A fetch of /api/read per poll cost the panel's browser about 8 % of a core on an idle page, the stream about 1 %.
-   A stream that fails, ends or brings nothing for READ_TIMEOUT_MS is a poll without an answer (the values turn
-   invalid), and the page opens a new one POLL_MS later. After a command the page opens a new stream at once
-   (live.kick): every answer that follows was read after the command, none still on its way from before it. A
-   hidden page (another tab in front) reads /api/read at
-   the pace the browser lets its timers run instead: it does not hold one of the six connections a browser keeps
-   to one server while nobody looks at it. */
+   A fetch of /api/read per poll cost the panel's browser 8-10 % of a core whatever the page did with the answer;
+   the stream's own cost is about 1 % (an idle page about 4 % with its own work on each answer). A stream that
+   fails, ends or brings nothing for READ_TIMEOUT_MS is a poll without an answer (the values turn invalid), and the
+   page opens a new one POLL_MS later. After a command the page opens a new stream at once (live.kick): every
+   answer that follows was read after the command, none still on its way from before it. A hidden page (another
+   tab in front) reads /api/read instead, at the pace the browser lets its timers run: it does not hold one of the
+   six connections a browser keeps to one server while nobody looks at it. */
 const MAX_ANSWER = 4 * 1024 * 1024;          // a line longer than any answer of MAX_NAMES variables: not our server
 const pause = (ms) => new Promise((resume) => setTimeout(resume, ms));
 function startPolling(names) {
