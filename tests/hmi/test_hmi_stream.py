@@ -165,7 +165,7 @@ def test_a_stream_client_that_reads_nothing_is_closed_at_the_send_deadline_and_o
 
 # --- the page -----------------------------------------------------------------------------------------------
 
-pytestmark_browser = pytest.mark.skipif(chromium_paths() is None, reason="chromium/chromedriver: run `make browser`")
+needs_chromium = pytest.mark.skipif(chromium_paths() is None, reason="chromium/chromedriver: run `make browser`")
 
 
 READS = ("performance.setResourceTimingBufferSize(100000); return performance.getEntriesByType('resource')"
@@ -186,7 +186,7 @@ def openings(monkeypatch):
     return opened
 
 
-@pytestmark_browser
+@needs_chromium
 def test_a_page_takes_its_polls_from_one_stream_and_reads_while_hidden(chromium, server, openings):
     chromium.open(server.page_url("stop", "engineer"))
     polls = lambda: chromium.driver.execute_script("return live.polls")   # noqa: E731
@@ -212,7 +212,7 @@ def test_a_page_takes_its_polls_from_one_stream_and_reads_while_hidden(chromium,
     assert chromium.text("pill-plc") == "PLC online"
 
 
-@pytestmark_browser
+@needs_chromium
 def test_a_command_opens_a_new_stream_so_its_answer_is_read_after_it(chromium, server, openings):
     """Stop Motion's Execute: the page takes Done only from answers read after the press (a new stream)."""
     chromium.open(server.page_url("stop", "engineer"))
@@ -234,7 +234,7 @@ def refusing_stop(plc: FakePlc) -> None:
     plc.executes_seen["Stop"] = execute
 
 
-@pytestmark_browser
+@needs_chromium
 def test_a_refused_command_is_reported_refused_though_its_release_clears_the_error(chromium, mapping, monkeypatch):
     """The page releases Execute after the FB answered; the polls that follow show Error FALSE again. The message
     must be the answer the page judged (it once read the values anew after the release and said Done), here with

@@ -13,12 +13,10 @@ const LABELS = {};
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
 let MAP = null;
-/* commandAt: the controller time (time_ns) at which the last command's Execute rose: an answer read before it
-   is not taken (see poll);
-   online: the last read was answered; robot: the server's summary of the robot (connected, Listen node, project);
+/* online: the last read was answered; robot: the server's summary of the robot (connected, Listen node, project);
    clock: the controller's date and time of the last answer; lostAt: when the answers stopped (browser time) */
 const live = { values: {}, online: false, fault: null, listeners: [], kick: null, polls: 0, robot: "", clock: "",
-  lostAt: 0, commandAt: 0 };
+  lostAt: 0 };
 
 /* ---------- server access ---------- */
 /* The access key comes in the address printed at start-up (…/#key=…): kept for this browser tab only and
@@ -450,12 +448,6 @@ function startPolling(names) {
   }
   /* one poll: ``data`` an answer of /api/read, null when none came */
   function poll(data) {
-    if (data && data.time_ns < live.commandAt) {
-      // read before the last command was taken: not a poll after it (its outcome cannot be there yet); an answer
-      // more than 2 s older is a controller whose clock started again (restarted): taken, and the mark dropped
-      if (live.commandAt - data.time_ns < 2e9) return;
-      live.commandAt = 0;
-    }
     if (data) {
       Object.assign(live.values, data.values);
       live.polls += 1;
@@ -564,8 +556,7 @@ function indicators(active) {
 async function executeCommand(execVar, values, what) {
   message(`Sending ${what} …`);
   try {
-    const sent = await api("/api/execute", { execute: execVar, values });
-    live.commandAt = Math.max(live.commandAt, sent.time_ns || 0);
+    await api("/api/execute", { execute: execVar, values });
     if (live.kick) live.kick();
     message(`${what}: sent, waiting for the function block's answer …`);
     return true;

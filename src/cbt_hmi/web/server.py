@@ -347,15 +347,20 @@ class _Handler(BaseHTTPRequestHandler):
         except (ValueError, OSError):
             pass
 
-    def _send(self, status: HTTPStatus, payload: bytes, content_type: str) -> None:
+    def _head(self, status: HTTPStatus, content_type: str, more: dict[str, str]) -> None:
+        """The header of every answer: never kept by the browser, never framed, no referrer; and ``more``."""
         self.send_response(status)
         self.send_header("Content-Type", content_type)
-        self.send_header("Content-Length", str(len(payload)))
+        for name, value in more.items():
+            self.send_header(name, value)
         self.send_header("Cache-Control", "no-store")
         self.send_header("X-Content-Type-Options", "nosniff")
         self.send_header("X-Frame-Options", "DENY")
         self.send_header("Referrer-Policy", "no-referrer")
         self.end_headers()
+
+    def _send(self, status: HTTPStatus, payload: bytes, content_type: str) -> None:
+        self._head(status, content_type, {"Content-Length": str(len(payload))})
         if self.command != "HEAD":
             self.wfile.write(payload)
 
@@ -418,14 +423,8 @@ class _Handler(BaseHTTPRequestHandler):
         (the front end sends the parts: cbt_hmi.web.front.Stream). A name the table does not allow is refused
         before anything is streamed, as by /api/read."""
         first = self.hmi.read(names)
-        self.send_response(HTTPStatus.OK)
-        self.send_header("Content-Type", "application/x-ndjson")
-        self.send_header("Cache-Control", "no-store")
-        self.send_header("X-Content-Type-Options", "nosniff")
-        self.send_header("X-Frame-Options", "DENY")
-        self.send_header("Referrer-Policy", "no-referrer")
-        self.send_header("X-Accel-Buffering", "no")          # a reverse proxy passes each part on at once
-        self.end_headers()
+        # no length: the answer ends with the connection; X-Accel-Buffering: a reverse proxy passes each part on
+        self._head(HTTPStatus.OK, "application/x-ndjson", {"X-Accel-Buffering": "no"})
         if self.command == "HEAD":
             return
         read = self.hmi.read
