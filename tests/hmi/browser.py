@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import itertools
+import os
 import pathlib
 import shutil
 import tempfile
@@ -33,10 +34,30 @@ SHOWN_TEXT = """
     const rowText = (r) => [...r.cells].map(shown).filter((t) => t).join(' ');"""
 
 
+# Debian's chromium-headless-shell: the same Blink, V8 and layout as `chromium` without the desktop browser around
+# them. Measured on the 2-core machine, a PnP page open and idle: 3.5 % of a core against 8.2 %, a page load
+# 0.10 against 0.19 CPU-s, a start 0.2 against 0.8 CPU-s. HMI_BROWSER=chromium runs the tests in the full browser.
+HEADLESS_SHELL = "/usr/lib/chromium/chromium-headless-shell"
+
+
 def chromium_paths() -> tuple[str, str] | None:
-    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    """(browser, chromedriver): the headless shell when it is installed (unless HMI_BROWSER=chromium), else the
+    full Chromium; None when there is no browser or no driver."""
     driver = shutil.which("chromedriver")
+    shell = HEADLESS_SHELL if os.access(HEADLESS_SHELL, os.X_OK) else None
+    full = shutil.which("chromium") or shutil.which("chromium-browser")
+    browser = full if os.environ.get("HMI_BROWSER") == "chromium" else shell or full
     return (browser, driver) if browser and driver else None
+
+
+def _shell_launcher(binary: str, folder: str) -> str:
+    """A launcher for the headless shell in ``folder``: it opens no page unless given an address, chromedriver
+    waits for a page and gives none (and puts "--" before every argument it is given), so the launcher adds one."""
+    path = os.path.join(folder, "headless-shell")
+    with open(path, "w", encoding="ascii") as fh:
+        fh.write(f'#!/bin/sh\nexec "{binary}" "$@" about:blank\n')
+    os.chmod(path, 0o700)
+    return path
 
 
 class Browser:
@@ -50,6 +71,8 @@ class Browser:
         self.loads = itertools.count(1)
         options = webdriver.ChromeOptions()
         options.binary_location = paths[0]
+        if paths[0] == HEADLESS_SHELL:          # the launcher in the profile folder, removed with it
+            options.binary_location = _shell_launcher(paths[0], self.profile)
         for flag in FLAGS + [f"--user-data-dir={self.profile}", "--window-size=800,480"]:
             options.add_argument(flag)
         self.driver = webdriver.Chrome(options=options, service=Service(paths[1]))
