@@ -35,6 +35,17 @@ def is_scalar(t: T.Type) -> bool:
     return not isinstance(t, (T.StructType, T.ArrayType, T.PouType))
 
 
+def holds_bytes(t: T.Type) -> bool:
+    """Are the values of ``t`` the integers 0..255 (BYTE, USINT and their subranges and aliases)? An array of them
+    is a ``bytearray``: the same elements as a list of ints, but a buffer the garbage collector never walks (a
+    library test PLC holds over a hundred 4096-byte buffers; as lists they were most of the time its collections
+    took)."""
+    u = T.unalias(t)
+    if isinstance(u, T.SubrangeType):
+        return holds_bytes(u.base)
+    return isinstance(u, T.ElementaryType) and u.bits == 8 and u.kind in ("bit", "uint")
+
+
 def _width(t: T.Type | None) -> T.ElementaryType | None:
     if t is None:
         return None
@@ -165,6 +176,7 @@ class ExprGen:
             return code
         if isinstance(u, T.ArrayType):
             n = u.count()
+            el = T.unalias(u.element)
             if isinstance(init, A.ArrayInit):
                 items = []
                 for it in init.items:
@@ -173,12 +185,15 @@ class ExprGen:
                         self.default(u.element, None, path)
                     items.append(f"*[{val} for _ in range({rep})]" if rep else val)
                 rest = self.default(u.element, None, path)
-                return f"_fill([{', '.join(items)}], {n}, lambda: {rest})"
-            el = T.unalias(u.element)
+                filled = f"_fill([{', '.join(items)}], {n}, lambda: {rest})"
+                return f"bytearray({filled})" if holds_bytes(el) else filled
             if isinstance(el, T.PouType):
                 lo = u.dims[0][0]
                 sub = f"({path}) + '[' + str(_j + {lo}) + ']'"
                 return f"[{self.default(el, None, sub)} for _j in range({n})]"
+            if holds_bytes(el):
+                first = self.default(el, None, path)
+                return f"bytearray({n})" if first == "0" else f"bytearray([{first}]) * {n}"
             if is_scalar(el):
                 return f"[{self.default(el, None, path)}] * {n}"
             return f"[{self.default(el, None, path)} for _ in range({n})]"

@@ -190,6 +190,8 @@ def store_bytes(arr: list[int] | ArrView, data: bytes) -> None:
 def copy_value(v: Any) -> Any:
     """Deep copy of a value (structs and arrays are copied; scalars are immutable)."""
     t: Any = type(v)
+    if t is bytearray:                          # an array of BYTE / USINT (compiler: holds_bytes)
+        return v[:]
     if t is list:
         if v and type(v[0]) in (int, float, bool, str):
             return v[:]
@@ -205,7 +207,7 @@ def copy_value(v: Any) -> Any:
 
 def assign_into(dst: Any, src: Any) -> None:
     """Structure / array assignment: copy ``src`` into the existing ``dst`` object (keeps references)."""
-    if isinstance(dst, (list, ArrView)):
+    if isinstance(dst, (list, bytearray, ArrView)):
         n = min(len(dst), len(src))
         if n and type(src[0]) in (int, float, bool, str):      # elements of one elementary type: in one piece
             dst[:n] = src[:n] if len(src) != n or type(src) is not list else src
@@ -214,7 +216,7 @@ def assign_into(dst: Any, src: Any) -> None:
             x = src[i]
             if type(x) in (int, float, bool, str):
                 dst[i] = x
-            elif isinstance(x, (list, ArrView)) or hasattr(x, "__dict__"):
+            elif isinstance(x, (list, bytearray, ArrView)) or hasattr(x, "__dict__"):
                 assign_into(dst[i], x)
         return
     for k, x in src.__dict__.items():
