@@ -23,7 +23,7 @@ demo: install
 ## Four on a two-core machine: the HMI and demo tests spend most of their time waiting on real time (pages,
 ## browser, child processes), which two more workers fill with other tests (same CPU time, ~40 % less wall time)
 test: test-deps browser
-	$(VPY) -m pytest -q -n 4 --dist loadfile
+	$(VPY) -m pytest -q -n 4 --dist loadfile --no-loadscope-reorder
 
 ## bench: performance figures of toolchain, simulator, library and HMI
 bench: install

@@ -35,3 +35,16 @@ def _run_cli(*args, module: str = "vplc", cwd=None, timeout: float = 300, **kw) 
 def run_cli():
     """A function that runs a project command line: run_cli("check", path) -> CompletedProcess."""
     return _run_cli
+
+
+
+# The files taking 10 s or more of a full run, longest first (tests/long_files_first.txt says why and when).
+LONG_FILES_FIRST = tuple(line.strip() for line in (ROOT / "tests" / "long_files_first.txt").read_text().splitlines()
+                         if line.strip() and not line.startswith("#"))
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The long files first (LONG_FILES_FIRST), every other test in its collected order."""
+    rank = {path: n for n, path in enumerate(LONG_FILES_FIRST)}
+    order = sorted(range(len(items)), key=lambda i: (rank.get(items[i].nodeid.split("::")[0], len(rank)), i))
+    items[:] = [items[i] for i in order]
