@@ -21,7 +21,8 @@ demo: install
 ## test: every test (unit, golden, ST suites, simulator, library end-to-end, HMI in headless Chromium),
 ## on four worker processes; each test file stays on one worker (its module fixtures and test order hold).
 ## Four on a two-core machine: the HMI and demo tests spend most of their time waiting on real time (pages,
-## browser, child processes), which two more workers fill with other tests (same CPU time, ~40 % less wall time)
+## browser, child processes), which two more workers fill with other tests (same CPU time, ~40 % less wall time).
+## Whole files per worker, taken in collection order: the longest first (tests/long_files_first.txt).
 test: test-deps browser
 	$(VPY) -m pytest -q -n 4 --dist loadfile --no-loadscope-reorder
 

@@ -37,7 +37,6 @@ def run_cli():
     return _run_cli
 
 
-
 # The files taking 10 s or more of a full run, longest first (tests/long_files_first.txt says why and when).
 LONG_FILES_FIRST = tuple(line.strip() for line in (ROOT / "tests" / "long_files_first.txt").read_text().splitlines()
                          if line.strip() and not line.startswith("#"))
