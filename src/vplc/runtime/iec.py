@@ -179,8 +179,9 @@ def bytes_of(arr: list[int] | ArrView, n: int) -> bytes:
         return bytes(x & 0xFF for x in items)
 
 
-def store_bytes(arr: list[int] | ArrView, data: bytes) -> None:
-    """Write ``data`` into the first elements of a byte array (a list, or a view starting at an element)."""
+def store_bytes(arr: bytearray | list[int] | ArrView, data: bytes) -> None:
+    """Write ``data`` into the first elements of a byte array (a bytearray or list, or a view starting at an
+    element)."""
     if isinstance(arr, ArrView):
         arr.base[arr.off:arr.off + len(data)] = data
     else:
@@ -210,7 +211,7 @@ def assign_into(dst: Any, src: Any) -> None:
     if isinstance(dst, (list, bytearray, ArrView)):
         n = min(len(dst), len(src))
         if n and type(src[0]) in (int, float, bool, str):      # elements of one elementary type: in one piece
-            dst[:n] = src[:n] if len(src) != n or type(src) is not list else src
+            dst[:n] = src[:n] if len(src) != n or type(src) not in (list, bytearray) else src
             return
         for i in range(n):
             x = src[i]

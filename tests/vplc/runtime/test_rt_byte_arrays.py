@@ -115,6 +115,8 @@ END_PROGRAM
 
 
 def test_sysmac_array_instructions_read_and_write_byte_arrays(tmp_path):
+    """W502: ToAryByte 2-453 .. 2-455, AryByteTo 2-459 .. 2-461 (runtime/sysmac_fns.py), StringToAry, AryToString and
+    AryMove, each reading or writing a byte array from an element on."""
     plc = run1(tmp_path, """
         n := ToAryByte(In := w, Order := _LOW_HIGH, AryOut := b[1]);
         ok := AryByteTo(In := b[1], Size := 4, Order := _LOW_HIGH, OutVal := back);
