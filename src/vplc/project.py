@@ -4,6 +4,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
+import threading
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -140,17 +141,59 @@ def load_project(paths: Paths, *, dialect: str = "sysmac", include_prelude: bool
 
 
 @contextlib.contextmanager
-def gc_paused() -> Iterator[None]:
-    """The cyclic garbage collector paused for the block. The front end and the code generator allocate many
-    small long-lived objects and free almost nothing: the collector would only re-scan them (making large files
-    quadratic-ish, and a compile in a process that already holds compiled programs 15-40 % slower)."""
+def gc_paused(long_lived: bool = True) -> Iterator[None]:
+    """The cyclic garbage collector paused for the block, whose objects then live long (see LongLived). The front
+    end and the code generator allocate many small long-lived objects and free almost nothing: the collector would
+    only re-scan them (making large files quadratic-ish, and a compile in a process that already holds compiled
+    programs 15-40 % slower)."""
     was_enabled = gc.isenabled()
     gc.disable()
     try:
         yield
     finally:
         if was_enabled:
+            if long_lived:
+                LONG_LIVED.keep()
             gc.enable()
+
+
+class LongLived:
+    """What a load, a compile or a controller's construction builds lives long (a checked project, a compiled
+    program, a PLC's variables), so at the end of each it goes to the collector's permanent generation
+    (``gc.freeze``) instead of through the young generations and into every later full collection. Python collects
+    the oldest generation when it has grown by a quarter; the permanent one is collected here (``reclaim``) when
+    the objects frozen since its last collection are as many as that collection kept, and at least
+    ``RECLAIM_MIN``: a process that loads once never pays for it, and one that loads and drops many projects (a
+    test suite) holds at most about twice its live objects. A controller's construction pauses the collector but
+    freezes nothing (``gc_paused(long_lived=False)``): a dropped PLC goes with the next collection, and its engine's
+    collector callback with it. Measured (27 Nov 2026, 2-core machine): three test files of hundreds of controllers
+    and compiles in one process 28.3 -> 22.5 CPU-s, peak memory 227 -> 300 MB; the whole test suite 305 -> 280
+    CPU-s, each worker's peak memory 240-329 -> 276-399 MB."""
+
+    RECLAIM_MIN = 1_000_000
+
+    def __init__(self) -> None:
+        self.kept = 0           # objects the last collection of the permanent generation left in it
+        self.since = 0          # objects frozen since then (counted when frozen, not all still alive)
+        self.lock = threading.Lock()
+
+    def keep(self) -> None:
+        """Freeze every object the collector tracks now; collect the permanent generation once it has doubled."""
+        with self.lock:
+            self.since += gc.get_count()[0] + len(gc.get_objects(1)) + len(gc.get_objects(2))
+            gc.freeze()
+            if self.since > max(self.kept, self.RECLAIM_MIN):
+                self.reclaim()
+
+    def reclaim(self) -> None:
+        """Collect everything, the permanent generation included, and freeze what is left."""
+        gc.unfreeze()
+        gc.collect()
+        gc.freeze()
+        self.kept, self.since = gc.get_freeze_count(), 0
+
+
+LONG_LIVED = LongLived()
 
 
 def _load(paths: Paths, dialect: str, include_prelude: bool, portable: bool) -> Project:
