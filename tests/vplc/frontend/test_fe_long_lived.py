@@ -7,6 +7,7 @@ import gc
 import subprocess
 import sys
 import weakref
+from pathlib import Path
 
 from vplc.project import LongLived
 
@@ -18,17 +19,23 @@ class Cycle:
         self.me = self
 
 
+def fresh_process(script: str) -> str:
+    """What ``script`` prints, run by a new Python process in the checkout (a process of its own: the collector's
+    generations are per process)."""
+    root = Path(__file__).resolve().parents[3]
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300, cwd=root)
+    assert out.returncode == 0, out.stderr
+    return out.stdout
+
+
 def test_a_process_that_loads_once_freezes_what_it_loaded_and_never_collects_the_permanent_generation():
-    script = (
+    printed = fresh_process(
         "import gc\n"
         "from vplc.project import LONG_LIVED, load_project\n"
         "proj = load_project(['lib/CBT_Commands_Lib'])\n"
         "assert not proj.has_errors\n"
         "print(gc.isenabled(), gc.get_freeze_count() > 50_000, LONG_LIVED.kept, gc.get_count()[0] < 700)\n")
-    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
-                         cwd=_root())
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.split() == ["True", "True", "0", "True"]
+    assert printed.split() == ["True", "True", "0", "True"]
 
 
 def test_garbage_frozen_with_the_long_lived_objects_is_collected_when_the_permanent_generation_doubles():
@@ -56,7 +63,7 @@ def test_garbage_frozen_with_the_long_lived_objects_is_collected_when_the_perman
 def test_loading_and_dropping_many_projects_keeps_the_permanent_generation_bounded():
     """With the reclaim threshold lowered to 200,000 objects, 30 loads of the library (about 65,000 objects each,
     all garbage once dropped, held together by cycles) leave at most twice the threshold frozen."""
-    script = (
+    printed = fresh_process(
         "import gc\n"
         "from vplc import project\n"
         "project.LongLived.RECLAIM_MIN = 200_000\n"
@@ -66,12 +73,4 @@ def test_loading_and_dropping_many_projects_keeps_the_permanent_generation_bound
         "    del proj\n"
         "    peak = max(peak, gc.get_freeze_count())\n"
         "print(peak)\n")
-    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
-                         cwd=_root())
-    assert out.returncode == 0, out.stderr
-    assert int(out.stdout) < 2 * 200_000 + 100_000      # without the reclaim: 30 x 65,000 = 1.9 million
-
-
-def _root():
-    from pathlib import Path
-    return Path(__file__).resolve().parents[3]
+    assert int(printed) < 2 * 200_000 + 100_000      # without the reclaim: 30 x 65,000 = 1.9 million
