@@ -255,6 +255,18 @@ def pnp_page_offers(browser) -> dict:
 
 
 @pytest.mark.slow
+def long_dwell_at_pick(system) -> bool:
+    """A long dwell (20 s: the stop surely hits it) for the dwell at the pick point only, written on the way to
+    pick before that dwell starts; False until then. The cycle goes on from where the test before left it: the
+    long dwell written at once was first waited out at the place point (22 s of the file's 62 s). Looked and
+    written under the PLC's lock, so no scan comes in between."""
+    with system.plc.lock:
+        if system.plc.read("PnP_Segment") != 1 or system.plc.read("PnP_Waiting"):
+            return False
+        system.plc.write("PnP_DwellTime", 20 * 1_000_000_000)
+        return True
+
+
 def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(connected):
     """Issue 25 item 1: Stop on the Stop Motion page while the cycle dwells at the pick point, and again while a
     move runs. The page releases Stop 1.5 s later; the robot must not move again by itself, and the PnP page
@@ -263,12 +275,13 @@ def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(co
     browser.click("btn-preset")
     browser.wait_for(lambda d: "Preset PnP cycle written" in browser.message(), "the preset")
     with connected.plc.lock:
-        connected.plc.write("PnP_DwellTime", 20 * 1_000_000_000)   # a long dwell: the stop surely hits it
+        connected.plc.write("PnP_DwellTime", DWELL_NS)
         connected.plc.write("PnP_MoveParameters[4].Speed", 2)      # a slow place move: a sure window for a stop
     cycles = connected.read("PnP_CycleCount")
     browser.wait_for(lambda d: pnp_page_offers(browser) == {"execute": True, "stop": False, "reset": False},
                      "Start offered while Idle")
     browser.click("btn-execute")
+    connected.wait(lambda: long_dwell_at_pick(connected), "the way to pick")
     connected.wait(lambda: connected.read("PnP_Waiting") and connected.read("PnP_Segment") == 1, "the dwell at pick")
 
     press_stop_motion(connected)                                 # 1) while dwelling
