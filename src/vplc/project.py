@@ -142,10 +142,10 @@ def load_project(paths: Paths, *, dialect: str = "sysmac", include_prelude: bool
 
 @contextlib.contextmanager
 def gc_paused(long_lived: bool = True) -> Iterator[None]:
-    """The cyclic garbage collector paused for the block, whose objects then live long (see LongLived). The front
-    end and the code generator allocate many small long-lived objects and free almost nothing: the collector would
-    only re-scan them (making large files quadratic-ish, and a compile in a process that already holds compiled
-    programs 15-40 % slower)."""
+    """The cyclic garbage collector paused for the block; with ``long_lived`` what the block built then goes to
+    the permanent generation (LongLived). The front end and the code generator allocate many small long-lived
+    objects and free almost nothing: the collector would only re-scan them (making large files quadratic-ish, and a
+    compile in a process that already holds compiled programs 15-40 % slower)."""
     was_enabled = gc.isenabled()
     gc.disable()
     try:
@@ -165,11 +165,12 @@ class LongLived:
     ``LONG_LIVED.reclaim()`` does). Python collects the oldest generation when it has grown by a quarter; the
     permanent one is collected here (``reclaim``) when the objects frozen since its last collection are as many as
     that collection kept, and at least ``RECLAIM_MIN``: a process that loads once never pays for it, and one that
-    loads and drops many projects (a test suite) holds at most about twice its live objects. A controller's construction pauses the collector but
-    freezes nothing (``gc_paused(long_lived=False)``): a dropped PLC goes with the next collection, and its engine's
-    collector callback with it. Measured (27 Nov 2026, 2-core machine): three test files of hundreds of controllers
-    and compiles in one process 28.3 -> 22.5 CPU-s, peak memory 227 -> 300 MB; the whole test suite 305 -> 280
-    CPU-s, each worker's peak memory 240-329 -> 276-399 MB."""
+    loads and drops many projects (a test suite) holds at most about twice its live objects. A controller's
+    construction pauses the collector but freezes nothing (``gc_paused(long_lived=False)``): a dropped PLC goes
+    with the next collection, and its engine's collector callback with it. Measured (27 Nov 2026, 2-core
+    machine): three test files of hundreds of controllers and compiles in one process 28.3 -> 22.5 CPU-s, peak
+    memory 227 -> 300 MB; the whole test suite 305 -> 280 CPU-s, each worker's peak memory 240-329 -> 276-399
+    MB."""
 
     RECLAIM_MIN = 1_000_000
 

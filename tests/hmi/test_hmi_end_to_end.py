@@ -254,12 +254,11 @@ def pnp_page_offers(browser) -> dict:
         "[name, !document.getElementById(`btn-${name}`).matches(':disabled')]))", ["execute", "stop", "reset"])
 
 
-@pytest.mark.slow
 def long_dwell_at_pick(system) -> bool:
     """A long dwell (20 s: the stop surely hits it) for the dwell at the pick point only, written on the way to
     pick before that dwell starts; False until then. The cycle goes on from where the test before left it: the
-    long dwell written at once was first waited out at the place point (22 s of the file's 62 s). Looked and
-    written under the PLC's lock, so no scan comes in between."""
+    long dwell written at once was first waited out at the place point (22 s). Looked and written under the PLC's
+    lock, so no scan comes in between."""
     with system.plc.lock:
         if system.plc.read("PnP_Segment") != 1 or system.plc.read("PnP_Waiting"):
             return False
@@ -267,6 +266,7 @@ def long_dwell_at_pick(system) -> bool:
         return True
 
 
+@pytest.mark.slow
 def test_pnp_stop_stays_stopped_while_dwelling_and_mid_move_until_a_new_start(connected):
     """Issue 25 item 1: Stop on the Stop Motion page while the cycle dwells at the pick point, and again while a
     move runs. The page releases Stop 1.5 s later; the robot must not move again by itself, and the PnP page
