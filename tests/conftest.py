@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import pathlib
+import socket
 import subprocess
 import sys
 
@@ -35,6 +36,27 @@ def _run_cli(*args, module: str = "vplc", cwd=None, timeout: float = 300, **kw) 
 def run_cli():
     """A function that runs a project command line: run_cli("check", path) -> CompletedProcess."""
     return _run_cli
+
+
+@pytest.fixture
+def free_port():
+    """A function giving a free loopback port, reserved until the test ends: for a server a test starts on a port of
+    its choosing (a child process, a command-line option). The port is held by a socket bound with SO_REUSEADDR and
+    not listening. The kernel then hands it out to nobody else: no other test's bind to port 0 and no outgoing
+    connection takes it (those are what made a port probed free and closed again get taken before the test's server
+    bound it). Our servers bind with SO_REUSEADDR and listen, which such a holder allows (Linux: two SO_REUSEADDR
+    sockets on one port conflict only when one of them listens). Each call gives another port."""
+    holders: list[socket.socket] = []
+
+    def reserve() -> int:
+        holder = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        holder.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        holder.bind(("127.0.0.1", 0))
+        holders.append(holder)
+        return holder.getsockname()[1]
+    yield reserve
+    for holder in holders:
+        holder.close()
 
 
 # The files taking 10 s or more of a full run, longest first (tests/long_files_first.txt says why and when).

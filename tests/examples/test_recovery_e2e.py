@@ -4,7 +4,6 @@ log is the witness that nothing ran twice."""
 from __future__ import annotations
 
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -68,14 +67,8 @@ def test_out_of_reach_mid_pnp_is_a_robot_error_acknowledged_and_resumed_without_
     assert len(closes) == picks                       # the gripper did not close again
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.mark.slow
-def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp_path):
+def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp_path, free_port):
     """SIGKILL: no FIN, no RST from a process that is gone — the kernel answers for it. CBT_Connect (Execute held)
     reports the loss and reconnects by itself once the simulator is back; the cycle resumes with an operator
     start where the part is and completes. The simulator runs as its own process in real time, so this test runs the

@@ -26,20 +26,14 @@ def busy_port():
     holder.close()
 
 
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def test_taken_robot_port_is_named_with_the_option_to_change_it(busy_port):
+def test_taken_robot_port_is_named_with_the_option_to_change_it(busy_port, free_port):
     result = run_demo("--robot-port", str(busy_port), "--hmi-port", str(free_port()))
     assert result.returncode == 2
     assert f"port {busy_port} on 127.0.0.1 (robot simulator) is already in use" in result.stderr
     assert "--robot-port PORT" in result.stderr and "Traceback" not in result.stderr
 
 
-def test_taken_hmi_port_is_named_with_the_option_to_change_it(busy_port):
+def test_taken_hmi_port_is_named_with_the_option_to_change_it(busy_port, free_port):
     result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(busy_port))
     assert result.returncode == 2
     assert f"port {busy_port} on 127.0.0.1 (web HMI) is already in use" in result.stderr
@@ -117,14 +111,10 @@ def wait_for_line(lines, text: str, timeout_s: float = 30.0) -> None:
         lines.put(line)
 
 
-def test_demo_runs_everything_stops_cleanly_on_ctrl_c_and_starts_again_at_once():
+def test_demo_runs_everything_stops_cleanly_on_ctrl_c_and_starts_again_at_once(free_port):
     import json
     import urllib.request
-    ports = []
-    while len(ports) < 4:
-        port = free_port()
-        if port not in ports:
-            ports.append(port)
+    ports = [free_port() for _ in range(4)]        # reserved: four different ports
     robot_port, hmi_port, svr_port, control_port = ports
     for attempt in range(2):          # the second start follows at once: the first one's connections in TIME_WAIT
         demo, text, lines = start_demo(robot_port, hmi_port, svr_port, control_port)
@@ -153,7 +143,7 @@ def test_demo_runs_everything_stops_cleanly_on_ctrl_c_and_starts_again_at_once()
         assert "Demo stopped" in out and "Traceback" not in err
 
 
-def test_taken_control_port_is_named_and_two_servers_on_one_port_are_refused(busy_port):
+def test_taken_control_port_is_named_and_two_servers_on_one_port_are_refused(busy_port, free_port):
     result = run_demo("--robot-port", str(free_port()), "--svr-port", str(free_port()), "--hmi-port",
                       str(free_port()), "--control-port", str(busy_port))
     assert result.returncode == 2
@@ -166,7 +156,7 @@ def test_taken_control_port_is_named_and_two_servers_on_one_port_are_refused(bus
     assert f"--hmi-port and --control-port are both {port}; give each server its own port." in result.stderr
 
 
-def test_control_port_defaults_to_the_port_before_the_robots_or_any_free_one(busy_port):
+def test_control_port_defaults_to_the_port_before_the_robots_or_any_free_one(busy_port, free_port):
     """As the simulator's command line derives it: 5889 for 5890; 0 (any free port, printed) when that one is taken or
     is one of the demo's own ports."""
     from cbt_hmi.demo import default_control_port
@@ -177,7 +167,7 @@ def test_control_port_defaults_to_the_port_before_the_robots_or_any_free_one(bus
     assert default_control_port(1, ()) == 0
 
 
-def test_taken_port_names_the_process_that_holds_it(busy_port):
+def test_taken_port_names_the_process_that_holds_it(busy_port, free_port):
     import os
     result = run_demo("--robot-port", str(free_port()), "--hmi-port", str(busy_port), "--svr-port", str(free_port()))
     assert result.returncode == 2
@@ -221,7 +211,7 @@ CELL_PAGE = """{
 """
 
 
-def test_demo_serves_the_users_page_descriptions_next_to_the_shipped_pages(tmp_path):
+def test_demo_serves_the_users_page_descriptions_next_to_the_shipped_pages(tmp_path, free_port):
     """--pages DIR: the good page is served (Main lists it, its address answers, its values are read); a page with
     an unknown variable and one writing a variable of the shipped pages are named with file and line, and left
     out; the demo runs on."""
@@ -232,11 +222,7 @@ def test_demo_serves_the_users_page_descriptions_next_to_the_shipped_pages(tmp_p
                                         '"label": "Cycles"}]}\n')
     (tmp_path / "taken.json").write_text('{"title": "Taken", "command": {"variable": "Connect_Execute", '
                                          '"label": "Connect"}}\n')
-    ports = []
-    while len(ports) < 4:
-        port = free_port()
-        if port not in ports:
-            ports.append(port)
+    ports = [free_port() for _ in range(4)]        # reserved: four different ports
     demo, text, lines = start_demo(*ports, "--pages", str(tmp_path))
     hmi = f"http://127.0.0.1:{ports[1]}"
     try:

@@ -5,21 +5,13 @@ the HMI shows the fault until Ctrl-C.
 """
 from __future__ import annotations
 
-import socket
-
 from hmi_http import Client
 
 from cbt_hmi.demo import Demo
 from vplc.api import PlcFault
 
 
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def test_a_major_fault_stops_the_plc_alone_and_the_hmi_shows_it():
+def test_a_major_fault_stops_the_plc_alone_and_the_hmi_shows_it(free_port):
     demo = Demo("127.0.0.1", free_port(), free_port(), free_port(), free_port())
     demo.start()
     try:

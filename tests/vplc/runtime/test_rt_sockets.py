@@ -163,11 +163,8 @@ def test_close_releases_the_handle_and_a_second_close_reports_2003(tmp_path, ser
     peer.close()
 
 
-def test_connection_refused_and_bad_address_give_documented_error_ids(tmp_path):
-    probe = socket.socket()
-    probe.bind(("127.0.0.1", 0))
-    port = probe.getsockname()[1]
-    probe.close()                                      # nothing listens there now
+def test_connection_refused_and_bad_address_give_documented_error_ids(tmp_path, free_port):
+    port = free_port()                                 # reserved, and nothing listens there
     plc = plc_from(tmp_path, BODY, DECLS)
     plc.write("Main.Port", port)
     plc.write("Main.Go", True)
@@ -210,11 +207,8 @@ def test_latency_model_delays_completion_by_controller_time(tmp_path, server):
         c.close()
 
 
-def test_accept_waits_for_a_client_and_times_out_with_2006(tmp_path):
-    probe = socket.socket()
-    probe.bind(("127.0.0.1", 0))
-    port = probe.getsockname()[1]
-    probe.close()
+def test_accept_waits_for_a_client_and_times_out_with_2006(tmp_path, free_port):
+    port = free_port()
     plc = plc_from(tmp_path, "acc(Execute := Go, SrcTcpPort := Port, TimeOut := 5, Socket => sock);",
                    "acc : SktTCPAccept; Go : BOOL; Port : UINT; sock : _sSOCKET;")
     plc.write("Main.Port", port)
