@@ -49,22 +49,42 @@ def run_cli():
     return _run_cli
 
 
+def _hold(port: int) -> socket.socket | None:
+    """A socket holding loopback ``port`` (0: one the kernel picks), None when the port is taken. It binds without
+    SO_REUSEADDR, so the bind fails when any socket has the port, then allows SO_REUSEADDR binds besides it."""
+    holder = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        holder.bind(("127.0.0.1", port))
+    except OSError:
+        holder.close()
+        return None
+    holder.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    return holder
+
+
 @pytest.fixture
 def free_port():
     """A function giving a free loopback port, reserved until the test ends: for a server a test starts on a port of
-    its choosing (a child process, a command-line option). The port is held by a socket bound with SO_REUSEADDR and
-    not listening. The kernel then hands it out to nobody else: no other test's bind to port 0 and no outgoing
-    connection takes it (those are what made a port probed free and closed again get taken before the test's server
-    bound it). Our servers bind with SO_REUSEADDR and listen, which such a holder allows (Linux: two SO_REUSEADDR
-    sockets on one port conflict only when one of them listens). Each call gives another port."""
+    its choosing (a child process, a command-line option). ``free_port(n)``: the first of ``n`` consecutive ones.
+    A port is held by a socket that is bound and does not listen, with SO_REUSEADDR set after its bind. The kernel
+    hands such a port to nobody else: no other test's bind to port 0 and no outgoing connection takes it (those are
+    what made a port probed free and closed again get taken before the test's server bound it). Our servers bind
+    with SO_REUSEADDR and listen, which such a holder allows (Linux: two SO_REUSEADDR sockets on one port conflict
+    only when one of them listens). Each call gives other ports."""
     holders: list[socket.socket] = []
 
-    def reserve() -> int:
-        holder = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        holder.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        holder.bind(("127.0.0.1", 0))
-        holders.append(holder)
-        return holder.getsockname()[1]
+    def reserve(count: int = 1) -> int:
+        for _attempt in range(50):
+            first = _hold(0)
+            assert first is not None, "no free loopback port"
+            base = first.getsockname()[1]
+            run = [first] + [h for h in (_hold(base + k) for k in range(1, count)) if h is not None]
+            if len(run) == count:
+                holders.extend(run)
+                return base
+            for holder in run:
+                holder.close()
+        pytest.skip(f"no {count} free consecutive loopback ports")
     yield reserve
     for holder in holders:
         holder.close()

@@ -177,7 +177,10 @@ def control_port(args: argparse.Namespace) -> int:
         return args.control_port
     derived = args.port - 1 if args.port > 1 else 0
     if derived:
+        # the probe binds the way the control channel's server does (SO_REUSEADDR): a port that only holds
+        # connections of a simulator just stopped (TIME_WAIT) is free for it, a port something listens on is not
         probe = socket.socket()
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             probe.bind((args.control_host, derived))
         except OSError:

@@ -212,15 +212,9 @@ def test_half_closed_client_still_gets_its_reply_then_is_closed(harness):
     assert ("TMSCT", "H,OK") in peer.texts()
 
 
-def test_many_robots_on_consecutive_ports_are_independent():
-    probe = socket.socket()
-    probe.bind(("127.0.0.1", 0))
-    base = probe.getsockname()[1]
-    probe.close()
-    try:
-        srv = SimServer(port=base, robots=3).start()
-    except OSError:
-        pytest.skip("no three free consecutive ports")
+def test_many_robots_on_consecutive_ports_are_independent(free_port):
+    base = free_port(3)
+    srv = SimServer(port=base, robots=3).start()
     try:
         assert srv.ports == [base, base + 1, base + 2]
         srv.robots[1].leave_listen_node()
@@ -424,27 +418,12 @@ def test_event_log_is_bounded_per_robot_and_overall():
     single.close()
 
 
-def _port_pair():
-    """A listening socket on some port q whose neighbour q + 1 was free a moment ago."""
-    for _ in range(20):
-        blocker = socket.socket()
-        blocker.bind(("127.0.0.1", 0))
-        q = blocker.getsockname()[1]
-        probe = socket.socket()
-        try:
-            probe.bind(("127.0.0.1", q + 1))
-        except OSError:
-            blocker.close()
-            continue
-        finally:
-            probe.close()
-        blocker.listen(1)
-        return blocker, q
-    pytest.skip("no free neighbouring ports")
-
-
-def test_cli_control_port_is_the_port_before_robot_1_or_a_free_one_when_that_is_taken(tmp_path):
-    blocker, q = _port_pair()                          # q busy, robot 1 on q + 1: the derived port q is taken
+def test_cli_control_port_is_the_port_before_robot_1_or_a_free_one_when_that_is_taken(tmp_path, free_port):
+    q = free_port(2)                                   # q busy, robot 1 on q + 1: the derived port q is taken
+    blocker = socket.socket()
+    blocker.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    blocker.bind(("127.0.0.1", q))
+    blocker.listen(1)
     proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
                              "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
@@ -460,14 +439,34 @@ def test_cli_control_port_is_the_port_before_robot_1_or_a_free_one_when_that_is_
     assert proc.returncode == 0 and "Traceback" not in err
 
 
-def test_cli_control_port_defaults_to_the_port_before_robot_1(tmp_path):
-    blocker, q = _port_pair()
-    blocker.close()                                    # q free again: the derived control port
+def test_cli_control_port_defaults_to_the_port_before_robot_1(tmp_path, free_port):
+    q = free_port(2)                                   # q free (reserved for this test): the derived control port
     proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
                              "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         lines = [proc.stdout.readline() for _ in range(2)]
         assert lines[1].startswith(f"control channel: 127.0.0.1:{q} ")
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=10)
+def test_cli_control_port_is_the_port_before_robot_1_even_while_old_connections_on_it_wait_out(tmp_path, free_port):
+    """A simulator stopped after serving control requests leaves their connections on the port in TIME_WAIT (it
+    closed them first). Restarted at once, it takes the same control port: the check binds as its server does."""
+    q = free_port(2)
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    server.bind(("127.0.0.1", q))
+    server.listen(1)
+    client = socket.create_connection(("127.0.0.1", q), timeout=5)
+    served, _ = server.accept()
+    served.close()                                     # the server's side closes first: its end waits out
+    client.close()
+    server.close()
+    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
+                             "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        lines = [proc.stdout.readline() for _ in range(2)]
+        assert lines[1].startswith(f"control channel: 127.0.0.1:{q} "), lines
     finally:
         proc.terminate()
         proc.communicate(timeout=10)
