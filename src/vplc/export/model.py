@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import bisect
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from ..frontend import ast as A
@@ -111,16 +112,17 @@ class _Comments:
         self.spans = sorted((s, e) for _style, s, e in (unit.comments or []))
         self.starts = [s for s, _e in self.spans]
 
-    def between(self, start: int, end: int) -> str:
-        """All comments fully inside ``[start, end)``, joined."""
-        parts = []
+    def starting(self, start: int, stop: int) -> Iterator[tuple[int, int]]:
+        """(start, end) of each comment that starts in ``[start, stop)``, in order."""
         spans = self.spans
         for i in range(bisect.bisect_left(self.starts, start), len(spans)):
-            s, e = spans[i]
-            if s >= end:
-                break
-            if e <= end:
-                parts.append(comment_text(self.text[s:e]))
+            if spans[i][0] >= stop:
+                return
+            yield spans[i]
+
+    def between(self, start: int, end: int) -> str:
+        """All comments fully inside ``[start, end)``, joined."""
+        parts = [comment_text(self.text[s:e]) for s, e in self.starting(start, end) if e <= end]
         return " ".join(p for p in parts if p)
 
     def line_end(self, offset: int) -> int:
@@ -132,11 +134,7 @@ class _Comments:
         """The comments on the rest of the line after offset ``end`` (a declaration's line comment)."""
         line_end = self.line_end(end)
         parts = []
-        spans = self.spans
-        for i in range(bisect.bisect_left(self.starts, end), len(spans)):
-            s, e = spans[i]
-            if s >= line_end:
-                break
+        for s, e in self.starting(end, line_end):
             if s >= end and not self.text[end:s].strip(" \t,;\r"):
                 parts.append(comment_text(self.text[s:e]))
                 end = e
