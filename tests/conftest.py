@@ -67,10 +67,12 @@ def free_port():
     """A function giving a free loopback port, reserved until the test ends: for a server a test starts on a port of
     its choosing (a child process, a command-line option). ``free_port(n)``: the first of ``n`` consecutive ones.
     A port is held by a socket that is bound and does not listen, with SO_REUSEADDR set after its bind. The kernel
-    hands such a port to nobody else: no other test's bind to port 0 and no outgoing connection takes it (those are
-    what made a port probed free and closed again get taken before the test's server bound it). Our servers bind
-    with SO_REUSEADDR and listen, which such a holder allows (Linux: two SO_REUSEADDR sockets on one port conflict
-    only when one of them listens). Each call gives other ports."""
+    hands such a port to no bind to port 0 and no outgoing connection (those are what made a port probed free and
+    closed again get taken before the test's server bound it), and a bind without SO_REUSEADDR is refused. Our
+    servers bind with SO_REUSEADDR and listen, which the holder allows (Linux refuses an SO_REUSEADDR bind only
+    next to a socket that listens or that has not set SO_REUSEADDR). A child started with a port derived from a
+    reserved one (a default control port) could still take another test's reserved port: give it its ports.
+    Each call gives other ports."""
     holders: list[socket.socket] = []
 
     def reserve(count: int = 1) -> int:
@@ -78,7 +80,8 @@ def free_port():
             first = _hold(0)
             assert first is not None, "no free loopback port"
             base = first.getsockname()[1]
-            run = [first] + [h for h in (_hold(base + k) for k in range(1, count)) if h is not None]
+            neighbours = range(base + 1, base + count) if base + count <= 65536 else ()
+            run = [first] + [h for h in map(_hold, neighbours) if h is not None]
             if len(run) == count:
                 holders.extend(run)
                 return base

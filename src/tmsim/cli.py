@@ -221,6 +221,10 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)
         return 1
+    # SIGTERM stops the simulator cleanly from here on, before the start-up lines: a supervisor that waits for them
+    # and then stops it gets the clean stop (exit 0), not the default action of the signal
+    done = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: done.set())
     for robot in server.robots:
         node = "in Listen node" if robot.session.node_state() == IN_NODE else "project running, not in Listen node"
         slave = f", Ethernet Slave on {args.host}:{robot.svr_port}" if server.svr is not None else ""
@@ -237,8 +241,6 @@ def main(argv: list[str] | None = None) -> int:
     print("Press Ctrl-C to stop.", flush=True)
     gc.disable()     # the server collects between bursts of requests (SimServer(manage_gc=True))
     gc.freeze()      # what start-up built lives for good: keep it out of every later collection
-    done = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: done.set())
     with contextlib.suppress(KeyboardInterrupt):
         server.serve_forever(done)          # the main thread serves: fastest replies
     server.close()

@@ -160,17 +160,17 @@ def gc_paused(long_lived: bool = True) -> Iterator[None]:
 class LongLived:
     """What a load or a compile builds lives long (a checked project, a compiled program), so at the end of each it
     goes to the collector's permanent generation (``gc.freeze``) instead of through the young generations and into
-    every later full collection; with it goes whatever else the process holds at that moment, its garbage too,
-    which then waits for the next collection of the permanent generation (``gc.collect()`` does not look there;
+    every later full collection; with it goes whatever else the process holds at that moment, its garbage too, which
+    then waits for the next collection of the permanent generation (``gc.collect()`` does not look there;
     ``LONG_LIVED.reclaim()`` does). Python collects the oldest generation when it has grown by a quarter; the
     permanent one is collected here (``reclaim``) when the objects frozen since its last collection are as many as
     that collection kept, and at least ``RECLAIM_MIN``: a process that loads once never pays for it, and one that
-    loads and drops many projects (a test suite) holds at most about twice its live objects. A controller's
-    construction pauses the collector but freezes nothing (``gc_paused(long_lived=False)``): a dropped PLC goes
-    with the next collection, and its engine's collector callback with it. Measured (27 Nov 2026, 2-core
-    machine): three test files of hundreds of controllers and compiles in one process 28.3 -> 22.5 CPU-s, peak
-    memory 227 -> 300 MB; the whole test suite 305 -> 280 CPU-s, each worker's peak memory 240-329 -> 276-399
-    MB."""
+    loads and drops many projects (a test suite) holds at most about twice its live objects, or its live objects and
+    ``RECLAIM_MIN`` more, whichever is larger. A controller's construction pauses the collector but freezes nothing
+    (``gc_paused(long_lived=False)``): a dropped PLC goes with the next collection, and its engine's collector
+    callback with it. Measured (27 Nov 2026, 2-core machine): three test files of hundreds of controllers and
+    compiles in one process 28.3 -> 22.5 CPU-s, peak memory 227 -> 300 MB; the whole test suite 305 -> 280 CPU-s,
+    each worker's peak memory 240-329 -> 276-399 MB."""
 
     RECLAIM_MIN = 1_000_000
 

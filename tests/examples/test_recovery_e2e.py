@@ -74,7 +74,7 @@ def test_simulator_killed_mid_pnp_and_started_again_is_reconnected_by_itself(tmp
     start where the part is and completes. The simulator runs as its own process in real time, so this test runs the
     PLC in real time too."""
     port = free_port()
-    cmd = [sys.executable, "-m", "tmsim", "--port", str(port), "--no-svr", "--speedup", "4"]
+    cmd = [sys.executable, "-m", "tmsim", "--port", str(port), "--no-svr", "--control-port", "0", "--speedup", "4"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     plc = load_plc(SOURCES)
     try:

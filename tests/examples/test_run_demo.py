@@ -161,7 +161,7 @@ def test_control_port_defaults_to_the_port_before_the_robots_or_any_free_one(bus
     is one of the demo's own ports."""
     from cbt_hmi.demo import default_control_port
     port = free_port()
-    assert default_control_port(port + 1, ()) in (port, 0)         # 0 only if another program took it meanwhile
+    assert default_control_port(port + 1, ()) == port              # reserved for this test: nobody took it
     assert default_control_port(busy_port + 1, ()) == 0
     assert default_control_port(port + 1, (port,)) == 0
     assert default_control_port(1, ()) == 0

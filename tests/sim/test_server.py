@@ -449,24 +449,87 @@ def test_cli_control_port_defaults_to_the_port_before_robot_1(tmp_path, free_por
     finally:
         proc.terminate()
         proc.communicate(timeout=10)
+def _listen_then_wait_out(port: int) -> bool:
+    """Serve one connection on ``port`` and close it first, as a stopped simulator's control channel did: the
+    server's end waits out (TIME_WAIT) on the port. False when ``port`` is taken."""
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        server.bind(("127.0.0.1", port))
+    except OSError:
+        server.close()
+        return False
+    server.listen(1)
+    client = socket.create_connection(("127.0.0.1", port), timeout=5)
+    served, _ = server.accept()
+    served.close()
+    client.close()
+    server.close()
+    return True
+
+
+def _start_cli(tmp_path, *args: str, robots: int = 1) -> tuple[subprocess.Popen, list[str]]:
+    """The simulator's command line started with ``args`` (no Ethernet Slave), and its start-up lines: one per
+    robot, then the control channel's."""
+    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), *args, "--no-svr"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    return proc, [proc.stdout.readline() for _ in range(robots + 1)]
+
+
+def _stop_cli(proc: subprocess.Popen) -> None:
+    proc.terminate()
+    _out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 0 and "Traceback" not in err, err
+
+
+def test_cli_stopped_right_after_its_first_start_up_line_stops_cleanly(tmp_path):
+    """A supervisor that waits for the first start-up line and stops the simulator at once gets the clean stop. With
+    200 robots the stop comes while the start-up lines are still being written (it was the signal's default action
+    then: exit -15, no "simulator stopped")."""
+    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", "0",
+                             "--control-port", "0", "--robots", "200", "--no-svr"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    assert proc.stdout.readline().startswith("robot 1: TM5-700 listening on 127.0.0.1:")
+    proc.terminate()
+    out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 0 and "simulator stopped" in out and "Traceback" not in err, (out[-300:], err)
+
+
 def test_cli_control_port_is_the_port_before_robot_1_even_while_old_connections_on_it_wait_out(tmp_path, free_port):
     """A simulator stopped after serving control requests leaves their connections on the port in TIME_WAIT (it
     closed them first). Restarted at once, it takes the same control port: the check binds as its server does."""
-    q = free_port(2)
-    server = socket.socket()
-    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    server.bind(("127.0.0.1", q))
-    server.listen(1)
-    client = socket.create_connection(("127.0.0.1", q), timeout=5)
-    served, _ = server.accept()
-    served.close()                                     # the server's side closes first: its end waits out
-    client.close()
-    server.close()
-    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
-                             "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    for _attempt in range(20):
+        robot = free_port()
+        if _listen_then_wait_out(robot - 1):
+            break
+    else:
+        pytest.skip("no free port before a free port")
+    proc, lines = _start_cli(tmp_path, "--port", str(robot))
     try:
-        lines = [proc.stdout.readline() for _ in range(2)]
-        assert lines[1].startswith(f"control channel: 127.0.0.1:{q} "), lines
+        assert lines[1].startswith(f"control channel: 127.0.0.1:{robot - 1} "), lines
     finally:
-        proc.terminate()
-        proc.communicate(timeout=10)
+        _stop_cli(proc)
+
+
+def test_a_robot_port_held_while_its_project_is_stopped_is_not_another_simulators_control_port(tmp_path, free_port):
+    """Simulator A's robot 2 stops its project: A holds its port (nothing listens there). Simulator B, started with
+    its robot 1 right after that port, does not take it for its default control channel, and A's robot 2 comes
+    back on it."""
+    base = free_port(3)
+    a, a_lines = _start_cli(tmp_path, "--port", str(base), "--robots", "2", "--control-port", "0", robots=2)
+    try:
+        assert a_lines[2].startswith("control channel: "), a_lines
+        a_control = int(a_lines[2].split(":")[2].split()[0])
+        assert control_request(a_control, {"cmd": "stop_project", "robot": 1})["ok"] is True
+        b, b_lines = _start_cli(tmp_path, "--port", str(base + 2))
+        try:
+            assert b_lines[0].startswith(f"robot 1: TM5-700 listening on 127.0.0.1:{base + 2} "), b_lines
+            assert b_lines[1].startswith("control channel: ") and f":{base + 1} " not in b_lines[1], b_lines
+            assert control_request(a_control, {"cmd": "start_project", "robot": 1})["ok"] is True
+            with socket.create_connection(("127.0.0.1", base + 1), timeout=5) as peer:
+                peer.sendall(sct("1", "QueueTag(1)"))
+                assert peer.recv(256).startswith(b"$TMSCT")
+        finally:
+            _stop_cli(b)
+    finally:
+        _stop_cli(a)

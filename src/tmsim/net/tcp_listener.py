@@ -54,7 +54,11 @@ class Listener:
         cannot be opened, ``{where}`` standing for host:port (e.g. "listen on {where} for robot 1"). ``held``: a
         socket already bound to the port by ``close(hold_port=True)``, which starts listening instead."""
         sock = held
-        if sock is None:
+        if sock is not None:
+            # held by close(), which gave SO_REUSEADDR up: a listener needs it again (the old listener's
+            # connections may still be in TIME_WAIT on the port)
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        else:
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             try:
@@ -105,6 +109,7 @@ class Listener:
         self.sock.close()
         if not hold_port:
             return None
+        # SO_REUSEADDR for the bind: the closed listener's connections may still be in TIME_WAIT on the port
         hold = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         hold.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
@@ -112,4 +117,7 @@ class Listener:
         except OSError:
             hold.close()
             return None
+        # bound, the holder gives SO_REUSEADDR up: another program's SO_REUSEADDR bind (a server, or a check of
+        # whether the port is free, as our default control ports do) is then refused instead of sharing the port
+        hold.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 0)
         return hold
