@@ -453,12 +453,12 @@ def _listen_then_wait_out(port: int) -> bool:
     """Serve one connection on ``port`` and close it first, as a stopped simulator's control channel did: the
     server's end waits out (TIME_WAIT) on the port. False when ``port`` is taken."""
     server = socket.socket()
-    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
     try:
-        server.bind(("127.0.0.1", port))
+        server.bind(("127.0.0.1", port))  # without SO_REUSEADDR: refused next to any socket (a reservation too)
     except OSError:
         server.close()
         return False
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)        # then as the control channel has it
     server.listen(1)
     client = socket.create_connection(("127.0.0.1", port), timeout=5)
     served, _ = server.accept()

@@ -8,6 +8,7 @@ says so once, and ``tick(now)`` watches it again; pending connections wait in th
 from __future__ import annotations
 
 import contextlib
+import errno
 import selectors
 import socket
 from collections.abc import Callable, Iterable
@@ -109,15 +110,23 @@ class Listener:
         self.sock.close()
         if not hold_port:
             return None
-        # SO_REUSEADDR for the bind: the closed listener's connections may still be in TIME_WAIT on the port
+        # The holder binds without SO_REUSEADDR, so another program's SO_REUSEADDR bind (a server, or a check of
+        # whether the port is free, as our default control ports do) is refused instead of sharing the port. Only
+        # when the closed listener's connections still hold the port (TIME_WAIT) does it need SO_REUSEADDR to
+        # bind; it gives it up once bound. (Binding with it first would let kernels before 6.8 mark the port as
+        # shared by reusing sockets, and clearing the option afterwards would not undo that.)
         hold = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        hold.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             hold.bind((host, self.port))
-        except OSError:
-            hold.close()
-            return None
-        # bound, the holder gives SO_REUSEADDR up: another program's SO_REUSEADDR bind (a server, or a check of
-        # whether the port is free, as our default control ports do) is then refused instead of sharing the port
-        hold.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 0)
+        except OSError as exc:
+            if exc.errno != errno.EADDRINUSE:
+                hold.close()
+                return None
+            hold.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                hold.bind((host, self.port))
+            except OSError:
+                hold.close()
+                return None
+            hold.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 0)
         return hold
