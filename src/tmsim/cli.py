@@ -17,7 +17,6 @@ users). Every number is range-checked before anything starts; a bad one is one l
 from __future__ import annotations
 
 import argparse
-import contextlib
 import gc
 import math
 import signal
@@ -191,6 +190,15 @@ def control_port(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command line; Ctrl-C before the simulator is up ends it with exit 130 and one line, no traceback."""
+    try:
+        return _run(argv)
+    except KeyboardInterrupt:
+        print("tmflow_listener: interrupted", file=sys.stderr)
+        return 130
+
+
+def _run(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     problems, svr_port, svr_items = check_args(args)
@@ -221,29 +229,33 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"tmflow_listener: error: {exc.strerror or exc}", file=sys.stderr)
         return 1
-    # SIGTERM stops the simulator cleanly from here on, before the start-up lines: a supervisor that waits for them
-    # and then stops it gets the clean stop (exit 0), not the default action of the signal
+    # SIGTERM and Ctrl-C stop the simulator cleanly from here on, before the start-up lines: a supervisor (or a user)
+    # that waits for them and then stops it gets the clean stop (exit 0), not the default action of the signal or a
+    # KeyboardInterrupt in the middle of a line; a second Ctrl-C does not interrupt the shutdown
     done = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: done.set())
-    for robot in server.robots:
-        node = "in Listen node" if robot.session.node_state() == IN_NODE else "project running, not in Listen node"
-        slave = f", Ethernet Slave on {args.host}:{robot.svr_port}" if server.svr is not None else ""
-        print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node}){slave}", flush=True)
-    if server.control is not None:
-        print(f"control channel: {args.control_host}:{server.control.port} "
-              f"(JSON lines; {robot_numbering(len(server.robots))})", flush=True)
-    first_slave = server.robots[0].slave
-    if first_slave is not None:
-        print(f"Ethernet Slave data table: every {args.svr_period:g} s, {args.svr_format}, "
-              f"{len(first_slave.session.config()['items'])} items", flush=True)
-    if args.speedup != 1.0:
-        print(f"robot clock runs {args.speedup:g} x faster than real time", flush=True)
-    print("Press Ctrl-C to stop.", flush=True)
-    gc.disable()     # the server collects between bursts of requests (SimServer(manage_gc=True))
-    gc.freeze()      # what start-up built lives for good: keep it out of every later collection
-    with contextlib.suppress(KeyboardInterrupt):
-        server.serve_forever(done)          # the main thread serves: fastest replies
-    server.close()
+    previous = {sig: signal.signal(sig, lambda *_: done.set()) for sig in (signal.SIGTERM, signal.SIGINT)}
+    try:
+        for robot in server.robots:
+            node = "in Listen node" if robot.session.node_state() == IN_NODE else "project running, not in Listen node"
+            slave = f", Ethernet Slave on {args.host}:{robot.svr_port}" if server.svr is not None else ""
+            print(f"robot {robot.index + 1}: TM5-700 listening on {args.host}:{robot.port} ({node}){slave}", flush=True)
+        if server.control is not None:
+            print(f"control channel: {args.control_host}:{server.control.port} "
+                  f"(JSON lines; {robot_numbering(len(server.robots))})", flush=True)
+        first_slave = server.robots[0].slave
+        if first_slave is not None:
+            print(f"Ethernet Slave data table: every {args.svr_period:g} s, {args.svr_format}, "
+                  f"{len(first_slave.session.config()['items'])} items", flush=True)
+        if args.speedup != 1.0:
+            print(f"robot clock runs {args.speedup:g} x faster than real time", flush=True)
+        print("Press Ctrl-C to stop.", flush=True)
+        gc.disable()     # the server collects between bursts of requests (SimServer(manage_gc=True))
+        gc.freeze()      # what start-up built lives for good: keep it out of every later collection
+        server.serve_forever(done)              # the main thread serves: fastest replies
+        server.close()
+    finally:                                # (for a caller in the same process)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     print("simulator stopped", flush=True)
     return 0
 

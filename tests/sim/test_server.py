@@ -1,6 +1,7 @@
 """SimServer over real loopback sockets, driven by poll() on a virtual clock (no sleeps)."""
 import json
 import pathlib
+import signal
 import socket
 import subprocess
 import sys
@@ -482,15 +483,16 @@ def _stop_cli(proc: subprocess.Popen) -> None:
     assert proc.returncode == 0 and "Traceback" not in err, err
 
 
-def test_cli_stopped_right_after_its_first_start_up_line_stops_cleanly(tmp_path):
-    """A supervisor that waits for the first start-up line and stops the simulator at once gets the clean stop. With
-    200 robots the stop comes while the start-up lines are still being written (it was the signal's default action
-    then: exit -15, no "simulator stopped")."""
+@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "Ctrl-C"])
+def test_cli_stopped_right_after_its_first_start_up_line_stops_cleanly(tmp_path, stop):
+    """A supervisor (or a user) that waits for the first start-up line and stops the simulator at once gets the clean
+    stop. With 200 robots the stop comes while the start-up lines are still being written (it was the signal's
+    default action then, exit -15, or a KeyboardInterrupt's traceback, and no "simulator stopped")."""
     proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", "0",
                              "--control-port", "0", "--robots", "200", "--no-svr"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     assert proc.stdout.readline().startswith("robot 1: TM5-700 listening on 127.0.0.1:")
-    proc.terminate()
+    proc.send_signal(stop)
     out, err = proc.communicate(timeout=10)
     assert proc.returncode == 0 and "simulator stopped" in out and "Traceback" not in err, (out[-300:], err)
 
