@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 from cbt_hmi.web.mapping import Mapping, MappingError
 from cbt_hmi.web.pagedesc import load_pages, program_table
 from cbt_hmi.web.server import HmiServer
-from tmsim.net.control import robot_numbering
+from tmsim.net.control import default_port, robot_numbering
 from tmsim.net.server import SimServer
 
 if TYPE_CHECKING:
@@ -85,20 +85,9 @@ def control_line(port: int) -> str:
 
 
 def default_control_port(robot_port: int, taken: tuple[int, ...]) -> int:
-    """The port before the robot's (5889 for 5890), as sim/tmflow_listener.py derives it; 0 (any free port,
-    printed at start) when that one is taken or is one of the demo's other ports."""
-    derived = robot_port - 1
-    if derived < 1 or derived in taken:
-        return 0
-    probe = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    try:
-        probe.bind((CONTROL_HOST, derived))
-    except OSError:
-        return 0
-    finally:
-        probe.close()
-    return derived
+    """The port before the robot's (5889 for 5890), as the simulator's command line derives it; 0 (any free port,
+    printed at start) when that one is in use or is one of the demo's other ports (``taken``)."""
+    return default_port(robot_port, CONTROL_HOST, taken)
 
 
 class DemoError(Exception):

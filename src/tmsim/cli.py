@@ -20,12 +20,11 @@ import argparse
 import gc
 import math
 import signal
-import socket
 import sys
 import threading
 
 from tmsim.limits import NODE_TIMEOUT_MAX_S, SPEEDUP_MAX
-from tmsim.net.control import robot_numbering
+from tmsim.net.control import default_port, robot_numbering
 from tmsim.net.server import SimServer
 from tmsim.protocol.listen_session import IN_NODE
 from tmsim.protocol.svr_session import DEFAULT_STREAM
@@ -170,23 +169,9 @@ def check_args(args: argparse.Namespace) -> tuple[list[str], int | None, list[st
 
 
 def control_port(args: argparse.Namespace) -> int:
-    """--control-port as given; by default the port before robot 1's (5889 for 5890), so two simulators on
-    different --port values do not collide, and any free port (printed at start) when that one is taken."""
-    if args.control_port is not None:
-        return args.control_port
-    derived = args.port - 1 if args.port > 1 else 0
-    if derived:
-        # the probe binds the way the control channel's server does (SO_REUSEADDR): a port that only holds
-        # connections of a simulator just stopped (TIME_WAIT) is free for it, a port something listens on is not
-        probe = socket.socket()
-        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            probe.bind((args.control_host, derived))
-        except OSError:
-            derived = 0
-        finally:
-            probe.close()
-    return derived
+    """--control-port as given; by default the port before robot 1's, or any free one when that is in use
+    (``tmsim.net.control.default_port``)."""
+    return args.control_port if args.control_port is not None else default_port(args.port, args.control_host)
 
 
 def main(argv: list[str] | None = None) -> int:

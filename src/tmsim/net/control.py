@@ -37,7 +37,7 @@ import json
 import math
 import selectors
 import socket
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from contextlib import AbstractContextManager
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -364,6 +364,26 @@ def robot_numbering(count: int) -> str:
     if count == 1:
         return '"robot": 0 is robot 1'
     return f'"robot": 0 to {count - 1} are robots 1 to {count}'
+
+
+def default_port(robot_port: int, host: str = "127.0.0.1", taken: Iterable[int] = ()) -> int:
+    """The control channel's default port: the one before robot 1's (5889 for 5890), so simulators on different
+    robot ports do not collide; 0 (any free port, printed at start) when that one is not a port, is one of
+    ``taken``, or is in use. The check binds as the control channel's server does (SO_REUSEADDR): connections of a
+    simulator just stopped (TIME_WAIT) do not count; a port something listens on, or that a simulator holds for a
+    robot whose project stopped, does."""
+    derived = robot_port - 1
+    if derived < 1 or derived in taken:
+        return 0
+    probe = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        probe.bind((host, derived))
+    except OSError:
+        return 0
+    finally:
+        probe.close()
+    return derived
 
 
 _NO_SLAVE = "the Ethernet Slave is not running (simulator started with --no-svr)"
