@@ -13,7 +13,7 @@ from cbt_hmi.web.server import MAX_BODY, HmiServer
 
 def test_main_page_and_script_are_served_with_text_types(client):
     status, body, headers = client.request("/")
-    assert status == 200 and b'<script src="hmi.js"' in body
+    assert status == 200 and b'<script src="hmi.js?v=' in body        # its version: cbt_hmi.web.assets
     assert headers["Content-Type"].startswith("text/html")
     status, _, headers = client.request("/hmi.js")
     assert status == 200 and "javascript" in headers["Content-Type"]

@@ -32,7 +32,7 @@ function operatorText(descrip) {
 }
 
 async function loadAlarms() {
-  try { alarms.texts = await (await fetch("errors.json")).json(); } catch (e) { alarms.texts = {}; }
+  try { alarms.texts = await (await fetch(dataFileAddress("errors.json"))).json(); } catch (e) { alarms.texts = {}; }
 }
 
 /* called by every poll with the /api/read answer (null: no answer) */

@@ -4,6 +4,14 @@
    here with the same ErrorID. */
 "use strict";
 
+/* The address of a data file the page shell preloads (errors.json, tm5_700.json): the server names it with its
+   version (cbt_hmi/web/assets.py), so the browser keeps it until the file changes; the plain name without one. Every
+   script of the shell uses it; this one is the shell's first. */
+function dataFileAddress(name) {
+  const link = document.querySelector(`link[rel="preload"][href^="${name}?"]`);
+  return link ? link.href : name;
+}
+
 /* {DataFormat: "CAP_Abs", MovementCommand: "Line", BlendingEnable: "TRUE", Module: "EndModule"} of a form */
 function formContext(root, prefix) {
   const context = {};

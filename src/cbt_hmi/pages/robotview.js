@@ -23,7 +23,7 @@ const RED = "#c0241a", VIOLET = "#6a2fa8";
 /* ---- the TM5-700's kinematics, from the one data file src/cbt_hmi/pages/tm5_700.json (checked against the simulator's
    src/tmsim/robot/kinematics.py by tests/hmi/test_hmi_robot_view.py). Matrices are 4x4 row lists. ---- */
 const ARM = { data: null };
-const armReady = fetch("tm5_700.json").then((r) => r.json()).then((d) => { ARM.data = d; })
+const armReady = fetch(dataFileAddress("tm5_700.json")).then((r) => r.json()).then((d) => { ARM.data = d; })
   .catch(() => { /* no arm data: the view draws no arm and the page leaves the reach check to the robot */ });
 const RAD = Math.PI / 180;
 

@@ -44,6 +44,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
 from .alarms import HISTORY, AlarmSystem, plc_fault, stamp
+from .assets import NEVER_KEPT, SHELL, Assets
 from .front import MAX_BODY, HttpFront, HttpLimits, Stream
 from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, validate
 from .trail import Trail
@@ -110,6 +111,7 @@ class HmiServer:
         self.host = host
         self.requested_port = port
         self.root = pathlib.Path(root).resolve()
+        self.assets = Assets(self.root)
         self.access = access or AccessPolicy()
         self._httpd: HttpFront | None = None
         self._thread: threading.Thread | None = None
@@ -347,13 +349,14 @@ class _Handler(BaseHTTPRequestHandler):
         except (ValueError, OSError):
             pass
 
-    def _head(self, status: HTTPStatus, content_type: str, more: dict[str, str]) -> None:
-        """The header of every answer: never kept by the browser, never framed, no referrer; and ``more``."""
+    def _head(self, status: HTTPStatus, content_type: str, more: dict[str, str], cache: str = NEVER_KEPT) -> None:
+        """The header of every answer: kept by the browser as ``cache`` says (an API answer: never), never framed,
+        no referrer; and ``more``."""
         self.send_response(status)
         self.send_header("Content-Type", content_type)
         for name, value in more.items():
             self.send_header(name, value)
-        self.send_header("Cache-Control", "no-store")
+        self.send_header("Cache-Control", cache)
         self.send_header("X-Content-Type-Options", "nosniff")
         self.send_header("X-Frame-Options", "DENY")
         self.send_header("Referrer-Policy", "no-referrer")
@@ -405,7 +408,7 @@ class _Handler(BaseHTTPRequestHandler):
             elif url.path.startswith("/api/"):
                 raise RequestError(f"unknown API endpoint {url.path}", HTTPStatus.NOT_FOUND)
             else:
-                self._static(url.path)
+                self._static(url)
         except (RequestError, AccessDenied) as exc:
             self._fail(exc)
         except ValueError as exc:                       # parse_qs: too many fields
@@ -503,14 +506,24 @@ class _Handler(BaseHTTPRequestHandler):
         self.close_connection = True
         return RequestError(message, status)
 
-    def _static(self, path: str) -> None:
-        relative = "index.html" if path in ("", "/") else path.lstrip("/")
+    def _static(self, url) -> None:
+        """A file of the pages folder; the page shell for every page's address (cbt_hmi.web.assets: what the
+        browser may keep)."""
+        relative = SHELL if url.path in ("", "/") else url.path.lstrip("/")
         if relative.endswith(".html") and relative[:-5] in self.hmi.mapping.pages:
-            relative = "index.html"          # one page shell; hmi.js builds the page named in the address
-        target = (self.hmi.root / relative).resolve()
-        if self.hmi.root not in target.parents or not target.is_file():
-            raise RequestError(f"no such page: {path}", HTTPStatus.NOT_FOUND)
+            relative = SHELL                 # one page shell; hmi.js builds the page named in the address
+        target = self.hmi.assets.find(relative)
+        if target is None:
+            raise RequestError(f"no such page: {url.path}", HTTPStatus.NOT_FOUND)
         content_type = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
         if content_type.startswith("text/") or content_type.endswith(("javascript", "json")):
             content_type += "; charset=utf-8"
-        self._send(HTTPStatus.OK, target.read_bytes(), content_type)
+        asked = parse_qs(url.query, max_num_fields=MAX_NAMES).get("v", [None])[0]
+        answer = self.hmi.assets.answer(relative, target, asked, self.headers.get("If-None-Match"))
+        more = {"ETag": answer.etag} if answer.etag else {}
+        if answer.status == HTTPStatus.NOT_MODIFIED:
+            self._head(HTTPStatus.NOT_MODIFIED, content_type, more, answer.cache)
+            return
+        self._head(HTTPStatus.OK, content_type, {"Content-Length": str(len(answer.body)), **more}, answer.cache)
+        if self.command != "HEAD":
+            self.wfile.write(answer.body)
