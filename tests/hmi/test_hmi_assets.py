@@ -1,9 +1,13 @@
 """What the panel's browser may keep of the pages (cbt_hmi.web.assets): the page shell never, a style sheet, script or
-data file named with the version of its bytes for good, any other file only with its validator (304 while unchanged).
+data file named with the version of its bytes for good, any other file only with its validators (304 while unchanged).
 Over HTTP against the shipped pages and a pages folder of the test's own, and in headless Chromium."""
 from __future__ import annotations
 
+import email.utils
+import os
+import pathlib
 import re
+import time
 
 import pytest
 from fake_plc import FakePlc, command_program, scanning
@@ -60,7 +64,7 @@ def test_a_file_asked_for_with_its_version_is_kept_for_good(client):
         assert headers["ETag"] == f'"{named[name]}"'
 
 
-@pytest.mark.parametrize("query", ["", "?v=0123456789abcdef", "?v=", "?v=%ZZ&v=x", "?load=3"])
+@pytest.mark.parametrize("query", ["", "?v=0123456789abcdef", "?v=", "?v=%ZZ&v=x", "?load=3", "?" + "a&" * 401])
 def test_a_file_asked_for_without_its_version_is_kept_only_with_its_validator(client, query):
     status, body, headers = client.request(f"/hmi.js{query}")
     assert status == 200 and body == (HMI_DIR / "hmi.js").read_bytes()
@@ -72,8 +76,28 @@ def test_a_file_asked_for_without_its_version_is_kept_only_with_its_validator(cl
 def test_an_unchanged_file_is_answered_304_without_its_bytes(client, form):
     _, _, headers = client.request("/alarms.js")
     status, body, again = client.request("/alarms.js", headers={"If-None-Match": form.format(tag=headers["ETag"])})
-    assert status == 304 and body == b""
+    assert status == 304 and body == b"" and "Content-Type" not in again
     assert again["ETag"] == headers["ETag"] and again["Cache-Control"] == "no-cache"
+
+
+def test_a_file_unchanged_since_the_date_a_browser_holds_is_answered_304(own_pages):
+    """Chromium revalidates what an HTTP/1.0 server sent with If-Modified-Since only; If-None-Match, when sent,
+    decides alone. A file changed within the last two seconds gets no date (a second change in the same second would
+    keep it)."""
+    client, folder = own_pages
+    hour_ago = time.time() - 3600
+    os.utime(folder / "app.js", (hour_ago, hour_ago))
+    _, _, headers = client.request("/app.js")
+    assert headers["Last-Modified"] == email.utils.formatdate(int(hour_ago), usegmt=True)
+    status, body, _ = client.request("/app.js", headers={"If-Modified-Since": headers["Last-Modified"]})
+    assert status == 304 and body == b""
+    for stale in ({"If-Modified-Since": email.utils.formatdate(hour_ago - 60, usegmt=True)},
+                  {"If-Modified-Since": "yesterday"},
+                  {"If-Modified-Since": headers["Last-Modified"], "If-None-Match": '"0000000000000000"'}):
+        assert client.request("/app.js", headers=stale)[0] == 200, stale
+    (folder / "app.js").write_text("const A = 3;", encoding="utf-8")        # changed just now: no date to hold
+    status, body, headers = client.request("/app.js", headers={"If-Modified-Since": headers["Last-Modified"]})
+    assert status == 200 and body == b"const A = 3;" and "Last-Modified" not in headers
 
 
 def test_a_changed_file_gets_its_bytes_again_and_a_new_version_in_the_next_shell(own_pages):
@@ -93,6 +117,27 @@ def test_a_changed_file_gets_its_bytes_again_and_a_new_version_in_the_next_shell
     # the old address still answers, with the new bytes, and they are not kept for good under the old version
     status, body, headers = client.request(f"/app.js?v={before['app.js']}")
     assert status == 200 and body == b"const A = 2;" and headers["Cache-Control"] == "no-cache"
+    assert references(client.request("/./index.html")[1]) == after          # the shell by any of its names
+
+
+def test_a_file_that_cannot_be_read_leaves_the_shell_served_and_says_why(own_pages, monkeypatch):
+    client, _ = own_pages
+    read = pathlib.Path.read_bytes
+
+    def refused(path):
+        if path.name == "look.css":
+            raise PermissionError(13, "Permission denied")
+        return read(path)
+    monkeypatch.setattr(pathlib.Path, "read_bytes", refused)
+    status, shell, _ = client.request("/")
+    assert status == 200 and b'href="look.css"' in shell and b'src="app.js?v=' in shell
+    status, answer = client.json("/look.css")
+    assert status == 500 and answer["error"] == "the page file /look.css cannot be read: Permission denied"
+
+
+def test_a_name_the_system_refuses_is_not_found(client):
+    status, answer = client.json("/" + "a" * 300 + ".js")
+    assert status == 404 and answer["error"].startswith("no such page")
 
 
 def test_the_second_load_of_a_page_reads_no_script_style_sheet_or_data_file_again(server, chromium):
@@ -102,7 +147,9 @@ def test_the_second_load_of_a_page_reads_no_script_style_sheet_or_data_file_agai
     chromium.open(server.page_url("moveabs", "engineer"))
     entries = chromium.driver.execute_script(
         "return performance.getEntriesByType('resource').map((e) => [e.name, e.transferSize]);")
-    files = {re.sub(r"^.*/([^/?]+)\?v=.*$", r"\1", name): size for name, size in entries if "?v=" in name}
-    assert sorted(files) == sorted(SHIPPED_REFERENCES), entries
-    assert all(size == 0 for size in files.values()), files
+    files = [(re.sub(r"^.*/([^/?]+)(\?v=[0-9a-f]{16})?$", r"\1\2", name), size) for name, size in entries
+             if "/api/" not in name]
+    # each file once, under its versioned address (a data file fetched by its plain name would be read twice)
+    assert sorted(name.partition("?v=")[0] for name, _ in files) == sorted(SHIPPED_REFERENCES), entries
+    assert all("?v=" in name and size == 0 for name, size in files), files
     assert any("/api/mapping" in name and size > 0 for name, size in entries), entries

@@ -44,7 +44,7 @@ from urllib.parse import parse_qs, urlsplit
 
 from .access import AccessDenied, AccessPolicy, role_at_least
 from .alarms import HISTORY, AlarmSystem, plc_fault, stamp
-from .assets import NEVER_KEPT, SHELL, Assets
+from .assets import NEVER_KEPT, SHELL, Assets, asked_version
 from .front import MAX_BODY, HttpFront, HttpLimits, Stream
 from .mapping import HMI_DIR, Leaf, Mapping, RequestError, format_dt, jsonable, validate
 from .trail import Trail
@@ -349,11 +349,13 @@ class _Handler(BaseHTTPRequestHandler):
         except (ValueError, OSError):
             pass
 
-    def _head(self, status: HTTPStatus, content_type: str, more: dict[str, str], cache: str = NEVER_KEPT) -> None:
-        """The header of every answer: kept by the browser as ``cache`` says (an API answer: never), never framed,
-        no referrer; and ``more``."""
+    def _head(self, status: HTTPStatus, content_type: str | None, more: dict[str, str],
+              cache: str = NEVER_KEPT) -> None:
+        """The header of every answer: its ``content_type`` (None: no body, a 304), kept by the browser as ``cache``
+        says (an API answer: never), never framed, no referrer; and ``more``."""
         self.send_response(status)
-        self.send_header("Content-Type", content_type)
+        if content_type is not None:
+            self.send_header("Content-Type", content_type)
         for name, value in more.items():
             self.send_header(name, value)
         self.send_header("Cache-Control", cache)
@@ -515,15 +517,19 @@ class _Handler(BaseHTTPRequestHandler):
         target = self.hmi.assets.find(relative)
         if target is None:
             raise RequestError(f"no such page: {url.path}", HTTPStatus.NOT_FOUND)
+        try:
+            answer = self.hmi.assets.answer(target, asked_version(url.query), self.headers.get("If-None-Match"),
+                                            self.headers.get("If-Modified-Since"))
+        except OSError as exc:
+            raise RequestError(f"the page file {url.path} cannot be read: {exc.strerror or exc}",
+                               HTTPStatus.INTERNAL_SERVER_ERROR) from None
+        if answer.status == HTTPStatus.NOT_MODIFIED:
+            self._head(HTTPStatus.NOT_MODIFIED, None, answer.validators, answer.cache)
+            return
         content_type = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
         if content_type.startswith("text/") or content_type.endswith(("javascript", "json")):
             content_type += "; charset=utf-8"
-        asked = parse_qs(url.query, max_num_fields=MAX_NAMES).get("v", [None])[0]
-        answer = self.hmi.assets.answer(relative, target, asked, self.headers.get("If-None-Match"))
-        more = {"ETag": answer.etag} if answer.etag else {}
-        if answer.status == HTTPStatus.NOT_MODIFIED:
-            self._head(HTTPStatus.NOT_MODIFIED, content_type, more, answer.cache)
-            return
-        self._head(HTTPStatus.OK, content_type, {"Content-Length": str(len(answer.body)), **more}, answer.cache)
+        self._head(HTTPStatus.OK, content_type, {"Content-Length": str(len(answer.body)), **answer.validators},
+                   answer.cache)
         if self.command != "HEAD":
             self.wfile.write(answer.body)
