@@ -419,37 +419,46 @@ def test_event_log_is_bounded_per_robot_and_overall():
     single.close()
 
 
+def _start_cli(tmp_path, *args: str, robots: int = 1) -> tuple[subprocess.Popen, list[str]]:
+    """The simulator's command line started with ``args`` (no Ethernet Slave), and its start-up lines: one per
+    robot, then the control channel's."""
+    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), *args, "--no-svr"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    return proc, [proc.stdout.readline() for _ in range(robots + 1)]
+
+
+def _stop_cli(proc: subprocess.Popen) -> None:
+    proc.terminate()
+    _out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 0 and "Traceback" not in err, err
+
+
 def test_cli_control_port_is_the_port_before_robot_1_or_a_free_one_when_that_is_taken(tmp_path, free_port):
     q = free_port(2)                                   # q busy, robot 1 on q + 1: the derived port q is taken
     blocker = socket.socket()
     blocker.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
     blocker.bind(("127.0.0.1", q))
     blocker.listen(1)
-    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
-                             "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    proc, lines = _start_cli(tmp_path, "--port", str(q + 1))
     try:
-        lines = [proc.stdout.readline() for _ in range(2)]
         assert lines[0].startswith(f"robot 1: TM5-700 listening on 127.0.0.1:{q + 1} ")
         port = int(lines[1].split(":")[2].split()[0])
         assert lines[1].startswith("control channel: ") and port != q
         assert control_request(port, {"cmd": "robots"})["result"][0]["port"] == q + 1
     finally:
         blocker.close()
-        proc.terminate()
-        out, err = proc.communicate(timeout=10)
-    assert proc.returncode == 0 and "Traceback" not in err
+        _stop_cli(proc)
 
 
 def test_cli_control_port_defaults_to_the_port_before_robot_1(tmp_path, free_port):
     q = free_port(2)                                   # q free (reserved for this test): the derived control port
-    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), "--port", str(q + 1),
-                             "--no-svr"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    proc, lines = _start_cli(tmp_path, "--port", str(q + 1))
     try:
-        lines = [proc.stdout.readline() for _ in range(2)]
         assert lines[1].startswith(f"control channel: 127.0.0.1:{q} ")
     finally:
-        proc.terminate()
-        proc.communicate(timeout=10)
+        _stop_cli(proc)
+
+
 def _listen_then_wait_out(port: int) -> bool:
     """Serve one connection on ``port`` and close it first, as a stopped simulator's control channel did: the
     server's end waits out (TIME_WAIT) on the port. False when ``port`` is taken."""
@@ -467,20 +476,6 @@ def _listen_then_wait_out(port: int) -> bool:
     client.close()
     server.close()
     return True
-
-
-def _start_cli(tmp_path, *args: str, robots: int = 1) -> tuple[subprocess.Popen, list[str]]:
-    """The simulator's command line started with ``args`` (no Ethernet Slave), and its start-up lines: one per
-    robot, then the control channel's."""
-    proc = subprocess.Popen([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), *args, "--no-svr"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-    return proc, [proc.stdout.readline() for _ in range(robots + 1)]
-
-
-def _stop_cli(proc: subprocess.Popen) -> None:
-    proc.terminate()
-    _out, err = proc.communicate(timeout=10)
-    assert proc.returncode == 0 and "Traceback" not in err, err
 
 
 @pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "Ctrl-C"])
