@@ -22,12 +22,18 @@ _DURATION = r"[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]+)?(?i:ms|us|ns|d|h|m|s)_?)++"
 _CLOCK = r"[0-9]+:[0-9]+(?::[0-9]+(?:\.[0-9]+)?)?"
 _YMD = r"[0-9]{4}-[0-9]{1,2}-[0-9]{1,2}"
 
+# Whitespace is skipped as the lead of the next token's match (one match per token, not two); a name that no
+# "#" or "://" follows is tried right after comments and pragmas: such a name can be no other token (a typed or
+# time literal and an I/O port address all need one of them just after the name), and names are most tokens. The
+# full list below still reads every name that one of them follows.
 _TOKEN_RE = re.compile(
     r"""
-    (?P<WS>[ \t\r\n\f\v]+)
-  | (?P<LINECOMMENT>//[^\n]*)
+    [ \t\r\n\f\v]*+
+    (?:
+    (?P<LINECOMMENT>//[^\n]*)
   | (?P<COMMENT>\(\*|/\*)
   | (?P<PRAGMA>\{)
+  | (?P<NAME>[A-Za-z_][A-Za-z0-9_]*+)(?!\#|://)
   | (?P<DT>(?i:DATE_AND_TIME|LDATE_AND_TIME|LDT|DT)\#""" + _YMD + r"-" + _CLOCK + r""")
   | (?P<TOD>(?i:TIME_OF_DAY|LTIME_OF_DAY|LTOD|TOD)\#""" + _CLOCK + r""")
   | (?P<DATE>(?i:LDATE|DATE|D)\#""" + _YMD + r""")
@@ -44,6 +50,7 @@ _TOKEN_RE = re.compile(
   | (?P<ADDRESS>%[IQM][XBWDL]?[0-9]+(?:\.[0-9]+)*+|%[IQM]\*|%(?i:[WHDA]|E[0-9A-F]{1,2}_)?[0-9]+(?:\.[0-9]+)?)
   | (?P<OP>:=|=>|<=|>=|<>|\*\*|\.\.|\\\\|[-+*/&=<>()\[\],;:.\#\\^])
   | (?P<BAD>.)
+    )
     """,
     re.VERBOSE | re.DOTALL,
 )
@@ -109,57 +116,59 @@ def tokenize(src: SourceFile, diags: DiagnosticBag, comments: list | None = None
     bad_start = -1
     while pos < n:
         m = match(text, pos)
-        assert m is not None            # the last alternative, BAD, matches any one character
+        if m is None:                   # only whitespace left (BAD, the last alternative, matches any character)
+            break
         kind = m.lastgroup or "BAD"     # every alternative is a named group
-        end = m.end()
-        if kind == "BAD":
-            if bad_start < 0:
-                bad_start = pos
-            pos = end
-            continue
-        if bad_start >= 0:
+        start, end = m.span(kind)
+        if bad_start >= 0 and (kind != "BAD" or start != pos):    # a run of bad characters ends at whitespace too
             chunk = text[bad_start:pos]
             diags.error(codes.BAD_CHARACTER, f"unexpected character {chunk[0]!r} (U+{ord(chunk[0]):04X}); "
                         "remove it or put it inside a comment or string", Span(src, bad_start, pos))
             bad_start = -1
-        if kind == "WS":
+        if kind == "NAME":
+            append(Token("IDENT", text[start:end], start, end))
+            pos = end
+            continue
+        if kind == "BAD":
+            if bad_start < 0:
+                bad_start = start
             pos = end
             continue
         if kind == "LINECOMMENT":
             if comments is not None:
-                comments.append(("//", pos, end))
+                comments.append(("//", start, end))
             pos = end
             continue
         if kind == "COMMENT":
-            stop = comment_end(text, pos)
+            stop = comment_end(text, start)
             if stop < 0:
                 diags.error(codes.UNCLOSED_COMMENT, "comment is never closed; add `*)` at its end",
-                            Span(src, pos, pos + 2))
+                            Span(src, start, start + 2))
                 break
             if comments is not None:
-                comments.append((text[pos:pos + 2], pos, stop))
+                comments.append((text[start:start + 2], start, stop))
             pos = stop
             continue
         if kind == "PRAGMA":
-            stop = text.find("}", pos)
+            stop = text.find("}", start)
             if stop < 0:
-                diags.error(codes.UNCLOSED_PRAGMA, "pragma is never closed; add `}`", Span(src, pos, pos + 1))
+                diags.error(codes.UNCLOSED_PRAGMA, "pragma is never closed; add `}`", Span(src, start, start + 1))
                 break
-            append(Token("PRAGMA", text[pos:stop + 1], pos, stop + 1))
+            append(Token("PRAGMA", text[start:stop + 1], start, stop + 1))
             pos = stop + 1
             continue
         if kind == "BADSTRING":
             diags.error(codes.UNCLOSED_STRING, "string literal is not closed on this line; add the closing quote",
-                        Span(src, pos, end))
-            append(Token("STRING" if text[pos] == "'" else "WSTRING", text[pos:end] + text[pos], pos, end))
+                        Span(src, start, end))
+            append(Token("STRING" if text[start] == "'" else "WSTRING", text[start:end] + text[start], start, end))
             pos = end
             continue
-        append(Token(kind, m.group(), pos, end))
+        append(Token(kind, text[start:end], start, end))
         pos = end
     if bad_start >= 0:
         ch = text[bad_start]
         diags.error(codes.BAD_CHARACTER, f"unexpected character {ch!r} (U+{ord(ch):04X}); "
-                    "remove it or put it inside a comment or string", Span(src, bad_start, n))
+                    "remove it or put it inside a comment or string", Span(src, bad_start, pos if pos < n else n))
     tokens.append(Token("EOF", "", n, n))
     return tokens
 

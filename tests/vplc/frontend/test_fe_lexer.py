@@ -62,3 +62,29 @@ def test_invalid_escape_is_named():
 
 def test_wide_string_uses_four_hex_digits():
     assert decode_string("$00E9", wide=True) == ("é", None)
+
+
+def spans(text: str):
+    d = DiagnosticBag()
+    tokens = [(t.kind, t.start, t.end) for t in tokenize(SourceFile("t.st", text), d)]
+    return tokens, [(x.code, x.span.start, x.span.end, x.message.split(" (U+")[0]) for x in d.items]
+
+
+def test_names_beside_a_hash_or_a_port_address_are_read_as_the_longer_token():
+    """A name is an IDENT unless "#" or "://" follows it: then a typed or time literal, or an I/O port address."""
+    assert toks("T#5s Tx#5 INT#5 TIME")[0] == [("TIME", "T#5s"), ("TYPED", "Tx#"), ("INT", "5"),
+                                               ("TYPED", "INT#"), ("INT", "5"), ("IDENT", "TIME")]
+    assert toks("ECAT://node#1 Other://x")[0][0] == ("IOPORT", "ECAT://node#1 Other")
+    assert toks("Other://x")[0] == [("IDENT", "Other"), ("OP", ":")]          # and a line comment
+    assert toks("a_1:=b2;")[0] == [("IDENT", "a_1"), ("OP", ":="), ("IDENT", "b2"), ("OP", ";")]
+
+
+def test_offsets_and_comments_after_whitespace_and_bad_characters_split_by_it():
+    tokens, errors = spans("  a\t(* c *)\n  b ?? ?\n")
+    assert tokens == [("IDENT", 2, 3), ("IDENT", 14, 15), ("EOF", 21, 21)]
+    assert errors == [("ST0101", 16, 18, "unexpected character '?'"), ("ST0101", 19, 20, "unexpected character '?'")]
+    comments: list = []
+    tokenize(SourceFile("t.st", " // one\n\t(* two *) x"), DiagnosticBag(), comments)
+    assert comments == [("//", 1, 7), ("(*", 9, 18)]
+    assert spans("x ?")[1] == [("ST0101", 2, 3, "unexpected character '?'")]
+    assert spans("   ")[0] == [("EOF", 3, 3)]
