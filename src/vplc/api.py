@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from .compiler.codegen import CodeGen
 from .frontend import types as T
+from .frontend.source import MAX_SOURCE_BYTES, FileRefused, read_file_bytes
 from .ladder.model import LadderBody
 from .runtime import abi, sysmac_system
 from .runtime.engine import Engine, Task
@@ -139,11 +140,10 @@ def _fingerprint(paths: list[str | os.PathLike[str]], dialect: str, count_statem
     try:
         prelude = sorted(n for n in os.listdir(PRELUDE_DIR) if n.endswith(".st"))
         for path in [os.path.join(PRELUDE_DIR, n) for n in prelude] + files:
-            with open(path, "rb") as fh:
-                data = fh.read()
+            data = read_file_bytes(path, MAX_SOURCE_BYTES)
             digest.update(f"\0{path}\0{len(data)}\0".encode())
             digest.update(data)
-    except OSError:
+    except (OSError, FileRefused):         # a pipe, a device, a file over the limit: the loader says which
         return None
     return digest.digest()
 

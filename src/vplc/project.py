@@ -20,7 +20,7 @@ from .frontend import codes
 from .frontend import types as T
 from .frontend.diagnostics import Diagnostic, DiagnosticBag, render_all, sort_key
 from .frontend.parser import parse, parse_kept
-from .frontend.source import SourceFile, Span
+from .frontend.source import MAX_SOURCE_BYTES, FileRefused, SourceFile, Span, read_file_bytes
 from .ladder.load import attach_ladders, check_operands, is_project_xml, is_xml, read_xml
 
 Paths = str | os.PathLike[str] | Iterable[str | os.PathLike[str]]    # one file or folder, or several
@@ -107,10 +107,15 @@ def collect_files(paths: Iterable[str | os.PathLike[str]], diags: DiagnosticBag)
 def read_source(path: str, diags: DiagnosticBag) -> SourceFile | None:
     empty = Span(SourceFile(path, ""), 0, 0)
     try:
-        with open(path, "rb") as fh:
-            data = fh.read()
+        data = read_file_bytes(path, MAX_SOURCE_BYTES)
     except OSError as exc:
         diags.error(codes.FILE_UNREADABLE, f"cannot read `{path}`: {exc.strerror or exc}", empty)
+        return None
+    except FileRefused as exc:
+        diags.error(codes.FILE_UNREADABLE, f"cannot read `{path}`: it {exc}", empty)
+        return None
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        diags.error(codes.FILE_NOT_UTF8, f"`{path}` is UTF-16 text; save the file as UTF-8", empty)
         return None
     if b"\x00" in data[:8192]:
         diags.error(codes.FILE_BINARY, f"`{path}` is a binary file, not Structured Text source", empty)

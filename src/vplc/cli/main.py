@@ -12,7 +12,7 @@ import errno
 import importlib
 import os
 import sys
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from ..frontend.diagnostics import ERROR, NOTE, WARNING, to_json
 
@@ -23,6 +23,13 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> NoReturn:  # usage errors: message + hint, exit 2, never a traceback
         self.print_usage(sys.stderr)
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+    def _get_values(self, action: argparse.Action, arg_strings: list[str]) -> Any:
+        # an option given an empty value (a script's unset variable: --duration "$T") is a usage error: read as
+        # absent, --duration '' ran for ever and --only '' exported everything
+        if action.option_strings and any(not text.strip() for text in arg_strings):
+            self.error(f"argument {'/'.join(action.option_strings)}: empty value; give one or leave the option out")
+        return super()._get_values(action, arg_strings)
 
 
 def register_check(subparsers: argparse._SubParsersAction) -> None:

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from ..frontend import types as T
 from ..frontend.parser_exprs import parse_duration as parse_time_literal
+from ..frontend.source import FileRefused, read_file_bytes
 from ..runtime.values import PathError, from_python, parse_duration
 from . import simlink
 
@@ -164,6 +165,7 @@ _EVERY = re.compile(r"^(.*?)\s+every\s+time$", re.IGNORECASE)
 _AFTER = re.compile(r"^(.*?)\s+after\s+(\S+)$", re.IGNORECASE)
 _AND = re.compile(r"\s+and\s+", re.IGNORECASE)
 MAX_REACTIONS = 10_000          # lines that act or react, per scenario (each is evaluated every scan)
+MAX_FILE_BYTES = 4 * 1024 * 1024   # a scenario file: far more lines than MAX_REACTIONS of any length one needs
 
 
 def _time(text: str, where: str, what: str) -> int:
@@ -309,10 +311,11 @@ def _robot(text: str, where: str) -> Action:
 def load(filename: str, sc: Scenario | None = None) -> Scenario:
     sc = sc or Scenario()
     try:
-        with open(filename, encoding="utf-8") as f:
-            lines = f.read().splitlines()
+        lines = read_file_bytes(filename, MAX_FILE_BYTES).decode("utf-8").splitlines()
     except OSError as exc:
-        raise ScenarioError(f"cannot read scenario {filename}: {exc.strerror}") from None
+        raise ScenarioError(f"cannot read scenario {filename}: {exc.strerror or exc}") from None
+    except FileRefused as exc:
+        raise ScenarioError(f"cannot read scenario {filename}: it {exc}") from None
     except UnicodeDecodeError:
         raise ScenarioError(f"scenario {filename} is not UTF-8 text") from None
     for n, line in enumerate(lines, 1):

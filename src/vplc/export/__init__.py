@@ -47,6 +47,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=run_export)
 
 
+def _same_file(a: str, b: str) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
 def _usage(msg: str) -> int:
     print(f"vplc export: error: {msg}", file=sys.stderr)
     return 2
@@ -83,6 +90,10 @@ def run_export(args: argparse.Namespace) -> int:
             return _usage(f"cannot write `{out}`: folder `{parent}` does not exist")
 
     proj = load_project(args.paths, dialect=args.dialect)
+    if args.format in ("iec61131-10", "plcopen") and os.path.exists(out) and any(
+            _same_file(out, source) for source in proj.files):
+        return _usage(f"output `{out}` is one of the sources; give another file name (the export would replace "
+                      "the source)")
     shown = [d for d in proj.diagnostics if d.severity != NOTE]
     errors = sum(1 for d in shown if d.severity == ERROR)
     if shown:

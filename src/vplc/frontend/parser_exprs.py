@@ -14,7 +14,7 @@ import re
 from . import ast as A
 from . import codes
 from .lexer import Token, decode_string
-from .parser_base import RESERVED, TokenCursor
+from .parser_base import MAX_DEPTH, RESERVED, TokenCursor
 
 BINARY_PREC = {"OR": 1, "XOR": 2, "AND": 3, "&": 3, "=": 4, "<>": 4, "<": 5, ">": 5, "<=": 5, ">=": 5,
                "+": 6, "-": 6, "*": 7, "/": 7, "MOD": 7}
@@ -105,7 +105,7 @@ class ExpressionParser:
             cur.advance()
             right = self.expression(prec + 1)
             chain += 1
-            if chain + cur.depth > 2 * 200:
+            if chain + cur.depth > 2 * MAX_DEPTH:
                 cur.fail("expression has too many operators in a row (over 400); split it using "
                          "intermediate variables", codes.NESTING_TOO_DEEP)
             left = A.Binary("AND" if op == "&" else op, left, right, span=cur.span_from(start))
@@ -130,11 +130,16 @@ class ExpressionParser:
         cur = self.cur
         start = cur.tok.start
         left = self.postfix()
+        chain = 0
         while cur.at_op("**"):
             cur.advance()
             cur.enter()
             right = self.unary() if (cur.at_op("-") or cur.at_op("+")) else self.postfix()
             cur.leave()
+            chain += 1               # each one nests the tree a level deeper, as the binary operators' chain does
+            if chain + cur.depth > 2 * MAX_DEPTH:
+                cur.fail("expression has too many operators in a row (over 400); split it using "
+                         "intermediate variables", codes.NESTING_TOO_DEEP)
             left = A.Binary("**", left, right, span=cur.span_from(start))
         return left
 
@@ -143,7 +148,12 @@ class ExpressionParser:
         cur = self.cur
         start = cur.tok.start
         node = self.primary()
+        parts = 0
         while True:
+            parts += 1               # each member, index and call nests the tree a level deeper
+            if parts + cur.depth > 2 * MAX_DEPTH:
+                cur.fail(f"over {2 * MAX_DEPTH} members, indexes and calls in a row; split the expression using "
+                         "intermediate variables", codes.NESTING_TOO_DEEP)
             if cur.at_op("."):
                 cur.advance()
                 t = cur.tok

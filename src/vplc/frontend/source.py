@@ -6,7 +6,35 @@ numbers are computed only when a diagnostic is rendered (:meth:`SourceFile.line_
 from __future__ import annotations
 
 import bisect
+import os
+import stat
 from dataclasses import dataclass, field
+
+MAX_SOURCE_BYTES = 64 * 1024 * 1024      # an ST file, as an XML project file (ladder/xmlsafe.py)
+
+
+class FileRefused(Exception):
+    """A file that is not read: not a regular file, or larger than its limit (the message says which, without the
+    file's name: the caller names it)."""
+
+
+def read_file_bytes(path: str | os.PathLike[str], limit: int, head: bool = False) -> bytes:
+    """The bytes of the regular file ``path``, at most ``limit`` of them. OSError when it cannot be opened;
+    FileRefused for a device, pipe, socket or folder, and for a file of more than ``limit`` bytes (``head``: its
+    first ``limit`` bytes instead). The file is opened without waiting (a pipe nobody writes to would hold a plain
+    open for ever) and read no further than ``limit`` (a link to /dev/zero is refused before it is read)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    with open(fd, "rb") as fh:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise FileRefused("is not a regular file (a device, pipe, socket or folder)")
+        data = fh.read(limit if head else limit + 1)
+    if len(data) > limit:
+        raise FileRefused(f"is larger than {_size(limit)}")
+    return data
+
+
+def _size(limit: int) -> str:
+    return f"{limit // 1048576} MiB" if limit % 1048576 == 0 else f"{limit:,} bytes"
 
 
 class SourceFile:

@@ -10,7 +10,7 @@ import re
 
 from ..frontend import ast as A
 from ..frontend import codes
-from ..frontend.source import SourceFile, Span
+from ..frontend.source import FileRefused, SourceFile, Span, read_file_bytes
 from . import iec10_read, plcopen_read
 from .decls import FormatError
 from .translate import LadderSource, unit_source
@@ -30,9 +30,8 @@ def is_project_xml(path: str) -> bool:
     or ``Project`` (IEC 61131-10). Other XML files in a source folder (test reports, settings) are not
     sources; a file named on the command line is always loaded, and refused with a reason if it is not one."""
     try:
-        with open(path, "rb") as fh:
-            head = fh.read(4096)
-    except OSError:
+        head = read_file_bytes(path, 4096, head=True)
+    except (OSError, FileRefused):
         return True                                      # the loader reports why it cannot be read
     return re.search(rb"<(?:[A-Za-z_][\w.-]*:)?[pP]roject[\s>/]", head) is not None
 
@@ -110,9 +109,8 @@ def attach_ladders(unit: A.CompilationUnit) -> None:
 
 def _raw_text(path: str) -> str:
     try:
-        with open(path, "rb") as fh:
-            return fh.read(1 << 20).decode("utf-8", "replace")
-    except OSError:
+        return read_file_bytes(path, 1 << 20, head=True).decode("utf-8", "replace")
+    except (OSError, FileRefused):
         return ""
 
 

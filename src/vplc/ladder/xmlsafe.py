@@ -12,6 +12,8 @@ import os
 import re
 import xml.etree.ElementTree as ET
 
+from ..frontend.source import FileRefused, read_file_bytes
+
 MAX_BYTES = 64 * 1024 * 1024
 XSI_TYPE = "{http://www.w3.org/2001/XMLSchema-instance}type"
 _DTD = re.compile(rb"<!\s*(DOCTYPE|ENTITY)", re.I)
@@ -32,10 +34,11 @@ def read(path: str) -> tuple[str, ET.Element]:
         if size > MAX_BYTES:
             raise XmlError(f"the file is {size / 1048576:.0f} MiB; XML project files are limited to "
                            f"{MAX_BYTES // 1048576} MiB")
-        with open(path, "rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
+        data = read_file_bytes(path, MAX_BYTES)
     except OSError as exc:
         raise XmlError(f"cannot read the file: {exc.strerror or exc}") from None
+    except FileRefused as exc:
+        raise XmlError(f"the file {exc}") from None
     return parse_bytes(data)
 
 

@@ -25,6 +25,8 @@ import tomllib
 from dataclasses import dataclass
 from typing import Any
 
+from ..frontend.source import FileRefused, read_file_bytes
+
 MAX_AXES = 64            # _MC_AX[0..63] (prelude/sysmac_motion.st)
 UNITS = {"pulse": 0, "mm": 1, "um": 2, "nm": 3, "deg": 4, "inch": 5}     # _eMC_UNITS values
 _MAX_FILE_BYTES = 1_000_000
@@ -57,12 +59,11 @@ def load_axes(path: str | os.PathLike[str]) -> tuple[AxisConfig, ...]:
     """Read and check the axis configuration file ``path``."""
     path = os.fspath(path)
     try:
-        with open(path, "rb") as fh:
-            data = fh.read(_MAX_FILE_BYTES + 1)
+        data = read_file_bytes(path, _MAX_FILE_BYTES)
     except OSError as exc:
         raise AxisConfigError(f"{path}: cannot read the axis configuration ({exc.strerror or exc})") from None
-    if len(data) > _MAX_FILE_BYTES:
-        raise AxisConfigError(f"{path}: the axis configuration is larger than {_MAX_FILE_BYTES:,} bytes")
+    except FileRefused as exc:
+        raise AxisConfigError(f"{path}: the axis configuration {exc}") from None
     try:
         doc = tomllib.loads(data.decode("utf-8"))
     except UnicodeDecodeError:

@@ -54,6 +54,25 @@ def test_unwritable_output_is_a_usage_error(tmp_path, capsys):
     _one_line(err)
 
 
+def test_an_output_that_is_one_of_the_sources_is_refused_and_the_source_kept(tmp_path, capsys):
+    src = tmp_path / "fb.st"
+    src.write_text(BAD.replace("x := y;", "x := 1;"), encoding="utf-8")
+    before = src.read_bytes()
+    for fmt in ("iec61131-10", "plcopen"):
+        for given in (src, tmp_path):           # named, or found in the folder given
+            code, _, err = run(capsys, "export", str(given), "--format", fmt, "-o", str(src))
+            assert code == 2 and "is one of the sources" in err and src.read_bytes() == before
+            _one_line(err)
+
+
+def test_an_empty_option_value_is_a_usage_error_not_an_absent_option(tmp_path, capsys):
+    """--only '' exported everything, as if the option were absent (a script's unset variable)."""
+    for option in ("--only", "--device"):
+        code, _, err = run(capsys, "export", str(LIB), option, "", "-o", str(tmp_path / "x.xml"))
+        assert code == 2 and f"argument {option}: empty value; give one or leave the option out" in err
+        assert not (tmp_path / "x.xml").exists()
+
+
 def test_missing_output_is_a_usage_error(capsys):
     code, _, err = run(capsys, "export", str(LIB))
     assert code == 2 and "-o" in err

@@ -1,12 +1,15 @@
 """Bad input: each case gives a clear diagnostic and exit 1 — never a traceback or a hang."""
 from __future__ import annotations
 
+import os
+
 import pytest
 from fe_helpers import check_text
 
+from vplc import project as vplc_project
 from vplc.frontend import codes
 from vplc.frontend.diagnostics import DiagnosticBag
-from vplc.project import read_source
+from vplc.project import load_project, read_source
 
 
 def _write(tmp_path, name, data):
@@ -85,3 +88,39 @@ def test_an_open_array_where_a_fixed_size_array_is_expected_is_a_type_error_not_
     assert errors == [(codes.TYPE_MISMATCH, 10), (codes.ARGUMENT_TYPE, 11)]
     assert "cannot use a value of type ARRAY[*] OF INT where ARRAY[0..3] OF INT is expected" in \
         proj.diagnostics[0].message
+
+
+def test_a_pipe_a_device_and_a_utf16_file_are_named_for_what_they_are(tmp_path):
+    """A pipe nobody writes to is refused at once (a plain open would wait for a writer for ever), a link to
+    /dev/zero before anything is read (it never ends), a UTF-16 file as UTF-16 (not as a binary file)."""
+    os.mkfifo(tmp_path / "pipe.st")
+    os.symlink("/dev/zero", tmp_path / "zero.st")
+    (tmp_path / "wide.st").write_bytes("PROGRAM P END_PROGRAM".encode("utf-16"))
+    for name, words in (("pipe.st", "is not a regular file"), ("zero.st", "is not a regular file"),
+                        ("wide.st", "is UTF-16 text; save the file as UTF-8")):
+        diags = DiagnosticBag()
+        assert read_source(str(tmp_path / name), diags) is None
+        [d] = diags.items
+        assert words in d.message and d.code == (codes.FILE_NOT_UTF8 if name == "wide.st" else codes.FILE_UNREADABLE)
+    project = load_project([str(tmp_path)])          # the folder: each file named, no wait, no traceback
+    assert sorted(d.code for d in project.diagnostics) == ["ST0002", "ST0005", "ST0005"]
+
+
+def test_a_file_over_the_size_limit_is_refused_without_reading_it_all(tmp_path, monkeypatch):
+    monkeypatch.setattr(vplc_project, "MAX_SOURCE_BYTES", 100)
+    path = _write(tmp_path, "big.st", "PROGRAM P END_PROGRAM " + " " * 200)
+    diags = DiagnosticBag()
+    assert read_source(path, diags) is None
+    [d] = diags.items
+    assert d.code == codes.FILE_UNREADABLE and d.message.endswith("big.st`: it is larger than 100 bytes")
+
+
+@pytest.mark.parametrize("statement", [
+    "x := " + "**".join(["1.0"] * 12000) + ";",           # ** had no limit of its own
+    "x := y" + ".a" * 15000 + ";", "x := y" + "[0]" * 15000 + ";", "x := y" + "[0]()" * 15000 + ";",
+    "y" + ".a" * 15000 + " := 1.0;",
+], ids=["power", "members", "indexes", "calls", "assigned_members"])
+def test_long_chains_of_power_members_indexes_and_calls_are_st0203_not_a_traceback(tmp_path, statement):
+    proj = check_text(tmp_path, f"PROGRAM P\nVAR x : LREAL; y : LREAL; END_VAR\n{statement}\nEND_PROGRAM\n")
+    errors = [d for d in proj.diagnostics if d.is_error]
+    assert [d.code for d in errors] == ["ST0203"] and "split" in errors[0].message

@@ -2,6 +2,8 @@
 ST checker's rules hold for ladder POUs (docs/toolchain/diagnostics.md, ST21xx)."""
 from __future__ import annotations
 
+import os
+
 import pytest
 from ld_xml import HEAD, block, coil, contact, invar, jump, label, outvar, program, rail
 
@@ -119,6 +121,15 @@ def test_huge_document_is_refused_without_reading_it(tmp_path, monkeypatch):
     monkeypatch.setattr(xmlsafe, "MAX_BYTES", 1000)
     d = one(write(tmp_path, HEAD + " " * 2000 + "<types/></project>"))
     assert d.code == "ST2101" and "limited to" in d.message
+
+
+def test_a_pipe_or_a_device_named_xml_is_refused_at_once(tmp_path):
+    """A pipe nobody writes to is not waited on; a link to /dev/zero is not read (its size reads 0)."""
+    os.mkfifo(tmp_path / "pipe.xml")
+    os.symlink("/dev/zero", tmp_path / "zero.xml")
+    for name in ("pipe.xml", "zero.xml"):
+        [d] = load_project([str(tmp_path / name)]).diagnostics
+        assert d.code == "ST2101" and "the file is not a regular file" in d.message, d.message
 
 
 def test_not_well_formed_xml_points_at_the_line(tmp_path):

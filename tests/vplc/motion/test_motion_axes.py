@@ -2,6 +2,8 @@
 its errors, axes that are not configured, axis names, and tracing _MC_AX members. W507/W508 sections as named in
 each test (the English pages were not readable in our manual corpus; W508's Chinese edition pages are linked in
 docs/toolchain/runtime_sysmac.md section 5)."""
+import os
+
 import pytest
 from motion_rig import Rig, files
 
@@ -200,6 +202,11 @@ def test_hostile_axis_configurations_are_refused_without_traceback(tmp_path_fact
         load_plc([main], axes=str(deep))
     with pytest.raises(LoadError, match="larger than 1,000,000 bytes"):
         load_plc([main], axes=str(big))
+    os.mkfifo(tmp_path / "pipe.toml")                 # refused at once, not waited on for a writer
+    os.symlink("/dev/zero", tmp_path / "zero.toml")   # refused before it is read
+    for name in ("pipe.toml", "zero.toml"):
+        with pytest.raises(LoadError, match="the axis configuration is not a regular file"):
+            load_plc([main], axes=str(tmp_path / name))
 
 
 def test_a_missing_axis_configuration_file_is_a_load_error(tmp_path_factory, tmp_path):

@@ -147,3 +147,14 @@ def test_set_takes_a_time_literal_with_several_units_as_st_writes_it(tmp_path):
         assert f"Main.Wait = {shown}" in r.stdout.splitlines()[-2]
     r = run(tmp_path, "--cycles", "1", "--set", "Main.Wait=T#1s5")
     assert r.returncode == 2 and "`T#1s5` is not a value for Main.Wait (TIME)" in r.stderr
+
+
+def test_a_scenario_that_is_a_pipe_or_a_device_is_a_usage_error_at_once(tmp_path):
+    """A pipe nobody writes to is refused at once (not waited on for ever), a link to /dev/zero before it is read."""
+    src = tmp_path / "m.st"
+    src.write_text(PROG)
+    os.mkfifo(tmp_path / "pipe.scn")
+    os.symlink("/dev/zero", tmp_path / "zero.scn")
+    for name in ("pipe.scn", "zero.scn"):
+        r = vplc("run", str(src), "--virtual-time", "--scenario", str(tmp_path / name))
+        assert r.returncode == 2 and f"cannot read scenario {tmp_path / name}: it is not a regular file" in r.stderr
