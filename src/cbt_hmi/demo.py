@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from cbt_hmi.web.mapping import Mapping, MappingError
 from cbt_hmi.web.pagedesc import load_pages, program_table
-from cbt_hmi.web.server import HmiServer
+from cbt_hmi.web.server import HmiServer, host_argument
 from tmsim.net.control import default_port, robot_numbering
 from tmsim.net.server import SimServer
 
@@ -150,7 +150,8 @@ def tcp_port(text: str) -> int:
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="cbt-demo", description=__doc__.splitlines()[0])
-    parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    parser.add_argument("--host", type=host_argument, default="127.0.0.1",
+                        help="address to bind (default 127.0.0.1; 0.0.0.0: every interface)")
     parser.add_argument("--robot-port", type=tcp_port, default=5890, help="robot Listen Node port (default 5890)")
     parser.add_argument("--svr-port", type=tcp_port, default=None,
                         help="robot Ethernet Slave port (default: the robot port + 1, i.e. 5891)")

@@ -35,13 +35,23 @@ from tmsim.tmscript.profiles import STOP_TAGS, VERSIONS, Profile
 SVR_FORMATS = {"binary": 1, "string": 2, "json": 3}
 
 
+def bind_address(text: str) -> str:
+    """An address to listen on (``--host``, ``--control-host``). An empty one (a script's unset variable) is a usage
+    error: the socket would take every network interface while the start-up lines said otherwise."""
+    address = text.strip()
+    if not address:
+        raise argparse.ArgumentTypeError("an address is needed: 127.0.0.1 for this computer only, 0.0.0.0 for "
+                                         "every interface")
+    return address
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="tmflow-sim",
         description="TMflow Listen Node simulator (TM5-700 model). Serves the external-script protocol "
                     "(TMSCT/TMSTA/CPERR) on one TCP port per robot.")
-    parser.add_argument("--host", default="127.0.0.1", metavar="ADDRESS",
-                        help="address to listen on (default 127.0.0.1)")
+    parser.add_argument("--host", type=bind_address, default="127.0.0.1", metavar="ADDRESS",
+                        help="address to listen on (default 127.0.0.1; 0.0.0.0: every interface)")
     parser.add_argument("--port", type=int, default=5890, metavar="PORT",
                         help="port of robot 1; further robots use the next ports (default 5890, 0 = any free port)")
     parser.add_argument("--robots", type=int, default=1, metavar="N",
@@ -60,7 +70,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="port of the local JSON control channel (default: the port before robot 1's, 5889 "
                              "for 5890, or any free port when that one is taken; 0 = any free port)")
     parser.add_argument("--no-control", action="store_true", help="do not open the control channel")
-    parser.add_argument("--control-host", default="127.0.0.1", metavar="ADDRESS",
+    parser.add_argument("--control-host", type=bind_address, default="127.0.0.1", metavar="ADDRESS",
                         help="address of the control channel (default 127.0.0.1, whatever --host says)")
     parser.add_argument("--data-timeout", type=float, default=0.0, metavar="S",
                         help="leave the node via Fail after S seconds without a packet (0 = none, default)")
@@ -161,6 +171,9 @@ def check_args(args: argparse.Namespace) -> tuple[list[str], int | None, list[st
     if not (math.isfinite(args.svr_period) and 0 <= args.svr_period <= 3600):
         problems.append(f"--svr-period must be 0 (off) .. 3600 s (got {args.svr_period:g})")
     svr_items = [name.strip() for name in args.svr_items.split(",") if name.strip()]
+    if not svr_items:
+        problems.append("--svr-items names no item: give the data table items to stream, A,B,... "
+                        "(see docs/simulator.md)")
     declared = {spec.partition(":")[0].strip() for spec in getattr(args, "svr_var", [])}
     unknown = [name for name in svr_items if name not in ITEMS and name not in declared]
     if unknown:

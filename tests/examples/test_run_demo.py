@@ -248,3 +248,17 @@ def test_demo_pages_option_names_a_missing_folder():
     assert result.returncode == 2
     assert "error: --pages no/such/folder: not a folder of page description files" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("command", ["demo", "cell"])
+def test_an_empty_host_is_a_usage_error_not_every_interface(command, capsys):
+    """--host "$HOST" with HOST unset bound 0.0.0.0 while the start-up line said 127.0.0.1."""
+    from cbt_hmi import demo
+    from cbt_hmi.web import cell
+    parse = demo.parse_args if command == "demo" else lambda argv: cell.parse_args([*argv, "--pages", ".", "x.st"])
+    with pytest.raises(SystemExit) as stopped:
+        parse(["--host", ""])
+    assert stopped.value.code == 2
+    assert "argument --host: an address is needed: 127.0.0.1 for this computer only, 0.0.0.0 for every " \
+           "interface" in capsys.readouterr().err
+    assert parse(["--host", "0.0.0.0"]).host == "0.0.0.0"

@@ -5,6 +5,7 @@ variables; bad page descriptions are reported with their file and line while the
 from __future__ import annotations
 
 import json
+import os
 import pathlib
 import shutil
 import urllib.error
@@ -105,6 +106,36 @@ def test_the_described_page_and_its_main_page_meet_the_panel_rules(cell, browser
     assert browser.driver.find_element("id", "nav-conveyor").text == "Conveyor"     # the main page lists it
 
 
+MARKUP = "Belt <img src=x onerror=\"document.documentElement.dataset.ran = 'yes'\"> & <b>co</b>"
+
+
+@needs_chromium
+def test_markup_in_a_page_description_is_shown_as_text_and_never_run(tmp_path, browser):
+    """A page description is a file anyone with the pages folder can edit: its title and labels are shown as
+    written, and the server's Content-Security-Policy runs no script written into a page."""
+    shutil.copy(CELL / "Conveyor.st", tmp_path / "Conveyor.st")
+    description = json.loads((CELL / "conveyor.json").read_text(encoding="utf-8"))
+    description["title"] = MARKUP
+    description["inputs"][0]["label"] = MARKUP
+    description["status"][0]["label"] = MARKUP
+    (tmp_path / "conveyor.json").write_text(json.dumps(description), encoding="utf-8")
+    with serving_user_program(tmp_path, "Conveyor.st", "Conveyor") as (_plc, server):
+        with urllib.request.urlopen(f"{server.url}conveyor.html", timeout=5) as answer:
+            policy = answer.headers["Content-Security-Policy"]
+        assert "script-src 'self'" in policy and "unsafe-inline" not in policy.split("script-src")[1].split(";")[0]
+        for name in ("conveyor", "index"):
+            sized(browser, (800, 480))
+            browser.open(server.page_url(name, "operator"))
+            d = browser.driver
+            assert d.execute_script("return document.documentElement.dataset.ran") is None
+            assert d.execute_script("return document.querySelectorAll('main img, header img').length") == 0
+        assert d.find_element("id", "nav-conveyor").text == MARKUP
+        browser.open(server.page_url("conveyor", "operator"))
+        assert browser.driver.find_element("css selector", "header h1").text == MARKUP
+        assert MARKUP in browser.driver.find_element("id", "main").text            # the input's and status's label
+        assert browser.driver.execute_script("return document.documentElement.dataset.ran") is None
+
+
 BAD = {   # file name -> (content, line of the mistake, words the error must contain)
     "unknown_variable.json": ('{"title": "A",\n "status": [\n  {"variable": "Belt_Running", "label": "Run"},\n'
                               '  {"variable": "Belt_Sped", "label": "Speed"}]}', 4, "unknown variable 'Belt_Sped'"),
@@ -151,6 +182,22 @@ def test_bad_page_descriptions_are_named_with_file_and_line_and_the_good_pages_a
             server.stop()
     finally:
         plc.close()
+
+
+def test_a_pipe_or_a_device_in_the_pages_folder_is_named_and_the_good_pages_are_loaded(tmp_path):
+    """A pipe nobody writes to is not waited on, a link to /dev/zero is not read (it never ends)."""
+    for name in ("Conveyor.st", "conveyor.json"):
+        shutil.copy(CELL / name, tmp_path / name)
+    os.mkfifo(tmp_path / "pipe.json")
+    os.symlink("/dev/zero", tmp_path / "zero.json")
+    plc = cell_plc(tmp_path)
+    try:
+        pages, errors = load_pages(tmp_path, plc)
+    finally:
+        plc.close()
+    assert list(pages) == ["conveyor"]
+    assert errors == [f"{tmp_path / name}: not a regular file (a device, pipe, socket or folder): not a page "
+                      "description" for name in ("pipe.json", "zero.json")]
 
 
 def test_the_cell_server_reports_a_bad_page_and_serves_the_others(tmp_path):

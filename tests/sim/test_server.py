@@ -313,6 +313,9 @@ def test_cli_starts_prints_one_line_per_robot_and_stops_on_terminate(tmp_path):
     (["--port", "65535", "--robots", "2"], "leaves the port range"),
     (["--stop-tags", "maybe"], "invalid choice: 'maybe'"),
     (["--tmflow", "3.0"], "invalid choice: '3.0'"),
+    (["--host", ""], "argument --host: an address is needed: 127.0.0.1 for this computer only"),  # not every one
+    (["--control-host", " "], "argument --control-host: an address is needed"),
+    (["--svr-items", ""], "--svr-items names no item"),
 ])
 def test_cli_rejects_bad_arguments_with_a_clear_message(args, message):
     result = subprocess.run([sys.executable, str(ROOT / "sim" / "tmflow_listener.py"), *args],

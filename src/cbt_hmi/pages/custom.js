@@ -9,7 +9,7 @@ function customLabel(item) { return item.unit ? `${item.label} (${item.unit})` :
    shipped command page without a parameter structure alike) */
 function inputsFieldset(inputs, legend) {
   const fs = document.createElement("fieldset");
-  fs.innerHTML = `<legend>${legend}</legend>`;
+  fs.innerHTML = `<legend>${esc(legend)}</legend>`;
   const grid = document.createElement("div");
   grid.className = "grid wide";
   for (const item of inputs) {

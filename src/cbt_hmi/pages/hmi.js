@@ -9,6 +9,10 @@ const POLL_MS = 50;            // 20 updates per second (issue: >= 10)
 
 /* the fields' labels by structure member or variable name, from the page descriptions (MAP.labels) */
 const LABELS = {};
+/* A text of the user's (a page description's title, label or legend, a POU name) as HTML that shows it as written:
+   markup in it is shown, never run (a page description is a file anyone with the pages folder can edit). */
+const HTML_ESCAPES = { "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;" };
+function esc(text) { return String(text).replace(/[&<>"']/g, (c) => HTML_ESCAPES[c]); }
 
 const BAD = new Set(["Error"]), BUSY = new Set(["Busy", "CommandAborted"]);
 
@@ -217,7 +221,7 @@ function buildStruct(container, path, typeName, legendText) {
       fs.dataset.member = field;
       const range = spec.min === undefined ? "" :
         ` <span class="range">${spec.min === -spec.max ? "±" + spec.max : spec.min + ".." + spec.max}</span>`;
-      fs.innerHTML = `<legend>${LABELS[field] || field}${range}</legend>`;
+      fs.innerHTML = `<legend>${esc(LABELS[field] || field)}${range}</legend>`;
       const grid = document.createElement("div");
       grid.className = "grid six";
       for (const [sub, subSpec] of Object.entries(fdef.fields)) {
@@ -231,7 +235,7 @@ function buildStruct(container, path, typeName, legendText) {
     else scalars.push([field, spec]);
   }
   const fs = document.createElement("fieldset");
-  fs.innerHTML = `<legend>${legendText}</legend>`;
+  fs.innerHTML = `<legend>${esc(legendText)}</legend>`;
   const grid = document.createElement("div");
   grid.className = "grid wide";
   for (const [field, spec] of scalars) grid.append(makeField(`${path}.${field}`, spec, LABELS[field] || field));
@@ -301,7 +305,7 @@ function collect(root, prefix) {
 function statusTable(title, rows) {
   const div = document.createElement("div");
   div.className = "status";
-  div.innerHTML = `<h2>${title}</h2>`;
+  div.innerHTML = `<h2>${esc(title)}</h2>`;
   const table = document.createElement("table");
   for (const [label, varName] of rows) {
     const spec = MAP.variables[varName];
@@ -474,7 +478,7 @@ function frame(title, isMain) {
   document.title = "CBT HMI – " + title;
   document.body.innerHTML = `<div class="panel">
     <header>${isMain ? "" : '<a class="menu" id="btn-menu" href="index.html">◀ Main Menu</a>'}
-      <h1>${title}</h1><span class="pill" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span>${stopKeyHtml()}</header>
+      <h1>${esc(title)}</h1><span class="pill" id="pill-role">${ACCESS.role[0].toUpperCase() + ACCESS.role.slice(1)}</span><span class="pill" id="pill-robot">Robot …</span><span class="pill" id="pill-plc">PLC …</span>${stopKeyHtml()}</header>
     <main id="main"></main><div id="message">${ACCESS.role === "monitor" ?
       "Monitor mode (read only): open the operator address printed at start-up to operate." : "Ready."}</div></div>`;
   alarmBanner(document.querySelector(".panel"));

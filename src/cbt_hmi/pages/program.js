@@ -116,7 +116,7 @@ async function programPage() {
   for (const p of programs) {
     const section = document.createElement("section");
     section.dataset.pou = p.pou;
-    section.innerHTML = `<h2>${p.pou} <span>(${p.instance})</span></h2>` + p.svg;
+    section.innerHTML = `<h2>${esc(p.pou)} <span>(${esc(p.instance)})</span></h2>` + p.svg;
     holder.append(section);
     wrapComments(section.querySelector("svg"), p.rungs);
     for (const r of p.rungs) {

@@ -12,17 +12,19 @@ from vplc.api import LoadError, load_plc
 
 from .mapping import Mapping, MappingError
 from .pagedesc import load_pages, program_table
-from .server import HmiServer
+from .server import HmiServer, host_argument
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(prog="python3 -m cbt_hmi.web.cell", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python3 -m cbt_hmi.web.cell",
+                                     description=" ".join(__doc__.split("\n\n")[0].split()))   # the whole paragraph
     parser.add_argument("sources", nargs="+", metavar="SOURCE", help="ST files or folders of the program")
     parser.add_argument("--pages", required=True, metavar="DIR", help="folder of page description files (*.json)")
     parser.add_argument("--task", default="Main@10ms", help="task and period (default Main@10ms)")
     parser.add_argument("--program", action="append", default=None, metavar="NAME",
                         help="PROGRAM to run in the task (repeat for several; default: those of the configuration)")
-    parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    parser.add_argument("--host", type=host_argument, default="127.0.0.1",
+                        help="address to bind (default 127.0.0.1; 0.0.0.0: every interface)")
     parser.add_argument("--port", type=int, default=8080, help="web HMI port (default 8080, 0: any free port)")
     return parser.parse_args(argv)
 

@@ -28,7 +28,9 @@ line of the item; a page with a mistake is left out and the others are served.""
 from __future__ import annotations
 
 import json
+import os
 import pathlib
+import stat
 from collections.abc import Callable
 from typing import Any, NamedTuple, NoReturn
 
@@ -107,9 +109,15 @@ def _decode_located(text: str) -> Any:
 def read_description(path: pathlib.Path) -> _Located:
     """The page description's JSON, each object with its line; PageError (file:line: reason) when unreadable."""
     try:
-        raw = path.read_bytes()[:MAX_FILE_BYTES + 1]
+        # opened without waiting and read no further than the limit: a pipe nobody writes to, or a link to a
+        # device such as /dev/zero, is refused instead of holding the start-up for ever or filling the memory
+        with open(path, "rb", opener=lambda name, flags: os.open(name, flags | os.O_NONBLOCK)) as fh:
+            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+                raise PageError(f"{path}: not a regular file (a device, pipe, socket or folder): not a page "
+                                "description")
+            raw = fh.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
-        raise PageError(f"{path}: cannot be read ({exc.strerror})") from None
+        raise PageError(f"{path}: cannot be read ({exc.strerror or exc})") from None
     if len(raw) > MAX_FILE_BYTES:
         raise PageError(f"{path}: larger than {MAX_FILE_BYTES // 1024} KiB: not a page description")
     try:

@@ -29,6 +29,7 @@ clients cannot lock the operator out. After a major fault of the PLC every answe
 """
 from __future__ import annotations
 
+import argparse
 import io
 import json
 import logging
@@ -56,6 +57,12 @@ MAX_DIGITS = 40                    # digits of one number in a request body (a L
 MAX_NAMES = 400
 SCAN_WAIT_S = 1.0
 STREAM_PERIOD_S = 0.05             # /api/stream: a new answer every 50 ms, the pages' 20 updates a second
+# What a page may load and run (W3C Content Security Policy Level 3): scripts only from the HMI's own files, none
+# written into the page (an onerror= in a text that reached the HTML is not run), styles also as style attributes,
+# images also as data: addresses (the shell's empty icon), nothing framed, no forms or links to other servers.
+CONTENT_SECURITY_POLICY = ("default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
+                           "img-src 'self' data:; object-src 'none'; base-uri 'none'; form-action 'self'; "
+                           "frame-ancestors 'none'")
 
 log = logging.getLogger("cbt_hmi.web")
 
@@ -97,6 +104,17 @@ _PROGRAM_PAGE = b"/api/program"
 
 def _answered_at_once(request: bytes) -> bool:
     return request.startswith(_ANSWERED_AT_ONCE) and not request.startswith(_PROGRAM_PAGE, request.find(b" ") + 1)
+
+
+def host_argument(text: str) -> str:
+    """The ``--host`` of a command line (an argparse type): an address to bind. An empty one (a script's unset
+    variable) is a usage error: the socket would take every network interface while the start-up line said
+    loopback."""
+    address = text.strip()
+    if not address:
+        raise argparse.ArgumentTypeError("an address is needed: 127.0.0.1 for this computer only, 0.0.0.0 for "
+                                         "every interface")
+    return address
 
 
 class HmiServer:
@@ -362,6 +380,7 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("X-Content-Type-Options", "nosniff")
         self.send_header("X-Frame-Options", "DENY")
         self.send_header("Referrer-Policy", "no-referrer")
+        self.send_header("Content-Security-Policy", CONTENT_SECURITY_POLICY)
         self.end_headers()
 
     def _send(self, status: HTTPStatus, payload: bytes, content_type: str) -> None:
