@@ -85,6 +85,7 @@ def test_valid_write_reaches_the_plc_leaf_by_leaf(client, fake_plc):
     ({"MoveAbs_Param.Speed": True}, 400, "is UINT: expected a whole number"),
     ({"MoveAbs_Param.Speed": 4501}, 400, "4501 is out of range 1 .. 4500"),
     ({"MoveAbs_Param.Speed": 0}, 400, "0 is out of range 1 .. 4500"),
+    ({"MoveAbs_Param.Speed": 1e308}, 400, "'MoveAbs_Param.Speed': 1e+308 is out of range 1 .. 4500"),   # 9 chars
     ({"MoveAbs_Param.AccelTime": 10000}, 400, "10000 is out of range 0 .. 9999"),
     ({"MoveAbs_Param.TargetPosition.X": "1e9"}, 400, "is REAL: expected a number"),
     ({"MoveAbs_Param.TargetPosition.Z": 100001}, 400, "100001 is out of range -100000 .. 100000"),
@@ -154,6 +155,12 @@ def test_execute_edge_is_seen_by_the_task_even_when_scans_skip_it(client, fake_p
 def test_execute_refuses_a_variable_that_is_not_an_execute_bit(client):
     status, answer = client.json("/api/execute", {"execute": "MoveAbs_Param.BlendingEnable"})
     assert status == 400 and "must name an Execute variable" in answer["error"]
+
+
+@pytest.mark.parametrize("values", [[], 0, False, None, "x"])
+def test_execute_with_values_that_are_not_an_object_is_refused_not_run_without_them(client, fake_plc, values):
+    status, answer = client.json("/api/execute", {"execute": "MoveAbs_Execute", "values": values})
+    assert status == 400 and '"values" must be a non-empty object' in answer["error"] and fake_plc.writes == []
 
 
 def test_execute_with_bad_parameters_sets_nothing(client, fake_plc):

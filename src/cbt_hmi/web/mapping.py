@@ -201,16 +201,16 @@ def validate(leaf: Leaf, value: object) -> object:
             raise RequestError(f"{where} is BOOL: expected true or false, got {json.dumps(value)}")
         return value
     if leaf.type in INT_RANGES:
-        if isinstance(value, float) and value.is_integer():
-            value = int(value)
-        if not isinstance(value, int) or isinstance(value, bool):
+        whole = isinstance(value, int) or (isinstance(value, float) and value.is_integer())
+        if not whole or isinstance(value, bool):
             raise RequestError(f"{where} is {leaf.type}: expected a whole number, got {json.dumps(value)}")
         low, high = INT_RANGES[leaf.type]
         low = low if leaf.min is None else max(low, leaf.min)
         high = high if leaf.max is None else min(high, leaf.max)
-        if not low <= value <= high:
-            raise RequestError(f"{where}: {value} is out of range {low} .. {high}")
-        return value
+        if not low <= value <= high:     # compared before any conversion: 1e308 is not made a 309-digit integer
+            shown = f"{value:.6g}" if isinstance(value, float) or abs(value) >= 10**21 else str(value)
+            raise RequestError(f"{where}: {shown} is out of range {low} .. {high}")
+        return int(value)
     if leaf.type in REAL_TYPES:
         if not isinstance(value, (int, float)) or isinstance(value, bool):
             raise RequestError(f"{where} is {leaf.type}: expected a number, got {json.dumps(value)}")

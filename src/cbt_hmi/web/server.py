@@ -297,8 +297,8 @@ class HmiServer:
         if leaf is None or not leaf.execute:
             raise RequestError(f'"execute" must name an Execute variable of the table, not {name!r}')
         self._writable(name, role)
-        values = body.get("values") or {}
-        checked = self._checked(values, role) if values else []
+        values = body.get("values", {})          # absent or {}: the command alone; [], 0, false: refused
+        checked = self._checked(values, role) if values != {} else []
         self._refuse_when_faulted()
         if not role_at_least(role, "engineer"):
             self._refuse_engineering_settings_set(leaf.path)
