@@ -301,6 +301,22 @@ def test_a_content_length_that_is_no_whole_number_is_a_clean_400(hmi, plc, decla
     assert plc.writes == []
 
 
+@pytest.mark.parametrize("extra", [b"Content-Length: 2\r\n", b"Transfer-Encoding: chunked\r\n"],
+                         ids=["two_lengths", "length_and_chunked"])
+def test_a_body_that_could_be_read_two_ways_is_refused(hmi, plc, extra):
+    """Two Content-Length headers, or one beside Transfer-Encoding (RFC 9112 6.3): the first length was taken."""
+    body = json.dumps({"values": {"MoveAbs_Param.Speed": 30}}).encode()
+    with socket.create_connection(("127.0.0.1", hmi.port), timeout=5) as sock:
+        sock.sendall(b"POST /api/write HTTP/1.1\r\nHost: 127.0.0.1:" + str(hmi.port).encode() +
+                     b"\r\nContent-Type: application/json\r\nX-HMI-Key: " + hmi.access.keys["operator"].encode() +
+                     b"\r\nContent-Length: " + str(len(body)).encode() + b"\r\n" + extra + b"\r\n" + body)
+        answer = read_until_closed(sock)
+    head, _, payload = answer.partition(b"\r\n\r\n")
+    assert head.split(b" ")[1] == b"400" and json.loads(payload) == {
+        "ok": False, "error": "the request must have one Content-Length and no Transfer-Encoding"}
+    assert plc.writes == []
+
+
 def test_a_content_length_of_5000_digits_is_413_without_python_text(hmi):
     status, answer = post_with_content_length(hmi, "9" * 5000)
     assert status == 413 and answer["error"] == (f"request body of 999999999999... bytes exceeds the limit of "

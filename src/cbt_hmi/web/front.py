@@ -84,13 +84,20 @@ def _head_end(data: bytearray) -> int:
 
 def _declared_body(head: bytes) -> int | None:
     """Bytes of body the front end waits for: the Content-Length when it is a whole number within MAX_BODY, 0
-    without one, None when it is refused (the handler answers 400 or 413 and the body is not read)."""
+    without one, None when it is refused (the handler answers 400 or 413 and the body is not read): also two
+    Content-Length headers, or one beside a Transfer-Encoding (RFC 9112 6.3: they can be read two ways)."""
+    found = None
     for line in head.split(b"\n")[1:]:
         name, colon, value = line.partition(b":")
-        if colon and name.strip().lower() == b"content-length":
+        name = name.strip().lower()
+        if colon and name == b"transfer-encoding":
+            return None
+        if colon and name == b"content-length":
+            if found is not None:
+                return None
             digits = value.strip()
-            return int(digits) if digits.isdigit() and len(digits) <= 12 and int(digits) <= MAX_BODY else None
-    return 0
+            found = int(digits) if digits.isdigit() and len(digits) <= 12 and int(digits) <= MAX_BODY else -1
+    return 0 if found is None else (None if found < 0 else found)
 
 
 def _answer(status: HTTPStatus, message: str) -> bytes:

@@ -499,6 +499,9 @@ class _Handler(BaseHTTPRequestHandler):
 
     def _body(self) -> dict:
         declared = self.headers.get("Content-Length")
+        if len(self.headers.get_all("Content-Length") or ()) > 1 or "Transfer-Encoding" in self.headers:
+            # two lengths, or a length beside a transfer coding, can be read two ways (RFC 9112 6.3): refused
+            raise self._unread("the request must have one Content-Length and no Transfer-Encoding")
         if declared is None:
             raise RequestError("the request needs a Content-Length header", HTTPStatus.LENGTH_REQUIRED)
         digits = declared.strip()
