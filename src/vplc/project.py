@@ -93,6 +93,9 @@ def collect_files(paths: Iterable[str | os.PathLike[str]], diags: DiagnosticBag)
             files += found
         elif os.path.exists(p):
             files.append(p)
+        elif os.path.islink(p):                # the link is there, what it names is not (or it names itself)
+            diags.error(codes.FILE_NOT_FOUND, f"`{p}` is a symbolic link to nothing: what it names does not exist "
+                        f"or the links loop", Span(SourceFile(p, ""), 0, 0))
         else:
             diags.error(codes.FILE_NOT_FOUND, f"file or folder `{p}` does not exist", Span(SourceFile(p, ""), 0, 0))
     seen, out = set(), []

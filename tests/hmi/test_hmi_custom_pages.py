@@ -150,6 +150,8 @@ BAD = {   # file name -> (content, line of the mistake, words the error must con
                       "unknown key 'lable'"),
     "not_json.json": ('{"title": "F",\n "status": [\n  {"variable": "Belt_Count" "label": "Parts"}]}', 3,
                       "not valid JSON"),
+    "abnormal_text.json": ('{"title": "H", "status": [\n {"variable": "Belt_Jam", "label": "J", "abnormal": "yes"}]}',
+                           2, "'abnormal' must be true or false, not \"yes\""),
     "int_range.json": ('{"title": "G", "inputs": [\n {"variable": "Belt_Target", "label": "T", "min": 0, '
                        '"max": 99999999999}]}', 2, "outside what DINT holds"),
 }

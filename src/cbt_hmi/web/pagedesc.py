@@ -458,7 +458,9 @@ def _check_item(section: str, item, parent_line: int, types: dict[str, Global], 
     if section in ("inputs", "writes"):
         result["role"] = role
     if "abnormal" in item:
-        if not isinstance(item["abnormal"], bool) or bare != "BOOL":
+        if not isinstance(item["abnormal"], bool):
+            fail(line, f"'abnormal' must be true or false, not {json.dumps(item['abnormal'])[:40]}")
+        if bare != "BOOL":
             fail(line, f"'abnormal' (true or false) is for BOOL status values; '{name}' is {declared}")
         result["abnormal"] = item["abnormal"]
     if "pattern" in item:

@@ -83,7 +83,11 @@ def run_tests(args: argparse.Namespace) -> int:
         return 2
     if args.junit:
         folder = os.path.dirname(os.path.abspath(args.junit))
-        if os.path.isdir(args.junit) or not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        if os.path.isdir(args.junit):
+            print(f"vplc test: error: --junit {args.junit!r} is a folder; give a file name such as "
+                  f"{os.path.join(args.junit, 'report.xml')}", file=sys.stderr)
+            return 2
+        if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
             print(f"vplc test: error: --junit {args.junit!r}: give a file name in an existing, writable folder "
                   f"({folder} does not exist or is not writable)", file=sys.stderr)
             return 2

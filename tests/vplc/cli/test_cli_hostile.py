@@ -35,6 +35,9 @@ def test_a_junit_report_into_a_missing_folder_is_a_usage_error_before_anything_r
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert r.stderr.startswith("vplc test: error: --junit") and "does not exist or is not writable" in r.stderr
     assert r.stdout == ""
+    (files / "report.xml").mkdir()                 # a folder: named as one (its folder exists and is writable)
+    r = vplc("test", files / "suite.st", "--junit", files / "report.xml")
+    assert r.returncode == 2 and f"--junit '{files / 'report.xml'}' is a folder; give a file name such as" in r.stderr
 
 
 full = pytest.mark.skipif(not os.path.exists("/dev/full"), reason="this system has no /dev/full")

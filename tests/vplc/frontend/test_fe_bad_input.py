@@ -43,6 +43,15 @@ def test_bad_file_gives_diagnostic_and_exit_1(tmp_path, name, run_cli):
     assert max(len(line) for line in result.stdout.splitlines()) < 1000
 
 
+def test_a_link_to_nothing_and_a_link_loop_are_named_as_links(tmp_path):
+    os.symlink(tmp_path / "gone.st", tmp_path / "dangling.st")
+    os.symlink(tmp_path / "b.st", tmp_path / "a.st")
+    os.symlink(tmp_path / "a.st", tmp_path / "b.st")
+    for name in ("dangling.st", "a.st"):
+        [d] = load_project([str(tmp_path / name)]).diagnostics
+        assert d.code == codes.FILE_NOT_FOUND and "is a symbolic link to nothing" in d.message
+
+
 def test_missing_file_gives_diagnostic_and_exit_1(tmp_path, run_cli):
     result = run_cli("check", str(tmp_path / "nope.st"))
     assert result.returncode == 1 and "error[ST0001]" in result.stdout and "does not exist" in result.stdout
