@@ -201,8 +201,8 @@ def validate(leaf: Leaf, value: object) -> object:
             raise RequestError(f"{where} is BOOL: expected true or false, got {json.dumps(value)}")
         return value
     if leaf.type in INT_RANGES:
-        whole = isinstance(value, int) or (isinstance(value, float) and value.is_integer())
-        if not whole or isinstance(value, bool):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+                (isinstance(value, float) and not value.is_integer()):
             raise RequestError(f"{where} is {leaf.type}: expected a whole number, got {json.dumps(value)}")
         low, high = INT_RANGES[leaf.type]
         low = low if leaf.min is None else max(low, leaf.min)
