@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import bisect
 import os
+import select
 import stat
 from dataclasses import dataclass, field
 
@@ -14,23 +15,50 @@ MAX_SOURCE_BYTES = 64 * 1024 * 1024      # an ST file, as an XML project file (l
 
 
 class FileRefused(Exception):
-    """A file that is not read: not a regular file, or larger than its limit (the message says which, without the
-    file's name: the caller names it)."""
+    """A file that is not read: not a regular file or a pipe, larger than its limit, or a pipe that sends nothing
+    (the message says which, without the file's name: the caller names it)."""
+
+
+PIPE_SILENCE_S = 10.0          # a pipe that sends nothing this long (its writer is stuck) is given up
 
 
 def read_file_bytes(path: str | os.PathLike[str], limit: int, head: bool = False) -> bytes:
-    """The bytes of the regular file ``path``, at most ``limit`` of them. OSError when it cannot be opened;
-    FileRefused for a device, pipe, socket or folder, and for a file of more than ``limit`` bytes (``head``: its
-    first ``limit`` bytes instead). The file is opened without waiting (a pipe nobody writes to would hold a plain
-    open for ever) and read no further than ``limit`` (a link to /dev/zero is refused before it is read)."""
+    """The bytes of the regular file or pipe ``path``, at most ``limit`` of them. OSError when it cannot be
+    opened; FileRefused for a device, socket or folder, for a file of more than ``limit`` bytes (``head``: its
+    first ``limit`` bytes instead) and for a pipe silent for PIPE_SILENCE_S. It is opened without waiting (a
+    named pipe nobody writes to would hold a plain open for ever; read, it is an empty file) and read no further
+    than ``limit`` (a link to /dev/zero is refused before it is read). A pipe with a writer is read as a file
+    (``vplc check /dev/stdin``, ``<(command)``)."""
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    with open(fd, "rb") as fh:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise FileRefused("is not a regular file (a device, pipe, socket or folder)")
-        data = fh.read(limit if head else limit + 1)
+    want = limit if head else limit + 1
+    with open(fd, "rb", buffering=0) as fh:
+        mode = os.fstat(fd).st_mode
+        if stat.S_ISFIFO(mode):
+            data = _read_pipe(fd, want)
+        elif stat.S_ISREG(mode):
+            data = fh.read(want) or b""
+        else:
+            raise FileRefused("is not a regular file or a pipe (a device, socket or folder)")
     if len(data) > limit:
         raise FileRefused(f"is larger than {_size(limit)}")
     return data
+
+
+def _read_pipe(fd: int, want: int) -> bytes:
+    chunks: list[bytes] = []
+    got = 0
+    while got < want:
+        try:
+            chunk = os.read(fd, min(65536, want - got))
+        except BlockingIOError:                     # the writer has sent nothing more yet
+            if not select.select([fd], [], [], PIPE_SILENCE_S)[0]:
+                raise FileRefused(f"is a pipe that sent nothing for {PIPE_SILENCE_S:g} s") from None
+            continue
+        if not chunk:                               # the writer closed it (or there was none)
+            break
+        chunks.append(chunk)
+        got += len(chunk)
+    return b"".join(chunks)
 
 
 def _size(limit: int) -> str:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import threading
 
 import pytest
 from fe_helpers import check_text
@@ -100,19 +101,56 @@ def test_an_open_array_where_a_fixed_size_array_is_expected_is_a_type_error_not_
 
 
 def test_a_pipe_a_device_and_a_utf16_file_are_named_for_what_they_are(tmp_path):
-    """A pipe nobody writes to is refused at once (a plain open would wait for a writer for ever), a link to
-    /dev/zero before anything is read (it never ends), a UTF-16 file as UTF-16 (not as a binary file)."""
+    """A named pipe nobody writes to is read at once as an empty file (a plain open would wait for a writer for
+    ever), a link to /dev/zero is refused before anything is read (it never ends), a UTF-16 file is named as
+    UTF-16 (not as a binary file)."""
     os.mkfifo(tmp_path / "pipe.st")
     os.symlink("/dev/zero", tmp_path / "zero.st")
     (tmp_path / "wide.st").write_bytes("PROGRAM P END_PROGRAM".encode("utf-16"))
-    for name, words in (("pipe.st", "is not a regular file"), ("zero.st", "is not a regular file"),
-                        ("wide.st", "is UTF-16 text; save the file as UTF-8")):
+    for name, code, words in (("pipe.st", codes.FILE_EMPTY, "is empty"),
+                              ("zero.st", codes.FILE_UNREADABLE, "is not a regular file or a pipe"),
+                              ("wide.st", codes.FILE_NOT_UTF8, "is UTF-16 text; save the file as UTF-8")):
         diags = DiagnosticBag()
         assert read_source(str(tmp_path / name), diags) is None
         [d] = diags.items
-        assert words in d.message and d.code == (codes.FILE_NOT_UTF8 if name == "wide.st" else codes.FILE_UNREADABLE)
+        assert words in d.message and d.code == code, d.message
     project = load_project([str(tmp_path)])          # the folder: each file named, no wait, no traceback
-    assert sorted(d.code for d in project.diagnostics) == ["ST0002", "ST0005", "ST0005"]
+    assert sorted(d.code for d in project.diagnostics) == ["ST0002", "ST0004", "ST0005"]
+
+
+def test_a_pipe_with_a_writer_is_read_like_a_file(tmp_path):
+    """`vplc check /dev/stdin` and `vplc check <(command)`: what the writer sends, to its end."""
+    read_end, write_end = os.pipe()
+    text = "PROGRAM P\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n" * 2000     # more than a pipe holds
+
+    def writer():
+        with os.fdopen(write_end, "w") as fh:
+            fh.write(text)
+    thread = threading.Thread(target=writer)
+    thread.start()
+    try:
+        diags = DiagnosticBag()
+        src = read_source(f"/dev/fd/{read_end}", diags)
+    finally:
+        thread.join(timeout=10)
+        os.close(read_end)
+    assert diags.items == [] and src is not None and src.text == text
+
+
+def test_a_pipe_is_read_once_when_a_program_is_compiled_from_it():
+    """`vplc run <(command)`: the compiled-program cache's fingerprint read the pipe to its end before the loader,
+    which then found it empty (ST0004)."""
+    from vplc.api import load_plc
+    read_end, write_end = os.pipe()
+    with os.fdopen(write_end, "w") as fh:
+        fh.write("PROGRAM Main\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n")
+    try:
+        plc = load_plc([f"/dev/fd/{read_end}"])
+    finally:
+        os.close(read_end)
+    plc.scan(plc.period_ns)
+    assert plc.read("Main.x") == 1
+    plc.close()
 
 
 def test_a_file_over_the_size_limit_is_refused_without_reading_it_all(tmp_path, monkeypatch):

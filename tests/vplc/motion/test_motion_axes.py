@@ -202,11 +202,9 @@ def test_hostile_axis_configurations_are_refused_without_traceback(tmp_path_fact
         load_plc([main], axes=str(deep))
     with pytest.raises(LoadError, match="larger than 1,000,000 bytes"):
         load_plc([main], axes=str(big))
-    os.mkfifo(tmp_path / "pipe.toml")                 # refused at once, not waited on for a writer
-    os.symlink("/dev/zero", tmp_path / "zero.toml")   # refused before it is read
-    for name in ("pipe.toml", "zero.toml"):
-        with pytest.raises(LoadError, match="the axis configuration is not a regular file"):
-            load_plc([main], axes=str(tmp_path / name))
+    os.symlink("/dev/zero", tmp_path / "zero.toml")   # refused before it is read (it never ends)
+    with pytest.raises(LoadError, match="the axis configuration is not a regular file or a pipe"):
+        load_plc([main], axes=str(tmp_path / "zero.toml"))
 
 
 def test_a_missing_axis_configuration_file_is_a_load_error(tmp_path_factory, tmp_path):
