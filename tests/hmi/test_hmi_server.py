@@ -86,6 +86,7 @@ def test_valid_write_reaches_the_plc_leaf_by_leaf(client, fake_plc):
     ({"MoveAbs_Param.Speed": 4501}, 400, "4501 is out of range 1 .. 4500"),
     ({"MoveAbs_Param.Speed": 0}, 400, "0 is out of range 1 .. 4500"),
     ({"MoveAbs_Param.Speed": 1e308}, 400, "'MoveAbs_Param.Speed': 1e+308 is out of range 1 .. 4500"),   # 9 chars
+    ({"MoveAbs_Param.Speed": 70000.0}, 400, "'MoveAbs_Param.Speed': 70000 is out of range 1 .. 4500"),
     ({"MoveAbs_Param.AccelTime": 10000}, 400, "10000 is out of range 0 .. 9999"),
     ({"MoveAbs_Param.TargetPosition.X": "1e9"}, 400, "is REAL: expected a number"),
     ({"MoveAbs_Param.TargetPosition.Z": 100001}, 400, "100001 is out of range -100000 .. 100000"),

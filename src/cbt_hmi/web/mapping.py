@@ -208,7 +208,7 @@ def validate(leaf: Leaf, value: object) -> object:
         low = low if leaf.min is None else max(low, leaf.min)
         high = high if leaf.max is None else min(high, leaf.max)
         if not low <= value <= high:     # compared before any conversion: 1e308 is not made a 309-digit integer
-            shown = f"{value:.6g}" if isinstance(value, float) or abs(value) >= 10**21 else str(value)
+            shown = str(int(value)) if abs(value) < 1e21 else f"{value:.6g}"
             raise RequestError(f"{where}: {shown} is out of range {low} .. {high}")
         return int(value)
     if leaf.type in REAL_TYPES:

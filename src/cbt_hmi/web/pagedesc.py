@@ -111,7 +111,7 @@ def read_description(path: pathlib.Path) -> _Located:
     try:
         # opened without waiting and read no further than the limit: a pipe nobody writes to, or a link to a
         # device such as /dev/zero, is refused instead of holding the start-up for ever or filling the memory
-        with open(path, "rb", opener=lambda name, flags: os.open(name, flags | os.O_NONBLOCK)) as fh:
+        with open(path, "rb", opener=lambda name, flags: os.open(name, flags | getattr(os, "O_NONBLOCK", 0))) as fh:
             if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
                 raise PageError(f"{path}: not a regular file (a device, pipe, socket or folder): not a page "
                                 "description")

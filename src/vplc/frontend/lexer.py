@@ -52,7 +52,7 @@ _TOKEN_RE = re.compile(
   | (?P<BAD>.)
     )
     """,
-    re.VERBOSE | re.DOTALL,
+    re.VERBOSE | re.DOTALL | re.ASCII,     # ASCII: a keyword's case is ASCII's (TıME# is no TIME literal, T#1ſ no 1 s)
 )
 
 

@@ -78,6 +78,9 @@ def parse_ymd(text: str) -> int | None:
         return None
 
 
+_POSTFIX = frozenset((".", "[", "(", "^"))
+
+
 class ExpressionParser:
     """Expressions at the cursor's position: each method consumes one construct and returns its AST node."""
 
@@ -150,10 +153,12 @@ class ExpressionParser:
         node = self.primary()
         parts = 0
         while True:
-            parts += 1               # each member, index and call nests the tree a level deeper
-            if parts + cur.depth > 2 * MAX_DEPTH:
-                cur.fail(f"over {2 * MAX_DEPTH} members, indexes and calls in a row; split the expression using "
-                         "intermediate variables", codes.NESTING_TOO_DEEP)
+            t = cur.tok
+            if t.kind == "OP" and t.text in _POSTFIX:
+                parts += 1           # each member, index and call nests the tree a level deeper
+                if parts + cur.depth > 2 * MAX_DEPTH:
+                    cur.fail(f"too many members, indexes and calls in a row (over {2 * MAX_DEPTH}); split the "
+                             "expression using intermediate variables", codes.NESTING_TOO_DEEP)
             if cur.at_op("."):
                 cur.advance()
                 t = cur.tok

@@ -29,32 +29,36 @@ def read_file_bytes(path: str | os.PathLike[str], limit: int, head: bool = False
     named pipe nobody writes to would hold a plain open for ever; read, it is an empty file) and read no further
     than ``limit`` (a link to /dev/zero is refused before it is read). A pipe with a writer is read as a file
     (``vplc check /dev/stdin``, ``<(command)``)."""
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    want = limit if head else limit + 1
-    with open(fd, "rb", buffering=0) as fh:
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+                 | getattr(os, "O_BINARY", 0))
+    try:
         mode = os.fstat(fd).st_mode
-        if stat.S_ISFIFO(mode):
-            data = _read_pipe(fd, want)
-        elif stat.S_ISREG(mode):
-            data = fh.read(want) or b""
-        else:
+        if not (stat.S_ISREG(mode) or stat.S_ISFIFO(mode)):
             raise FileRefused("is not a regular file or a pipe (a device, socket or folder)")
+        data = _read_up_to(fd, limit if head else limit + 1)
+    finally:
+        os.close(fd)
     if len(data) > limit:
         raise FileRefused(f"is larger than {_size(limit)}")
     return data
 
 
-def _read_pipe(fd: int, want: int) -> bytes:
+def _read_up_to(fd: int, want: int) -> bytes:
+    """At most ``want`` bytes of ``fd``, to its end; a pipe is waited on up to PIPE_SILENCE_S for each part."""
     chunks: list[bytes] = []
     got = 0
+    waiter = None
     while got < want:
         try:
-            chunk = os.read(fd, min(65536, want - got))
-        except BlockingIOError:                     # the writer has sent nothing more yet
-            if not select.select([fd], [], [], PIPE_SILENCE_S)[0]:
+            chunk = os.read(fd, min(1 << 20, want - got))
+        except BlockingIOError:                     # the pipe's writer has sent nothing more yet
+            if waiter is None:
+                waiter = select.poll()              # poll, not select: any descriptor number
+                waiter.register(fd, select.POLLIN)
+            if not waiter.poll(PIPE_SILENCE_S * 1000):
                 raise FileRefused(f"is a pipe that sent nothing for {PIPE_SILENCE_S:g} s") from None
             continue
-        if not chunk:                               # the writer closed it (or there was none)
+        if not chunk:                               # the end (a pipe: its writer closed it, or there was none)
             break
         chunks.append(chunk)
         got += len(chunk)

@@ -118,6 +118,16 @@ def test_a_pipe_a_device_and_a_utf16_file_are_named_for_what_they_are(tmp_path):
     assert sorted(d.code for d in project.diagnostics) == ["ST0002", "ST0004", "ST0005"]
 
 
+def test_a_folder_given_as_a_file_leaves_no_descriptor_open(tmp_path):
+    """os.open takes a folder; the reader must close it (a long-running caller lost one descriptor a call)."""
+    before = len(os.listdir("/proc/self/fd"))
+    for _ in range(20):
+        diags = DiagnosticBag()
+        assert read_source(str(tmp_path), diags) is None
+        assert "is not a regular file or a pipe" in diags.items[0].message
+    assert len(os.listdir("/proc/self/fd")) == before
+
+
 def test_a_pipe_with_a_writer_is_read_like_a_file(tmp_path):
     """`vplc check /dev/stdin` and `vplc check <(command)`: what the writer sends, to its end."""
     read_end, write_end = os.pipe()

@@ -88,3 +88,10 @@ def test_offsets_and_comments_after_whitespace_and_bad_characters_split_by_it():
     assert comments == [("//", 1, 7), ("(*", 9, 18)]
     assert spans("x ?")[1] == [("ST0101", 2, 3, "unexpected character '?'")]
     assert spans("   ")[0] == [("EOF", 3, 3)]
+
+
+def test_keywords_and_units_are_ascii_only():
+    """Unicode case folding made TıME# (dotless i) a TIME keyword and ſ (long s) the unit s; IEC 61131-3 letters
+    are ASCII."""
+    assert toks("TıME#1s")[1] == ["ST0101"]
+    assert toks("T#1ſ")[1] == ["ST0101"] and toks("T#1s")[0] == [("TIME", "T#1s")]
