@@ -148,6 +148,15 @@ def tcp_port(text: str) -> int:
     return port
 
 
+def history_file(text: str) -> str:
+    """``--alarm-log``: a file, created when missing. A pipe would hold the start-up for ever, a device fill the
+    memory, a folder cannot be written: each is a usage error."""
+    path = pathlib.Path(text)
+    if not text.strip() or (path.exists() and not path.is_file()):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a regular file; name a file (it is created when missing)")
+    return text
+
+
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="cbt-demo", description=__doc__.splitlines()[0])
     parser.add_argument("--host", type=host_argument, default="127.0.0.1",
@@ -159,7 +168,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--control-port", type=tcp_port, default=None,
                         help="simulator control channel port, always on 127.0.0.1 (default: the robot port - 1, "
                              "i.e. 5889; any free port, printed at start, when that one is taken)")
-    parser.add_argument("--alarm-log", metavar="FILE", default=None,
+    parser.add_argument("--alarm-log", metavar="FILE", default=None, type=history_file,
                         help="keep the HMI's alarm history in FILE (JSON lines) across restarts (default: in memory "
                              "only; make demo uses build/alarm_history.jsonl)")
     parser.add_argument("--project", metavar="DIR", default=None,

@@ -1,6 +1,7 @@
 """`make demo` launcher: clear messages instead of tracebacks when it cannot start."""
 from __future__ import annotations
 
+import os
 import pathlib
 import socket
 import subprocess
@@ -262,3 +263,14 @@ def test_an_empty_host_is_a_usage_error_not_every_interface(command, capsys):
     assert "argument --host: an address is needed: 127.0.0.1 for this computer only, 0.0.0.0 for every " \
            "interface" in capsys.readouterr().err
     assert parse(["--host", "0.0.0.0"]).host == "0.0.0.0"
+
+
+def test_an_alarm_log_that_is_a_pipe_a_device_or_a_folder_is_a_usage_error(tmp_path, capsys):
+    """A pipe held the start-up for ever (the history is read first), /dev/zero filled the memory."""
+    from cbt_hmi import demo
+    os.mkfifo(tmp_path / "pipe.jsonl")
+    for given in (tmp_path / "pipe.jsonl", "/dev/zero", tmp_path, ""):
+        with pytest.raises(SystemExit) as stopped:
+            demo.parse_args(["--alarm-log", str(given)])
+        assert stopped.value.code == 2 and "is not a regular file; name a file" in capsys.readouterr().err
+    assert demo.parse_args(["--alarm-log", str(tmp_path / "new.jsonl")]).alarm_log == str(tmp_path / "new.jsonl")

@@ -5,6 +5,7 @@ restart and never makes a sample wait for the disk."""
 from __future__ import annotations
 
 import json
+import os
 import threading
 
 import pytest
@@ -312,6 +313,20 @@ def test_a_history_file_with_a_damaged_line_is_read_without_it(mapping, tmp_path
                     '{"n": 2, "alarm": 1, "event": "normal"}\n')
     system = AlarmSystem(FakePlc(mapping), mapping, path)
     assert [e["n"] for e in system.summary(history=10)["history"]] == [2, 1]
+
+
+def test_a_history_path_that_is_a_pipe_or_a_device_or_too_large_is_not_read(mapping, tmp_path, monkeypatch):
+    """A pipe would hold the start-up for ever, /dev/zero fill the memory: neither is read; a file larger than
+    this history ever writes starts a new history."""
+    os.mkfifo(tmp_path / "pipe.jsonl")
+    os.symlink("/dev/zero", tmp_path / "zero.jsonl")
+    for name in ("pipe.jsonl", "zero.jsonl"):
+        history = alarm_module.History(tmp_path / name)
+        assert list(history.entries) == []
+    monkeypatch.setattr(alarm_module, "MAX_HISTORY_FILE_BYTES", 100)
+    big = tmp_path / "big.jsonl"
+    big.write_text('{"n": 1, "alarm": 1, "event": "raised"}\n' * 10)
+    assert list(alarm_module.History(big).entries) == []
 
 
 # --- the API ---------------------------------------------------------------------------------------------------

@@ -46,6 +46,7 @@ ON_DELAY_S = 0.5        # a consequence waits this long for its cause before it 
 STALL_S = 1.0           # the PLC's tasks completed no cycle for this long: "PLC not scanning"
 LOCK_WAIT_S = 0.5       # plc.lock not free for this long: "PLC not answering"
 HISTORY = 1000          # history entries kept (and read back from the file at start-up)
+MAX_HISTORY_FILE_BYTES = 16 * 1024 * 1024    # the file holds at most 2 x HISTORY entries of well under 1 KiB each
 MAX_DETAILS = 20        # consequences kept per alarm
 MAX_LISTED = 200        # alarms listed at most: beyond, the oldest returned ones leave the list unacknowledged
 
@@ -153,13 +154,17 @@ class History:
         self._queue: queue.SimpleQueue = queue.SimpleQueue()
         self._lines = 0
         self._thread: threading.Thread | None = None
-        if self.path is not None and self.path.exists():
+        if self.path is not None and self.path.is_file():       # a pipe or a device is not read (the demo refuses it)
             self._load(self.path)
 
     def _load(self, path: pathlib.Path) -> None:
         try:
-            lines = path.read_text(encoding="utf-8").splitlines()
-        except (OSError, UnicodeDecodeError) as exc:
+            with path.open("rb") as fh:
+                data = fh.read(MAX_HISTORY_FILE_BYTES + 1)
+            if len(data) > MAX_HISTORY_FILE_BYTES:      # not a file this history wrote (it keeps 2 x HISTORY lines)
+                raise ValueError(f"larger than {MAX_HISTORY_FILE_BYTES // 1048576} MiB")
+            lines = data.decode("utf-8").splitlines()
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
             log.warning("HMI alarm history %s not read (%s): starting a new one", path, exc)
             return
         for number, line in enumerate(lines, start=1):
