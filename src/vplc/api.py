@@ -9,7 +9,6 @@ import gc
 import hashlib
 import os
 import re
-import stat
 import threading
 import time
 from collections import OrderedDict
@@ -141,12 +140,10 @@ def _fingerprint(paths: list[str | os.PathLike[str]], dialect: str, count_statem
     try:
         prelude = sorted(n for n in os.listdir(PRELUDE_DIR) if n.endswith(".st"))
         for path in [os.path.join(PRELUDE_DIR, n) for n in prelude] + files:
-            if not stat.S_ISREG(os.stat(path).st_mode):
-                return None                # a pipe is read once, by the loader (a device: the loader says why)
-            data = read_file_bytes(path, MAX_SOURCE_BYTES)
+            data = read_file_bytes(path, MAX_SOURCE_BYTES, pipes=False)   # a pipe is read once, by the loader
             digest.update(f"\0{path}\0{len(data)}\0".encode())
             digest.update(data)
-    except (OSError, FileRefused):         # a file over the limit: the loader says which
+    except (OSError, FileRefused):         # a pipe, a device, a file over the limit: the loader says which
         return None
     return digest.digest()
 

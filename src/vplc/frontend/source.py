@@ -22,19 +22,21 @@ class FileRefused(Exception):
 PIPE_SILENCE_S = 10.0          # a pipe that sends nothing this long (its writer is stuck) is given up
 
 
-def read_file_bytes(path: str | os.PathLike[str], limit: int, head: bool = False) -> bytes:
+def read_file_bytes(path: str | os.PathLike[str], limit: int, head: bool = False, pipes: bool = True) -> bytes:
     """The bytes of the regular file or pipe ``path``, at most ``limit`` of them. OSError when it cannot be
     opened; FileRefused for a device, socket or folder, for a file of more than ``limit`` bytes (``head``: its
-    first ``limit`` bytes instead) and for a pipe silent for PIPE_SILENCE_S. It is opened without waiting (a
-    named pipe nobody writes to would hold a plain open for ever; read, it is an empty file) and read no further
-    than ``limit`` (a link to /dev/zero is refused before it is read). A pipe with a writer is read as a file
-    (``vplc check /dev/stdin``, ``<(command)``)."""
+    first ``limit`` bytes instead) and for a pipe silent for PIPE_SILENCE_S (``pipes`` False: for any pipe, before
+    it is read). It is opened without waiting (a named pipe nobody writes to would hold a plain open for ever;
+    read, it is an empty file) and read no further than ``limit`` (a link to /dev/zero is refused before it is
+    read). A pipe with a writer is read as a file (``vplc check /dev/stdin``, ``<(command)``)."""
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
                  | getattr(os, "O_BINARY", 0))
     try:
         mode = os.fstat(fd).st_mode
         if not (stat.S_ISREG(mode) or stat.S_ISFIFO(mode)):
             raise FileRefused("is not a regular file or a pipe (a device, socket or folder)")
+        if not pipes and stat.S_ISFIFO(mode):
+            raise FileRefused("is a pipe")
         data = _read_up_to(fd, limit if head else limit + 1)
     finally:
         os.close(fd)
